@@ -1,0 +1,179 @@
+//! `drape check`: the resolved model of a scene, in words.
+
+use std::fmt::Write;
+
+use crate::physics::timestep::fit_to_frame;
+use crate::physics::{Model, Stepper};
+use crate::scene::{BendingModel, Integrator, PinMotion, Scene, StiffnessRule, TimeStep};
+use crate::world::{BuildError, World};
+
+/// Describes what a run of `scene` will compute: mesh, forces (and what is not
+/// modelled), integrator and time step, pins.
+pub fn describe(scene: &Scene) -> Result<String, BuildError> {
+    let world = World::from_scene(scene)?;
+    let model = Model::from_scene(scene);
+    let stepper = Stepper::new(model, &world);
+    let (el, ext, mat) = (
+        &stepper.elements,
+        &stepper.model.external,
+        &stepper.model.material,
+    );
+    let mut s = String::new();
+    let sim = &scene.simulation;
+    let frames = (sim.duration * sim.frame_rate).round().max(1.0) as u64;
+    // Writing to a String cannot fail.
+    let _ = writeln!(s, "scene `{}`", scene.name);
+    let _ = writeln!(
+        s,
+        "cloth: {:?}, {} vertices, {} triangles, {} edges ({} interior); rest area {:.6} m^2, mass {:.6} kg",
+        scene.cloth.shape,
+        world.mesh.vertex_count(),
+        world.mesh.triangles.len(),
+        world.mesh.edges.len(),
+        world.mesh.edges.iter().filter(|e| e.is_interior()).count(),
+        world.mesh.total_rest_area(),
+        el.total_mass()
+    );
+    let _ = writeln!(s, "forces computed:");
+    let rule = match mat.stiffness_rule {
+        StiffnessRule::Consistent => "consistent (Van Gelder: k = stretch * sum(A) / L^2)",
+        StiffnessRule::PaperA => "paper_a (k = stretch * 2^(level/2) per spring)",
+    };
+    let stretch_springs = world.mesh.edges.len();
+    let _ = writeln!(
+        s,
+        "  stretch: {} springs, {} N/m, rule {}",
+        stretch_springs, mat.stretch, rule
+    );
+    if mat.bending > 0.0 {
+        match mat.bending_model {
+            BendingModel::Dihedral => {
+                let _ = writeln!(
+                    s,
+                    "  bending: dihedral angle, {} hinges, rigidity {} N m",
+                    el.hinges.len(),
+                    mat.bending
+                );
+            }
+            BendingModel::HingeSpring => {
+                let _ = writeln!(
+                    s,
+                    "  bending: hinge springs (paper A), {} springs, rigidity {} N m",
+                    el.springs.len() - stretch_springs,
+                    mat.bending
+                );
+            }
+        }
+    }
+    if mat.damping > 0.0 {
+        let _ = writeln!(
+            s,
+            "  spring damping: {} s times each spring's stiffness (paper B eq. 2)",
+            mat.damping
+        );
+    }
+    if let Some(g) = ext.gravity {
+        let _ = writeln!(s, "  gravity: [{}, {}, {}] m/s^2", g.x, g.y, g.z);
+    }
+    if let Some(d) = ext.drag {
+        let _ = writeln!(
+            s,
+            "  air drag: {d} kg/(m^2 s) against air moving at {:?} m/s",
+            ext.air_velocity.to_array()
+        );
+    }
+    if let Some(w) = &ext.wind {
+        let _ = writeln!(
+            s,
+            "  wind: {:?} m/s, pressure coefficient {}, air density {} kg/m^3",
+            w.velocity.to_array(),
+            w.coefficient,
+            w.air_density
+        );
+    }
+    let mut absent = Vec::new();
+    if mat.bending <= 0.0 {
+        absent.push("bending");
+    }
+    if mat.damping <= 0.0 {
+        absent.push("spring damping");
+    }
+    if ext.gravity.is_none() {
+        absent.push("gravity");
+    }
+    if ext.drag.is_none() {
+        absent.push("air drag");
+    }
+    if ext.wind.is_none() {
+        absent.push("wind");
+    }
+    absent.extend([
+        "adaptive meshing",
+        "obstacles and collisions",
+        "self-collision",
+    ]);
+    let _ = writeln!(s, "not modelled: {}", absent.join(", "));
+    let interval = 1.0 / sim.frame_rate;
+    let (target, how) = match sim.dt {
+        TimeStep::Fixed(dt) => (dt, "fixed".to_string()),
+        TimeStep::Auto => {
+            let how = match sim.integrator {
+                Integrator::Implicit => "auto: implicit accuracy cap".to_string(),
+                _ => format!("auto: stability estimate {:.3e} s", stepper.auto_dt(&world)),
+            };
+            (stepper.auto_dt(&world), how)
+        }
+    };
+    let (steps, dt) = fit_to_frame(target, interval);
+    let _ = writeln!(s, "integrator: {:?}", sim.integrator);
+    if sim.integrator == Integrator::Implicit {
+        let _ = writeln!(
+            s,
+            "  conjugate gradients: tolerance {:e}, at most {} iterations",
+            sim.cg_tolerance, sim.cg_max_iterations
+        );
+    }
+    let _ = writeln!(s, "time step: {dt:.4e} s ({how}); {steps} steps per frame");
+    let _ = writeln!(
+        s,
+        "run: {} s, {} fps: {} frames after the initial one, {} steps",
+        sim.duration,
+        sim.frame_rate,
+        frames,
+        frames * steps
+    );
+    if scene.pin.is_empty() {
+        let _ = writeln!(s, "pins: none");
+    }
+    for (p, pin) in scene.pin.iter().enumerate() {
+        let count = world
+            .pins
+            .anchors
+            .iter()
+            .filter(|a| a.pin as usize == p)
+            .count();
+        let motion = match pin.motion {
+            PinMotion::Fixed => "fixed".to_string(),
+            PinMotion::Linear => format!(
+                "linear, v {:?} m/s, a {:?} m/s^2",
+                pin.velocity, pin.acceleration
+            ),
+            PinMotion::Circular => {
+                format!(
+                    "circular about {:?} through {:?} at {} rad/s",
+                    pin.axis, pin.center, pin.angular_velocity
+                )
+            }
+        };
+        let release = pin
+            .release_time
+            .map(|t| format!(", released at {t} s"))
+            .unwrap_or_default();
+        let _ = writeln!(
+            s,
+            "pin {p}: `{}`, {count} vertices, {motion}{release}",
+            pin.region
+        );
+    }
+    Ok(s)
+}

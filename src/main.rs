@@ -1,0 +1,158 @@
+//! The `drape` command line.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use anyhow::{Context, Result};
+use clap::{Args, Parser, Subcommand};
+use indicatif::{ProgressBar, ProgressStyle};
+
+use drape::run::{Progress, RunError, RunOptions, run};
+use drape::scene::{Scene, default_scene, load_scene_file};
+
+/// Adaptive mass-spring cloth simulation, recorded to Rerun .rrd files.
+#[derive(Parser)]
+#[command(name = "drape", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Simulate a scene and record every frame to a .rrd file.
+    Run(RunArgs),
+    /// Validate a scene and print the resolved model without simulating.
+    Check(SceneArgs),
+}
+
+#[derive(Args)]
+struct SceneArgs {
+    /// Scene file (TOML). Without one, the embedded default scene is used.
+    scene: Option<PathBuf>,
+    /// Override a scene value by its dotted path, e.g. `--set cloth.resolution=64` (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    overrides: Vec<String>,
+}
+
+#[derive(Args)]
+struct RunArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// Output recording (default: the scene's name + `.rrd` in the current directory).
+    #[arg(long, short, value_name = "FILE.rrd", conflicts_with = "no_record")]
+    out: Option<PathBuf>,
+    /// Do not write a recording.
+    #[arg(long)]
+    no_record: bool,
+    /// Write a machine-readable summary (JSON) here.
+    #[arg(long, value_name = "FILE.json")]
+    summary: Option<PathBuf>,
+    /// Write every recorded frame as an OBJ file into this directory.
+    #[arg(long, value_name = "DIR")]
+    obj_dir: Option<PathBuf>,
+    /// Worker threads (default: one per core). Results are identical at any count.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    threads: Option<u32>,
+    /// No progress bar.
+    #[arg(long, short)]
+    quiet: bool,
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Run(args) => cmd_run(args),
+        Command::Check(args) => cmd_check(args),
+    };
+    match result {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(1)
+        }
+    }
+}
+
+fn load(args: &SceneArgs) -> Result<Scene> {
+    Ok(match &args.scene {
+        Some(path) => load_scene_file(path, &args.overrides)?,
+        None => default_scene(&args.overrides)?,
+    })
+}
+
+fn cmd_check(args: SceneArgs) -> Result<ExitCode> {
+    let scene = load(&args)?;
+    print!("{}", drape::check::describe(&scene)?);
+    Ok(ExitCode::SUCCESS)
+}
+
+fn cmd_run(args: RunArgs) -> Result<ExitCode> {
+    let scene = load(&args.scene)?;
+    let record = (!args.no_record).then(|| {
+        args.out
+            .clone()
+            .unwrap_or_else(|| PathBuf::from(format!("{}.rrd", scene.name)))
+    });
+    let opts = RunOptions {
+        record,
+        obj_dir: args.obj_dir.clone(),
+        threads: args.threads.map(|n| n as usize),
+    };
+    let interrupt = Arc::new(AtomicBool::new(false));
+    {
+        let flag = interrupt.clone();
+        ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed))
+            .context("installing the Ctrl-C handler")?;
+    }
+    let bar = if args.quiet {
+        ProgressBar::hidden()
+    } else {
+        ProgressBar::new(0)
+    };
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{spinner} [{elapsed_precise}] {bar:40} frame {pos}/{len} {msg} (eta {eta})",
+        )
+        .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let mut on_progress = |p: Progress| {
+        bar.set_length(p.frames);
+        bar.set_position(p.frame);
+        bar.set_message(format!("t = {:.2} s", p.sim_time));
+    };
+    let outcome = run(&scene, &opts, &interrupt, &mut on_progress);
+    bar.finish_and_clear();
+    let (summary, failure) = match outcome {
+        Ok(s) => (s, None),
+        Err(e) => match &e {
+            // The run stopped on a numerical failure: still report what it did.
+            RunError::Numerical { summary, .. } => (summary.as_ref().clone(), Some(e.to_string())),
+            _ => return Err(e.into()),
+        },
+    };
+    println!("{}", summary.paragraph());
+    if let Some(path) = &args.summary {
+        write_json(path, &summary)?;
+    }
+    if let Some(message) = failure {
+        eprintln!("error: {message}");
+        return Ok(ExitCode::from(2));
+    }
+    Ok(if summary.interrupted {
+        ExitCode::from(130)
+    } else {
+        ExitCode::SUCCESS
+    })
+}
+
+fn write_json(path: &Path, summary: &drape::summary::Summary) -> Result<()> {
+    let mut f = std::fs::File::create(path)
+        .with_context(|| format!("cannot write summary {}", path.display()))?;
+    serde_json::to_writer_pretty(&mut f, summary)?;
+    writeln!(f)?;
+    Ok(())
+}

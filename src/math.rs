@@ -1,0 +1,42 @@
+//! Scalar and vector aliases used by the whole engine.
+//!
+//! The engine computes in `f64` with glam 0.33, the glam that parry3d-f64 uses, so
+//! the collision module can hand vectors to parry without conversion. The recording
+//! module converts to rerun's own glam at the edge with `to_array()`.
+
+/// The floating-point type of every physical quantity.
+pub type Scalar = f64;
+/// A point or vector in world space (metres, m/s, newtons, ...).
+pub type Vector = glam::DVec3;
+/// A point in material (rest) space, the flat 2D parameter domain of the cloth.
+pub type Vector2 = glam::DVec2;
+/// A 3x3 matrix (spring Jacobian blocks, rotations).
+pub type Matrix3 = glam::DMat3;
+
+/// Rotation matrix from Euler angles in degrees, applied about x, then y, then z
+/// (extrinsic axes), i.e. `R = Rz * Ry * Rx`.
+pub fn rotation_from_euler_deg(angles: [Scalar; 3]) -> Matrix3 {
+    let [x, y, z] = angles.map(|a| a.to_radians());
+    Matrix3::from_rotation_z(z) * Matrix3::from_rotation_y(y) * Matrix3::from_rotation_x(x)
+}
+
+/// Sum of `values` in a fixed association order, independent of the thread count.
+///
+/// Rayon's `sum` splits work adaptively, so its rounding depends on the number of
+/// threads. This sums fixed-size chunks in parallel, then the chunk sums in order.
+pub fn deterministic_sum<F>(len: usize, term: F) -> Scalar
+where
+    F: Fn(usize) -> Scalar + Sync,
+{
+    use rayon::prelude::*;
+    const CHUNK: usize = 2048;
+    let chunks = len.div_ceil(CHUNK);
+    let partial: Vec<Scalar> = (0..chunks)
+        .into_par_iter()
+        .map(|c| {
+            let end = ((c + 1) * CHUNK).min(len);
+            (c * CHUNK..end).map(&term).sum()
+        })
+        .collect();
+    partial.iter().sum()
+}

@@ -1,0 +1,136 @@
+//! Mesh generators for the built-in cloth shapes, centred on the material origin.
+
+use super::{Mesh, MeshError};
+use crate::math::{Scalar, Vector2};
+use crate::scene::DiagonalPattern;
+
+/// A `width` x `height` grid with `resolution` segments along the longer side
+/// (at least one along the shorter), each square split into two right triangles.
+/// Material coordinates: u in [-width/2, width/2], v in [-height/2, height/2].
+pub fn rectangle(
+    width: Scalar,
+    height: Scalar,
+    resolution: u32,
+    pattern: DiagonalPattern,
+) -> Result<Mesh, MeshError> {
+    let (nx, ny) = grid_counts(width, height, resolution);
+    let mut material = Vec::with_capacity((nx + 1) * (ny + 1));
+    for j in 0..=ny {
+        for i in 0..=nx {
+            material.push(Vector2::new(
+                -0.5 * width + width * i as Scalar / nx as Scalar,
+                -0.5 * height + height * j as Scalar / ny as Scalar,
+            ));
+        }
+    }
+    let id = |i: usize, j: usize| (j * (nx + 1) + i) as u32;
+    let mut triangles = Vec::with_capacity(2 * nx * ny);
+    for j in 0..ny {
+        for i in 0..nx {
+            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+            let along_ac = match pattern {
+                DiagonalPattern::Regular => true,
+                DiagonalPattern::Alternating => (i + j) % 2 == 0,
+            };
+            if along_ac {
+                triangles.push([a, b, c]);
+                triangles.push([a, c, d]);
+            } else {
+                triangles.push([a, b, d]);
+                triangles.push([b, c, d]);
+            }
+        }
+    }
+    Mesh::new(material, triangles)
+}
+
+/// Segments along u and v for a rectangle.
+pub(crate) fn grid_counts(width: Scalar, height: Scalar, resolution: u32) -> (usize, usize) {
+    let r = resolution.max(1) as Scalar;
+    let (long, short) = (width.max(height), width.min(height));
+    let along_short = ((r * short / long).round() as usize).max(1);
+    if width >= height {
+        (resolution.max(1) as usize, along_short)
+    } else {
+        (along_short, resolution.max(1) as usize)
+    }
+}
+
+/// A disk of the given radius: concentric rings of nearly equilateral triangles,
+/// ring spacing `2 * radius / resolution` (so `resolution` segments span the diameter).
+pub fn disk(radius: Scalar, resolution: u32) -> Result<Mesh, MeshError> {
+    let rings = (resolution.max(1) as usize).div_ceil(2);
+    let mut material = vec![Vector2::ZERO];
+    let mut ring_start = vec![0usize];
+    for k in 1..=rings {
+        ring_start.push(material.len());
+        let count = 6 * k;
+        let r = radius * k as Scalar / rings as Scalar;
+        for m in 0..count {
+            let a = std::f64::consts::TAU * m as Scalar / count as Scalar;
+            material.push(Vector2::new(r * a.cos(), r * a.sin()));
+        }
+    }
+    let mut triangles = Vec::new();
+    for k in 1..=rings {
+        let (inner_n, outer_n) = (if k == 1 { 1 } else { 6 * (k - 1) }, 6 * k);
+        let inner = |i: usize| (ring_start[k - 1] + i % inner_n) as u32;
+        let outer = |o: usize| (ring_start[k] + o % outer_n) as u32;
+        if k == 1 {
+            for o in 0..outer_n {
+                triangles.push([0, outer(o), outer(o + 1)]);
+            }
+            continue;
+        }
+        // Zip the two rings by angle: advance whichever ring's next vertex comes first.
+        let (mut i, mut o) = (0usize, 0usize);
+        while i < inner_n || o < outer_n {
+            let next_inner = (i + 1) as Scalar / inner_n as Scalar;
+            let next_outer = (o + 1) as Scalar / outer_n as Scalar;
+            if o < outer_n && (i == inner_n || next_outer <= next_inner) {
+                triangles.push([inner(i), outer(o), outer(o + 1)]);
+                o += 1;
+            } else {
+                triangles.push([inner(i), outer(o), inner(i + 1)]);
+                i += 1;
+            }
+        }
+    }
+    Mesh::new(material, triangles)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rectangle_counts_and_area() {
+        let m = rectangle(2.0, 1.0, 8, DiagonalPattern::Alternating).unwrap();
+        assert_eq!(m.vertex_count(), 9 * 5);
+        assert_eq!(m.triangles.len(), 2 * 8 * 4);
+        assert!((m.total_rest_area() - 2.0).abs() < 1e-12);
+        let interior = m.edges.iter().filter(|e| e.is_interior()).count();
+        // Euler: E = V + F - 1 for a disk-like surface.
+        assert_eq!(m.edges.len(), m.vertex_count() + m.triangles.len() - 1);
+        assert!(interior > 0);
+    }
+
+    #[test]
+    fn disk_is_manifold_with_exact_polygon_area() {
+        for res in [1, 2, 7, 16] {
+            let m = disk(0.5, res).unwrap();
+            let rings = (res as usize).div_ceil(2);
+            assert_eq!(m.vertex_count(), 1 + 3 * rings * (rings + 1));
+            // The outer ring is a regular 6n-gon inscribed in the circle.
+            let n = 6.0 * rings as f64;
+            let polygon = 0.5 * n * 0.25 * (std::f64::consts::TAU / n).sin();
+            assert!((m.total_rest_area() - polygon).abs() < 1e-12, "res {res}");
+            assert!(
+                m.triangles
+                    .iter()
+                    .enumerate()
+                    .all(|(t, _)| m.rest_area(t) > 0.0)
+            );
+        }
+    }
+}

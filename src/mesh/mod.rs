@@ -1,0 +1,208 @@
+//! Index-based triangle mesh of the cloth in material (rest) space.
+//!
+//! Every vertex carries material coordinates (2D). All rest quantities (lengths,
+//! areas, masses) derive from them, so any mesh of the same cloth describes the
+//! same physical sheet. Topology is index-based: triangles reference vertices,
+//! edges reference their two triangles (the hinge).
+
+mod generate;
+mod obj;
+mod topology;
+
+pub use generate::{disk, rectangle};
+pub use obj::{ObjCloth, ObjError, load_obj};
+pub use topology::{Edge, NO_TRIANGLE};
+
+use crate::math::{Scalar, Vector2};
+
+/// Why a mesh was refused.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum MeshError {
+    /// The mesh has no triangles.
+    #[error("the mesh has no triangles")]
+    Empty,
+    /// A triangle references a vertex that does not exist.
+    #[error("triangle {triangle} references vertex {vertex}, but the mesh has {count} vertices")]
+    BadIndex {
+        /// Triangle index.
+        triangle: usize,
+        /// Offending vertex index.
+        vertex: u32,
+        /// Number of vertices.
+        count: usize,
+    },
+    /// A triangle has zero (or nearly zero) area in material space.
+    #[error("triangle {triangle} is degenerate: its rest area is {area:.3e} m^2")]
+    Degenerate {
+        /// Triangle index.
+        triangle: usize,
+        /// Its signed rest area.
+        area: Scalar,
+    },
+    /// An edge is shared by more than two triangles.
+    #[error("non-manifold mesh: the edge between vertices {a} and {b} has {count} triangles")]
+    NonManifoldEdge {
+        /// First vertex of the edge.
+        a: u32,
+        /// Second vertex of the edge.
+        b: u32,
+        /// Number of triangles at the edge.
+        count: usize,
+    },
+    /// The triangles around a vertex do not form a single fan (a "bow tie").
+    #[error("non-manifold mesh: the triangles around vertex {vertex} form {fans} separate fans")]
+    NonManifoldVertex {
+        /// The vertex.
+        vertex: u32,
+        /// Number of separate fans.
+        fans: usize,
+    },
+    /// Two neighbouring triangles have opposite orientation in material space (folded rest shape).
+    #[error(
+        "triangles {a} and {b} overlap in material space (the rest shape folds over at their shared edge)"
+    )]
+    Folded {
+        /// First triangle.
+        a: usize,
+        /// Second triangle.
+        b: usize,
+    },
+    /// The mesh falls into several pieces.
+    #[error(
+        "the mesh is disconnected: it has {components} separate pieces; drape simulates one connected cloth"
+    )]
+    Disconnected {
+        /// Number of connected pieces.
+        components: usize,
+    },
+    /// A vertex is used by no triangle.
+    #[error("vertex {vertex} is not used by any triangle")]
+    UnusedVertex {
+        /// The vertex.
+        vertex: u32,
+    },
+}
+
+/// The cloth mesh: material coordinates, triangles, edges and per-triangle levels.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Mesh {
+    /// Material (rest) coordinates of each vertex, m.
+    pub material: Vec<Vector2>,
+    /// Triangles, counter-clockwise in material space.
+    pub triangles: Vec<[u32; 3]>,
+    /// Refinement level of each triangle (0 for the input mesh).
+    pub levels: Vec<u8>,
+    /// Unique edges with their adjacent triangles.
+    pub edges: Vec<Edge>,
+}
+
+impl Mesh {
+    /// Builds and validates a mesh. Triangles are re-oriented counter-clockwise in
+    /// material space; the mesh must be a connected manifold without degenerate
+    /// triangles or unused vertices.
+    pub fn new(material: Vec<Vector2>, mut triangles: Vec<[u32; 3]>) -> Result<Mesh, MeshError> {
+        if triangles.is_empty() {
+            return Err(MeshError::Empty);
+        }
+        let n = material.len();
+        for (t, tri) in triangles.iter().enumerate() {
+            if let Some(&v) = tri.iter().find(|&&v| v as usize >= n) {
+                return Err(MeshError::BadIndex {
+                    triangle: t,
+                    vertex: v,
+                    count: n,
+                });
+            }
+        }
+        // Degeneracy is relative to the mesh's scale: a triangle whose area is a
+        // vanishing fraction of its longest edge squared is refused.
+        let mut all_negative = true;
+        for (t, tri) in triangles.iter().enumerate() {
+            let area = signed_area(&material, tri);
+            let longest = longest_edge_sq(&material, tri);
+            if area.abs() <= 1e-12 * longest || longest == 0.0 {
+                return Err(MeshError::Degenerate { triangle: t, area });
+            }
+            all_negative &= area < 0.0;
+        }
+        // A mirrored material map (all clockwise) is fine: flip everything.
+        if all_negative {
+            for tri in &mut triangles {
+                tri.swap(1, 2);
+            }
+        }
+        let edges = topology::build_edges(&triangles, n)?;
+        // Mixed orientation means the rest shape folds over itself.
+        for e in &edges {
+            if e.is_interior() {
+                let (a, b) = (e.triangles[0] as usize, e.triangles[1] as usize);
+                let sa = signed_area(&material, &triangles[a]) > 0.0;
+                let sb = signed_area(&material, &triangles[b]) > 0.0;
+                if sa != sb {
+                    return Err(MeshError::Folded { a, b });
+                }
+            }
+        }
+        topology::check_vertices(&triangles, n)?;
+        let levels = vec![0; triangles.len()];
+        Ok(Mesh {
+            material,
+            triangles,
+            levels,
+            edges,
+        })
+    }
+
+    /// Number of vertices.
+    pub fn vertex_count(&self) -> usize {
+        self.material.len()
+    }
+
+    /// Rest (material-space) area of triangle `t`, m^2.
+    pub fn rest_area(&self, t: usize) -> Scalar {
+        signed_area(&self.material, &self.triangles[t])
+    }
+
+    /// Total rest area, m^2.
+    pub fn total_rest_area(&self) -> Scalar {
+        (0..self.triangles.len()).map(|t| self.rest_area(t)).sum()
+    }
+
+    /// Rest length of edge `e`, m.
+    pub fn rest_length(&self, e: usize) -> Scalar {
+        let [a, b] = self.edges[e].vertices;
+        self.material[a as usize].distance(self.material[b as usize])
+    }
+
+    /// The vertex of triangle `t` that is not on edge `e` (the hinge's wing tip).
+    pub fn opposite_vertex(&self, t: u32, e: &Edge) -> u32 {
+        let tri = self.triangles[t as usize];
+        tri.into_iter()
+            .find(|&v| v != e.vertices[0] && v != e.vertices[1])
+            .unwrap_or(tri[0])
+    }
+
+    /// Axis-aligned bounding box of the material coordinates: (min, max).
+    pub fn material_bounds(&self) -> (Vector2, Vector2) {
+        let mut lo = Vector2::splat(Scalar::INFINITY);
+        let mut hi = Vector2::splat(Scalar::NEG_INFINITY);
+        for p in &self.material {
+            lo = lo.min(*p);
+            hi = hi.max(*p);
+        }
+        (lo, hi)
+    }
+}
+
+/// Signed area of a triangle in material space (positive when counter-clockwise).
+pub fn signed_area(material: &[Vector2], tri: &[u32; 3]) -> Scalar {
+    let [a, b, c] = tri.map(|v| material[v as usize]);
+    0.5 * (b - a).perp_dot(c - a)
+}
+
+fn longest_edge_sq(material: &[Vector2], tri: &[u32; 3]) -> Scalar {
+    let [a, b, c] = tri.map(|v| material[v as usize]);
+    a.distance_squared(b)
+        .max(b.distance_squared(c))
+        .max(c.distance_squared(a))
+}

@@ -1,0 +1,115 @@
+//! The physical model and the stepper.
+//!
+//! [`Model`] is the resolved, immutable physics of a scene; [`Stepper`] holds the
+//! force elements derived from the current mesh plus all scratch memory, and
+//! advances a [`World`] by one step with the chosen integrator.
+
+pub mod bending;
+pub mod elements;
+pub mod explicit;
+pub mod forces;
+pub mod implicit;
+pub mod pins;
+pub mod timestep;
+
+pub use elements::{Elements, Hinge, MaterialParams, Spring};
+pub use forces::{Energy, ExternalForces, WindForce};
+
+use crate::math::Scalar;
+use crate::scene::Integrator;
+use crate::world::World;
+
+/// The resolved physics of a scene.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Model {
+    /// Fabric parameters.
+    pub material: MaterialParams,
+    /// Declared external forces.
+    pub external: ExternalForces,
+    /// Time integrator.
+    pub integrator: Integrator,
+    /// Relative residual at which CG stops (implicit only).
+    pub cg_tolerance: Scalar,
+    /// CG iteration cap (implicit only).
+    pub cg_max_iterations: u32,
+}
+
+/// Counters of what the stepper did.
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
+pub struct StepStats {
+    /// Steps taken.
+    pub steps: u64,
+    /// CG iterations over all implicit steps.
+    pub cg_iterations: u64,
+    /// Implicit steps whose CG stopped at the iteration cap.
+    pub cg_capped: u64,
+}
+
+/// Force elements of the current mesh plus scratch memory; no simulation state.
+#[derive(Debug, Clone)]
+pub struct Stepper {
+    /// The physics being integrated.
+    pub model: Model,
+    /// Springs, hinges and masses of the current mesh.
+    pub elements: Elements,
+    /// What has been done so far.
+    pub stats: StepStats,
+    held: Vec<bool>,
+    forces: forces::ForceScratch,
+    rk4: explicit::Rk4Scratch,
+    implicit: implicit::ImplicitScratch,
+}
+
+impl Stepper {
+    /// A stepper for `model` on the world's current mesh.
+    pub fn new(model: Model, world: &World) -> Stepper {
+        let elements = Elements::build(&world.mesh, &model.material);
+        Stepper {
+            model,
+            elements,
+            stats: StepStats::default(),
+            held: vec![false; world.mesh.vertex_count()],
+            forces: Default::default(),
+            rk4: Default::default(),
+            implicit: Default::default(),
+        }
+    }
+
+    /// Rebuilds the force elements after the world's mesh changed.
+    pub fn rebuild(&mut self, world: &World) {
+        self.elements = Elements::build(&world.mesh, &self.model.material);
+        self.held.resize(world.mesh.vertex_count(), false);
+    }
+
+    /// Advances `world` by `dt` seconds with the model's integrator.
+    pub fn step(&mut self, world: &mut World, dt: Scalar) {
+        match self.model.integrator {
+            Integrator::SymplecticEuler => explicit::symplectic_euler(self, world, dt),
+            Integrator::Rk4 => explicit::rk4(self, world, dt),
+            Integrator::Implicit => {
+                let iterations = implicit::backward_euler(self, world, dt);
+                self.stats.cg_iterations += iterations as u64;
+                if iterations >= self.model.cg_max_iterations {
+                    self.stats.cg_capped += 1;
+                }
+            }
+        }
+        world.time += dt;
+        self.stats.steps += 1;
+    }
+
+    /// Energies of the world's current state.
+    pub fn energy(&self, world: &World) -> Energy {
+        forces::energy(&self.elements, &self.model.external, &world.x, &world.v)
+    }
+
+    /// The automatic time step for this model on the current mesh.
+    pub fn auto_dt(&self, world: &World) -> Scalar {
+        timestep::auto_dt(
+            self.model.integrator,
+            &world.mesh,
+            &self.elements,
+            self.model.external.drag.unwrap_or(0.0),
+        )
+    }
+}

@@ -1,0 +1,367 @@
+//! Running a scene: build the world, step it frame by frame, record every frame,
+//! and summarise. The step is a short list of named phases:
+//! forces + integrate (the stepper), health check, record.
+
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+use crate::math::{Scalar, Vector, deterministic_sum};
+use crate::physics::timestep::fit_to_frame;
+use crate::physics::{Energy, Model, Stepper};
+use crate::record::{FrameView, RecordError, Recorder, obj::write_frame_obj};
+use crate::scene::{Scene, TimeStep};
+use crate::summary::{EnergySummary, Range, RecordingSummary, Summary};
+use crate::world::{BuildError, World};
+
+/// How often a failing frame is retried with half the step before giving up.
+pub const MAX_STEP_HALVINGS: u32 = 4;
+
+/// What to produce besides the simulation itself.
+#[derive(Debug, Clone, Default)]
+pub struct RunOptions {
+    /// Write the recording here (`None`: no recording).
+    pub record: Option<PathBuf>,
+    /// Write each recorded frame as an OBJ into this directory.
+    pub obj_dir: Option<PathBuf>,
+    /// Worker threads (`None`: rayon's default, one per core).
+    pub threads: Option<usize>,
+}
+
+/// Progress report after each frame.
+#[derive(Debug, Clone, Copy)]
+pub struct Progress {
+    /// Frames done (including the initial frame).
+    pub frame: u64,
+    /// Frames in the whole run.
+    pub frames: u64,
+    /// Simulated time, s.
+    pub sim_time: Scalar,
+}
+
+/// Why a run failed.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// The scene could not become a world.
+    #[error("{0}")]
+    Build(#[from] BuildError),
+    /// Recording failed.
+    #[error("recording: {0}")]
+    Record(#[from] RecordError),
+    /// The thread pool could not be created.
+    #[error("cannot start {threads} worker threads: {reason}")]
+    Threads {
+        /// Requested threads.
+        threads: usize,
+        /// Why.
+        reason: String,
+    },
+    /// The state became non-finite even with the smallest step tried.
+    #[error(
+        "numerical failure in frame {frame} (t = {time:.4} s): positions became NaN or infinite even with the step halved {halvings} times to {dt:.3e} s; the run stopped and the recording holds every frame up to the last good one. Likely cause: the time step is too large for the stiffness ({cause})"
+    )]
+    Numerical {
+        /// Frame whose steps failed.
+        frame: u64,
+        /// Simulated time at the start of that frame.
+        time: Scalar,
+        /// Halvings tried.
+        halvings: u32,
+        /// The last step size tried.
+        dt: Scalar,
+        /// A hint naming the likely cause.
+        cause: String,
+        /// What the run produced up to the failure.
+        summary: Box<Summary>,
+    },
+}
+
+/// Runs `scene` to the end (or until `interrupt` is set), calling `progress`
+/// after every frame.
+pub fn run(
+    scene: &Scene,
+    opts: &RunOptions,
+    interrupt: &AtomicBool,
+    progress: &mut (dyn FnMut(Progress) + Send),
+) -> Result<Summary, RunError> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(opts.threads.unwrap_or(0))
+        .build()
+        .map_err(|e| RunError::Threads {
+            threads: opts.threads.unwrap_or(0),
+            reason: e.to_string(),
+        })?;
+    pool.install(|| run_in_pool(scene, opts, interrupt, progress))
+}
+
+fn run_in_pool(
+    scene: &Scene,
+    opts: &RunOptions,
+    interrupt: &AtomicBool,
+    progress: &mut (dyn FnMut(Progress) + Send),
+) -> Result<Summary, RunError> {
+    // Open the output first: an unwritable path fails before any simulation.
+    let mut recorder = match &opts.record {
+        Some(path) => Some(Recorder::create(path, &scene.name)?),
+        None => None,
+    };
+    if let Some(dir) = &opts.obj_dir {
+        std::fs::create_dir_all(dir).map_err(|source| RecordError::Obj {
+            path: dir.clone(),
+            source,
+        })?;
+    }
+    let mut world = World::from_scene(scene)?;
+    let model = Model::from_scene(scene);
+    let mut stepper = Stepper::new(model, &world);
+    let frame_interval = 1.0 / scene.simulation.frame_rate;
+    let frames = (scene.simulation.duration * scene.simulation.frame_rate)
+        .round()
+        .max(1.0) as u64;
+    let target_dt = match scene.simulation.dt {
+        TimeStep::Fixed(dt) => dt,
+        TimeStep::Auto => stepper.auto_dt(&world),
+    };
+    let (steps_per_frame, dt) = fit_to_frame(target_dt, frame_interval);
+
+    let mut tally = Tally::new(&world, &stepper);
+    let started = Instant::now();
+    let mut sim_seconds = 0.0;
+    let mut record_seconds = 0.0;
+    let mut nan_recoveries = 0u64;
+    let mut frames_done = 0u64;
+    let mut interrupted = false;
+    let mut normals = Vec::new();
+    let mut failure = None;
+    for frame in 0..=frames {
+        if frame > 0 {
+            if interrupt.load(Ordering::Relaxed) {
+                interrupted = true;
+                break;
+            }
+            let t0 = Instant::now();
+            match advance_frame(&mut stepper, &mut world, steps_per_frame, dt) {
+                Ok(recoveries) => nan_recoveries += recoveries,
+                Err(last_dt) => {
+                    failure = Some((frame, last_dt));
+                    break;
+                }
+            }
+            sim_seconds += t0.elapsed().as_secs_f64();
+        }
+        let energy = stepper.energy(&world);
+        tally.observe(&world, energy);
+        let t1 = Instant::now();
+        if let Some(rec) = recorder.as_mut() {
+            world.vertex_normals(&mut normals);
+            let pinned: Vec<u32> = world.pins.anchors.iter().map(|a| a.vertex).collect();
+            let scalars = frame_scalars(&world, energy, dt, sim_seconds, record_seconds, frame);
+            rec.record_frame(&FrameView {
+                frame,
+                sim_time: world.time,
+                positions: &world.x,
+                vertex_normals: &normals,
+                triangles: &world.mesh.triangles,
+                triangle_levels: &world.mesh.levels,
+                pinned: &pinned,
+                scalars: &scalars,
+            })?;
+        }
+        if let Some(dir) = &opts.obj_dir {
+            write_frame_obj(
+                dir,
+                frame,
+                &world.x,
+                &world.mesh.material,
+                &world.mesh.triangles,
+            )?;
+        }
+        record_seconds += t1.elapsed().as_secs_f64();
+        frames_done = frame + 1;
+        progress(Progress {
+            frame: frames_done,
+            frames: frames + 1,
+            sim_time: world.time,
+        });
+    }
+    let recording = match recorder {
+        Some(rec) => Some((opts.record.clone().unwrap_or_default(), rec.finish()?)),
+        None => None,
+    };
+    let summary = tally.finish(TallyEnd {
+        scene: scene.name.clone(),
+        frames: frames_done,
+        steps: stepper.stats.steps,
+        sim_time: world.time,
+        wall_time_s: started.elapsed().as_secs_f64(),
+        sim_wall_s: sim_seconds,
+        record_wall_s: record_seconds,
+        dt,
+        nan_recoveries,
+        interrupted,
+        recording,
+        stepper: &stepper,
+    });
+    match failure {
+        None => Ok(summary),
+        Some((frame, last_dt)) => Err(RunError::Numerical {
+            frame,
+            time: world.time,
+            halvings: MAX_STEP_HALVINGS,
+            dt: last_dt,
+            cause: format!(
+                "step {dt:.3e} s with the {:?} integrator; try a smaller `simulation.dt`, `dt = \"auto\"`, or `integrator = \"implicit\"`",
+                stepper.model.integrator
+            ),
+            summary: Box::new(summary),
+        }),
+    }
+}
+
+/// Advances one frame; on a non-finite state, restores the frame's start and
+/// retries with the step halved (up to [`MAX_STEP_HALVINGS`] times).
+/// Returns the number of recoveries, or the last step tried when all failed.
+fn advance_frame(
+    stepper: &mut Stepper,
+    world: &mut World,
+    steps: u64,
+    dt: Scalar,
+) -> Result<u64, Scalar> {
+    let (x0, v0, t0) = (world.x.clone(), world.v.clone(), world.time);
+    let mut recoveries = 0;
+    for halving in 0..=MAX_STEP_HALVINGS {
+        let (n, h) = (steps << halving, dt / (1u64 << halving) as Scalar);
+        let mut healthy = true;
+        for _ in 0..n {
+            stepper.step(world, h);
+            if !is_finite(&world.x) {
+                healthy = false;
+                break;
+            }
+        }
+        // Land exactly on the frame time whatever the rounding of n * h.
+        world.time = t0 + dt * steps as Scalar;
+        if healthy {
+            return Ok(recoveries);
+        }
+        recoveries += 1;
+        world.x.copy_from_slice(&x0);
+        world.v.copy_from_slice(&v0);
+        world.time = t0;
+    }
+    Err(dt / (1u64 << MAX_STEP_HALVINGS) as Scalar)
+}
+
+/// True when every coordinate is finite (a NaN or infinity anywhere poisons the sum).
+fn is_finite(x: &[Vector]) -> bool {
+    deterministic_sum(x.len(), |i| x[i].x + x[i].y + x[i].z).is_finite()
+}
+
+fn frame_scalars(
+    world: &World,
+    e: Energy,
+    dt: Scalar,
+    sim_s: Scalar,
+    rec_s: Scalar,
+    frame: u64,
+) -> Vec<(&'static str, f64)> {
+    let per_frame = |s: Scalar| {
+        if frame == 0 {
+            0.0
+        } else {
+            1e3 * s / frame as Scalar
+        }
+    };
+    vec![
+        ("mesh/vertices", world.x.len() as f64),
+        ("mesh/triangles", world.mesh.triangles.len() as f64),
+        ("energy/kinetic", e.kinetic),
+        ("energy/gravitational", e.gravitational),
+        ("energy/elastic", e.elastic),
+        ("energy/total", e.total()),
+        ("time/dt", dt),
+        ("timing/sim_ms_per_frame", per_frame(sim_s)),
+        ("timing/record_ms_per_frame", per_frame(rec_s)),
+    ]
+}
+
+/// Running statistics for the summary.
+struct Tally {
+    vertices: Range,
+    triangles: Range,
+    energy_initial: Scalar,
+    energy_final: Scalar,
+    energy_max: Scalar,
+    mass_initial: Scalar,
+}
+
+/// End-of-run facts handed to [`Tally::finish`].
+struct TallyEnd<'a> {
+    scene: String,
+    frames: u64,
+    steps: u64,
+    sim_time: Scalar,
+    wall_time_s: Scalar,
+    sim_wall_s: Scalar,
+    record_wall_s: Scalar,
+    dt: Scalar,
+    nan_recoveries: u64,
+    interrupted: bool,
+    recording: Option<(PathBuf, u64)>,
+    stepper: &'a Stepper,
+}
+
+impl Tally {
+    fn new(world: &World, stepper: &Stepper) -> Tally {
+        let e = stepper.energy(world).total();
+        Tally {
+            vertices: Range::empty(),
+            triangles: Range::empty(),
+            energy_initial: e,
+            energy_final: e,
+            energy_max: e,
+            mass_initial: stepper.elements.total_mass(),
+        }
+    }
+
+    fn observe(&mut self, world: &World, e: Energy) {
+        self.vertices.add(world.x.len() as Scalar);
+        self.triangles.add(world.mesh.triangles.len() as Scalar);
+        self.energy_final = e.total();
+        self.energy_max = self.energy_max.max(e.total());
+    }
+
+    fn finish(self, end: TallyEnd) -> Summary {
+        let vertex_steps = end.steps as Scalar * self.vertices.mean;
+        Summary {
+            scene: end.scene,
+            frames: end.frames,
+            steps: end.steps,
+            sim_time: end.sim_time,
+            wall_time_s: end.wall_time_s,
+            simulation_wall_s: end.sim_wall_s,
+            recording_wall_s: end.record_wall_s,
+            dt: end.dt,
+            vertex_steps_per_s: if end.sim_wall_s > 0.0 {
+                vertex_steps / end.sim_wall_s
+            } else {
+                0.0
+            },
+            vertices: self.vertices,
+            triangles: self.triangles,
+            mass_initial: self.mass_initial,
+            mass_final: end.stepper.elements.total_mass(),
+            energy: EnergySummary {
+                initial: self.energy_initial,
+                r#final: self.energy_final,
+                max: self.energy_max,
+            },
+            nan_recoveries: end.nan_recoveries,
+            solver: end.stepper.stats,
+            interrupted: end.interrupted,
+            recording: end
+                .recording
+                .map(|(path, bytes)| RecordingSummary { path, bytes }),
+        }
+    }
+}

@@ -1,0 +1,295 @@
+//! The scene file's data model: one struct per TOML section, deserialised by serde.
+//!
+//! Every key is documented in `docs/scenes.md`. Absent optional sections are not
+//! modelled at all (no force, no cost). Ranges are checked in `validate.rs`, which
+//! names the key and its line.
+
+use serde::Deserialize;
+
+/// A whole scene file.
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// Name of the scene; the default output file is `NAME.rrd`.
+    pub name: String,
+    /// Time span, integrator and global forces.
+    pub simulation: Simulation,
+    /// The cloth's rest shape and where it starts.
+    pub cloth: Cloth,
+    /// Physical parameters of the fabric.
+    pub material: Material,
+    /// Pinned regions (`[[pin]]`), none by default.
+    #[serde(default)]
+    pub pin: Vec<Pin>,
+    /// Air drag; absent: no drag is computed.
+    pub air: Option<Air>,
+    /// Wind; absent: no wind force is computed.
+    pub wind: Option<Wind>,
+}
+
+/// `[simulation]`: time span, integrator and global forces.
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Simulation {
+    /// Simulated duration in seconds (> 0).
+    pub duration: f64,
+    /// Recorded frames per second (> 0).
+    #[serde(default = "default_frame_rate")]
+    pub frame_rate: f64,
+    /// Time integrator.
+    #[serde(default)]
+    pub integrator: Integrator,
+    /// Time step: `"auto"` or a step in seconds (> 0).
+    #[serde(default)]
+    pub dt: TimeStep,
+    /// Gravity in m/s^2; z is up. `[0, 0, 0]` turns gravity off.
+    #[serde(default = "default_gravity")]
+    pub gravity: [f64; 3],
+    /// Relative residual at which the implicit integrator's conjugate gradients stop.
+    #[serde(default = "default_cg_tolerance")]
+    pub cg_tolerance: f64,
+    /// Iteration cap of the implicit integrator's conjugate gradients (reported when hit).
+    #[serde(default = "default_cg_max_iterations")]
+    pub cg_max_iterations: u32,
+}
+
+/// The time integrator.
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum Integrator {
+    /// Symplectic (semi-implicit) Euler, paper A.
+    SymplecticEuler,
+    /// Classic fourth-order Runge-Kutta, paper B.
+    Rk4,
+    /// Backward Euler with one Newton step solved by conjugate gradients (Baraff-Witkin).
+    #[default]
+    Implicit,
+}
+
+/// A fixed step in seconds, or `"auto"` (a stability estimate).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum TimeStep {
+    /// Chosen from the stiffest spring and the lightest mass (see `physics::timestep`).
+    #[default]
+    Auto,
+    /// This step in seconds (rounded down so that a whole number of steps fills a frame).
+    Fixed(f64),
+}
+
+/// `[cloth]`: the rest shape (material space) and the initial placement in the world.
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Cloth {
+    /// Which generator or loader makes the mesh.
+    pub shape: ClothShape,
+    /// Rectangle width in m (along material u / local x).
+    pub width: Option<f64>,
+    /// Rectangle height in m (along material v / local y).
+    pub height: Option<f64>,
+    /// Disk radius in m.
+    pub radius: Option<f64>,
+    /// Segments along the longer side (rectangle) or the diameter (disk).
+    pub resolution: Option<u32>,
+    /// Diagonal pattern of the rectangle's grid.
+    #[serde(default)]
+    pub diagonals: DiagonalPattern,
+    /// OBJ file for `shape = "obj"`, relative to the scene file.
+    pub path: Option<String>,
+    /// Metres per texture-coordinate unit when an OBJ's `vt` become material coordinates.
+    #[serde(default = "default_one")]
+    pub uv_scale: f64,
+    /// World position of the cloth's local origin (the centre of generated shapes), m.
+    #[serde(default)]
+    pub position: [f64; 3],
+    /// Euler angles in degrees (about x, then y, then z); the generated sheet lies in xy.
+    #[serde(default)]
+    pub rotation: [f64; 3],
+}
+
+/// How the cloth's mesh is made.
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum ClothShape {
+    /// A `width` x `height` grid of right triangles.
+    Rectangle,
+    /// A disk of concentric rings of nearly equilateral triangles.
+    Disk,
+    /// A triangle mesh read from an OBJ file.
+    Obj,
+}
+
+/// Which diagonal splits each grid square of a rectangle.
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum DiagonalPattern {
+    /// Every square split along the same diagonal.
+    Regular,
+    /// Diagonals alternate in a checkerboard, which is more isotropic.
+    #[default]
+    Alternating,
+}
+
+/// `[material]`: physical fabric parameters, per area, independent of the mesh.
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Material {
+    /// Area density in kg/m^2 (> 0).
+    pub density: f64,
+    /// Stretch stiffness in N/m (> 0).
+    pub stretch: f64,
+    /// Bending rigidity in N m (>= 0; 0 turns bending off).
+    #[serde(default)]
+    pub bending: f64,
+    /// Stiffness-proportional spring damping in s (>= 0; 0 turns damping off).
+    #[serde(default)]
+    pub damping: f64,
+    /// Bending force model.
+    #[serde(default)]
+    pub bending_model: BendingModel,
+    /// How spring constants follow from the material.
+    #[serde(default)]
+    pub stiffness_rule: StiffnessRule,
+}
+
+/// The bending force model.
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum BendingModel {
+    /// Discrete dihedral-angle bending scaled to be resolution independent.
+    #[default]
+    Dihedral,
+    /// Paper A: a spring between the two vertices opposite each interior edge.
+    HingeSpring,
+}
+
+/// How stretch spring constants are derived.
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum StiffnessRule {
+    /// From the rest triangles (Van Gelder 1998): resolution independent.
+    #[default]
+    Consistent,
+    /// Paper A: the same constant on every level-0 spring, times 2^(n/2) at level n.
+    PaperA,
+}
+
+/// `[[pin]]`: a pinned region of the cloth, selected in material space.
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Pin {
+    /// `corner:top_left|top_right|bottom_left|bottom_right`, `edge:top|bottom|left|right`,
+    /// `box` (with `box_min`/`box_max`) or `all`.
+    pub region: String,
+    /// Lower corner of a `box` region in material coordinates (m).
+    pub box_min: Option<[f64; 2]>,
+    /// Upper corner of a `box` region in material coordinates (m).
+    pub box_max: Option<[f64; 2]>,
+    /// How the pinned vertices move.
+    #[serde(default)]
+    pub motion: PinMotion,
+    /// Velocity in m/s for `linear` motion.
+    #[serde(default)]
+    pub velocity: [f64; 3],
+    /// Acceleration in m/s^2 for `linear` motion.
+    #[serde(default)]
+    pub acceleration: [f64; 3],
+    /// A point on the rotation axis (world, m) for `circular` motion.
+    #[serde(default)]
+    pub center: [f64; 3],
+    /// Rotation axis for `circular` motion (normalised; must not be zero).
+    #[serde(default = "default_axis")]
+    pub axis: [f64; 3],
+    /// Angular velocity in rad/s for `circular` motion (right-handed about `axis`).
+    #[serde(default)]
+    pub angular_velocity: f64,
+    /// Time in s at which the pin lets go (absent: never).
+    pub release_time: Option<f64>,
+}
+
+/// How a pin moves.
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum PinMotion {
+    /// Held in place.
+    #[default]
+    Fixed,
+    /// `x(t) = x0 + velocity t + acceleration t^2 / 2`.
+    Linear,
+    /// Rotation about `axis` through `center` at `angular_velocity`.
+    Circular,
+}
+
+/// `[air]`: drag on the velocity relative to the air (the wind velocity, or still air).
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Air {
+    /// Linear drag per area in kg/(m^2 s) (>= 0): `F_i = -drag * A_i * (v_i - v_air)`.
+    pub drag: f64,
+    /// Air density in kg/m^3 used by the wind force.
+    #[serde(default = "default_air_density")]
+    pub density: f64,
+}
+
+/// `[wind]`: aerodynamic pressure on each triangle from the relative air velocity.
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Wind {
+    /// Wind velocity in m/s.
+    pub velocity: [f64; 3],
+    /// Pressure (normal force) coefficient, dimensionless (>= 0).
+    #[serde(default = "default_one")]
+    pub coefficient: f64,
+}
+
+fn default_frame_rate() -> f64 {
+    30.0
+}
+fn default_gravity() -> [f64; 3] {
+    [0.0, 0.0, -9.81]
+}
+fn default_cg_tolerance() -> f64 {
+    1e-6
+}
+fn default_cg_max_iterations() -> u32 {
+    500
+}
+fn default_one() -> f64 {
+    1.0
+}
+fn default_axis() -> [f64; 3] {
+    [0.0, 0.0, 1.0]
+}
+/// Air density at sea level, kg/m^3.
+pub const DEFAULT_AIR_DENSITY: f64 = 1.2;
+fn default_air_density() -> f64 {
+    DEFAULT_AIR_DENSITY
+}
+
+impl<'de> Deserialize<'de> for TimeStep {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl serde::de::Visitor<'_> for V {
+            type Value = TimeStep;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("\"auto\" or a time step in seconds")
+            }
+            fn visit_str<E: serde::de::Error>(self, s: &str) -> Result<TimeStep, E> {
+                if s == "auto" {
+                    Ok(TimeStep::Auto)
+                } else {
+                    Err(E::invalid_value(serde::de::Unexpected::Str(s), &self))
+                }
+            }
+            fn visit_f64<E: serde::de::Error>(self, x: f64) -> Result<TimeStep, E> {
+                Ok(TimeStep::Fixed(x))
+            }
+            fn visit_i64<E: serde::de::Error>(self, x: i64) -> Result<TimeStep, E> {
+                Ok(TimeStep::Fixed(x as f64))
+            }
+            fn visit_u64<E: serde::de::Error>(self, x: u64) -> Result<TimeStep, E> {
+                Ok(TimeStep::Fixed(x as f64))
+            }
+        }
+        d.deserialize_any(V)
+    }
+}

@@ -1,0 +1,61 @@
+//! What each key allows, in words, for error messages (mirrors `docs/scenes.md`).
+
+/// The allowed values of the key at `path` (`pin.0.region` is looked up as
+/// `pin.region`), or `None` for paths that are not keys of the format.
+pub(crate) fn allowed(path: &str) -> Option<&'static str> {
+    let key: Vec<&str> = path
+        .split('.')
+        .filter(|p| p.parse::<usize>().is_err())
+        .collect();
+    Some(match key.join(".").as_str() {
+        "name" => "a non-empty string without `/` or `\\`",
+        "simulation" => "a table [simulation]",
+        "simulation.duration" => "a finite number > 0 (s)",
+        "simulation.frame_rate" => "a finite number > 0 (frames per second)",
+        "simulation.integrator" => "\"symplectic_euler\", \"rk4\" or \"implicit\"",
+        "simulation.dt" => "\"auto\" or a finite number of seconds > 0 and <= 1/frame_rate",
+        "simulation.gravity" => "an array of 3 finite numbers (m/s^2)",
+        "simulation.cg_tolerance" => "a number in the open interval (0, 1)",
+        "simulation.cg_max_iterations" => "an integer >= 1",
+        "cloth" => "a table [cloth]",
+        "cloth.shape" => "\"rectangle\", \"disk\" or \"obj\"",
+        "cloth.width" | "cloth.height" | "cloth.radius" => "a finite number > 0 (m)",
+        "cloth.resolution" => "an integer >= 1 (segments)",
+        "cloth.diagonals" => "\"alternating\" or \"regular\"",
+        "cloth.path" => "a non-empty path to an OBJ file, relative to the scene file",
+        "cloth.uv_scale" => "a finite number > 0 (m per texture-coordinate unit)",
+        "cloth.position" => "an array of 3 finite numbers (m)",
+        "cloth.rotation" => "an array of 3 finite numbers (degrees)",
+        "material" => "a table [material]",
+        "material.density" => "a finite number > 0 (kg/m^2)",
+        "material.stretch" => "a finite number > 0 (N/m)",
+        "material.bending" => "a finite number >= 0 (N m)",
+        "material.damping" => "a finite number >= 0 (s)",
+        "material.bending_model" => "\"dihedral\" or \"hinge_spring\"",
+        "material.stiffness_rule" => "\"consistent\" or \"paper_a\"",
+        "pin" => "an array of tables [[pin]]",
+        "pin.region" => REGIONS,
+        "pin.box_min" | "pin.box_max" => {
+            "an array of 2 finite numbers (material coordinates, m), box_min < box_max"
+        }
+        "pin.motion" => "\"fixed\", \"linear\" or \"circular\"",
+        "pin.velocity" => "an array of 3 finite numbers (m/s)",
+        "pin.acceleration" => "an array of 3 finite numbers (m/s^2)",
+        "pin.center" => "an array of 3 finite numbers (m)",
+        "pin.axis" => "an array of 3 finite numbers, not all zero",
+        "pin.angular_velocity" => "a finite number (rad/s)",
+        "pin.release_time" => "a finite number >= 0 (s)",
+        "air" => "a table [air]",
+        "air.drag" => "a finite number >= 0 (kg/(m^2 s))",
+        "air.density" => "a finite number > 0 (kg/m^3)",
+        "wind" => "a table [wind]",
+        "wind.velocity" => "an array of 3 finite numbers (m/s)",
+        "wind.coefficient" => "a finite number >= 0",
+        _ => return None,
+    })
+}
+
+/// The pin region syntax.
+pub(crate) const REGIONS: &str = "\"corner:top_left\", \"corner:top_right\", \
+\"corner:bottom_left\", \"corner:bottom_right\", \"edge:top\", \"edge:bottom\", \
+\"edge:left\", \"edge:right\", \"box\" (with box_min and box_max) or \"all\"";

@@ -1,0 +1,327 @@
+//! Range and consistency checks on a deserialised [`Scene`]. Each check names the
+//! key path; `parse.rs` turns the path into a line of the file or a `--set`.
+
+use std::fmt::Display;
+
+use toml::{Table, Value};
+
+use super::error::{Issue, KeyPath, SceneErrorKind as Kind, Seg, dotted, keys};
+use super::schema;
+use super::{Air, Cloth, ClothShape, Material, Pin, PinMotion, Scene, Simulation, TimeStep, Wind};
+
+/// The first problem in `scene`, if any. `doc` is the document it came from
+/// (after `--set`), used to tell keys that were written from defaults.
+pub(crate) fn validate(scene: &Scene, doc: &Table) -> Result<(), Issue> {
+    name(&scene.name)?;
+    simulation(&scene.simulation)?;
+    cloth(&scene.cloth, section(doc, "cloth"))?;
+    material(&scene.material)?;
+    let pins = doc.get("pin").and_then(Value::as_array);
+    for (i, pin) in scene.pin.iter().enumerate() {
+        let written = pins.and_then(|a| a.get(i)).and_then(Value::as_table);
+        check_pin(i, pin, scene.cloth.shape, written)?;
+    }
+    if let Some(a) = &scene.air {
+        air(a)?;
+    }
+    if let Some(w) = &scene.wind {
+        wind(w)?;
+    }
+    Ok(())
+}
+
+fn section<'a>(doc: &'a Table, key: &str) -> Option<&'a Table> {
+    doc.get(key).and_then(Value::as_table)
+}
+
+fn allowed_for(path: &KeyPath) -> String {
+    schema::allowed(&dotted(path))
+        .unwrap_or("see docs/scenes.md")
+        .to_owned()
+}
+
+fn out_of_range(path: KeyPath, what: impl Display) -> Issue {
+    let allowed = allowed_for(&path);
+    Issue::new(path, Kind::OutOfRange, what).allowed(allowed)
+}
+
+fn finite(path: &KeyPath, x: f64) -> Result<(), Issue> {
+    if x.is_finite() {
+        Ok(())
+    } else {
+        Err(out_of_range(
+            path.clone(),
+            format!("{x} is not a finite number"),
+        ))
+    }
+}
+
+fn positive(path: KeyPath, x: f64) -> Result<(), Issue> {
+    finite(&path, x)?;
+    if x > 0.0 {
+        Ok(())
+    } else {
+        Err(out_of_range(
+            path,
+            format!("{x} is out of range: must be > 0"),
+        ))
+    }
+}
+
+fn non_negative(path: KeyPath, x: f64) -> Result<(), Issue> {
+    finite(&path, x)?;
+    if x >= 0.0 {
+        Ok(())
+    } else {
+        Err(out_of_range(
+            path,
+            format!("{x} is out of range: must be >= 0"),
+        ))
+    }
+}
+
+fn all_finite(path: KeyPath, v: &[f64]) -> Result<(), Issue> {
+    match v.iter().find(|x| !x.is_finite()) {
+        None => Ok(()),
+        Some(x) => Err(out_of_range(
+            path,
+            format!("element {x} is not a finite number"),
+        )),
+    }
+}
+
+fn name(name: &str) -> Result<(), Issue> {
+    if name.trim().is_empty() || name.contains(['/', '\\']) {
+        let path = keys(&["name"]);
+        let allowed = allowed_for(&path);
+        return Err(Issue::new(
+            path,
+            Kind::BadValue,
+            format!("{name:?} is not a usable name"),
+        )
+        .allowed(allowed));
+    }
+    Ok(())
+}
+
+fn simulation(s: &Simulation) -> Result<(), Issue> {
+    let at = |k: &str| keys(&["simulation", k]);
+    positive(at("duration"), s.duration)?;
+    positive(at("frame_rate"), s.frame_rate)?;
+    if let TimeStep::Fixed(dt) = s.dt {
+        positive(at("dt"), dt)?;
+        let frame = 1.0 / s.frame_rate;
+        if dt > frame * (1.0 + 1e-12) {
+            return Err(out_of_range(
+                at("dt"),
+                format!("{dt} s is longer than one frame (1/frame_rate = {frame} s)"),
+            ));
+        }
+    }
+    all_finite(at("gravity"), &s.gravity)?;
+    finite(&at("cg_tolerance"), s.cg_tolerance)?;
+    if !(s.cg_tolerance > 0.0 && s.cg_tolerance < 1.0) {
+        return Err(out_of_range(
+            at("cg_tolerance"),
+            format!("{} is out of range: must be in (0, 1)", s.cg_tolerance),
+        ));
+    }
+    if s.cg_max_iterations < 1 {
+        return Err(out_of_range(
+            at("cg_max_iterations"),
+            "0 is out of range: must be >= 1",
+        ));
+    }
+    Ok(())
+}
+
+/// Keys that a shape needs, and keys that do not apply to it.
+fn shape_keys(
+    shape: ClothShape,
+) -> (
+    &'static str,
+    &'static [&'static str],
+    &'static [&'static str],
+) {
+    match shape {
+        ClothShape::Rectangle => (
+            "rectangle",
+            &["width", "height", "resolution"],
+            &["radius", "path", "uv_scale"],
+        ),
+        ClothShape::Disk => (
+            "disk",
+            &["radius", "resolution"],
+            &["width", "height", "diagonals", "path", "uv_scale"],
+        ),
+        ClothShape::Obj => (
+            "obj",
+            &["path"],
+            &["width", "height", "radius", "resolution", "diagonals"],
+        ),
+    }
+}
+
+fn cloth(c: &Cloth, written: Option<&Table>) -> Result<(), Issue> {
+    let at = |k: &str| keys(&["cloth", k]);
+    let (shape, required, foreign) = shape_keys(c.shape);
+    let has = |k: &str| written.is_some_and(|t| t.contains_key(k));
+    if let Some(k) = foreign.iter().find(|k| has(k)) {
+        return Err(Issue::new(
+            at(k),
+            Kind::NotApplicable,
+            format!("`{k}` does not apply to shape = \"{shape}\""),
+        )
+        .allowed(format!("for shape = \"{shape}\": {}", required.join(", "))));
+    }
+    if let Some(k) = required.iter().find(|k| !has(k)) {
+        let allowed = allowed_for(&at(k));
+        return Err(Issue::new(
+            at(k),
+            Kind::MissingKey,
+            format!("missing required key `{k}` for shape = \"{shape}\""),
+        )
+        .allowed(allowed));
+    }
+    for (k, v) in [
+        ("width", c.width),
+        ("height", c.height),
+        ("radius", c.radius),
+    ] {
+        if let Some(x) = v {
+            positive(at(k), x)?;
+        }
+    }
+    if c.resolution == Some(0) {
+        return Err(out_of_range(
+            at("resolution"),
+            "0 is out of range: must be >= 1",
+        ));
+    }
+    if c.path.as_deref().is_some_and(|p| p.trim().is_empty()) {
+        let allowed = allowed_for(&at("path"));
+        return Err(Issue::new(at("path"), Kind::BadValue, "the path is empty").allowed(allowed));
+    }
+    positive(at("uv_scale"), c.uv_scale)?;
+    all_finite(at("position"), &c.position)?;
+    all_finite(at("rotation"), &c.rotation)
+}
+
+fn material(m: &Material) -> Result<(), Issue> {
+    let at = |k: &str| keys(&["material", k]);
+    positive(at("density"), m.density)?;
+    positive(at("stretch"), m.stretch)?;
+    non_negative(at("bending"), m.bending)?;
+    non_negative(at("damping"), m.damping)
+}
+
+fn check_pin(i: usize, p: &Pin, shape: ClothShape, written: Option<&Table>) -> Result<(), Issue> {
+    let at = |k: &str| vec![Seg::Key("pin".into()), Seg::Index(i), Seg::Key(k.into())];
+    let has = |k: &str| written.is_some_and(|t| t.contains_key(k));
+    let region = p.region.as_str();
+    let corner_or_edge = matches!(
+        region,
+        "corner:top_left"
+            | "corner:top_right"
+            | "corner:bottom_left"
+            | "corner:bottom_right"
+            | "edge:top"
+            | "edge:bottom"
+            | "edge:left"
+            | "edge:right"
+    );
+    if !corner_or_edge && region != "box" && region != "all" {
+        return Err(Issue::new(
+            at("region"),
+            Kind::BadValue,
+            format!("{region:?} is not a pin region"),
+        )
+        .allowed(schema::REGIONS));
+    }
+    if corner_or_edge && shape != ClothShape::Rectangle {
+        return Err(Issue::new(
+            at("region"),
+            Kind::BadValue,
+            format!("{region:?} needs shape = \"rectangle\" (corners and edges are named on a rectangle only)"),
+        )
+        .allowed("\"box\" (with box_min and box_max) or \"all\" for this shape"));
+    }
+    if region == "box" {
+        let (Some(lo), Some(hi)) = (p.box_min, p.box_max) else {
+            let k = if p.box_min.is_none() {
+                "box_min"
+            } else {
+                "box_max"
+            };
+            let allowed = allowed_for(&at(k));
+            return Err(Issue::new(
+                at(k),
+                Kind::MissingKey,
+                format!("missing required key `{k}` for region = \"box\""),
+            )
+            .allowed(allowed));
+        };
+        all_finite(at("box_min"), &lo)?;
+        all_finite(at("box_max"), &hi)?;
+        if !(lo[0] < hi[0] && lo[1] < hi[1]) {
+            return Err(out_of_range(
+                at("box_max"),
+                format!("box_max {hi:?} is not above box_min {lo:?} in both coordinates"),
+            ));
+        }
+    } else if let Some(k) = ["box_min", "box_max"].into_iter().find(|k| has(k)) {
+        return Err(Issue::new(
+            at(k),
+            Kind::NotApplicable,
+            format!("`{k}` applies only to region = \"box\""),
+        )
+        .allowed("remove it, or set region = \"box\""));
+    }
+    let (motion, foreign): (&str, &[&str]) = match p.motion {
+        PinMotion::Fixed => (
+            "fixed",
+            &[
+                "velocity",
+                "acceleration",
+                "center",
+                "axis",
+                "angular_velocity",
+            ],
+        ),
+        PinMotion::Linear => ("linear", &["center", "axis", "angular_velocity"]),
+        PinMotion::Circular => ("circular", &["velocity", "acceleration"]),
+    };
+    if let Some(k) = foreign.iter().find(|k| has(k)) {
+        return Err(Issue::new(at(k), Kind::NotApplicable, format!("`{k}` does not apply to motion = \"{motion}\""))
+            .allowed("velocity and acceleration for \"linear\"; center, axis and angular_velocity for \"circular\""));
+    }
+    all_finite(at("velocity"), &p.velocity)?;
+    all_finite(at("acceleration"), &p.acceleration)?;
+    all_finite(at("center"), &p.center)?;
+    all_finite(at("axis"), &p.axis)?;
+    finite(&at("angular_velocity"), p.angular_velocity)?;
+    let len2: f64 = p.axis.iter().map(|a| a * a).sum();
+    if p.motion == PinMotion::Circular && !(len2 > 0.0 && len2.is_finite()) {
+        return Err(out_of_range(
+            at("axis"),
+            format!(
+                "{:?} has no usable direction (zero or overflowing length)",
+                p.axis
+            ),
+        ));
+    }
+    if let Some(t) = p.release_time {
+        non_negative(at("release_time"), t)?;
+    }
+    Ok(())
+}
+
+fn air(a: &Air) -> Result<(), Issue> {
+    non_negative(keys(&["air", "drag"]), a.drag)?;
+    positive(keys(&["air", "density"]), a.density)
+}
+
+fn wind(w: &Wind) -> Result<(), Issue> {
+    all_finite(keys(&["wind", "velocity"]), &w.velocity)?;
+    non_negative(keys(&["wind", "coefficient"]), w.coefficient)
+}

@@ -1,0 +1,148 @@
+//! The machine-readable run summary (`--summary FILE.json`) and its one-paragraph
+//! human form.
+
+use std::path::PathBuf;
+
+use serde::Serialize;
+
+use crate::math::Scalar;
+use crate::physics::StepStats;
+
+/// Minimum, mean and maximum of a quantity sampled once per recorded frame.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Range {
+    /// Smallest sample.
+    pub min: Scalar,
+    /// Mean of the samples.
+    pub mean: Scalar,
+    /// Largest sample.
+    pub max: Scalar,
+    #[serde(skip)]
+    count: u64,
+}
+
+impl Range {
+    /// No samples yet.
+    pub fn empty() -> Range {
+        Range {
+            min: Scalar::INFINITY,
+            mean: 0.0,
+            max: Scalar::NEG_INFINITY,
+            count: 0,
+        }
+    }
+
+    /// Adds one sample.
+    pub fn add(&mut self, x: Scalar) {
+        self.count += 1;
+        self.min = self.min.min(x);
+        self.max = self.max.max(x);
+        self.mean += (x - self.mean) / self.count as Scalar;
+    }
+}
+
+/// Total energy (kinetic + gravitational + elastic) at the start, the end, and its maximum, J.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct EnergySummary {
+    /// At t = 0.
+    pub initial: Scalar,
+    /// At the last recorded frame.
+    pub r#final: Scalar,
+    /// Largest over the recorded frames.
+    pub max: Scalar,
+}
+
+/// Where the recording went.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RecordingSummary {
+    /// The `.rrd` file.
+    pub path: PathBuf,
+    /// Its size in bytes.
+    pub bytes: u64,
+}
+
+/// Everything `--summary` writes.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Summary {
+    /// Scene name.
+    pub scene: String,
+    /// Recorded frames, including the initial one.
+    pub frames: u64,
+    /// Time steps taken (including retried ones).
+    pub steps: u64,
+    /// Simulated time reached, s.
+    pub sim_time: Scalar,
+    /// Wall time of the whole run, s.
+    pub wall_time_s: Scalar,
+    /// Wall time spent stepping, s.
+    pub simulation_wall_s: Scalar,
+    /// Wall time spent recording (and exporting OBJ), s.
+    pub recording_wall_s: Scalar,
+    /// The time step, s.
+    pub dt: Scalar,
+    /// Steps times mean vertices per second of stepping wall time.
+    pub vertex_steps_per_s: Scalar,
+    /// Vertex counts over the recorded frames.
+    pub vertices: Range,
+    /// Triangle counts over the recorded frames.
+    pub triangles: Range,
+    /// Total mass at the start, kg.
+    pub mass_initial: Scalar,
+    /// Total mass at the end, kg.
+    pub mass_final: Scalar,
+    /// Total energy.
+    pub energy: EnergySummary,
+    /// Frames retried with a smaller step after a non-finite state.
+    pub nan_recoveries: u64,
+    /// CG iterations and capped solves of the implicit integrator.
+    pub solver: StepStats,
+    /// True when Ctrl-C ended the run early.
+    pub interrupted: bool,
+    /// The recording, if one was written.
+    pub recording: Option<RecordingSummary>,
+}
+
+impl Summary {
+    /// The one-paragraph summary printed at the end of a run.
+    pub fn paragraph(&self) -> String {
+        let rec = match &self.recording {
+            Some(r) => format!(
+                "Recording: {} ({:.1} MB).",
+                r.path.display(),
+                r.bytes as f64 / 1e6
+            ),
+            None => "No recording.".to_string(),
+        };
+        let end = if self.interrupted {
+            " Interrupted by Ctrl-C."
+        } else {
+            ""
+        };
+        format!(
+            "{}: {} frames, {} steps of {:.3e} s to t = {:.3} s in {:.2} s wall ({:.2} s stepping, {:.2} s recording); \
+             {:.0} vertices, {:.0} triangles; {:.3e} vertex-steps/s. Mass {:.6} -> {:.6} kg; \
+             energy {:.4e} -> {:.4e} J (max {:.4e}); {} NaN recoveries; {} CG iterations ({} capped).{} {}",
+            self.scene,
+            self.frames,
+            self.steps,
+            self.dt,
+            self.sim_time,
+            self.wall_time_s,
+            self.simulation_wall_s,
+            self.recording_wall_s,
+            self.vertices.mean,
+            self.triangles.mean,
+            self.vertex_steps_per_s,
+            self.mass_initial,
+            self.mass_final,
+            self.energy.initial,
+            self.energy.r#final,
+            self.energy.max,
+            self.nan_recoveries,
+            self.solver.cg_iterations,
+            self.solver.cg_capped,
+            end,
+            rec
+        )
+    }
+}

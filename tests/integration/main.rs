@@ -1,0 +1,5 @@
+//! All integration tests in one binary: each test file is a module here, so the
+//! heavy dependencies (rerun) are linked once.
+
+mod recording;
+mod scene_errors;

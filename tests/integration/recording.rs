@@ -1,0 +1,341 @@
+//! Recording module: `.rrd` output decoded back, `RERUN=off`, error paths, OBJ export.
+
+use std::path::PathBuf;
+
+use drape::math::{Vector, Vector2};
+use drape::record::{FrameView, RecordError, Recorder, obj::write_frame_obj};
+use rerun::external::re_log_encoding::DecoderApp;
+use rerun::log::{Chunk, LogMsg};
+
+/// A fresh path in the temp dir, unique per process, test and call.
+fn temp_path(name: &str) -> PathBuf {
+    use std::sync::atomic::{AtomicU64, Ordering};
+    static COUNTER: AtomicU64 = AtomicU64::new(0);
+    let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+    std::env::temp_dir().join(format!("drape-test-{}-{n}-{name}", std::process::id()))
+}
+
+/// Two triangles forming a unit square in the z = 0 plane, the second one refined (level 1).
+struct Square {
+    positions: Vec<Vector>,
+    normals: Vec<Vector>,
+    triangles: Vec<[u32; 3]>,
+    levels: Vec<u8>,
+    pinned: Vec<u32>,
+}
+
+fn square() -> Square {
+    Square {
+        positions: vec![
+            Vector::new(0.0, 0.0, 0.0),
+            Vector::new(1.0, 0.0, 0.0),
+            Vector::new(1.0, 1.0, 0.0),
+            Vector::new(0.0, 1.0, 0.0),
+        ],
+        normals: vec![Vector::Z; 4],
+        triangles: vec![[0, 1, 2], [0, 2, 3]],
+        levels: vec![0, 1],
+        pinned: vec![2, 3],
+    }
+}
+
+/// Records `frames` frames of the square falling under gravity, then finishes.
+fn record_square(path: &std::path::Path, frames: u64) -> Result<u64, RecordError> {
+    record_mesh(path, &square(), frames, std::time::Duration::ZERO).map(|(size, _)| size)
+}
+
+/// Records `frames` frames of `mesh` falling under gravity, pausing `pause` between frames;
+/// returns the file size and the mean time spent in `record_frame`.
+fn record_mesh(
+    path: &std::path::Path,
+    mesh: &Square,
+    frames: u64,
+    pause: std::time::Duration,
+) -> Result<(u64, std::time::Duration), RecordError> {
+    let mut rec = Recorder::create(path, "two-triangles")?;
+    let mut positions = mesh.positions.clone();
+    let mut spent = std::time::Duration::ZERO;
+    for f in 0..frames {
+        let t = f as f64 / 60.0;
+        for (p, p0) in positions.iter_mut().zip(&mesh.positions) {
+            *p = *p0 - Vector::Z * (0.5 * 9.81 * t * t);
+        }
+        let scalars = [
+            ("energy/kinetic", 0.5 * (9.81 * t) * (9.81 * t)),
+            ("mesh/vertices", positions.len() as f64),
+            ("timing/sim_ms", 0.1),
+        ];
+        let start = std::time::Instant::now();
+        rec.record_frame(&FrameView {
+            frame: f,
+            sim_time: t,
+            positions: &positions,
+            vertex_normals: &mesh.normals,
+            triangles: &mesh.triangles,
+            triangle_levels: &mesh.levels,
+            pinned: &mesh.pinned,
+            scalars: &scalars,
+        })?;
+        spent += start.elapsed();
+        std::thread::sleep(pause);
+    }
+    let size = rec.finish()?;
+    Ok((
+        size,
+        spent / u32::try_from(frames.max(1)).unwrap_or(u32::MAX),
+    ))
+}
+
+/// An `n` x `n` grid of quads (2 n^2 triangles), levels cycling 0..4, two corners pinned.
+fn grid(n: u32) -> Square {
+    let mut sq = Square {
+        positions: Vec::new(),
+        normals: Vec::new(),
+        triangles: Vec::new(),
+        levels: Vec::new(),
+        pinned: vec![0, n],
+    };
+    for j in 0..=n {
+        for i in 0..=n {
+            sq.positions.push(Vector::new(
+                f64::from(i) / f64::from(n),
+                f64::from(j) / f64::from(n),
+                1.0,
+            ));
+            sq.normals.push(Vector::Z);
+        }
+    }
+    let v = |i: u32, j: u32| j * (n + 1) + i;
+    for j in 0..n {
+        for i in 0..n {
+            sq.triangles.push([v(i, j), v(i + 1, j), v(i + 1, j + 1)]);
+            sq.triangles.push([v(i, j), v(i + 1, j + 1), v(i, j + 1)]);
+            sq.levels.extend([(i % 4) as u8, (j % 4) as u8]);
+        }
+    }
+    sq
+}
+
+/// What the decoded recording store holds.
+#[derive(Debug, Default)]
+struct Decoded {
+    /// Rows per entity path in the recording store.
+    rows: std::collections::BTreeMap<String, usize>,
+    /// Timeline names seen on `cloth/mesh`.
+    mesh_timelines: std::collections::BTreeSet<String>,
+    recording_ids: std::collections::BTreeSet<String>,
+    blueprint_msgs: usize,
+}
+
+fn decode(path: &std::path::Path) -> Decoded {
+    let file = std::fs::File::open(path).expect("open rrd");
+    let decoder = DecoderApp::decode_eager(std::io::BufReader::new(file)).expect("rrd header");
+    let mut out = Decoded::default();
+    for msg in decoder {
+        let msg = msg.expect("decodable message");
+        let store = msg.store_id().clone();
+        if store.kind() != rerun::StoreKind::Recording {
+            out.blueprint_msgs += 1;
+            continue;
+        }
+        out.recording_ids.insert(store.recording_id().to_string());
+        if let LogMsg::ArrowMsg(_, arrow) = &msg {
+            let chunk = Chunk::from_arrow_msg(arrow).expect("chunk");
+            let entity = chunk.entity_path().to_string();
+            *out.rows.entry(entity.clone()).or_default() += chunk.num_rows();
+            if entity == "/cloth/mesh" {
+                out.mesh_timelines
+                    .extend(chunk.timelines().keys().map(|t| t.to_string()));
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn three_frames_decode_to_three_mesh_rows() {
+    let path = temp_path("three.rrd");
+    let size = record_square(&path, 3).expect("recording");
+    let bytes = std::fs::read(&path).expect("read rrd");
+    assert_eq!(size, bytes.len() as u64);
+    assert!(bytes.starts_with(b"RRF2"), "rrd magic");
+    // Stream footer: "RRF2" "FOOT" + u32 footer count, written on close.
+    assert_eq!(&bytes[bytes.len() - 12..bytes.len() - 4], b"RRF2FOOT");
+
+    let d = decode(&path);
+    println!("three frames: {size} bytes, rows {:?}", d.rows);
+    println!(
+        "mesh timelines {:?}, blueprint messages {}",
+        d.mesh_timelines, d.blueprint_msgs
+    );
+    assert_eq!(d.rows.get("/cloth/mesh"), Some(&3));
+    assert_eq!(d.rows.get("/cloth/pins"), Some(&3));
+    assert_eq!(d.rows.get("/plots/energy/kinetic"), Some(&3));
+    assert_eq!(d.rows.get("/plots/mesh/vertices"), Some(&3));
+    assert!(d.mesh_timelines.contains("frame"), "{:?}", d.mesh_timelines);
+    assert!(
+        d.mesh_timelines.contains("sim_time"),
+        "{:?}",
+        d.mesh_timelines
+    );
+    assert!(d.rows.contains_key("/cloth"), "annotation context");
+    let id = drape::record::recording_id("two-triangles");
+    assert_eq!(d.recording_ids.iter().collect::<Vec<_>>(), vec![&id]);
+    if rerun::decide_logging_enabled(true) {
+        assert!(d.blueprint_msgs > 0, "default blueprint sent");
+    }
+    std::fs::remove_file(&path).ok();
+}
+
+#[test]
+fn recording_id_is_deterministic() {
+    let a = drape::record::recording_id("tablecloth");
+    assert_eq!(a, drape::record::recording_id("tablecloth"));
+    assert_ne!(a, drape::record::recording_id("flag"));
+    assert_eq!(a.len(), 36);
+    assert_eq!(&a[14..15], "8", "uuid version nibble");
+}
+
+/// Runs [`three_frames_decode_to_three_mesh_rows`] again in a child process of this test
+/// binary with `RERUN=off`: setting the variable here would race with the other test threads.
+#[test]
+fn recording_is_forced_on_with_rerun_off() {
+    let exe = std::env::current_exe().expect("test binary path");
+    let out = std::process::Command::new(exe)
+        .args([
+            "--exact",
+            "recording::three_frames_decode_to_three_mesh_rows",
+            "--nocapture",
+            "--test-threads=1",
+        ])
+        .env("RERUN", "off")
+        .output()
+        .expect("run child test");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    println!("child with RERUN=off:\n{stdout}{stderr}");
+    assert!(out.status.success(), "child failed");
+    assert!(stdout.contains("1 passed"), "child ran the test");
+}
+
+#[test]
+fn size_and_time_per_frame() {
+    let one = temp_path("one.rrd");
+    let many = temp_path("many.rrd");
+    let s1 = record_square(&one, 1).expect("recording");
+    let s101 = record_square(&many, 101).expect("recording");
+    println!(
+        "2-triangle mesh, frames batched into one chunk: 1 frame {s1} B, 101 frames {s101} B, \
+         {:.0} B/frame",
+        (s101 - s1) as f64 / 100.0
+    );
+    // Pauses longer than the file sink's 200 ms batching tick: one chunk per entity per frame.
+    let pause = std::time::Duration::from_millis(250);
+    let (s4, _) = record_mesh(&many, &square(), 4, pause).expect("recording");
+    println!(
+        "2-triangle mesh, one chunk per frame: 4 frames {s4} B, {:.0} B/frame",
+        (s4 - s1) as f64 / 3.0
+    );
+    let big = grid(100);
+    let (b1, _) = record_mesh(&one, &big, 1, std::time::Duration::ZERO).expect("recording");
+    let (b11, t) = record_mesh(&many, &big, 11, std::time::Duration::ZERO).expect("recording");
+    println!(
+        "{} triangles: {:.0} kB/frame, record_frame {:.2} ms/frame",
+        big.triangles.len(),
+        (b11 - b1) as f64 / 10.0 / 1000.0,
+        t.as_secs_f64() * 1e3
+    );
+    std::fs::remove_file(&one).ok();
+    std::fs::remove_file(&many).ok();
+}
+
+#[test]
+fn dropped_recorder_leaves_valid_file() {
+    let path = temp_path("dropped.rrd");
+    let sq = square();
+    let result: Result<(), RecordError> = (|| {
+        let mut rec = Recorder::create(&path, "dropped")?;
+        rec.record_frame(&FrameView {
+            frame: 0,
+            sim_time: 0.0,
+            positions: &sq.positions,
+            vertex_normals: &sq.normals,
+            triangles: &sq.triangles,
+            triangle_levels: &sq.levels,
+            pinned: &sq.pinned,
+            scalars: &[],
+        })?;
+        // A later frame is invalid: `?` returns early and drops the recorder.
+        rec.record_frame(&FrameView {
+            frame: 1,
+            sim_time: 0.1,
+            positions: &sq.positions,
+            vertex_normals: &sq.normals,
+            triangles: &[[0, 1, 7]],
+            triangle_levels: &[0],
+            pinned: &[],
+            scalars: &[],
+        })?;
+        Ok(())
+    })();
+    let err = result.expect_err("index 7 of 4 vertices is invalid");
+    println!("invalid frame error: {err}");
+    assert!(matches!(err, RecordError::InvalidFrame { frame: 1, .. }));
+    let bytes = std::fs::read(&path).expect("read rrd");
+    assert_eq!(&bytes[bytes.len() - 12..bytes.len() - 4], b"RRF2FOOT");
+    assert_eq!(decode(&path).rows.get("/cloth/mesh"), Some(&1));
+    std::fs::remove_file(&path).ok();
+}
+
+#[test]
+fn unwritable_path_is_an_error() {
+    let err = Recorder::create(std::path::Path::new("/nonexistent-dir/x.rrd"), "unwritable")
+        .expect_err("missing directory");
+    println!("unwritable path error: {err}");
+    assert!(matches!(err, RecordError::Create { .. }));
+    assert!(err.to_string().contains("/nonexistent-dir/x.rrd"));
+}
+
+#[test]
+fn obj_export_writes_v_vt_f_lines() {
+    let dir = temp_path("obj");
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let sq = square();
+    let material: Vec<Vector2> = sq.positions.iter().map(|p| p.truncate() * 2.0).collect();
+    let path = write_frame_obj(&dir, 7, &sq.positions, &material, &sq.triangles).expect("obj");
+    assert_eq!(path, dir.join("frame_00007.obj"));
+    let text = std::fs::read_to_string(&path).expect("read obj");
+    let lines: Vec<&str> = text.lines().filter(|l| !l.starts_with('#')).collect();
+    assert_eq!(
+        lines,
+        [
+            "v 0 0 0",
+            "v 1 0 0",
+            "v 1 1 0",
+            "v 0 1 0",
+            "vt 0 0",
+            "vt 2 0",
+            "vt 2 2",
+            "vt 0 2",
+            "f 1/1 2/2 3/3",
+            "f 1/1 3/3 4/4",
+        ]
+    );
+    // The written file reads back with tobj.
+    let (models, _) = tobj::load_obj(&path, &tobj::GPU_LOAD_OPTIONS).expect("tobj");
+    assert_eq!(models[0].mesh.indices.len(), 6);
+
+    let err = write_frame_obj(
+        &dir.join("missing"),
+        0,
+        &sq.positions,
+        &material,
+        &sq.triangles,
+    )
+    .expect_err("missing directory");
+    assert!(matches!(err, RecordError::Obj { .. }), "{err}");
+    let err = write_frame_obj(&dir, 0, &sq.positions, &material[..2], &sq.triangles)
+        .expect_err("material length");
+    assert!(matches!(err, RecordError::InvalidFrame { .. }), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}

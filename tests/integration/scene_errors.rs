@@ -1,0 +1,636 @@
+//! Scene errors name the file, the line and the key.
+
+use drape::scene::{
+    ClothShape, Integrator, SceneError, SceneErrorKind as Kind, TimeStep, default_scene,
+    load_scene_file, load_scene_str,
+};
+
+/// A valid scene; line numbers are asserted below.
+const BASE: &str = r#"name = "t"
+[simulation]
+duration = 1.0
+[cloth]
+shape = "rectangle"
+width = 1.0
+height = 1.0
+resolution = 4
+[material]
+density = 0.15
+stretch = 200.0
+[[pin]]
+region = "corner:top_left"
+[[pin]]
+region = "corner:top_right"
+"#;
+
+/// `BASE` with `from` replaced by `to` (which must occur).
+fn edit(from: &str, to: &str) -> String {
+    assert!(BASE.contains(from), "test bug: {from:?} not in BASE");
+    BASE.replacen(from, to, 1)
+}
+
+fn sets(args: &[&str]) -> Vec<String> {
+    args.iter().map(|s| (*s).to_owned()).collect()
+}
+
+/// The error for `text`, checked to name the file, `line` and `key` in its message.
+fn error_at(text: &str, line: usize, key: &str, kind: Kind) -> SceneError {
+    let e = match load_scene_str(text, "test.toml", &[]) {
+        Ok(_) => panic!("expected an error at {key}"),
+        Err(e) => e,
+    };
+    let msg = e.to_string();
+    assert_eq!(e.kind, kind, "{msg}");
+    assert_eq!(e.line, Some(line), "{msg}");
+    assert_eq!(e.key.as_deref(), Some(key), "{msg}");
+    assert!(
+        msg.starts_with(&format!("test.toml:{line}: key `{key}`: ")),
+        "{msg}"
+    );
+    e
+}
+
+/// The error for `BASE` with `args` as `--set`, checked to name the file, the
+/// `--set` and the key, with no line.
+fn set_error(args: &[&str], key: &str, kind: Kind) -> SceneError {
+    let e = match load_scene_str(BASE, "test.toml", &sets(args)) {
+        Ok(_) => panic!("expected an error at {key}"),
+        Err(e) => e,
+    };
+    let msg = e.to_string();
+    assert_eq!(e.kind, kind, "{msg}");
+    assert_eq!(e.line, None, "{msg}");
+    assert_eq!(e.key.as_deref(), Some(key), "{msg}");
+    assert!(msg.starts_with("test.toml: --set "), "{msg}");
+    assert!(msg.contains(&format!("key `{key}`")), "{msg}");
+    e
+}
+
+#[test]
+fn base_scene_is_valid() {
+    let s = load_scene_str(BASE, "test.toml", &[]).expect("BASE is valid");
+    assert_eq!(s.cloth.shape, ClothShape::Rectangle);
+    assert_eq!(s.pin.len(), 2);
+    assert_eq!(s.simulation.dt, TimeStep::Auto);
+}
+
+#[test]
+fn malformed_toml_names_file_and_line() {
+    let e = load_scene_str(
+        &edit("density = 0.15", "density = = 0.15"),
+        "test.toml",
+        &[],
+    )
+    .expect_err("syntax error");
+    assert_eq!(e.kind, Kind::Syntax);
+    assert_eq!(e.line, Some(10), "{e}");
+    assert!(
+        e.to_string().starts_with("test.toml:10: TOML syntax error"),
+        "{e}"
+    );
+    let e = load_scene_str(&edit("[material]", "[material"), "test.toml", &[]).expect_err("syntax");
+    assert_eq!(e.line, Some(9), "{e}");
+}
+
+#[test]
+fn unknown_key_lists_allowed_keys() {
+    let e = error_at(
+        &edit("resolution = 4\n", "resolution = 4\ncolour = \"red\"\n"),
+        9,
+        "cloth.colour",
+        Kind::UnknownKey,
+    );
+    let msg = e.to_string();
+    assert!(
+        msg.contains("unknown key") && msg.contains("`width`") && msg.contains("`diagonals`"),
+        "{msg}"
+    );
+    error_at(
+        &edit("duration = 1.0", "duration = 1.0\nspeed = 2"),
+        4,
+        "simulation.speed",
+        Kind::UnknownKey,
+    );
+    error_at(
+        &format!("{BASE}[weather]\nrain = true\n"),
+        16,
+        "weather",
+        Kind::UnknownKey,
+    );
+    let e = error_at(
+        &format!("{BASE}colour = 1\n"),
+        16,
+        "pin.1.colour",
+        Kind::UnknownKey,
+    );
+    assert!(e.to_string().contains("`release_time`"), "{e}");
+}
+
+#[test]
+fn wrong_type_names_key_and_expectation() {
+    let e = error_at(
+        &edit("resolution = 4", "resolution = \"high\""),
+        8,
+        "cloth.resolution",
+        Kind::WrongType,
+    );
+    assert!(e.to_string().contains("an integer >= 1"), "{e}");
+    error_at(
+        &edit("width = 1.0", "width = [1.0]"),
+        6,
+        "cloth.width",
+        Kind::WrongType,
+    );
+    error_at(
+        &edit("duration = 1.0", "duration = 1.0\ngravity = [0.0, -9.8]"),
+        4,
+        "simulation.gravity",
+        Kind::WrongType,
+    );
+    error_at(
+        &edit(
+            "duration = 1.0",
+            "duration = 1.0\ngravity = [0.0, 0.0, \"down\"]",
+        ),
+        4,
+        "simulation.gravity",
+        Kind::WrongType,
+    );
+}
+
+#[test]
+fn bad_enum_value_lists_allowed_values() {
+    let e = error_at(
+        &edit("duration = 1.0", "duration = 1.0\nintegrator = \"verlet\""),
+        4,
+        "simulation.integrator",
+        Kind::BadValue,
+    );
+    let msg = e.to_string();
+    assert!(
+        msg.contains("verlet") && msg.contains("\"symplectic_euler\", \"rk4\" or \"implicit\""),
+        "{msg}"
+    );
+    error_at(
+        &edit("\"rectangle\"", "\"square\""),
+        5,
+        "cloth.shape",
+        Kind::BadValue,
+    );
+    error_at(
+        &edit("duration = 1.0", "duration = 1.0\ndt = \"fast\""),
+        4,
+        "simulation.dt",
+        Kind::BadValue,
+    );
+    error_at(
+        &edit(
+            "stretch = 200.0",
+            "stretch = 200.0\nbending_model = \"beam\"",
+        ),
+        12,
+        "material.bending_model",
+        Kind::BadValue,
+    );
+    error_at(
+        &edit(
+            "\"corner:top_right\"",
+            "\"corner:top_right\"\nmotion = \"spin\"",
+        ),
+        16,
+        "pin.1.motion",
+        Kind::BadValue,
+    );
+}
+
+#[test]
+fn missing_required_key_points_at_its_section() {
+    let e = error_at(
+        &edit("density = 0.15\n", ""),
+        9,
+        "material.density",
+        Kind::MissingKey,
+    );
+    assert!(e.to_string().contains("missing required key"), "{e}");
+    error_at(
+        &edit("duration = 1.0\n", ""),
+        2,
+        "simulation.duration",
+        Kind::MissingKey,
+    );
+    error_at(
+        &edit("region = \"corner:top_right\"\n", "motion = \"fixed\"\n"),
+        14,
+        "pin.1.region",
+        Kind::MissingKey,
+    );
+    let e = load_scene_str(&edit("name = \"t\"\n", ""), "test.toml", &[]).expect_err("no name");
+    assert_eq!(
+        (e.kind, e.line, e.key.as_deref()),
+        (Kind::MissingKey, None, Some("name")),
+        "{e}"
+    );
+}
+
+#[test]
+fn out_of_range_values_are_errors() {
+    let cases: &[(&str, &str, usize, &str)] = &[
+        (
+            "duration = 1.0",
+            "duration = -1.0",
+            3,
+            "simulation.duration",
+        ),
+        ("duration = 1.0", "duration = inf", 3, "simulation.duration"),
+        (
+            "duration = 1.0",
+            "duration = 1.0\nframe_rate = 0",
+            4,
+            "simulation.frame_rate",
+        ),
+        (
+            "duration = 1.0",
+            "duration = 1.0\ndt = 0.0",
+            4,
+            "simulation.dt",
+        ),
+        (
+            "duration = 1.0",
+            "duration = 1.0\ndt = 0.1",
+            4,
+            "simulation.dt",
+        ),
+        (
+            "duration = 1.0",
+            "duration = 1.0\ngravity = [0, 0, nan]",
+            4,
+            "simulation.gravity",
+        ),
+        (
+            "duration = 1.0",
+            "duration = 1.0\ncg_tolerance = 1.0",
+            4,
+            "simulation.cg_tolerance",
+        ),
+        (
+            "duration = 1.0",
+            "duration = 1.0\ncg_tolerance = 0.0",
+            4,
+            "simulation.cg_tolerance",
+        ),
+        (
+            "duration = 1.0",
+            "duration = 1.0\ncg_max_iterations = 0",
+            4,
+            "simulation.cg_max_iterations",
+        ),
+        ("width = 1.0", "width = 0.0", 6, "cloth.width"),
+        ("resolution = 4", "resolution = 0", 8, "cloth.resolution"),
+        (
+            "resolution = 4",
+            "resolution = 4\nposition = [0, -inf, 0]",
+            9,
+            "cloth.position",
+        ),
+        ("density = 0.15", "density = 0.0", 10, "material.density"),
+        (
+            "stretch = 200.0",
+            "stretch = -200.0",
+            11,
+            "material.stretch",
+        ),
+        (
+            "stretch = 200.0",
+            "stretch = 200.0\nbending = -1e-5",
+            12,
+            "material.bending",
+        ),
+        (
+            "stretch = 200.0",
+            "stretch = 200.0\ndamping = -0.1",
+            12,
+            "material.damping",
+        ),
+        (
+            "name = \"t\"",
+            "name = \"t\"\n[air]\ndrag = -0.5",
+            3,
+            "air.drag",
+        ),
+        (
+            "name = \"t\"",
+            "name = \"t\"\n[air]\ndrag = 0.5\ndensity = 0",
+            4,
+            "air.density",
+        ),
+        (
+            "name = \"t\"",
+            "name = \"t\"\n[wind]\nvelocity = [1, 0, 0]\ncoefficient = -1",
+            4,
+            "wind.coefficient",
+        ),
+    ];
+    for (from, to, line, key) in cases {
+        let e = error_at(&edit(from, to), *line, key, Kind::OutOfRange);
+        assert!(e.to_string().contains("; allowed: "), "{e}");
+    }
+    let e = error_at(
+        &edit("duration = 1.0", "duration = 1.0\ndt = 0.1"),
+        4,
+        "simulation.dt",
+        Kind::OutOfRange,
+    );
+    assert!(e.to_string().contains("frame_rate"), "{e}");
+    // No silent caps: a large resolution is accepted.
+    load_scene_str(&edit("resolution = 4", "resolution = 100000"), "t", &[])
+        .expect("no upper bound");
+}
+
+#[test]
+fn shape_keys_must_match_the_shape() {
+    let e = error_at(
+        &edit("resolution = 4", "resolution = 4\nradius = 0.5"),
+        9,
+        "cloth.radius",
+        Kind::NotApplicable,
+    );
+    assert!(
+        e.to_string()
+            .contains("does not apply to shape = \"rectangle\""),
+        "{e}"
+    );
+    error_at(
+        &edit("resolution = 4", "resolution = 4\nuv_scale = 2.0"),
+        9,
+        "cloth.uv_scale",
+        Kind::NotApplicable,
+    );
+    error_at(
+        &edit("height = 1.0\n", ""),
+        4,
+        "cloth.height",
+        Kind::MissingKey,
+    );
+    let disk = "shape = \"disk\"\nradius = 0.5\nresolution = 4\n";
+    let rect = "shape = \"rectangle\"\nwidth = 1.0\nheight = 1.0\nresolution = 4\n";
+    let pins = "[[pin]]\nregion = \"corner:top_left\"\n[[pin]]\nregion = \"corner:top_right\"\n";
+    let disk_scene = BASE
+        .replacen(rect, disk, 1)
+        .replacen(pins, "[[pin]]\nregion = \"all\"\n", 1);
+    load_scene_str(&disk_scene, "t", &[]).expect("disk scene is valid");
+    let e = load_scene_str(
+        &disk_scene.replacen("radius = 0.5\n", "", 1),
+        "test.toml",
+        &[],
+    )
+    .expect_err("disk without radius");
+    assert_eq!(
+        (e.kind, e.line, e.key.as_deref()),
+        (Kind::MissingKey, Some(4), Some("cloth.radius")),
+        "{e}"
+    );
+    let e = load_scene_str(
+        &disk_scene.replacen("radius = 0.5", "radius = 0.5\nwidth = 1.0", 1),
+        "test.toml",
+        &[],
+    )
+    .expect_err("width on disk");
+    assert_eq!(
+        (e.kind, e.line, e.key.as_deref()),
+        (Kind::NotApplicable, Some(6), Some("cloth.width")),
+        "{e}"
+    );
+    let obj_scene = BASE.replacen(rect, "shape = \"obj\"\n", 1);
+    let e = load_scene_str(&obj_scene, "test.toml", &[]).expect_err("obj without path");
+    assert_eq!(
+        (e.kind, e.key.as_deref()),
+        (Kind::MissingKey, Some("cloth.path")),
+        "{e}"
+    );
+}
+
+#[test]
+fn pin_errors() {
+    let region = |r: &str| edit("\"corner:top_right\"", r);
+    let e = error_at(
+        &region("\"corner:middle\""),
+        15,
+        "pin.1.region",
+        Kind::BadValue,
+    );
+    assert!(
+        e.to_string().contains("edge:left") && e.to_string().contains("\"all\""),
+        "{e}"
+    );
+    error_at(
+        &region("\"box\"\nbox_max = [0.1, 0.1]"),
+        14,
+        "pin.1.box_min",
+        Kind::MissingKey,
+    );
+    error_at(
+        &region("\"box\"\nbox_min = [0.1, 0.0]\nbox_max = [0.2, 0.0]"),
+        17,
+        "pin.1.box_max",
+        Kind::OutOfRange,
+    );
+    load_scene_str(
+        &region("\"box\"\nbox_min = [0.1, 0.0]\nbox_max = [0.2, 0.1]"),
+        "t",
+        &[],
+    )
+    .expect("valid box");
+    error_at(
+        &region("\"all\"\nbox_min = [0.1, 0.0]"),
+        16,
+        "pin.1.box_min",
+        Kind::NotApplicable,
+    );
+    error_at(
+        &region("\"all\"\nmotion = \"circular\"\naxis = [0, 0, 0]"),
+        17,
+        "pin.1.axis",
+        Kind::OutOfRange,
+    );
+    error_at(
+        &region("\"all\"\nvelocity = [1, 0, 0]"),
+        16,
+        "pin.1.velocity",
+        Kind::NotApplicable,
+    );
+    error_at(
+        &region("\"all\"\nrelease_time = -1.0"),
+        16,
+        "pin.1.release_time",
+        Kind::OutOfRange,
+    );
+    let disk = BASE
+        .replacen("width = 1.0\nheight = 1.0", "radius = 0.5", 1)
+        .replacen("\"rectangle\"", "\"disk\"", 1);
+    let e = load_scene_str(&disk, "test.toml", &[]).expect_err("corner on a disk");
+    assert_eq!(
+        (e.kind, e.line, e.key.as_deref()),
+        (Kind::BadValue, Some(11), Some("pin.0.region")),
+        "{e}"
+    );
+}
+
+#[test]
+fn planned_sections_are_reported_honestly() {
+    for (section, line, key, words) in [
+        (
+            "[adapt]\nmethod = \"red_green\"\n",
+            16,
+            "adapt",
+            "adaptive meshing",
+        ),
+        (
+            "[[obstacle]]\nshape = \"sphere\"\n",
+            16,
+            "obstacle",
+            "[[obstacle]]",
+        ),
+        (
+            "[self_collision]\nthickness = 0.003\n",
+            16,
+            "self_collision",
+            "[self_collision]",
+        ),
+    ] {
+        let e = error_at(&format!("{BASE}{section}"), line, key, Kind::Unsupported);
+        assert!(
+            e.to_string()
+                .contains("not supported by this version of drape yet"),
+            "{e}"
+        );
+        assert!(e.to_string().contains(words), "{e}");
+    }
+}
+
+#[test]
+fn overrides_apply_before_validation() {
+    let s = load_scene_str(
+        BASE,
+        "t",
+        &sets(&[
+            "cloth.resolution=64",
+            "simulation.integrator=rk4",
+            "simulation.gravity=[0,0,-1]",
+            "simulation.dt=0.001",
+            "pin.0.region=corner:bottom_left",
+            "wind.velocity=[3,0,0]",
+        ]),
+    )
+    .expect("valid overrides");
+    assert_eq!(s.cloth.resolution, Some(64));
+    assert_eq!(s.simulation.integrator, Integrator::Rk4);
+    assert_eq!(s.simulation.gravity, [0.0, 0.0, -1.0]);
+    assert_eq!(s.simulation.dt, TimeStep::Fixed(0.001));
+    assert_eq!(s.pin[0].region, "corner:bottom_left");
+    assert_eq!(s.wind.as_ref().map(|w| w.velocity), Some([3.0, 0.0, 0.0]));
+}
+
+#[test]
+fn override_errors_name_the_set() {
+    let e = set_error(
+        &["cloth.resolution=0"],
+        "cloth.resolution",
+        Kind::OutOfRange,
+    );
+    assert!(e.to_string().contains("--set cloth.resolution=0"), "{e}");
+    set_error(&["cloth.colour=red"], "cloth.colour", Kind::UnknownKey);
+    set_error(
+        &["simulation.integrator=verlet"],
+        "simulation.integrator",
+        Kind::BadValue,
+    );
+    set_error(
+        &["cloth.resolution=high"],
+        "cloth.resolution",
+        Kind::WrongType,
+    );
+    set_error(&["wind.coefficient=2"], "wind.velocity", Kind::MissingKey);
+    set_error(&["pin.1.region=box"], "pin.1.box_min", Kind::MissingKey);
+    set_error(&["pin.7.region=all"], "pin", Kind::BadOverride);
+    set_error(&["adapt.method=edge"], "adapt", Kind::Unsupported);
+    let e = load_scene_str(BASE, "test.toml", &sets(&["cloth.resolution"])).expect_err("no =");
+    assert_eq!(e.kind, Kind::BadOverride, "{e}");
+    assert!(e.to_string().contains("--set cloth.resolution"), "{e}");
+    // A later --set wins; an error in the file itself still has its line.
+    let e = load_scene_str(
+        &edit("density = 0.15", "density = -1"),
+        "test.toml",
+        &sets(&["cloth.resolution=8"]),
+    )
+    .expect_err("bad density");
+    assert_eq!((e.line, e.set.as_deref()), (Some(10), None), "{e}");
+}
+
+#[test]
+fn shipped_scenes_are_valid() {
+    let s = default_scene(&[]).expect("default scene");
+    assert_eq!(
+        (s.name.as_str(), s.cloth.resolution, s.pin.len()),
+        ("default", Some(24), 2)
+    );
+    assert!(s.air.is_some() && s.wind.is_none());
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    let s = load_scene_file(&dir.join("hanging_sheet.toml"), &[]).expect("hanging_sheet");
+    assert_eq!((s.cloth.resolution, s.simulation.duration), (Some(32), 4.0));
+    let s = load_scene_file(&dir.join("flag.toml"), &[]).expect("flag");
+    assert_eq!(s.simulation.integrator, Integrator::Rk4);
+    assert_eq!(s.cloth.rotation, [90.0, 0.0, 0.0]);
+    assert_eq!(s.wind.map(|w| w.velocity), Some([6.0, 0.0, 0.5]));
+    let e = default_scene(&sets(&["material.density=0"])).expect_err("bad override");
+    assert!(
+        e.to_string()
+            .starts_with("<default scene>: --set material.density=0: key `material.density`"),
+        "{e}"
+    );
+}
+
+#[test]
+fn obj_path_is_relative_to_the_scene_file() {
+    let dir = std::env::temp_dir().join(format!("drape-scene-test-{}", std::process::id()));
+    std::fs::create_dir_all(dir.join("meshes")).expect("temp dir");
+    std::fs::write(
+        dir.join("meshes/patch.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+    )
+    .expect("obj");
+    let text = BASE
+        .replacen(
+            "shape = \"rectangle\"\nwidth = 1.0\nheight = 1.0\nresolution = 4\n",
+            "shape = \"obj\"\npath = \"meshes/patch.obj\"\n",
+            1,
+        )
+        .replacen("corner:top_left", "all", 1)
+        .replacen("corner:top_right", "all", 1);
+    let scene_path = dir.join("obj_scene.toml");
+    std::fs::write(&scene_path, &text).expect("scene");
+    let s = load_scene_file(&scene_path, &[]).expect("obj scene");
+    let resolved = s.cloth.path.expect("path");
+    assert_eq!(
+        std::path::Path::new(&resolved),
+        dir.join("meshes/patch.obj")
+    );
+    std::fs::write(&scene_path, text.replacen("patch.obj", "missing.obj", 1)).expect("scene");
+    let e = load_scene_file(&scene_path, &[]).expect_err("missing obj");
+    assert_eq!(
+        (e.line, e.key.as_deref()),
+        (Some(5), Some("cloth.path")),
+        "{e}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn unreadable_file_is_an_error() {
+    let e = load_scene_file(std::path::Path::new("/nonexistent/scene.toml"), &[]).expect_err("io");
+    assert_eq!(e.kind, Kind::Io);
+    assert!(
+        e.to_string()
+            .starts_with("/nonexistent/scene.toml: cannot read"),
+        "{e}"
+    );
+}
