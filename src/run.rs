@@ -228,7 +228,7 @@ fn advance_frame(
     dt: Scalar,
 ) -> Result<u64, Scalar> {
     let (x0, v0, t0) = (world.x.clone(), world.v.clone(), world.time);
-    let mut recoveries = 0;
+    // Each halving tried is one recovery from a failed attempt.
     for halving in 0..=MAX_STEP_HALVINGS {
         let (n, h) = (steps << halving, dt / (1u64 << halving) as Scalar);
         let mut healthy = true;
@@ -242,9 +242,8 @@ fn advance_frame(
         // Land exactly on the frame time whatever the rounding of n * h.
         world.time = t0 + dt * steps as Scalar;
         if healthy {
-            return Ok(recoveries);
+            return Ok(halving as u64);
         }
-        recoveries += 1;
         world.x.copy_from_slice(&x0);
         world.v.copy_from_slice(&v0);
         world.time = t0;

@@ -8,7 +8,13 @@
 //! the damping rate, symplectic Euler on `x'' = -omega^2 x - zeta x'` is stable
 //! for `h^2 omega^2 + 2 h zeta <= 4`, i.e. `h <= (sqrt(zeta^2 + 4 omega^2) - zeta) / omega^2`.
 //! RK4's stability region reaches about 1.39 times further along both axes.
-//! A safety factor of 0.8 covers the nonlinearity of large rotations.
+//!
+//! The safety factor covers the nonlinearity of large rotations, which the linear
+//! estimate does not see. Measured on a 1 m sheet (res 12) swinging from two
+//! pinned corners without damping, 10^4 symplectic Euler steps: at 0.8 of the
+//! limit the total energy rose steadily (secular drift, 3.1% of E0 by the end);
+//! at 0.5 the largest deviation was still 0.94% of E0; at 0.4 it only
+//! oscillated (largest deviation 0.6% of E0, -0.05% at the end). So 0.4.
 
 use super::bending::dihedral_angle_and_gradient;
 use super::elements::Elements;
@@ -17,7 +23,7 @@ use crate::mesh::Mesh;
 use crate::scene::Integrator;
 
 /// Safety factor applied to the explicit stability limits.
-pub const SAFETY: Scalar = 0.8;
+pub const SAFETY: Scalar = 0.4;
 /// Largest automatic step of the implicit integrator, s (an accuracy bound:
 /// backward Euler damps motions faster than about 1/h).
 pub const IMPLICIT_MAX_DT: Scalar = 0.01;

@@ -38,23 +38,23 @@ pub struct SceneError {
     /// What kind of problem this is.
     pub kind: SceneErrorKind,
     /// The scene's origin: its path, or e.g. `<default scene>`.
-    pub file: String,
+    pub file: Box<str>,
     /// 1-based line in the file, when the problem has one.
     pub line: Option<usize>,
     /// The `--set` argument that supplied the offending value, if any.
-    pub set: Option<String>,
+    pub set: Option<Box<str>>,
     /// Dotted path of the offending key (`cloth.resolution`, `pin.0.region`), if any.
-    pub key: Option<String>,
+    pub key: Option<Box<str>>,
     /// What is wrong.
-    pub message: String,
+    pub message: Box<str>,
     /// What is allowed instead, if that can be said.
-    pub allowed: Option<String>,
+    pub allowed: Option<Box<str>>,
 }
 
 impl SceneError {
     /// The full one-line message (also the `Display` form).
     pub fn render(&self) -> String {
-        let mut s = self.file.clone();
+        let mut s = self.file.to_string();
         if let Some(line) = self.line {
             s.push_str(&format!(":{line}"));
         }
@@ -114,6 +114,8 @@ pub(crate) struct Issue {
     pub message: String,
     /// What is allowed.
     pub allowed: Option<String>,
+    /// The key whose value makes this a problem (e.g. `cloth.shape` for a missing `radius`).
+    pub cause: Option<KeyPath>,
 }
 
 impl Issue {
@@ -124,12 +126,19 @@ impl Issue {
             kind,
             message: message.to_string(),
             allowed: None,
+            cause: None,
         }
     }
 
     /// The same issue with an "allowed: ..." part.
     pub fn allowed(mut self, allowed: impl fmt::Display) -> Self {
         self.allowed = Some(allowed.to_string());
+        self
+    }
+
+    /// The same issue, caused by the value at `cause`.
+    pub fn because(mut self, cause: KeyPath) -> Self {
+        self.cause = Some(cause);
         self
     }
 }

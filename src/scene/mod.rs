@@ -11,6 +11,8 @@ pub mod model;
 mod overrides;
 mod parse;
 mod schema;
+mod serde_errors;
+mod spans;
 mod validate;
 
 use std::path::Path;
@@ -34,11 +36,11 @@ pub fn load_scene_file(path: &Path, overrides: &[String]) -> Result<Scene, Scene
     let origin = path.display().to_string();
     let text = std::fs::read_to_string(path).map_err(|e| SceneError {
         kind: SceneErrorKind::Io,
-        file: origin.clone(),
+        file: origin.as_str().into(),
         line: None,
         set: None,
         key: None,
-        message: format!("cannot read the scene file: {e}"),
+        message: format!("cannot read the scene file: {e}").into(),
         allowed: None,
     })?;
     parse::load(&text, &origin, path.parent(), overrides)

@@ -1,14 +1,12 @@
 //! Loading: TOML text -> document -> `--set` overrides -> `Scene` -> validation,
 //! with every error located at a line of the file or at the `--set` that caused it.
 
-use std::ops::Range;
 use std::path::Path;
 
-use toml::Spanned;
-use toml::de::{DeTable, DeValue};
-
 use super::error::{Issue, KeyPath, SceneError, SceneErrorKind, Seg, dotted, keys};
-use super::{Scene, overrides, schema, validate};
+use super::serde_errors::translate;
+use super::spans::{line_at, line_of};
+use super::{Scene, overrides, validate};
 
 /// Sections the format names that this version does not implement, with what is planned.
 const UNSUPPORTED: [(&str, &str, &str); 3] = [
@@ -89,6 +87,13 @@ impl Ctx<'_> {
         if let Some(arg) = self.set_for(&issue.path) {
             return self.at_set(arg, issue);
         }
+        // A requirement that a --set introduced (e.g. `--set pin.0.region=box` needs
+        // box_min): point at the file's line and name that --set.
+        let cause = issue
+            .cause
+            .as_ref()
+            .and_then(|c| self.set_for(c))
+            .map(str::to_owned);
         let (line, complete, depth) = line_of(self.text, &issue.path);
         if !complete {
             // The deepest part that exists in the file; if a --set created what
@@ -104,7 +109,7 @@ impl Ctx<'_> {
                 return self.at_set(&arg, issue);
             }
         }
-        self.error(issue, line, None)
+        self.error(issue, line, cause)
     }
 
     /// The error for `issue` caused by the `--set` argument `arg`.
@@ -115,12 +120,12 @@ impl Ctx<'_> {
     fn error(&self, issue: Issue, line: Option<usize>, set: Option<String>) -> SceneError {
         SceneError {
             kind: issue.kind,
-            file: self.origin.to_owned(),
+            file: self.origin.into(),
             line,
-            set,
-            key: (!issue.path.is_empty()).then(|| dotted(&issue.path)),
-            message: issue.message,
-            allowed: issue.allowed,
+            set: set.map(Into::into),
+            key: (!issue.path.is_empty()).then(|| dotted(&issue.path).into()),
+            message: issue.message.into(),
+            allowed: issue.allowed.map(Into::into),
         }
     }
 }
@@ -129,23 +134,13 @@ fn syntax_error(origin: &str, text: &str, e: &toml::de::Error) -> SceneError {
     let line = e.span().map(|s| line_at(text, s.start));
     SceneError {
         kind: SceneErrorKind::Syntax,
-        file: origin.to_owned(),
+        file: origin.into(),
         line,
         set: None,
         key: None,
-        message: format!("TOML syntax error: {}", e.message().trim()),
+        message: format!("TOML syntax error: {}", e.message().trim()).into(),
         allowed: None,
     }
-}
-
-/// 1-based line of byte `offset` in `text`.
-fn line_at(text: &str, offset: usize) -> usize {
-    let end = offset.min(text.len());
-    text.as_bytes()[..end]
-        .iter()
-        .filter(|&&b| b == b'\n')
-        .count()
-        + 1
 }
 
 fn unsupported(doc: &toml::Table) -> Result<(), Issue> {
@@ -173,182 +168,4 @@ fn deserialize(doc: &toml::Table) -> Result<Scene, Issue> {
         )
     })?;
     toml::from_str::<Scene>(&canon).map_err(|e| translate(&canon, &e))
-}
-
-/// Turns a serde error into an issue at the key its span points to.
-fn translate(canon: &str, e: &toml::de::Error) -> Issue {
-    let mut path = match (DeTable::parse(canon), e.span()) {
-        (Ok(root), Some(span)) => path_at(root.get_ref(), &span),
-        _ => KeyPath::new(),
-    };
-    let msg = e.message().trim();
-    let expected = |m: &str| {
-        m.split_once(", expected ")
-            .map(|(_, x)| x.trim_start_matches("one of ").to_owned())
-    };
-    let described = |path: &KeyPath, fallback: Option<String>| {
-        schema::allowed(&dotted(path))
-            .map(str::to_owned)
-            .or(fallback.map(|x| plain(&x)))
-    };
-    let (kind, message, allowed) = if let Some(rest) = msg.strip_prefix("unknown field ") {
-        let list = expected(rest).unwrap_or_else(|| "no keys".to_owned());
-        (
-            SceneErrorKind::UnknownKey,
-            "unknown key".to_owned(),
-            Some(list),
-        )
-    } else if let Some(rest) = msg.strip_prefix("missing field ") {
-        path.push(Seg::Key(rest.trim_matches('`').to_owned()));
-        let allowed = described(&path, None);
-        (
-            SceneErrorKind::MissingKey,
-            "missing required key".to_owned(),
-            allowed,
-        )
-    } else if let Some(rest) = msg.strip_prefix("unknown variant ") {
-        let value = rest.split(", expected").next().unwrap_or(rest);
-        let allowed = described(&path, expected(rest));
-        (
-            SceneErrorKind::BadValue,
-            format!("{value} is not a valid value"),
-            allowed,
-        )
-    } else if let Some(rest) = msg.strip_prefix("invalid type: ") {
-        let found = rest.split(", expected").next().unwrap_or(rest);
-        let allowed = described(&path, expected(rest));
-        (
-            SceneErrorKind::WrongType,
-            format!("wrong type: found {found}"),
-            allowed,
-        )
-    } else if let Some(rest) = msg.strip_prefix("invalid length ") {
-        let n = rest.split(", expected").next().unwrap_or(rest);
-        let allowed = described(&path, expected(rest));
-        (
-            SceneErrorKind::WrongType,
-            format!("wrong number of elements: {n}"),
-            allowed,
-        )
-    } else if let Some(rest) = msg.strip_prefix("invalid value: ") {
-        let found = rest.split(", expected").next().unwrap_or(rest);
-        let allowed = described(&path, expected(rest));
-        (
-            SceneErrorKind::BadValue,
-            format!("invalid value: {found}"),
-            allowed,
-        )
-    } else {
-        let allowed = described(&path, None);
-        (SceneErrorKind::BadValue, msg.to_owned(), allowed)
-    };
-    // Errors inside an array of numbers name the array, not the element.
-    while matches!(path.last(), Some(Seg::Index(_))) && kind != SceneErrorKind::UnknownKey {
-        if path.len() >= 2 && matches!(path[path.len() - 2], Seg::Key(ref k) if k == "pin") {
-            break;
-        }
-        path.pop();
-    }
-    Issue {
-        path,
-        kind,
-        message,
-        allowed,
-    }
-}
-
-/// Serde's type names in plain words.
-fn plain(expected: &str) -> String {
-    match expected {
-        "u32" => "a non-negative integer".to_owned(),
-        "f64" => "a number".to_owned(),
-        "a sequence" => "an array".to_owned(),
-        x if x.starts_with("struct ") => "a table".to_owned(),
-        x => x.to_owned(),
-    }
-}
-
-/// The key path of the smallest key or value whose span contains `span`.
-fn path_at(root: &DeTable<'_>, span: &Range<usize>) -> KeyPath {
-    let mut best: Option<(usize, KeyPath)> = None;
-    let mut here = KeyPath::new();
-    search_table(root, span, &mut here, &mut best);
-    best.map(|(_, p)| p).unwrap_or_default()
-}
-
-fn consider(
-    s: Range<usize>,
-    span: &Range<usize>,
-    here: &KeyPath,
-    best: &mut Option<(usize, KeyPath)>,
-) {
-    if s.start <= span.start && span.end <= s.end {
-        let len = s.end - s.start;
-        if best.as_ref().is_none_or(|(l, _)| len < *l) {
-            *best = Some((len, here.clone()));
-        }
-    }
-}
-
-fn search_table(
-    t: &DeTable<'_>,
-    span: &Range<usize>,
-    here: &mut KeyPath,
-    best: &mut Option<(usize, KeyPath)>,
-) {
-    for (k, v) in t.iter() {
-        here.push(Seg::Key(k.get_ref().to_string()));
-        consider(k.span(), span, here, best);
-        search_value(v, span, here, best);
-        here.pop();
-    }
-}
-
-fn search_value(
-    v: &Spanned<DeValue<'_>>,
-    span: &Range<usize>,
-    here: &mut KeyPath,
-    best: &mut Option<(usize, KeyPath)>,
-) {
-    consider(v.span(), span, here, best);
-    match v.get_ref() {
-        DeValue::Table(t) => search_table(t, span, here, best),
-        DeValue::Array(a) => {
-            for (i, e) in a.iter().enumerate() {
-                here.push(Seg::Index(i));
-                search_value(e, span, here, best);
-                here.pop();
-            }
-        }
-        _ => {}
-    }
-}
-
-/// The line of `path` in `text`: of the key itself, or of the deepest part of
-/// the path that exists. Also whether the whole path exists and how many of its
-/// steps do.
-fn line_of(text: &str, path: &[Seg]) -> (Option<usize>, bool, usize) {
-    let Ok(root) = DeTable::parse(text) else {
-        return (None, false, 0);
-    };
-    let mut value: Option<&Spanned<DeValue<'_>>> = None;
-    let mut table: Option<&DeTable<'_>> = Some(root.get_ref());
-    let mut line = None;
-    for (depth, seg) in path.iter().enumerate() {
-        let found = match (seg, table, value.map(Spanned::get_ref)) {
-            (Seg::Key(k), Some(t), _) => t
-                .iter()
-                .find(|(key, _)| key.get_ref().as_ref() == k.as_str())
-                .map(|(key, v)| (key.span().start, v)),
-            (Seg::Index(i), _, Some(DeValue::Array(a))) => a.get(*i).map(|v| (v.span().start, v)),
-            _ => None,
-        };
-        let Some((start, v)) = found else {
-            return (line, false, depth);
-        };
-        line = Some(line_at(text, start));
-        value = Some(v);
-        table = v.get_ref().as_table();
-    }
-    (line, true, path.len())
 }

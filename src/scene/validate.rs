@@ -115,7 +115,8 @@ fn simulation(s: &Simulation) -> Result<(), Issue> {
             return Err(out_of_range(
                 at("dt"),
                 format!("{dt} s is longer than one frame (1/frame_rate = {frame} s)"),
-            ));
+            )
+            .because(at("frame_rate")));
         }
     }
     all_finite(at("gravity"), &s.gravity)?;
@@ -172,7 +173,8 @@ fn cloth(c: &Cloth, written: Option<&Table>) -> Result<(), Issue> {
             Kind::NotApplicable,
             format!("`{k}` does not apply to shape = \"{shape}\""),
         )
-        .allowed(format!("for shape = \"{shape}\": {}", required.join(", "))));
+        .allowed(format!("for shape = \"{shape}\": {}", required.join(", ")))
+        .because(at("shape")));
     }
     if let Some(k) = required.iter().find(|k| !has(k)) {
         let allowed = allowed_for(&at(k));
@@ -181,7 +183,8 @@ fn cloth(c: &Cloth, written: Option<&Table>) -> Result<(), Issue> {
             Kind::MissingKey,
             format!("missing required key `{k}` for shape = \"{shape}\""),
         )
-        .allowed(allowed));
+        .allowed(allowed)
+        .because(at("shape")));
     }
     for (k, v) in [
         ("width", c.width),
@@ -244,7 +247,8 @@ fn check_pin(i: usize, p: &Pin, shape: ClothShape, written: Option<&Table>) -> R
             Kind::BadValue,
             format!("{region:?} needs shape = \"rectangle\" (corners and edges are named on a rectangle only)"),
         )
-        .allowed("\"box\" (with box_min and box_max) or \"all\" for this shape"));
+        .allowed("\"box\" (with box_min and box_max) or \"all\" for this shape")
+        .because(keys(&["cloth", "shape"])));
     }
     if region == "box" {
         let (Some(lo), Some(hi)) = (p.box_min, p.box_max) else {
@@ -259,7 +263,8 @@ fn check_pin(i: usize, p: &Pin, shape: ClothShape, written: Option<&Table>) -> R
                 Kind::MissingKey,
                 format!("missing required key `{k}` for region = \"box\""),
             )
-            .allowed(allowed));
+            .allowed(allowed)
+            .because(at("region")));
         };
         all_finite(at("box_min"), &lo)?;
         all_finite(at("box_max"), &hi)?;
@@ -275,7 +280,8 @@ fn check_pin(i: usize, p: &Pin, shape: ClothShape, written: Option<&Table>) -> R
             Kind::NotApplicable,
             format!("`{k}` applies only to region = \"box\""),
         )
-        .allowed("remove it, or set region = \"box\""));
+        .allowed("remove it, or set region = \"box\"")
+        .because(at("region")));
     }
     let (motion, foreign): (&str, &[&str]) = match p.motion {
         PinMotion::Fixed => (
@@ -293,7 +299,8 @@ fn check_pin(i: usize, p: &Pin, shape: ClothShape, written: Option<&Table>) -> R
     };
     if let Some(k) = foreign.iter().find(|k| has(k)) {
         return Err(Issue::new(at(k), Kind::NotApplicable, format!("`{k}` does not apply to motion = \"{motion}\""))
-            .allowed("velocity and acceleration for \"linear\"; center, axis and angular_velocity for \"circular\""));
+            .allowed("velocity and acceleration for \"linear\"; center, axis and angular_velocity for \"circular\"")
+            .because(at("motion")));
     }
     all_finite(at("velocity"), &p.velocity)?;
     all_finite(at("acceleration"), &p.acceleration)?;

@@ -1,5 +1,6 @@
 //! All integration tests in one binary: each test file is a module here, so the
 //! heavy dependencies (rerun) are linked once.
 
+mod physics;
 mod recording;
 mod scene_errors;

@@ -397,7 +397,7 @@ fn shape_keys_must_match_the_shape() {
     .expect_err("width on disk");
     assert_eq!(
         (e.kind, e.line, e.key.as_deref()),
-        (Kind::NotApplicable, Some(6), Some("cloth.width")),
+        (Kind::NotApplicable, Some(7), Some("cloth.width")),
         "{e}"
     );
     let obj_scene = BASE.replacen(rect, "shape = \"obj\"\n", 1);
@@ -470,7 +470,7 @@ fn pin_errors() {
     let e = load_scene_str(&disk, "test.toml", &[]).expect_err("corner on a disk");
     assert_eq!(
         (e.kind, e.line, e.key.as_deref()),
-        (Kind::BadValue, Some(11), Some("pin.0.region")),
+        (Kind::BadValue, Some(12), Some("pin.0.region")),
         "{e}"
     );
 }
@@ -550,7 +550,18 @@ fn override_errors_name_the_set() {
         Kind::WrongType,
     );
     set_error(&["wind.coefficient=2"], "wind.velocity", Kind::MissingKey);
-    set_error(&["pin.1.region=box"], "pin.1.box_min", Kind::MissingKey);
+    // A requirement introduced by a --set: the file's line and the --set.
+    let e = load_scene_str(BASE, "test.toml", &sets(&["pin.1.region=box"])).expect_err("box");
+    assert_eq!(
+        (e.line, e.set.as_deref()),
+        (Some(14), Some("pin.1.region=box")),
+        "{e}"
+    );
+    assert!(
+        e.to_string()
+            .starts_with("test.toml:14: --set pin.1.region=box: key `pin.1.box_min`"),
+        "{e}"
+    );
     set_error(&["pin.7.region=all"], "pin", Kind::BadOverride);
     set_error(&["adapt.method=edge"], "adapt", Kind::Unsupported);
     let e = load_scene_str(BASE, "test.toml", &sets(&["cloth.resolution"])).expect_err("no =");
@@ -618,7 +629,7 @@ fn obj_path_is_relative_to_the_scene_file() {
     let e = load_scene_file(&scene_path, &[]).expect_err("missing obj");
     assert_eq!(
         (e.line, e.key.as_deref()),
-        (Some(5), Some("cloth.path")),
+        (Some(6), Some("cloth.path")),
         "{e}"
     );
     let _ = std::fs::remove_dir_all(&dir);
@@ -632,5 +643,38 @@ fn unreadable_file_is_an_error() {
         e.to_string()
             .starts_with("/nonexistent/scene.toml: cannot read"),
         "{e}"
+    );
+}
+
+#[test]
+fn dotted_keys_and_inline_tables_are_located() {
+    let text = "name = \"t\"\nsimulation = { duration = 1.0 }\ncloth.shape = \"rectangle\"\n\
+                cloth.width = 1.0\ncloth.height = \"tall\"\ncloth.resolution = 4\n\
+                material = { density = 0.15, stretch = 200.0 }\n";
+    error_at(text, 5, "cloth.height", Kind::WrongType);
+    let text = text
+        .replace("\"tall\"", "1.0")
+        .replace("stretch = 200.0", "stretch = 0.0");
+    error_at(&text, 7, "material.stretch", Kind::OutOfRange);
+}
+
+#[test]
+fn every_shipped_scene_file_is_valid() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    let entries = std::fs::read_dir(&dir).expect("scenes/ exists");
+    let mut count = 0;
+    for entry in entries {
+        let path = entry.expect("dir entry").path();
+        if path.extension().is_some_and(|e| e == "toml") {
+            if let Err(e) = load_scene_file(&path, &[]) {
+                panic!("{e}");
+            }
+            count += 1;
+        }
+    }
+    assert!(
+        count >= 2,
+        "expected the shipped scenes in {}",
+        dir.display()
     );
 }
