@@ -1,7 +1,7 @@
 //! The `drape` command line.
 
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -71,10 +71,24 @@ fn main() -> ExitCode {
     match result {
         Ok(code) => code,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", one_line(&e));
             ExitCode::from(1)
         }
     }
+}
+
+/// The error and its causes on one line. Most of drape's errors already include their
+/// source in their own message, so a cause whose text is already there is not repeated
+/// (`{e:#}` would print each one again).
+fn one_line(e: &anyhow::Error) -> String {
+    let mut text = e.to_string();
+    for cause in e.chain().skip(1) {
+        let cause = cause.to_string();
+        if !text.contains(&cause) {
+            text = format!("{text}: {cause}");
+        }
+    }
+    text
 }
 
 fn load(args: &SceneArgs) -> Result<Scene> {
@@ -101,6 +115,14 @@ fn cmd_run(args: RunArgs) -> Result<ExitCode> {
         record,
         obj_dir: args.obj_dir.clone(),
         threads: args.threads.map(|n| n as usize),
+    };
+    // Open the summary now so that an unwritable path fails before a long run.
+    let summary_file = match &args.summary {
+        Some(path) => Some(
+            std::fs::File::create(path)
+                .with_context(|| format!("cannot write summary {}", path.display()))?,
+        ),
+        None => None,
     };
     let interrupt = Arc::new(AtomicBool::new(false));
     {
@@ -131,12 +153,18 @@ fn cmd_run(args: RunArgs) -> Result<ExitCode> {
         Err(e) => match &e {
             // The run stopped on a numerical failure: still report what it did.
             RunError::Numerical { summary, .. } => (summary.as_ref().clone(), Some(e.to_string())),
-            _ => return Err(e.into()),
+            _ => {
+                // No summary to write: remove the file opened for it.
+                if let Some(path) = &args.summary {
+                    let _ = std::fs::remove_file(path);
+                }
+                return Err(e.into());
+            }
         },
     };
     println!("{}", summary.paragraph());
-    if let Some(path) = &args.summary {
-        write_json(path, &summary)?;
+    if let Some(file) = summary_file {
+        write_json(file, &summary)?;
     }
     if let Some(message) = failure {
         eprintln!("error: {message}");
@@ -149,9 +177,7 @@ fn cmd_run(args: RunArgs) -> Result<ExitCode> {
     })
 }
 
-fn write_json(path: &Path, summary: &drape::summary::Summary) -> Result<()> {
-    let mut f = std::fs::File::create(path)
-        .with_context(|| format!("cannot write summary {}", path.display()))?;
+fn write_json(mut f: std::fs::File, summary: &drape::summary::Summary) -> Result<()> {
     serde_json::to_writer_pretty(&mut f, summary)?;
     writeln!(f)?;
     Ok(())

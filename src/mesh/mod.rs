@@ -115,30 +115,27 @@ impl Mesh {
             }
         }
         // Degeneracy is relative to the mesh's scale: a triangle whose area is a
-        // vanishing fraction of its longest edge squared is refused.
-        let mut all_negative = true;
-        for (t, tri) in triangles.iter().enumerate() {
+        // vanishing fraction of its longest edge squared is refused. Each triangle
+        // is then wound counter-clockwise on its own (OBJ winding is unreliable).
+        for (t, tri) in triangles.iter_mut().enumerate() {
             let area = signed_area(&material, tri);
             let longest = longest_edge_sq(&material, tri);
             if area.abs() <= 1e-12 * longest || longest == 0.0 {
                 return Err(MeshError::Degenerate { triangle: t, area });
             }
-            all_negative &= area < 0.0;
-        }
-        // A mirrored material map (all clockwise) is fine: flip everything.
-        if all_negative {
-            for tri in &mut triangles {
+            if area < 0.0 {
                 tri.swap(1, 2);
             }
         }
         let edges = topology::build_edges(&triangles, n)?;
-        // Mixed orientation means the rest shape folds over itself.
+        // Unfolded neighbours run their shared edge in opposite directions; if both
+        // run it the same way, their tips lie on the same side: the rest shape folds.
         for e in &edges {
             if e.is_interior() {
                 let (a, b) = (e.triangles[0] as usize, e.triangles[1] as usize);
-                let sa = signed_area(&material, &triangles[a]) > 0.0;
-                let sb = signed_area(&material, &triangles[b]) > 0.0;
-                if sa != sb {
+                if runs_forward(&triangles[a], e.vertices)
+                    == runs_forward(&triangles[b], e.vertices)
+                {
                     return Err(MeshError::Folded { a, b });
                 }
             }
@@ -198,6 +195,11 @@ impl Mesh {
 pub fn signed_area(material: &[Vector2], tri: &[u32; 3]) -> Scalar {
     let [a, b, c] = tri.map(|v| material[v as usize]);
     0.5 * (b - a).perp_dot(c - a)
+}
+
+/// True when triangle `tri` runs from `v[0]` to `v[1]` along one of its sides.
+fn runs_forward(tri: &[u32; 3], v: [u32; 2]) -> bool {
+    (0..3).any(|k| tri[k] == v[0] && tri[(k + 1) % 3] == v[1])
 }
 
 fn longest_edge_sq(material: &[Vector2], tri: &[u32; 3]) -> Scalar {

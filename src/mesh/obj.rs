@@ -75,6 +75,7 @@ pub fn load_obj(path: &Path, uv_scale: Scalar) -> Result<ObjCloth, ObjError> {
         ignore_lines: true,
         ..Default::default()
     };
+    check_texcoords_everywhere_or_nowhere(path, &name)?;
     let (models, _) = tobj::load_obj(path, &options).map_err(|e| ObjError::Read {
         path: name.clone(),
         reason: e.to_string(),
@@ -145,17 +146,50 @@ pub fn load_obj(path: &Path, uv_scale: Scalar) -> Result<ObjCloth, ObjError> {
     Ok(ObjCloth { mesh, positions })
 }
 
+/// tobj fills a face corner without `vt` with another corner's coordinates, so a
+/// file that gives `vt` on some faces only is recognised from its text.
+fn check_texcoords_everywhere_or_nowhere(path: &Path, name: &str) -> Result<(), ObjError> {
+    let Ok(text) = std::fs::read_to_string(path) else {
+        return Ok(()); // tobj reports unreadable files with its own message.
+    };
+    let (mut with, mut without) = (0usize, 0usize);
+    for line in text.lines() {
+        let mut tokens = line.split_whitespace();
+        if tokens.next() != Some("f") {
+            continue;
+        }
+        for corner in tokens {
+            match corner.split('/').nth(1) {
+                Some(vt) if !vt.is_empty() => with += 1,
+                _ => without += 1,
+            }
+        }
+    }
+    if with > 0 && without > 0 {
+        return Err(ObjError::PartialTexcoords {
+            path: name.to_string(),
+        });
+    }
+    Ok(())
+}
+
 /// Coordinates of the points in the plane of the mesh; `Err(distance)` if not flat.
 fn planar_rest_shape(positions: &[Vector], triangles: &[[u32; 3]]) -> Result<Vec<Vector2>, Scalar> {
     if positions.is_empty() {
         return Ok(Vec::new());
     }
     let centroid = positions.iter().copied().sum::<Vector>() / positions.len() as Scalar;
+    // Face normals, each turned to agree with the first (winding is unreliable).
+    let face = |t: &[u32; 3]| {
+        let [a, b, c] = t.map(|v| positions[v as usize]);
+        (b - a).cross(c - a)
+    };
+    let first = triangles.first().map(face).unwrap_or(Vector::ZERO);
     let normal = triangles
         .iter()
         .map(|t| {
-            let [a, b, c] = t.map(|v| positions[v as usize]);
-            (b - a).cross(c - a)
+            let n = face(t);
+            if n.dot(first) < 0.0 { -n } else { n }
         })
         .sum::<Vector>()
         .normalize_or_zero();

@@ -1,6 +1,8 @@
 //! All integration tests in one binary: each test file is a module here, so the
 //! heavy dependencies (rerun) are linked once.
 
+mod cli;
+mod mesh;
 mod physics;
 mod recording;
 mod scene_errors;

@@ -118,16 +118,17 @@ fn grid(n: u32) -> Square {
 
 /// What the decoded recording store holds.
 #[derive(Debug, Default)]
-struct Decoded {
+pub(crate) struct Decoded {
     /// Rows per entity path in the recording store.
-    rows: std::collections::BTreeMap<String, usize>,
+    pub(crate) rows: std::collections::BTreeMap<String, usize>,
     /// Timeline names seen on `cloth/mesh`.
     mesh_timelines: std::collections::BTreeSet<String>,
     recording_ids: std::collections::BTreeSet<String>,
     blueprint_msgs: usize,
 }
 
-fn decode(path: &std::path::Path) -> Decoded {
+/// Decodes a `.rrd` file (panics if it does not decode); also used by the CLI tests.
+pub(crate) fn decode(path: &std::path::Path) -> Decoded {
     let file = std::fs::File::open(path).expect("open rrd");
     let decoder = DecoderApp::decode_eager(std::io::BufReader::new(file)).expect("rrd header");
     let mut out = Decoded::default();
