@@ -2,6 +2,7 @@
 
 use std::fmt::Write;
 
+use crate::collide::Collider;
 use crate::physics::timestep::fit_to_frame;
 use crate::physics::{Model, Stepper};
 use crate::scene::{BendingModel, Integrator, PinMotion, Scene, StiffnessRule, TimeStep};
@@ -107,12 +108,21 @@ pub fn describe(scene: &Scene) -> Result<String, BuildError> {
     if ext.wind.is_none() {
         absent.push("wind");
     }
-    absent.extend([
-        "adaptive meshing",
-        "obstacles and collisions",
-        "self-collision",
-    ]);
+    absent.push("adaptive meshing");
+    let collider = Collider::from_scene(scene)?;
+    if !collider.as_ref().is_some_and(Collider::has_obstacles) {
+        absent.push("obstacles and collisions");
+    }
+    if !collider.as_ref().is_some_and(Collider::has_self_collision) {
+        absent.push("self-collision");
+    }
     let _ = writeln!(s, "not modelled: {}", absent.join(", "));
+    if let Some(c) = &collider {
+        let _ = writeln!(s, "collisions:");
+        for line in c.describe() {
+            let _ = writeln!(s, "  {line}");
+        }
+    }
     let interval = 1.0 / sim.frame_rate;
     let (target, how) = match sim.dt {
         TimeStep::Fixed(dt) => (dt, "fixed".to_string()),

@@ -5,7 +5,9 @@
 //! integrate -> record. Simulation state ([`world::World`]) is kept apart from the
 //! stepper's scratch memory ([`physics::Stepper`]), as in rapier's sets and pipeline.
 
+pub mod adapt;
 pub mod check;
+pub mod collide;
 pub mod math;
 pub mod mesh;
 pub mod physics;

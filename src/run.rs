@@ -6,6 +6,8 @@ use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
+use crate::adapt::{AdaptConfig, AdaptStats, Adapter, EventKind, edge_angles};
+use crate::collide::{CollideError, Collider, CollisionStats};
 use crate::math::{Scalar, Vector, deterministic_sum};
 use crate::physics::timestep::fit_to_frame;
 use crate::physics::{Energy, Model, Stepper};
@@ -48,6 +50,18 @@ pub enum RunError {
     /// Recording failed.
     #[error("recording: {0}")]
     Record(#[from] RecordError),
+    /// The scene's obstacles could not be built.
+    #[error("{0}")]
+    Collide(#[from] CollideError),
+    /// Remeshing produced an invalid mesh (a bug: please report it).
+    #[error("adaptive remeshing: {0}")]
+    Remesh(#[from] crate::mesh::MeshError),
+    /// Internal: every step size tried in a frame failed (becomes `Numerical`).
+    #[error("all step sizes failed, down to {last_dt:.3e} s")]
+    StepFailed {
+        /// The last step tried.
+        last_dt: Scalar,
+    },
     /// The thread pool could not be created.
     #[error("cannot start {threads} worker threads: {reason}")]
     Threads {
@@ -113,18 +127,28 @@ fn run_in_pool(
     }
     let mut world = World::from_scene(scene)?;
     let model = Model::from_scene(scene);
-    let mut stepper = Stepper::new(model, &world);
+    let stepper = Stepper::new(model, &world);
+    let adapter = AdaptConfig::from_scene(scene.adapt.as_ref())
+        .map(|c| Adapter::new(c, &world, scene.material.density));
+    let collider = Collider::from_scene(scene)?;
+    let mut pipe = Pipeline {
+        stepper,
+        adapter,
+        steps_done: 0,
+        collider,
+        collision: CollisionStats::default(),
+    };
     let frame_interval = 1.0 / scene.simulation.frame_rate;
     let frames = (scene.simulation.duration * scene.simulation.frame_rate)
         .round()
         .max(1.0) as u64;
     let target_dt = match scene.simulation.dt {
         TimeStep::Fixed(dt) => dt,
-        TimeStep::Auto => stepper.auto_dt(&world),
+        TimeStep::Auto => pipe.stepper.auto_dt(&world),
     };
     let (steps_per_frame, dt) = fit_to_frame(target_dt, frame_interval);
 
-    let mut tally = Tally::new(&world, &stepper);
+    let mut tally = Tally::new(&world, &pipe.stepper);
     let started = Instant::now();
     let mut sim_seconds = 0.0;
     let mut record_seconds = 0.0;
@@ -140,22 +164,44 @@ fn run_in_pool(
                 break;
             }
             let t0 = Instant::now();
-            match advance_frame(&mut stepper, &mut world, steps_per_frame, dt) {
+            match pipe.advance_frame(&mut world, steps_per_frame, dt) {
                 Ok(recoveries) => nan_recoveries += recoveries,
-                Err(last_dt) => {
+                Err(RunError::StepFailed { last_dt }) => {
                     failure = Some((frame, last_dt));
                     break;
                 }
+                Err(e) => return Err(e),
             }
             sim_seconds += t0.elapsed().as_secs_f64();
         }
-        let energy = stepper.energy(&world);
+        let energy = pipe.stepper.energy(&world);
+        let events = pipe
+            .adapter
+            .as_mut()
+            .map(Adapter::take_events)
+            .unwrap_or_default();
+        let max_angle = edge_angles(&world).into_iter().fold(0.0, Scalar::max);
         tally.observe(&world, energy);
         let t1 = Instant::now();
         if let Some(rec) = recorder.as_mut() {
             world.vertex_normals(&mut normals);
             let pinned: Vec<u32> = world.pins.anchors.iter().map(|a| a.vertex).collect();
-            let scalars = frame_scalars(&world, energy, dt, sim_seconds, record_seconds, frame);
+            let mut scalars = frame_scalars(&world, energy, dt, sim_seconds, record_seconds, frame);
+            scalars.push(("adapt/max_angle_deg", max_angle));
+            if pipe.adapter.is_some() {
+                let count = |k: EventKind| events.iter().filter(|e| e.kind == k).count() as f64;
+                scalars.push((
+                    "adapt/splits",
+                    count(EventKind::Split) + count(EventKind::ClosureSplit),
+                ));
+                scalars.push(("adapt/merges", count(EventKind::Merge)));
+                scalars.push(("adapt/rollbacks", count(EventKind::Rollback)));
+            }
+            if pipe.collider.is_some() {
+                let c = &pipe.collision;
+                scalars.push(("collision/contacts", c.last_contacts as f64));
+                scalars.push(("collision/max_penetration", c.last_penetration));
+            }
             rec.record_frame(&FrameView {
                 frame,
                 sim_time: world.time,
@@ -166,6 +212,14 @@ fn run_in_pool(
                 pinned: &pinned,
                 scalars: &scalars,
             })?;
+            if let Some(c) = &pipe.collider {
+                // Static obstacles once, moving ones every frame.
+                for m in c.obstacle_meshes(world.time) {
+                    if m.moving || frame == 0 {
+                        rec.record_obstacle(&m.name, &m.positions, &m.triangles, !m.moving)?;
+                    }
+                }
+            }
         }
         if let Some(dir) = &opts.obj_dir {
             write_frame_obj(
@@ -191,7 +245,7 @@ fn run_in_pool(
     let summary = tally.finish(TallyEnd {
         scene: scene.name.clone(),
         frames: frames_done,
-        steps: stepper.stats.steps,
+        steps: pipe.stepper.stats.steps,
         sim_time: world.time,
         wall_time_s: started.elapsed().as_secs_f64(),
         sim_wall_s: sim_seconds,
@@ -200,7 +254,10 @@ fn run_in_pool(
         nan_recoveries,
         interrupted,
         recording,
-        stepper: &stepper,
+        stepper: &pipe.stepper,
+        adapt: pipe.adapter.as_ref().map(|a| a.stats),
+        collision: pipe.collision,
+        cusick: pipe.collider.as_ref().and_then(|c| c.cusick(scene, &world)),
     });
     match failure {
         None => Ok(summary),
@@ -211,44 +268,107 @@ fn run_in_pool(
             dt: last_dt,
             cause: format!(
                 "step {dt:.3e} s with the {:?} integrator; try a smaller `simulation.dt`, `dt = \"auto\"`, or `integrator = \"implicit\"`",
-                stepper.model.integrator
+                pipe.stepper.model.integrator
             ),
             summary: Box::new(summary),
         }),
     }
 }
 
-/// Advances one frame; on a non-finite state, restores the frame's start and
-/// retries with the step halved (up to [`MAX_STEP_HALVINGS`] times).
-/// Returns the number of recoveries, or the last step tried when all failed.
-fn advance_frame(
-    stepper: &mut Stepper,
-    world: &mut World,
-    steps: u64,
-    dt: Scalar,
-) -> Result<u64, Scalar> {
-    let (x0, v0, t0) = (world.x.clone(), world.v.clone(), world.time);
-    // Each halving tried is one recovery from a failed attempt.
-    for halving in 0..=MAX_STEP_HALVINGS {
-        let (n, h) = (steps << halving, dt / (1u64 << halving) as Scalar);
-        let mut healthy = true;
-        for _ in 0..n {
-            stepper.step(world, h);
-            if !is_finite(&world.x) {
-                healthy = false;
-                break;
+/// The per-run machinery that advances the world: the stepper (forces and
+/// integration), the adapter (remeshing), and the global step counter.
+struct Pipeline {
+    stepper: Stepper,
+    adapter: Option<Adapter>,
+    /// Steps completed (not counting retried ones).
+    steps_done: u64,
+    /// Obstacle and self-collision passes (`None`: the scene has neither).
+    collider: Option<Collider>,
+    /// What the collision passes did.
+    collision: CollisionStats,
+}
+
+impl Pipeline {
+    /// Advances one frame; on a non-finite state, restores the frame's start
+    /// (mesh included) and retries with the step halved (up to
+    /// [`MAX_STEP_HALVINGS`] times). Returns the number of recoveries, or the
+    /// last step tried when all failed.
+    fn advance_frame(
+        &mut self,
+        world: &mut World,
+        steps: u64,
+        dt: Scalar,
+    ) -> Result<u64, RunError> {
+        let start = world.clone();
+        let adapter_start = self.adapter.clone();
+        let steps_start = self.steps_done;
+        let t0 = world.time;
+        for halving in 0..=MAX_STEP_HALVINGS {
+            let (n, h) = (steps << halving, dt / (1u64 << halving) as Scalar);
+            let mut healthy = true;
+            for _ in 0..n {
+                if !self.step(world, h)? {
+                    healthy = false;
+                    break;
+                }
             }
+            // Land exactly on the frame time whatever the rounding of n * h.
+            world.time = t0 + dt * steps as Scalar;
+            if healthy {
+                return Ok(halving as u64);
+            }
+            *world = start.clone();
+            self.adapter = adapter_start.clone();
+            self.steps_done = steps_start;
+            self.stepper.rebuild(world);
         }
-        // Land exactly on the frame time whatever the rounding of n * h.
-        world.time = t0 + dt * steps as Scalar;
-        if healthy {
-            return Ok(halving as u64);
-        }
-        world.x.copy_from_slice(&x0);
-        world.v.copy_from_slice(&v0);
-        world.time = t0;
+        Err(RunError::StepFailed {
+            last_dt: dt / (1u64 << MAX_STEP_HALVINGS) as Scalar,
+        })
     }
-    Err(dt / (1u64 << MAX_STEP_HALVINGS) as Scalar)
+
+    /// One step, in phases: integrate (forces and integrator), health check,
+    /// rollback (paper A: redo the step on a refined mesh when it bent past the
+    /// upper threshold), adapt. Returns false when the state became non-finite.
+    fn step(&mut self, world: &mut World, h: Scalar) -> Result<bool, RunError> {
+        let rollback = self.adapter.as_ref().is_some_and(|a| a.config.rollback);
+        let mut tries = 0;
+        loop {
+            let before = rollback.then(|| (world.x.clone(), world.v.clone(), world.time));
+            if let Some(c) = self.collider.as_mut() {
+                c.begin_step(world);
+            }
+            self.stepper.step(world, h);
+            if !is_finite(&world.x) {
+                return Ok(false);
+            }
+            if let Some(c) = self.collider.as_mut() {
+                c.end_step(world, h, &mut self.collision);
+            }
+            if let (Some(ad), Some((x, v, t))) = (self.adapter.as_mut(), before)
+                && tries < ad.config.max_rollbacks
+            {
+                let marks = ad.refinement_marks(world, &edge_angles(world));
+                if !marks.is_empty() {
+                    (world.x, world.v, world.time) = (x, v, t);
+                    ad.note_rollback(world, self.steps_done);
+                    ad.refine(world, &marks, self.steps_done)?;
+                    self.stepper.rebuild(world);
+                    tries += 1;
+                    continue;
+                }
+            }
+            break;
+        }
+        self.steps_done += 1;
+        if let Some(ad) = self.adapter.as_mut()
+            && self.steps_done.is_multiple_of(ad.config.every)
+            && ad.pass(world, self.steps_done)?
+        {
+            self.stepper.rebuild(world);
+        }
+        Ok(true)
+    }
 }
 
 /// True when every coordinate is finite (a NaN or infinity anywhere poisons the sum).
@@ -292,6 +412,7 @@ struct Tally {
     energy_final: Scalar,
     energy_max: Scalar,
     mass_initial: Scalar,
+    max_level: u8,
 }
 
 /// End-of-run facts handed to [`Tally::finish`].
@@ -308,6 +429,9 @@ struct TallyEnd<'a> {
     interrupted: bool,
     recording: Option<(PathBuf, u64)>,
     stepper: &'a Stepper,
+    adapt: Option<AdaptStats>,
+    collision: CollisionStats,
+    cusick: Option<crate::collide::cusick::CusickSummary>,
 }
 
 impl Tally {
@@ -320,10 +444,14 @@ impl Tally {
             energy_final: e,
             energy_max: e,
             mass_initial: stepper.elements.total_mass(),
+            max_level: 0,
         }
     }
 
     fn observe(&mut self, world: &World, e: Energy) {
+        self.max_level = self
+            .max_level
+            .max(world.mesh.levels.iter().copied().max().unwrap_or(0));
         self.vertices.add(world.x.len() as Scalar);
         self.triangles.add(world.mesh.triangles.len() as Scalar);
         self.energy_final = e.total();
@@ -358,6 +486,18 @@ impl Tally {
             nan_recoveries: end.nan_recoveries,
             solver: end.stepper.stats,
             interrupted: end.interrupted,
+            splits: end.adapt.map_or(0, |a| a.splits),
+            merges: end.adapt.map_or(0, |a| a.merges),
+            rollbacks: end.adapt.map_or(0, |a| a.rollbacks),
+            max_level: self.max_level,
+            adapt: end.adapt,
+            max_penetration: end.collision.max_penetration,
+            contacts: end.collision.mean_contacts(),
+            self_pairs_tested: end.collision.mean_self_pairs_tested(),
+            self_culled_fraction: end.collision.self_culled_fraction(),
+            collision_wall_s: end.collision.collision_wall_s,
+            self_collision_wall_s: end.collision.self_collision_wall_s,
+            cusick: end.cusick,
             recording: end
                 .recording
                 .map(|(path, bytes)| RecordingSummary { path, bytes }),

@@ -96,6 +96,32 @@ pub struct Summary {
     pub nan_recoveries: u64,
     /// CG iterations and capped solves of the implicit integrator.
     pub solver: StepStats,
+    /// 1-4 splits made by adaptive meshing (including forced ones).
+    pub splits: u64,
+    /// Merges made by adaptive meshing.
+    pub merges: u64,
+    /// Steps redone by rollback.
+    pub rollbacks: u64,
+    /// Highest triangle level reached (0: never refined).
+    pub max_level: u8,
+    /// All adaptivity counters, when the scene adapts.
+    pub adapt: Option<crate::adapt::AdaptStats>,
+    /// Largest depth of a cloth vertex below an obstacle surface, measured after the
+    /// collision response of every step, m (0 without obstacles).
+    pub max_penetration: Scalar,
+    /// Mean number of vertex-obstacle contacts per step.
+    pub contacts: Scalar,
+    /// Mean number of cloth triangle pairs given to the exact self-collision tests per step.
+    pub self_pairs_tested: Scalar,
+    /// Share of the box-overlapping triangle pairs that Volino culling removed (0..1).
+    pub self_culled_fraction: Scalar,
+    /// Wall time in the obstacle collision passes, s (part of `simulation_wall_s`).
+    pub collision_wall_s: Scalar,
+    /// Wall time in self-collision, s (part of `simulation_wall_s`).
+    pub self_collision_wall_s: Scalar,
+    /// Cusick drape measurements at the end, when the scene is a disk specimen on a
+    /// vertical support cylinder (see `collide::cusick`).
+    pub cusick: Option<crate::collide::cusick::CusickSummary>,
     /// True when Ctrl-C ended the run early.
     pub interrupted: bool,
     /// The recording, if one was written.
@@ -121,7 +147,7 @@ impl Summary {
         format!(
             "{}: {} frames, {} steps of {:.3e} s to t = {:.3} s in {:.2} s wall ({:.2} s stepping, {:.2} s recording); \
              {:.0} vertices, {:.0} triangles; {:.3e} vertex-steps/s. Mass {:.6} -> {:.6} kg; \
-             energy {:.4e} -> {:.4e} J (max {:.4e}); {} NaN recoveries; {} CG iterations ({} capped).{} {}",
+             energy {:.4e} -> {:.4e} J (max {:.4e}); {} NaN recoveries; {} CG iterations ({} capped).{}{} {}",
             self.scene,
             self.frames,
             self.steps,
@@ -141,6 +167,13 @@ impl Summary {
             self.nan_recoveries,
             self.solver.cg_iterations,
             self.solver.cg_capped,
+            match &self.adapt {
+                Some(a) => format!(
+                    " Adaptive: {} splits ({} forced), {} merges, {} rollbacks, max level {}.",
+                    a.splits, a.closure_splits, a.merges, a.rollbacks, self.max_level
+                ),
+                None => String::new(),
+            },
             end,
             rec
         )

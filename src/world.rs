@@ -23,6 +23,9 @@ pub enum BuildError {
     /// A pin region could not be resolved.
     #[error("{0}")]
     Pin(#[from] PinError),
+    /// An obstacle could not be built (e.g. a broken OBJ mesh).
+    #[error("{0}")]
+    Collide(#[from] crate::collide::CollideError),
     /// A key the shape needs is missing (validation normally catches this first).
     #[error("cloth: `{0}` is required for this shape")]
     Missing(&'static str),

@@ -150,6 +150,23 @@ impl Mesh {
         })
     }
 
+    /// A mesh produced by remeshing a valid mesh: rebuilds the edge table (which
+    /// still refuses non-manifold edges) but skips the per-vertex fan and
+    /// connectivity checks, which [`crate::adapt::check_consistency`] covers.
+    pub fn from_parts(
+        material: Vec<Vector2>,
+        triangles: Vec<[u32; 3]>,
+        levels: Vec<u8>,
+    ) -> Result<Mesh, MeshError> {
+        let edges = topology::build_edges(&triangles, material.len())?;
+        Ok(Mesh {
+            material,
+            triangles,
+            levels,
+            edges,
+        })
+    }
+
     /// Number of vertices.
     pub fn vertex_count(&self) -> usize {
         self.material.len()

@@ -80,6 +80,10 @@ pub const ENTITY_MESH: &str = "cloth/mesh";
 pub const ENTITY_PINS: &str = "cloth/pins";
 /// Parent entity of the scalar plots: scalar `name` is logged at `plots/<name>`.
 pub const ENTITY_PLOTS: &str = "plots";
+/// Parent entity of the obstacles: each is a mesh at `obstacles/<name>`.
+pub const ENTITY_OBSTACLES: &str = "obstacles";
+/// Colour of the obstacles (light grey).
+const OBSTACLE_COLOR: [u8; 3] = [0xB0, 0xB0, 0xB0];
 
 /// Colour of the pin markers (white, visible on every level colour).
 const PIN_COLOR: [u8; 3] = [0xFF, 0xFF, 0xFF];
@@ -335,6 +339,43 @@ impl Recorder {
                 .map_err(|e| self.log_err(&format!("{ENTITY_PLOTS}/{name}"), e))?;
         }
         Ok(())
+    }
+
+    /// Logs an obstacle's triangulation at `obstacles/<name>` (non-alphanumeric characters of
+    /// `name` become `_`) in a neutral grey: as static data when `fixed` (log it once), else
+    /// at the current frame (call it after [`Recorder::record_frame`] every frame).
+    pub fn record_obstacle(
+        &mut self,
+        name: &str,
+        positions: &[Vector],
+        triangles: &[[u32; 3]],
+        fixed: bool,
+    ) -> Result<(), RecordError> {
+        let n = positions.len();
+        if let Some(t) = triangles
+            .iter()
+            .find(|t| t.iter().any(|&i| i as usize >= n))
+        {
+            return Err(RecordError::InvalidFrame {
+                frame: 0,
+                reason: format!("obstacle {name}: triangle {t:?} indexes past {n} vertices"),
+            });
+        }
+        let clean: String = name
+            .chars()
+            .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
+            .collect();
+        let entity = format!("{ENTITY_OBSTACLES}/{clean}");
+        let [r, g, b] = OBSTACLE_COLOR;
+        let mesh = rerun::Mesh3D::new(positions.iter().map(|&p| convert::position(p)))
+            .with_triangle_indices(triangles.iter().copied())
+            .with_albedo_factor(rerun::Rgba32::from_rgb(r, g, b));
+        let logged = if fixed {
+            self.stream.log_static(entity.as_str(), &mesh)
+        } else {
+            self.stream.log(entity.as_str(), &mesh)
+        };
+        logged.map_err(|e| self.log_err(&entity, e))
     }
 
     /// Flushes and closes the file, footer included, and returns its size in bytes.

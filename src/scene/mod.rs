@@ -14,6 +14,7 @@ mod schema;
 mod serde_errors;
 mod spans;
 mod validate;
+mod validate_collide;
 
 use std::path::Path;
 

@@ -25,6 +25,13 @@ pub struct Scene {
     pub air: Option<Air>,
     /// Wind; absent: no wind force is computed.
     pub wind: Option<Wind>,
+    /// Adaptive meshing; absent (or `method = "none"`): the mesh never changes.
+    pub adapt: Option<Adapt>,
+    /// Obstacles (`[[obstacle]]`), none by default: no collision pass runs.
+    #[serde(default)]
+    pub obstacle: Vec<Obstacle>,
+    /// Self-collision; absent: the cloth may pass through itself (no cost).
+    pub self_collision: Option<SelfCollision>,
 }
 
 /// `[simulation]`: time span, integrator and global forces.
@@ -239,6 +246,165 @@ pub struct Wind {
     /// Pressure (normal force) coefficient, dimensionless (>= 0).
     #[serde(default = "default_one")]
     pub coefficient: f64,
+}
+
+/// `[[obstacle]]`: a rigid obstacle the cloth collides with (a parry3d shape).
+///
+/// The shape is defined in its local frame (round shapes' axes along local z), placed by
+/// `position` and `rotation`, and optionally moved: translated at `velocity` and rotated at
+/// `angular_velocity` about `axis` through its (moving) `position`.
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Obstacle {
+    /// Which shape.
+    pub shape: ObstacleShape,
+    /// Radius in m (sphere, capsule, cylinder).
+    pub radius: Option<f64>,
+    /// Half the length of the axis in m (capsule: of the segment between the caps; cylinder).
+    pub half_height: Option<f64>,
+    /// Half the size along local x, y, z in m (box).
+    pub half_extents: Option<[f64; 3]>,
+    /// Outward normal of a plane in its local frame (plane); the solid is below it.
+    #[serde(default = "default_axis")]
+    pub normal: [f64; 3],
+    /// OBJ file of a `mesh` obstacle, relative to the scene file.
+    pub path: Option<String>,
+    /// Scale applied to a mesh's coordinates (mesh).
+    #[serde(default = "default_one")]
+    pub scale: f64,
+    /// World position of the local origin (a point on a plane), m.
+    #[serde(default)]
+    pub position: [f64; 3],
+    /// Euler angles in degrees (about x, then y, then z), as for the cloth.
+    #[serde(default)]
+    pub rotation: [f64; 3],
+    /// Static friction coefficient (Coulomb, paper A), >= 0.
+    #[serde(default = "default_friction")]
+    pub friction_static: f64,
+    /// Kinetic friction coefficient, 0 <= kinetic <= static; absent: equal to `friction_static`.
+    pub friction_kinetic: Option<f64>,
+    /// Cloth thickness against this obstacle, m: vertices are kept this far outside.
+    #[serde(default = "default_thickness")]
+    pub thickness: f64,
+    /// Linear velocity, m/s.
+    #[serde(default)]
+    pub velocity: [f64; 3],
+    /// Angular velocity about `axis` through `position`, rad/s (right-handed).
+    #[serde(default)]
+    pub angular_velocity: f64,
+    /// Rotation axis in world coordinates (normalised; not zero when `angular_velocity` is set).
+    #[serde(default = "default_axis")]
+    pub axis: [f64; 3],
+}
+
+/// The shape of an obstacle.
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum ObstacleShape {
+    /// A ball of `radius`.
+    Sphere,
+    /// A cuboid of `half_extents`.
+    Box,
+    /// A half-space below the plane through `position` with outward `normal`.
+    Plane,
+    /// A capsule along local z: `half_height` and `radius`.
+    Capsule,
+    /// A cylinder along local z: `half_height` and `radius` (a disk on a stand).
+    Cylinder,
+    /// A triangle mesh from an OBJ file (`path`, `scale`).
+    Mesh,
+}
+
+/// `[self_collision]`: contacts of the cloth with itself.
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct SelfCollision {
+    /// Distance kept between non-adjacent parts of the cloth, m (> 0).
+    #[serde(default = "default_thickness")]
+    pub thickness: f64,
+    /// Repulsion passes per step (>= 1).
+    #[serde(default = "default_self_iterations")]
+    pub iterations: u32,
+    /// Volino's curvature-based culling of patches that cannot self-intersect.
+    #[serde(default = "default_true")]
+    pub culling: bool,
+    /// Size of the culling patches in material space, m (> 0); absent: about 12 triangles across.
+    pub patch_size: Option<f64>,
+}
+
+fn default_friction() -> f64 {
+    0.5
+}
+/// Default cloth thickness for obstacle and self contact, m.
+pub const DEFAULT_THICKNESS: f64 = 0.003;
+fn default_thickness() -> f64 {
+    DEFAULT_THICKNESS
+}
+fn default_self_iterations() -> u32 {
+    4
+}
+fn default_true() -> bool {
+    true
+}
+/// `[adapt]`: adaptive refinement and coarsening driven by dihedral angles.
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Adapt {
+    /// Which remeshing method runs.
+    pub method: AdaptMethod,
+    /// Upper threshold, degrees: refine where the angle between the normals of the
+    /// two triangles at an interior edge exceeds it.
+    #[serde(default = "default_refine_angle")]
+    pub refine_angle: f64,
+    /// Lower threshold, degrees: coarsen where every relevant angle is below it.
+    #[serde(default = "default_coarsen_angle")]
+    pub coarsen_angle: f64,
+    /// Finest level (paper A's levels: a 1-4 split adds 2, a 1-2 split adds 1).
+    #[serde(default = "default_max_level")]
+    pub max_level: u32,
+    /// Shortest edge refinement may create, in material space (m); 0: no limit.
+    #[serde(default)]
+    pub min_edge_length: f64,
+    /// Adapt every this many steps.
+    #[serde(default = "default_every")]
+    pub every: u32,
+    /// Paper A's rollback: redo a step after refining where it bent too far.
+    #[serde(default)]
+    pub rollback: bool,
+    /// Rollbacks allowed per step before the step is accepted as it is.
+    #[serde(default = "default_max_rollbacks")]
+    pub max_rollbacks: u32,
+    /// Paper A's multirate stepping: each level with its own time step.
+    #[serde(default)]
+    pub multirate: bool,
+}
+
+/// The adaptive remeshing method.
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum AdaptMethod {
+    /// Paper A: hierarchical 1-4 (red) splits closed by 1-2 (green) splits, merging.
+    RedGreen,
+    /// Paper B: edge splits with local re-triangulation, coarsening by edge collapse.
+    Edge,
+    /// No adaptation (the same as leaving `[adapt]` out).
+    None,
+}
+
+fn default_refine_angle() -> f64 {
+    15.0
+}
+fn default_coarsen_angle() -> f64 {
+    1.5
+}
+fn default_max_level() -> u32 {
+    4
+}
+fn default_every() -> u32 {
+    1
+}
+fn default_max_rollbacks() -> u32 {
+    3
 }
 
 fn default_frame_rate() -> f64 {

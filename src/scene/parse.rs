@@ -9,19 +9,8 @@ use super::spans::{line_at, line_of};
 use super::{Scene, overrides, validate};
 
 /// Sections the format names that this version does not implement, with what is planned.
-const UNSUPPORTED: [(&str, &str, &str); 3] = [
-    ("adapt", "[adapt]", "adaptive meshing is planned"),
-    (
-        "obstacle",
-        "[[obstacle]]",
-        "obstacles and collisions are planned",
-    ),
-    (
-        "self_collision",
-        "[self_collision]",
-        "self-collision handling is planned",
-    ),
-];
+/// (None at present; the mechanism stays for sections added to the format later.)
+const UNSUPPORTED: [(&str, &str, &str); 0] = [];
 
 /// Loads and validates the scene in `text`; `origin` names it in messages and `base`
 /// is the directory that `cloth.path` is relative to (`None`: the current directory).
@@ -60,6 +49,30 @@ pub(crate) fn load(
             return Err(ctx.locate(issue));
         }
         scene.cloth.path = Some(resolved.to_string_lossy().into_owned());
+    }
+    for i in 0..scene.obstacle.len() {
+        let Some(p) = scene.obstacle[i].path.as_deref() else {
+            continue;
+        };
+        let key = vec![
+            Seg::Key("obstacle".into()),
+            Seg::Index(i),
+            Seg::Key("path".into()),
+        ];
+        let resolved = match base {
+            Some(dir) if ctx.set_for(&key).is_none() => dir.join(p),
+            _ => Path::new(p).to_path_buf(),
+        };
+        if !resolved.is_file() {
+            let issue = Issue::new(
+                key,
+                SceneErrorKind::BadValue,
+                format!("no such file: `{}`", resolved.display()),
+            )
+            .allowed("an existing OBJ file; paths in a scene file are relative to its directory");
+            return Err(ctx.locate(issue));
+        }
+        scene.obstacle[i].path = Some(resolved.to_string_lossy().into_owned());
     }
     Ok(scene)
 }

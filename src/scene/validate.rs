@@ -7,7 +7,10 @@ use toml::{Table, Value};
 
 use super::error::{Issue, KeyPath, SceneErrorKind as Kind, Seg, dotted, keys};
 use super::schema;
-use super::{Air, Cloth, ClothShape, Material, Pin, PinMotion, Scene, Simulation, TimeStep, Wind};
+use super::{
+    Adapt, AdaptMethod, Air, Cloth, ClothShape, Integrator, Material, Pin, PinMotion, Scene,
+    Simulation, TimeStep, Wind,
+};
 
 /// The first problem in `scene`, if any. `doc` is the document it came from
 /// (after `--set`), used to tell keys that were written from defaults.
@@ -27,6 +30,17 @@ pub(crate) fn validate(scene: &Scene, doc: &Table) -> Result<(), Issue> {
     if let Some(w) = &scene.wind {
         wind(w)?;
     }
+    let obstacles = doc.get("obstacle").and_then(Value::as_array);
+    for (i, o) in scene.obstacle.iter().enumerate() {
+        let written = obstacles.and_then(|a| a.get(i)).and_then(Value::as_table);
+        super::validate_collide::obstacle(i, o, written)?;
+    }
+    if let Some(s) = &scene.self_collision {
+        super::validate_collide::self_collision(s)?;
+    }
+    if let Some(a) = &scene.adapt {
+        adapt(a, scene.simulation.integrator)?;
+    }
     Ok(())
 }
 
@@ -34,18 +48,18 @@ fn section<'a>(doc: &'a Table, key: &str) -> Option<&'a Table> {
     doc.get(key).and_then(Value::as_table)
 }
 
-fn allowed_for(path: &KeyPath) -> String {
+pub(super) fn allowed_for(path: &KeyPath) -> String {
     schema::allowed(&dotted(path))
         .unwrap_or("see docs/scenes.md")
         .to_owned()
 }
 
-fn out_of_range(path: KeyPath, what: impl Display) -> Issue {
+pub(super) fn out_of_range(path: KeyPath, what: impl Display) -> Issue {
     let allowed = allowed_for(&path);
     Issue::new(path, Kind::OutOfRange, what).allowed(allowed)
 }
 
-fn finite(path: &KeyPath, x: f64) -> Result<(), Issue> {
+pub(super) fn finite(path: &KeyPath, x: f64) -> Result<(), Issue> {
     if x.is_finite() {
         Ok(())
     } else {
@@ -56,7 +70,7 @@ fn finite(path: &KeyPath, x: f64) -> Result<(), Issue> {
     }
 }
 
-fn positive(path: KeyPath, x: f64) -> Result<(), Issue> {
+pub(super) fn positive(path: KeyPath, x: f64) -> Result<(), Issue> {
     finite(&path, x)?;
     if x > 0.0 {
         Ok(())
@@ -68,7 +82,7 @@ fn positive(path: KeyPath, x: f64) -> Result<(), Issue> {
     }
 }
 
-fn non_negative(path: KeyPath, x: f64) -> Result<(), Issue> {
+pub(super) fn non_negative(path: KeyPath, x: f64) -> Result<(), Issue> {
     finite(&path, x)?;
     if x >= 0.0 {
         Ok(())
@@ -80,7 +94,7 @@ fn non_negative(path: KeyPath, x: f64) -> Result<(), Issue> {
     }
 }
 
-fn all_finite(path: KeyPath, v: &[f64]) -> Result<(), Issue> {
+pub(super) fn all_finite(path: KeyPath, v: &[f64]) -> Result<(), Issue> {
     match v.iter().find(|x| !x.is_finite()) {
         None => Ok(()),
         Some(x) => Err(out_of_range(
@@ -331,4 +345,59 @@ fn air(a: &Air) -> Result<(), Issue> {
 fn wind(w: &Wind) -> Result<(), Issue> {
     all_finite(keys(&["wind", "velocity"]), &w.velocity)?;
     non_negative(keys(&["wind", "coefficient"]), w.coefficient)
+}
+
+fn adapt(a: &Adapt, integrator: Integrator) -> Result<(), Issue> {
+    let angle = |key: &str, x: f64| -> Result<(), Issue> {
+        positive(keys(&["adapt", key]), x)?;
+        if x >= 180.0 {
+            return Err(out_of_range(
+                keys(&["adapt", key]),
+                format!("{x} degrees is out of range: must be < 180"),
+            ));
+        }
+        Ok(())
+    };
+    angle("refine_angle", a.refine_angle)?;
+    angle("coarsen_angle", a.coarsen_angle)?;
+    if a.coarsen_angle >= a.refine_angle {
+        return Err(out_of_range(
+            keys(&["adapt", "coarsen_angle"]),
+            format!(
+                "the lower threshold {} is not below the upper threshold refine_angle = {}",
+                a.coarsen_angle, a.refine_angle
+            ),
+        ));
+    }
+    if !(1..=254).contains(&a.max_level) {
+        return Err(out_of_range(
+            keys(&["adapt", "max_level"]),
+            format!("{} is out of range", a.max_level),
+        ));
+    }
+    non_negative(keys(&["adapt", "min_edge_length"]), a.min_edge_length)?;
+    if a.every == 0 {
+        return Err(out_of_range(
+            keys(&["adapt", "every"]),
+            "0 is out of range: must be >= 1",
+        ));
+    }
+    if a.method == AdaptMethod::Edge {
+        let path = keys(&["adapt", "method"]);
+        return Err(Issue::new(
+            path,
+            Kind::Unsupported,
+            "method \"edge\" (paper B) is not implemented in this version of drape yet; use \"red_green\"",
+        ));
+    }
+    if a.multirate {
+        let path = keys(&["adapt", "multirate"]);
+        let why = if integrator == Integrator::Implicit {
+            "multirate stepping is for the explicit integrators (symplectic_euler, rk4)"
+        } else {
+            "multirate stepping is not implemented in this version of drape yet"
+        };
+        return Err(Issue::new(path, Kind::Unsupported, why));
+    }
+    Ok(())
 }

@@ -1,6 +1,7 @@
 //! All integration tests in one binary: each test file is a module here, so the
 //! heavy dependencies (rerun) are linked once.
 
+mod adapt;
 mod cli;
 mod mesh;
 mod physics;

@@ -476,35 +476,31 @@ fn pin_errors() {
 }
 
 #[test]
-fn planned_sections_are_reported_honestly() {
+fn planned_adapt_options_are_reported_honestly() {
     for (section, line, key, words) in [
         (
-            "[adapt]\nmethod = \"red_green\"\n",
-            16,
-            "adapt",
-            "adaptive meshing",
+            "[adapt]\nmethod = \"edge\"\n",
+            17,
+            "adapt.method",
+            "not implemented in this version",
         ),
         (
-            "[[obstacle]]\nshape = \"sphere\"\n",
-            16,
-            "obstacle",
-            "[[obstacle]]",
-        ),
-        (
-            "[self_collision]\nthickness = 0.003\n",
-            16,
-            "self_collision",
-            "[self_collision]",
+            "[adapt]\nmethod = \"red_green\"\nmultirate = true\n",
+            18,
+            "adapt.multirate",
+            "multirate",
         ),
     ] {
         let e = error_at(&format!("{BASE}{section}"), line, key, Kind::Unsupported);
-        assert!(
-            e.to_string()
-                .contains("not supported by this version of drape yet"),
-            "{e}"
-        );
         assert!(e.to_string().contains(words), "{e}");
     }
+    // The implemented method loads.
+    load_scene_str(
+        &format!("{BASE}[adapt]\nmethod = \"red_green\"\n"),
+        "test.toml",
+        &[],
+    )
+    .expect("red_green");
 }
 
 #[test]
@@ -563,7 +559,7 @@ fn override_errors_name_the_set() {
         "{e}"
     );
     set_error(&["pin.7.region=all"], "pin", Kind::BadOverride);
-    set_error(&["adapt.method=edge"], "adapt", Kind::Unsupported);
+    set_error(&["adapt.method=edge"], "adapt.method", Kind::Unsupported);
     let e = load_scene_str(BASE, "test.toml", &sets(&["cloth.resolution"])).expect_err("no =");
     assert_eq!(e.kind, Kind::BadOverride, "{e}");
     assert!(e.to_string().contains("--set cloth.resolution"), "{e}");

@@ -1,0 +1,378 @@
+//! Adaptive meshing (SPEC section 4): refine where the angle between the normals
+//! of the two triangles at an interior edge exceeds the upper threshold, coarsen
+//! where every relevant angle is below the lower one.
+//!
+//! An adaptation pass: measure angles -> choose operations -> apply them to the
+//! refinement hierarchy -> close the mesh -> transfer the state onto the new
+//! topology -> report events. The stepper must rebuild its elements afterwards.
+
+mod check;
+pub mod red_green;
+pub mod transfer;
+
+pub use check::{ConsistencyError, check_consistency};
+
+use rayon::prelude::*;
+
+use crate::math::{Scalar, Vector};
+use crate::mesh::MeshError;
+use crate::scene::{Adapt, AdaptMethod};
+use crate::world::World;
+use red_green::{Applied, RedGreen, RedGreenOp};
+use transfer::{Origin, Remeshed, transfer};
+
+/// What happened, for the recording and the counters.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EventKind {
+    /// A 1-4 split asked for by the angle criterion.
+    Split,
+    /// A 1-4 split forced by closure (two hanging nodes) or by 1-irregularity.
+    ClosureSplit,
+    /// Four children merged back into their parent.
+    Merge,
+    /// A step restored, refined and integrated again.
+    Rollback,
+}
+
+/// One remeshing event.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AdaptEvent {
+    /// What happened.
+    pub kind: EventKind,
+    /// Where (world position of the affected triangle's centroid), m.
+    pub position: Vector,
+    /// Level of the triangles created.
+    pub level: u8,
+    /// The largest angle at the triangle's edges that triggered it, degrees
+    /// (`None` for forced splits).
+    pub angle: Option<Scalar>,
+    /// The step after which it happened.
+    pub step: u64,
+}
+
+/// Counters over a run.
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
+pub struct AdaptStats {
+    /// 1-4 splits (asked for and forced).
+    pub splits: u64,
+    /// Of those, forced by closure or 1-irregularity.
+    pub closure_splits: u64,
+    /// Merges.
+    pub merges: u64,
+    /// Steps redone after refining.
+    pub rollbacks: u64,
+    /// Adaptation passes run.
+    pub passes: u64,
+    /// Passes that changed the mesh.
+    pub changed_passes: u64,
+    /// Largest number of operations in one pass.
+    pub max_ops_per_pass: u64,
+}
+
+/// Adaptivity settings (the scene's `[adapt]`, resolved).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AdaptConfig {
+    /// Upper threshold, degrees.
+    pub refine_angle: Scalar,
+    /// Lower threshold, degrees.
+    pub coarsen_angle: Scalar,
+    /// Finest level.
+    pub max_level: u8,
+    /// Shortest edge refinement may create (material space), m.
+    pub min_edge_length: Scalar,
+    /// Adapt every this many steps.
+    pub every: u64,
+    /// Redo steps that bent too far.
+    pub rollback: bool,
+    /// Rollbacks per step.
+    pub max_rollbacks: u32,
+}
+
+impl AdaptConfig {
+    /// The configuration of a scene's `[adapt]`, or `None` when it does not adapt.
+    pub fn from_scene(a: Option<&Adapt>) -> Option<AdaptConfig> {
+        let a = a?;
+        (a.method != AdaptMethod::None).then(|| AdaptConfig {
+            refine_angle: a.refine_angle,
+            coarsen_angle: a.coarsen_angle,
+            max_level: a.max_level.min(254) as u8,
+            min_edge_length: a.min_edge_length,
+            every: a.every.max(1) as u64,
+            rollback: a.rollback,
+            max_rollbacks: a.max_rollbacks,
+        })
+    }
+}
+
+/// The adaptive state of a run: settings, refinement hierarchy, counters, and the
+/// events not yet taken by the recorder.
+#[derive(Debug, Clone)]
+pub struct Adapter {
+    /// Settings.
+    pub config: AdaptConfig,
+    /// Counters.
+    pub stats: AdaptStats,
+    /// Events since the last [`Adapter::take_events`].
+    events: Vec<AdaptEvent>,
+    hierarchy: RedGreen,
+    /// Leaf of the hierarchy that owns each triangle of the world's mesh.
+    owner: Vec<u32>,
+    density: Scalar,
+}
+
+/// Angle in degrees between the normals of the two triangles at each edge
+/// (0 at boundary edges).
+pub fn edge_angles(world: &World) -> Vec<Scalar> {
+    let (x, tris) = (&world.x, &world.mesh.triangles);
+    let normal = |t: u32| {
+        let [a, b, c] = tris[t as usize].map(|i| x[i as usize]);
+        (b - a).cross(c - a)
+    };
+    world
+        .mesh
+        .edges
+        .par_iter()
+        .with_min_len(1024)
+        .map(|e| {
+            if !e.is_interior() {
+                return 0.0;
+            }
+            let (n0, n1) = (normal(e.triangles[0]), normal(e.triangles[1]));
+            n0.cross(n1).length().atan2(n0.dot(n1)).to_degrees()
+        })
+        .collect()
+}
+
+impl Adapter {
+    /// Starts adapting `world`'s mesh (its current triangles become level 0).
+    pub fn new(config: AdaptConfig, world: &World, density: Scalar) -> Adapter {
+        let hierarchy = RedGreen::new(&world.mesh.triangles, &world.mesh.material);
+        let owner = (0..world.mesh.triangles.len() as u32).collect();
+        Adapter {
+            config,
+            stats: AdaptStats::default(),
+            events: Vec::new(),
+            hierarchy,
+            owner,
+            density,
+        }
+    }
+
+    /// Events since the last call.
+    pub fn take_events(&mut self) -> Vec<AdaptEvent> {
+        std::mem::take(&mut self.events)
+    }
+
+    /// The refinement hierarchy (for tests and inspection).
+    pub fn hierarchy(&self) -> &RedGreen {
+        &self.hierarchy
+    }
+
+    /// Leaves the angle criterion asks to split, with the angle that asked,
+    /// from angles measured on the world's current shape.
+    pub fn refinement_marks(&self, world: &World, angles: &[Scalar]) -> Vec<(u32, Scalar)> {
+        let mut marks: Vec<(u32, Scalar)> = Vec::new();
+        for (e, edge) in world.mesh.edges.iter().enumerate() {
+            if angles[e] <= self.config.refine_angle {
+                continue;
+            }
+            for &t in &edge.triangles {
+                let leaf = self.owner[t as usize];
+                let finer = self.hierarchy.level(leaf) as u32 + 2;
+                let long_enough = self.config.min_edge_length <= 0.0
+                    || 0.5 * self.hierarchy.shortest_edge(leaf) >= self.config.min_edge_length;
+                if finer <= self.config.max_level as u32 && long_enough {
+                    marks.push((leaf, angles[e]));
+                }
+            }
+        }
+        marks.sort_by(|a, b| a.0.cmp(&b.0).then(b.1.total_cmp(&a.1)));
+        marks.dedup_by_key(|m| m.0);
+        marks
+    }
+
+    /// Parents whose children may merge: every angle at the edges of their
+    /// triangles is below the lower threshold, and below half the upper one (a
+    /// merge about doubles the angles, so this keeps a merge from being split
+    /// again at once when the thresholds are close).
+    fn merge_marks(&self, world: &World, angles: &[Scalar]) -> Vec<(u32, Scalar)> {
+        let mut leaf_max: std::collections::HashMap<u32, Scalar> = std::collections::HashMap::new();
+        for (e, edge) in world.mesh.edges.iter().enumerate() {
+            for &t in edge
+                .triangles
+                .iter()
+                .filter(|&&t| t != crate::mesh::NO_TRIANGLE)
+            {
+                let m = leaf_max.entry(self.owner[t as usize]).or_insert(0.0);
+                *m = m.max(angles[e]);
+            }
+        }
+        let limit = self
+            .config
+            .coarsen_angle
+            .min(0.5 * self.config.refine_angle);
+        let mut out = Vec::new();
+        for p in self.hierarchy.mergeable_parents() {
+            let children = self.hierarchy.children(p).unwrap_or_default();
+            let worst = children
+                .iter()
+                .map(|c| leaf_max.get(c).copied().unwrap_or(0.0))
+                .fold(0.0, Scalar::max);
+            if worst < limit {
+                out.push((p, worst));
+            }
+        }
+        out
+    }
+
+    /// One adaptation pass on `world` after step `step`: merges, then splits,
+    /// then closure; returns true when the mesh changed.
+    pub fn pass(&mut self, world: &mut World, step: u64) -> Result<bool, MeshError> {
+        let angles = edge_angles(world);
+        let merges = self.merge_marks(world, &angles);
+        let splits = self.refinement_marks(world, &angles);
+        self.stats.passes += 1;
+        let mut ops: Vec<(RedGreenOp, Option<Scalar>)> = merges
+            .iter()
+            .map(|&(p, a)| (RedGreenOp::Merge(p), Some(a)))
+            .collect();
+        ops.extend(splits.iter().map(|&(l, a)| (RedGreenOp::Split(l), Some(a))));
+        self.apply(world, &ops, step)
+    }
+
+    /// Refines the leaves in `marks` (from [`Adapter::refinement_marks`]) and
+    /// rebuilds the world; used by rollback on the restored state.
+    pub fn refine(
+        &mut self,
+        world: &mut World,
+        marks: &[(u32, Scalar)],
+        step: u64,
+    ) -> Result<bool, MeshError> {
+        let ops: Vec<_> = marks
+            .iter()
+            .map(|&(l, a)| (RedGreenOp::Split(l), Some(a)))
+            .collect();
+        self.apply(world, &ops, step)
+    }
+
+    /// Records a rollback of step `step`.
+    pub fn note_rollback(&mut self, world: &World, step: u64) {
+        self.stats.rollbacks += 1;
+        let centre = world.x.iter().copied().sum::<Vector>() / world.x.len().max(1) as Scalar;
+        self.events.push(AdaptEvent {
+            kind: EventKind::Rollback,
+            position: centre,
+            level: 0,
+            angle: None,
+            step,
+        });
+    }
+
+    /// Applies operations (each with the angle that asked for it), closes the
+    /// mesh and moves the world onto it.
+    pub fn apply(
+        &mut self,
+        world: &mut World,
+        ops: &[(RedGreenOp, Option<Scalar>)],
+        step: u64,
+    ) -> Result<bool, MeshError> {
+        let mut applied: Vec<Applied> = Vec::new();
+        let plain: Vec<RedGreenOp> = ops.iter().map(|o| o.0).collect();
+        self.hierarchy.apply(&plain, &mut applied);
+        // The angle that asked for each operation (forced splits have none).
+        let asked_for = |op: RedGreenOp| ops.iter().find(|o| o.0 == op).and_then(|o| o.1);
+        let mut asked: Vec<Option<Scalar>> = applied.iter().map(|a| asked_for(a.op)).collect();
+        let before = applied.len();
+        self.hierarchy.close(&mut applied);
+        asked.extend(std::iter::repeat_n(None, applied.len() - before));
+        if applied.is_empty() {
+            return Ok(false);
+        }
+        for (a, angle) in applied.iter().zip(asked) {
+            let centre = a
+                .vertices
+                .iter()
+                .map(|&v| world.x[v as usize])
+                .sum::<Vector>()
+                / 3.0;
+            let kind = match a.op {
+                RedGreenOp::Merge(_) => {
+                    self.stats.merges += 1;
+                    EventKind::Merge
+                }
+                RedGreenOp::Split(_) if a.forced => {
+                    self.stats.splits += 1;
+                    self.stats.closure_splits += 1;
+                    EventKind::ClosureSplit
+                }
+                RedGreenOp::Split(_) => {
+                    self.stats.splits += 1;
+                    EventKind::Split
+                }
+            };
+            let angle = if a.forced { None } else { angle };
+            self.events.push(AdaptEvent {
+                kind,
+                position: centre,
+                level: a.level,
+                angle,
+                step,
+            });
+        }
+        self.stats.changed_passes += 1;
+        self.stats.max_ops_per_pass = self.stats.max_ops_per_pass.max(applied.len() as u64);
+        self.rebuild_world(world)?;
+        Ok(true)
+    }
+
+    /// Builds the conforming mesh from the hierarchy, compacts the vertices and
+    /// transfers the world's state onto it.
+    fn rebuild_world(&mut self, world: &mut World) -> Result<(), MeshError> {
+        let (tris, levels, owner) = self.hierarchy.build();
+        let all = self.hierarchy.material().len();
+        let mut used = vec![false; all];
+        for t in &tris {
+            for &v in t {
+                used[v as usize] = true;
+            }
+        }
+        let mut map = vec![u32::MAX; all];
+        let mut next = 0u32;
+        for (v, &u) in used.iter().enumerate() {
+            if u {
+                map[v] = next;
+                next += 1;
+            }
+        }
+        let (first_new, created) = self.hierarchy.created();
+        let mut material = Vec::with_capacity(next as usize);
+        let mut origin = Vec::with_capacity(next as usize);
+        for v in 0..all {
+            if !used[v] {
+                continue;
+            }
+            material.push(self.hierarchy.material()[v]);
+            origin.push(if (v as u32) < first_new {
+                Origin::Old(v as u32)
+            } else {
+                let (a, b) = created[v - first_new as usize];
+                Origin::Midpoint(map[a as usize], map[b as usize])
+            });
+        }
+        let triangles: Vec<[u32; 3]> = tris.iter().map(|t| t.map(|v| map[v as usize])).collect();
+        transfer(
+            world,
+            self.density,
+            Remeshed {
+                material: material.clone(),
+                triangles,
+                levels,
+                origin,
+            },
+        )?;
+        self.hierarchy.remap(&map, &material);
+        self.owner = owner;
+        Ok(())
+    }
+}

@@ -1,0 +1,499 @@
+//! Paper A's hierarchical refinement: 1-4 ("red") splits kept in a forest,
+//! closed by 1-2 ("green") splits so the simulation mesh is always conforming.
+//!
+//! * The forest's leaves form the *red mesh*, which may have hanging nodes (the
+//!   midpoint of a leaf's edge created by the neighbour's split). Neighbours
+//!   across an edge differ by at most one red split (1-irregularity): a split
+//!   first splits any coarser neighbour, and a merge is refused when it would
+//!   leave a neighbour two splits finer.
+//! * Closure: a leaf with two or three hanging nodes is split red (paper A's
+//!   rule 3); a leaf with one gets a green 1-2 split (rule 2), rebuilt on every
+//!   pass from the red mesh (greens are derived, never stored).
+//! * Levels (paper A, 2.1): a red split adds 2, a green split adds 1.
+//!
+//! Vertex ids here are the world's vertex indices; vertices created during a pass
+//! are appended, and [`RedGreen::remap`] follows the world's compaction.
+
+use std::collections::HashMap;
+
+use crate::math::Vector2;
+
+/// Marks "no node" (a root's parent).
+const NONE: u32 = u32::MAX;
+
+/// A triangle of the red forest.
+#[derive(Debug, Clone, PartialEq)]
+struct Node {
+    /// Vertices, counter-clockwise in material space.
+    v: [u32; 3],
+    /// Paper A level (even: 0, 2, 4, ...).
+    level: u8,
+    /// Parent node, or [`NONE`].
+    parent: u32,
+    /// The four children after a 1-4 split: three corners, then the middle.
+    children: Option<[u32; 4]>,
+}
+
+/// One red-green operation as a value: applying it to the forest and undoing it
+/// (the opposite operation on the same node) are exact inverses on the topology.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RedGreenOp {
+    /// 1-4 split of a leaf.
+    Split(u32),
+    /// Merge of the four leaf children of a node back into it.
+    Merge(u32),
+}
+
+impl RedGreenOp {
+    /// The operation that undoes this one.
+    pub fn inverse(self) -> RedGreenOp {
+        match self {
+            RedGreenOp::Split(n) => RedGreenOp::Merge(n),
+            RedGreenOp::Merge(n) => RedGreenOp::Split(n),
+        }
+    }
+}
+
+/// What a split or merge did, for events and counters.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Applied {
+    /// The operation.
+    pub op: RedGreenOp,
+    /// The node's vertices (for the event position).
+    pub vertices: [u32; 3],
+    /// Level of the triangles the operation created (children for a split, the
+    /// parent for a merge).
+    pub level: u8,
+    /// True for a split forced by closure or 1-irregularity rather than asked for.
+    pub forced: bool,
+}
+
+/// The red forest with its lookup tables.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RedGreen {
+    nodes: Vec<Node>,
+    roots: Vec<u32>,
+    free: Vec<u32>,
+    /// Sorted edge -> its midpoint vertex, for every edge split by some red split.
+    mid: HashMap<(u32, u32), u32>,
+    /// Directed half edge of a split node -> the directed edge it halves.
+    half_of: HashMap<(u32, u32), (u32, u32)>,
+    /// Directed edge of a leaf (counter-clockwise) -> that leaf.
+    leaf_by_edge: HashMap<(u32, u32), u32>,
+    /// Material coordinates of every vertex, including those made in this pass.
+    material: Vec<Vector2>,
+    /// For each vertex made in this pass (id `first_new + k`), its parent edge.
+    created: Vec<(u32, u32)>,
+    first_new: u32,
+}
+
+fn sorted(a: u32, b: u32) -> (u32, u32) {
+    (a.min(b), a.max(b))
+}
+
+fn edges_of(v: [u32; 3]) -> [(u32, u32); 3] {
+    [(v[0], v[1]), (v[1], v[2]), (v[2], v[0])]
+}
+
+impl RedGreen {
+    /// A forest whose roots are the triangles of the input mesh (all level 0).
+    pub fn new(triangles: &[[u32; 3]], material: &[Vector2]) -> RedGreen {
+        let mut rg = RedGreen {
+            nodes: Vec::with_capacity(triangles.len()),
+            roots: Vec::with_capacity(triangles.len()),
+            free: Vec::new(),
+            mid: HashMap::new(),
+            half_of: HashMap::new(),
+            leaf_by_edge: HashMap::new(),
+            material: material.to_vec(),
+            created: Vec::new(),
+            first_new: material.len() as u32,
+        };
+        for &v in triangles {
+            let id = rg.alloc(Node {
+                v,
+                level: 0,
+                parent: NONE,
+                children: None,
+            });
+            rg.roots.push(id);
+            rg.add_leaf_edges(id);
+        }
+        rg
+    }
+
+    fn alloc(&mut self, node: Node) -> u32 {
+        match self.free.pop() {
+            Some(id) => {
+                self.nodes[id as usize] = node;
+                id
+            }
+            None => {
+                self.nodes.push(node);
+                (self.nodes.len() - 1) as u32
+            }
+        }
+    }
+
+    fn add_leaf_edges(&mut self, id: u32) {
+        for e in edges_of(self.nodes[id as usize].v) {
+            self.leaf_by_edge.insert(e, id);
+        }
+    }
+
+    fn remove_leaf_edges(&mut self, id: u32) {
+        for e in edges_of(self.nodes[id as usize].v) {
+            self.leaf_by_edge.remove(&e);
+        }
+    }
+
+    /// True when `n` is a leaf of the forest.
+    pub fn is_leaf(&self, n: u32) -> bool {
+        self.nodes[n as usize].children.is_none()
+    }
+
+    /// Level of node `n`.
+    pub fn level(&self, n: u32) -> u8 {
+        self.nodes[n as usize].level
+    }
+
+    /// Parent of node `n`, if any.
+    pub fn parent(&self, n: u32) -> Option<u32> {
+        let p = self.nodes[n as usize].parent;
+        (p != NONE).then_some(p)
+    }
+
+    /// The four children of node `n` after a split.
+    pub fn children(&self, n: u32) -> Option<[u32; 4]> {
+        self.nodes[n as usize].children
+    }
+
+    /// Vertices of node `n`.
+    pub fn vertices(&self, n: u32) -> [u32; 3] {
+        self.nodes[n as usize].v
+    }
+
+    /// Material coordinates of all vertices (old and made in this pass).
+    pub fn material(&self) -> &[Vector2] {
+        &self.material
+    }
+
+    /// Parent edges of the vertices made since the last [`RedGreen::remap`].
+    pub fn created(&self) -> (u32, &[(u32, u32)]) {
+        (self.first_new, &self.created)
+    }
+
+    /// Shortest material edge of node `n`, m.
+    pub fn shortest_edge(&self, n: u32) -> f64 {
+        edges_of(self.vertices(n))
+            .iter()
+            .map(|&(a, b)| self.material[a as usize].distance(self.material[b as usize]))
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// Applies `ops`: all merges first, decided together, then the splits in
+    /// order. Returns what was done (a split may first split coarser neighbours);
+    /// operations that do not apply (a merge that would break conformity, a
+    /// split of a node that is no longer a leaf) are skipped.
+    pub fn apply(&mut self, ops: &[RedGreenOp], out: &mut Vec<Applied>) {
+        let merges: Vec<u32> = ops
+            .iter()
+            .filter_map(|op| match op {
+                RedGreenOp::Merge(n) => Some(*n),
+                _ => None,
+            })
+            .collect();
+        self.merge_batch(&merges, out);
+        for op in ops {
+            if let RedGreenOp::Split(n) = *op {
+                self.split(n, false, out);
+            }
+        }
+    }
+
+    /// 1-4 split of leaf `t`, splitting coarser neighbours first.
+    fn split(&mut self, t: u32, forced: bool, out: &mut Vec<Applied>) {
+        if !self.is_leaf(t) {
+            return;
+        }
+        for (p, q) in edges_of(self.vertices(t)) {
+            if self.leaf_by_edge.contains_key(&(q, p)) {
+                continue; // a neighbour leaf of the same level
+            }
+            if let Some(&(pp, qq)) = self.half_of.get(&(p, q))
+                && let Some(&coarse) = self.leaf_by_edge.get(&(qq, pp))
+            {
+                self.split(coarse, true, out);
+            }
+        }
+        let [a, b, c] = self.vertices(t);
+        let (mab, mbc, mca) = (
+            self.midpoint(a, b),
+            self.midpoint(b, c),
+            self.midpoint(c, a),
+        );
+        let level = self.level(t) + 2;
+        self.remove_leaf_edges(t);
+        let corners = [[a, mab, mca], [mab, b, mbc], [mca, mbc, c], [mab, mbc, mca]];
+        let mut ids = [0u32; 4];
+        for (k, v) in corners.into_iter().enumerate() {
+            ids[k] = self.alloc(Node {
+                v,
+                level,
+                parent: t,
+                children: None,
+            });
+            self.add_leaf_edges(ids[k]);
+        }
+        for ((p, q), m) in edges_of([a, b, c]).into_iter().zip([mab, mbc, mca]) {
+            self.half_of.insert((p, m), (p, q));
+            self.half_of.insert((m, q), (p, q));
+        }
+        self.nodes[t as usize].children = Some(ids);
+        out.push(Applied {
+            op: RedGreenOp::Split(t),
+            vertices: [a, b, c],
+            level,
+            forced,
+        });
+    }
+
+    /// The midpoint vertex of edge (a, b), made if it does not exist yet.
+    fn midpoint(&mut self, a: u32, b: u32) -> u32 {
+        if let Some(&m) = self.mid.get(&sorted(a, b)) {
+            return m;
+        }
+        let m = self.material.len() as u32;
+        self.material
+            .push((self.material[a as usize] + self.material[b as usize]) * 0.5);
+        self.created.push((a, b));
+        self.mid.insert(sorted(a, b), m);
+        m
+    }
+
+    /// True when `n`'s children are leaves and no neighbour is two splits finer
+    /// along `n`'s edges (merging would leave a hanging node at a quarter point).
+    fn children_mergeable(&self, n: u32) -> bool {
+        let Some(children) = self.nodes[n as usize].children else {
+            return false;
+        };
+        if !children.iter().all(|&c| self.is_leaf(c)) {
+            return false;
+        }
+        edges_of(self.vertices(n))
+            .iter()
+            .all(|&(p, q)| match self.mid.get(&sorted(p, q)) {
+                Some(&m) => {
+                    !self.mid.contains_key(&sorted(p, m)) && !self.mid.contains_key(&sorted(m, q))
+                }
+                None => false,
+            })
+    }
+
+    /// The leaf across `n`'s edge (p, q) that uses its midpoint `m`, if any.
+    fn outside_user(&self, p: u32, q: u32, m: u32) -> Option<u32> {
+        self.leaf_by_edge
+            .get(&(q, m))
+            .or_else(|| self.leaf_by_edge.get(&(m, p)))
+            .copied()
+    }
+
+    /// True when `n` can merge on its own (see [`RedGreen::merge_batch`]).
+    pub fn can_merge(&self, n: u32) -> bool {
+        self.children_mergeable(n) && self.persisting_uses(n, &[]) <= 1
+    }
+
+    /// Midpoints of `n`'s edges that stay in use by neighbours after merging `n`
+    /// together with the nodes in `merging` (sorted).
+    fn persisting_uses(&self, n: u32, merging: &[u32]) -> usize {
+        edges_of(self.vertices(n))
+            .iter()
+            .filter(|&&(p, q)| {
+                let m = self.mid[&sorted(p, q)];
+                self.outside_user(p, q, m).is_some_and(|u| {
+                    self.parent(u)
+                        .is_none_or(|up| merging.binary_search(&up).is_err())
+                })
+            })
+            .count()
+    }
+
+    /// Merges a set of nodes together. A node is dropped from the set while more
+    /// than one of its edge midpoints would stay in use by neighbours that are
+    /// not merging too (closure would split it again at once); the rest merge.
+    pub fn merge_batch(&mut self, candidates: &[u32], out: &mut Vec<Applied>) {
+        let mut set: Vec<u32> = candidates
+            .iter()
+            .copied()
+            .filter(|&n| self.children_mergeable(n))
+            .collect();
+        set.sort_unstable();
+        set.dedup();
+        loop {
+            let keep: Vec<u32> = set
+                .iter()
+                .copied()
+                .filter(|&n| self.persisting_uses(n, &set) <= 1)
+                .collect();
+            if keep.len() == set.len() {
+                break;
+            }
+            set = keep;
+        }
+        for n in set {
+            self.merge(n, out);
+        }
+    }
+
+    fn merge(&mut self, n: u32, out: &mut Vec<Applied>) {
+        let Some(children) = self.nodes[n as usize].children else {
+            return;
+        };
+        for &c in &children {
+            self.remove_leaf_edges(c);
+        }
+        for (p, q) in edges_of(self.vertices(n)) {
+            let m = self.mid[&sorted(p, q)];
+            self.half_of.remove(&(p, m));
+            self.half_of.remove(&(m, q));
+            if self.outside_user(p, q, m).is_none() {
+                self.mid.remove(&sorted(p, q));
+            }
+        }
+        self.nodes[n as usize].children = None;
+        self.add_leaf_edges(n);
+        self.free.extend(children);
+        let level = self.level(n);
+        out.push(Applied {
+            op: RedGreenOp::Merge(n),
+            vertices: self.vertices(n),
+            level,
+            forced: false,
+        });
+    }
+
+    /// Number of hanging nodes on the edges of leaf `t`.
+    fn hanging(&self, t: u32) -> usize {
+        edges_of(self.vertices(t))
+            .iter()
+            .filter(|&&(p, q)| self.mid.contains_key(&sorted(p, q)))
+            .count()
+    }
+
+    /// Red-splits every leaf with two or more hanging nodes until none is left.
+    pub fn close(&mut self, out: &mut Vec<Applied>) {
+        loop {
+            let crowded: Vec<u32> = self
+                .leaves()
+                .into_iter()
+                .filter(|&t| self.hanging(t) >= 2)
+                .collect();
+            if crowded.is_empty() {
+                return;
+            }
+            for t in crowded {
+                self.split(t, true, out);
+            }
+        }
+    }
+
+    /// The leaves in a fixed order (roots in input order, depth first).
+    pub fn leaves(&self) -> Vec<u32> {
+        let mut out = Vec::new();
+        let mut stack: Vec<u32> = self.roots.iter().rev().copied().collect();
+        while let Some(n) = stack.pop() {
+            match self.nodes[n as usize].children {
+                None => out.push(n),
+                Some(ch) => stack.extend(ch.iter().rev()),
+            }
+        }
+        out
+    }
+
+    /// Nodes whose four children are leaves and could merge (alone or together
+    /// with neighbours), in leaf order.
+    pub fn mergeable_parents(&self) -> Vec<u32> {
+        let mut seen = Vec::new();
+        for t in self.leaves() {
+            if let Some(p) = self.parent(t)
+                && seen.last() != Some(&p)
+                && self.children_mergeable(p)
+            {
+                seen.push(p);
+            }
+        }
+        seen
+    }
+
+    /// The conforming simulation mesh: each leaf, or its two green halves when it
+    /// has one hanging node. Returns triangles, their levels and their leaf.
+    pub fn build(&self) -> (Vec<[u32; 3]>, Vec<u8>, Vec<u32>) {
+        let leaves = self.leaves();
+        let mut tris = Vec::with_capacity(leaves.len() + leaves.len() / 4);
+        let mut levels = Vec::with_capacity(tris.capacity());
+        let mut owner = Vec::with_capacity(tris.capacity());
+        for t in leaves {
+            let v = self.vertices(t);
+            let level = self.level(t);
+            let hanging = (0..3).find_map(|k| {
+                let (p, q) = (v[k], v[(k + 1) % 3]);
+                self.mid.get(&sorted(p, q)).map(|&m| (k, m))
+            });
+            match hanging {
+                None => {
+                    tris.push(v);
+                    levels.push(level);
+                    owner.push(t);
+                }
+                Some((k, m)) => {
+                    let (p, q, o) = (v[k], v[(k + 1) % 3], v[(k + 2) % 3]);
+                    tris.extend([[p, m, o], [m, q, o]]);
+                    levels.extend([level + 1, level + 1]);
+                    owner.extend([t, t]);
+                }
+            }
+        }
+        (tris, levels, owner)
+    }
+
+    /// Follows the world's vertex compaction: `map[old]` is the new index of
+    /// every surviving vertex (`u32::MAX` for removed ones).
+    pub fn remap(&mut self, map: &[u32], material: &[Vector2]) {
+        let m = |v: u32| map[v as usize];
+        let live = self.live_nodes();
+        for n in live {
+            let node = &mut self.nodes[n as usize];
+            node.v = node.v.map(m);
+        }
+        self.mid = self
+            .mid
+            .iter()
+            .map(|(&(a, b), &v)| (sorted(m(a), m(b)), m(v)))
+            .collect();
+        self.half_of = self
+            .half_of
+            .iter()
+            .map(|(&(a, b), &(p, q))| ((m(a), m(b)), (m(p), m(q))))
+            .collect();
+        self.leaf_by_edge = self
+            .leaf_by_edge
+            .iter()
+            .map(|(&(a, b), &n)| ((m(a), m(b)), n))
+            .collect();
+        self.material = material.to_vec();
+        self.created.clear();
+        self.first_new = material.len() as u32;
+    }
+
+    fn live_nodes(&self) -> Vec<u32> {
+        let mut out = Vec::new();
+        let mut stack = self.roots.clone();
+        while let Some(n) = stack.pop() {
+            out.push(n);
+            if let Some(ch) = self.nodes[n as usize].children {
+                stack.extend(ch);
+            }
+        }
+        out
+    }
+}

@@ -1,0 +1,419 @@
+//! Collisions (SPEC section 5): cloth against rigid obstacles and against itself.
+//!
+//! This is the only module that imports `parry3d_f64`. Engine vectors are glam 0.33
+//! `DVec3`, which is parry's own `Vector`, so no conversion happens at the boundary.
+//!
+//! Around each integrator step the run driver calls [`Collider::begin_step`] (stores the
+//! start-of-step positions and which vertices are pinned) and [`Collider::end_step`],
+//! which, for every unpinned vertex and every obstacle near it:
+//! 1. **continuous detection**: in the obstacle's frame (its pose at the start and at the
+//!    end of the step), casts the vertex's path from its start position to its end
+//!    position against the shape; a path entering the solid is stopped at the entry point,
+//!    so no step size lets a vertex tunnel through a thin obstacle;
+//! 2. **proximity**: otherwise, a vertex closer than the obstacle's `thickness` to the
+//!    surface (or inside it) is in contact at its nearest surface point;
+//! 3. **response**: the vertex is placed `thickness` outside the surface along the normal;
+//!    its velocity relative to the obstacle loses its approaching normal part `dvn`
+//!    (inelastic), and Coulomb friction acts on the tangential part `vt` (paper A; Bridson
+//!    et al. 2002): it stops when `|vt| <= mu_s dvn`, else shrinks by `mu_k dvn`. The
+//!    tangential displacement of the step is corrected to match, so static friction holds
+//!    the cloth in place and a moving obstacle carries it along.
+//!
+//! Then self-collision runs if the scene turns it on ([`selfcol`], with Volino culling,
+//! [`volino`]), followed by a last proximity pass against the obstacles. Finally the
+//! largest depth of a vertex below an obstacle surface is measured.
+//!
+//! No per-vertex state survives a step except what `begin_step` stores, so the mesh may
+//! change between steps (adaptivity). Every per-vertex pass writes only its own vertex,
+//! and every reduction is exact (integer sums, maxima), so results are the same at any
+//! thread count.
+
+pub mod cusick;
+pub mod geometry;
+pub mod obstacle;
+pub mod selfcol;
+pub mod volino;
+
+use std::time::Instant;
+
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::math::{Scalar, Vector};
+use crate::scene::{ClothShape, ObstacleShape, Scene};
+use crate::world::World;
+use obstacle::Body;
+use parry3d_f64::math::Pose;
+use selfcol::SelfCollider;
+
+/// Why the collision setup of a scene failed.
+#[derive(Debug, thiserror::Error)]
+pub enum CollideError {
+    /// An obstacle's OBJ file is unreadable or unusable.
+    #[error("obstacle {index}: {path}: cannot use the OBJ mesh: {reason}")]
+    Obj {
+        /// Obstacle index.
+        index: usize,
+        /// The file.
+        path: String,
+        /// What is wrong.
+        reason: String,
+    },
+    /// A key the shape needs is missing (validation normally catches this first).
+    #[error("obstacle {index}: `{key}` is required for this shape")]
+    Missing {
+        /// Obstacle index.
+        index: usize,
+        /// The key.
+        key: &'static str,
+    },
+}
+
+/// Collision counters over a run.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct CollisionStats {
+    /// Steps with collision handling.
+    pub steps: u64,
+    /// Vertex-obstacle contacts, summed over the steps.
+    pub contacts: u64,
+    /// Largest depth of a vertex below an obstacle surface after resolution, m.
+    pub max_penetration: Scalar,
+    /// Contacts in the last step.
+    pub last_contacts: u64,
+    /// Largest depth below an obstacle surface in the last step, m.
+    pub last_penetration: Scalar,
+    /// Triangle pairs given to the exact self-collision tests, summed over the steps.
+    pub self_pairs_tested: u64,
+    /// Box-overlapping triangle pairs skipped by Volino culling, summed over the steps.
+    pub self_pairs_culled: u64,
+    /// Self-collision primitive pairs that acted, summed over steps and iterations.
+    pub self_resolved: u64,
+    /// Wall time in obstacle passes, s.
+    pub collision_wall_s: Scalar,
+    /// Wall time in self-collision, s.
+    pub self_collision_wall_s: Scalar,
+}
+
+impl CollisionStats {
+    /// Mean contacts per step.
+    pub fn mean_contacts(&self) -> Scalar {
+        self.contacts as Scalar / self.steps.max(1) as Scalar
+    }
+
+    /// Mean triangle pairs tested per step.
+    pub fn mean_self_pairs_tested(&self) -> Scalar {
+        self.self_pairs_tested as Scalar / self.steps.max(1) as Scalar
+    }
+
+    /// Share of box-overlapping pairs that culling removed (0 when none were found).
+    pub fn self_culled_fraction(&self) -> Scalar {
+        let all = self.self_pairs_tested + self.self_pairs_culled;
+        if all == 0 {
+            0.0
+        } else {
+            self.self_pairs_culled as Scalar / all as Scalar
+        }
+    }
+}
+
+/// A triangulated obstacle for display: world positions and triangles.
+#[derive(Debug, Clone)]
+pub struct ObstacleMesh {
+    /// Name, `obstacle N (shape)`.
+    pub name: String,
+    /// Whether it moves (then it must be drawn every frame).
+    pub moving: bool,
+    /// Vertex positions, m.
+    pub positions: Vec<Vector>,
+    /// Triangles.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// The collision passes of a scene and their per-step scratch.
+#[derive(Debug)]
+pub struct Collider {
+    bodies: Vec<Body>,
+    self_collider: Option<SelfCollider>,
+    x0: Vec<Vector>,
+    held: Vec<bool>,
+    t0: Scalar,
+}
+
+impl Collider {
+    /// The collision passes `scene` declares; `None` when it has neither obstacles nor
+    /// self-collision (nothing runs, nothing costs).
+    pub fn from_scene(scene: &Scene) -> Result<Option<Collider>, CollideError> {
+        if scene.obstacle.is_empty() && scene.self_collision.is_none() {
+            return Ok(None);
+        }
+        let bodies = scene
+            .obstacle
+            .iter()
+            .enumerate()
+            .map(|(i, o)| Body::from_scene(i, o))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(Some(Collider {
+            bodies,
+            self_collider: scene.self_collision.as_ref().map(SelfCollider::new),
+            x0: Vec::new(),
+            held: Vec::new(),
+            t0: 0.0,
+        }))
+    }
+
+    /// The obstacles, for `drape check`: name, friction, thickness, moving.
+    pub fn describe(&self) -> Vec<String> {
+        let mut out: Vec<String> = self
+            .bodies
+            .iter()
+            .map(|b| {
+                format!(
+                    "{}: thickness {} m, friction static {} kinetic {}{}",
+                    b.name,
+                    b.thickness,
+                    b.mu_static,
+                    b.mu_kinetic,
+                    if b.is_moving() { ", moving" } else { "" }
+                )
+            })
+            .collect();
+        if !self.bodies.is_empty() {
+            out.push(
+                "obstacle passes: continuous detection along each vertex's path, proximity within the thickness, Coulomb friction"
+                    .into(),
+            );
+        }
+        if let Some(s) = &self.self_collider {
+            out.push(format!(
+                "self-collision: thickness {} m, {} repulsion passes, vertex-triangle and edge-edge, Volino culling {}",
+                s.thickness,
+                s.iterations,
+                if s.culling { "on" } else { "off" }
+            ));
+        }
+        out
+    }
+
+    /// True when self-collision runs.
+    pub fn has_self_collision(&self) -> bool {
+        self.self_collider.is_some()
+    }
+
+    /// True when there are obstacles.
+    pub fn has_obstacles(&self) -> bool {
+        !self.bodies.is_empty()
+    }
+
+    /// Every obstacle triangulated at time `t`, in world coordinates.
+    pub fn obstacle_meshes(&self, t: Scalar) -> Vec<ObstacleMesh> {
+        self.bodies
+            .iter()
+            .map(|b| {
+                let (positions, triangles) = b.world_triangles(t);
+                ObstacleMesh {
+                    name: b.name.clone(),
+                    moving: b.is_moving(),
+                    positions,
+                    triangles,
+                }
+            })
+            .collect()
+    }
+
+    /// True when some obstacle moves.
+    pub fn any_moving(&self) -> bool {
+        self.bodies.iter().any(Body::is_moving)
+    }
+
+    /// Stores the start-of-step state; call right before the integrator step.
+    pub fn begin_step(&mut self, world: &World) {
+        self.x0.clear();
+        self.x0.extend_from_slice(&world.x);
+        self.held.resize(world.x.len(), false);
+        world.pins.held_at(world.time, &mut self.held);
+        self.t0 = world.time;
+    }
+
+    /// Resolves collisions after an integrator step of `h` seconds (see the module docs).
+    pub fn end_step(&mut self, world: &mut World, h: Scalar, stats: &mut CollisionStats) {
+        let (t0, t1) = (self.t0, world.time);
+        let started = Instant::now();
+        let poses: Vec<(Pose, Pose)> = self
+            .bodies
+            .iter()
+            .map(|b| (b.pose(t0), b.pose(t1)))
+            .collect();
+        let contacts = if self.bodies.is_empty() {
+            0
+        } else {
+            let (bodies, x0, held) = (&self.bodies, &self.x0, &self.held);
+            world
+                .x
+                .par_iter_mut()
+                .zip(world.v.par_iter_mut())
+                .enumerate()
+                .with_min_len(256)
+                .map(|(i, (x, v))| {
+                    if held[i] {
+                        return 0u64;
+                    }
+                    let mut hit = false;
+                    for (b, pose) in bodies.iter().zip(&poses) {
+                        hit |= respond(b, pose, t1, h, x0[i], x, v);
+                    }
+                    u64::from(hit)
+                })
+                .sum()
+        };
+        stats.collision_wall_s += started.elapsed().as_secs_f64();
+        if let Some(sc) = self.self_collider.as_mut() {
+            let started = Instant::now();
+            let s = sc.resolve(
+                &world.mesh,
+                &self.x0,
+                &mut world.x,
+                &mut world.v,
+                &self.held,
+            );
+            stats.self_pairs_tested += s.pairs_tested;
+            stats.self_pairs_culled += s.pairs_culled;
+            stats.self_resolved += s.resolved;
+            stats.self_collision_wall_s += started.elapsed().as_secs_f64();
+        }
+        let started = Instant::now();
+        if !self.bodies.is_empty() {
+            let (bodies, held) = (&self.bodies, &self.held);
+            let after_self = self.self_collider.is_some();
+            let depth = world
+                .x
+                .par_iter_mut()
+                .zip(world.v.par_iter_mut())
+                .enumerate()
+                .with_min_len(256)
+                .map(|(i, (x, v))| {
+                    let mut deepest: Scalar = 0.0;
+                    for (b, pose) in bodies.iter().zip(&poses) {
+                        if after_self && !held[i] {
+                            push_out(b, &pose.1, t1, x, v);
+                        }
+                        deepest = deepest.max(depth_below(b, &pose.1, *x));
+                    }
+                    deepest
+                })
+                .reduce(|| 0.0, Scalar::max);
+            stats.max_penetration = stats.max_penetration.max(depth);
+            stats.last_penetration = depth;
+        }
+        stats.steps += 1;
+        stats.contacts += contacts;
+        stats.last_contacts = contacts;
+        stats.collision_wall_s += started.elapsed().as_secs_f64();
+    }
+
+    /// The Cusick drape measurements, when the scene is a disk specimen lying on a
+    /// vertical cylinder (the support disk) centred under it.
+    pub fn cusick(&self, scene: &Scene, world: &World) -> Option<cusick::CusickSummary> {
+        if scene.cloth.shape != ClothShape::Disk {
+            return None;
+        }
+        let specimen = scene.cloth.radius?;
+        let centre = Vector::from_array(scene.cloth.position);
+        let (top, disk) = self
+            .bodies
+            .iter()
+            .filter(|b| b.kind == ObstacleShape::Cylinder)
+            .find_map(Body::vertical_cylinder_top)?;
+        let off = (top - centre).truncate().length();
+        (off < 0.25 * disk && disk < specimen)
+            .then(|| cusick::measure(&world.mesh, &world.x, top, specimen, disk))
+    }
+}
+
+/// Contact response of one vertex against one obstacle (module docs, steps 1-3).
+/// `p0` is the start-of-step position, `x`/`v` the state after the integrator.
+/// Returns true when the vertex touched the obstacle.
+fn respond(
+    b: &Body,
+    (pose0, pose1): &(Pose, Pose),
+    t1: Scalar,
+    h: Scalar,
+    p0: Vector,
+    x: &mut Vector,
+    v: &mut Vector,
+) -> bool {
+    let q0 = pose0.inverse_transform_point(p0);
+    let q1 = pose1.inverse_transform_point(*x);
+    if !b.may_touch(q0, q1) {
+        return false;
+    }
+    let thick = b.thickness;
+    // The contact plane: outward normal and its offset n . s at the surface point s.
+    let mut plane = None;
+    if b.probe(q0).signed >= 0.0
+        && let Some((toi, n)) = b.first_entry(q0, q1)
+    {
+        plane = Some((n, n.dot(q0 + (q1 - q0) * toi)));
+    }
+    if plane.is_none() {
+        let p = b.probe(q1);
+        if p.signed < thick {
+            plane = Some((p.normal, p.normal.dot(q1) - p.signed));
+        }
+    }
+    let Some((n, offset)) = plane else {
+        return false;
+    };
+    let mut q = q1 + n * (offset + thick - n.dot(q1));
+    let rot = pose1.rotation;
+    let mut u = rot.inverse() * (*v - b.point_velocity(t1, pose1.transform_point(q)));
+    let un = u.dot(n);
+    if un < 0.0 {
+        let ut = u - n * un;
+        let speed = ut.length();
+        let dun = -un;
+        let ut_new = if speed <= b.mu_static * dun {
+            Vector::ZERO
+        } else {
+            ut * (1.0 - b.mu_kinetic * dun / speed)
+        };
+        q += (ut_new - ut) * h;
+        u = ut_new;
+    }
+    // Curved surfaces and corners: make sure the final point is a thickness outside.
+    let f = b.probe(q);
+    if f.signed < thick {
+        q += f.normal * (thick - f.signed);
+    }
+    *x = pose1.transform_point(q);
+    *v = rot * u + b.point_velocity(t1, *x);
+    true
+}
+
+/// Pushes a vertex that came within the thickness back out along the normal and removes
+/// its approaching normal velocity (the pass after self-collision).
+fn push_out(b: &Body, pose: &Pose, t: Scalar, x: &mut Vector, v: &mut Vector) {
+    let q = pose.inverse_transform_point(*x);
+    if !b.may_touch(q, q) {
+        return;
+    }
+    let p = b.probe(q);
+    if p.signed >= b.thickness {
+        return;
+    }
+    *x = pose.transform_point(q + p.normal * (b.thickness - p.signed));
+    let n = pose.rotation * p.normal;
+    let rel = *v - b.point_velocity(t, *x);
+    let vn = rel.dot(n);
+    if vn < 0.0 {
+        *v -= n * vn;
+    }
+}
+
+/// Depth of `x` below the obstacle's surface, m (0 outside).
+fn depth_below(b: &Body, pose: &Pose, x: Vector) -> Scalar {
+    let q = pose.inverse_transform_point(x);
+    if !b.may_touch(q, q) {
+        return 0.0;
+    }
+    (-b.probe(q).signed).max(0.0)
+}

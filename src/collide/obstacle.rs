@@ -1,0 +1,284 @@
+//! One rigid obstacle: a parry3d shape in its local frame, a pose that may move with time,
+//! friction and the cloth thickness kept against it.
+
+use std::path::Path;
+
+use parry3d_f64::bounding_volume::{Aabb, BoundingVolume};
+use parry3d_f64::math::Pose;
+use parry3d_f64::query::Ray;
+use parry3d_f64::shape::{
+    Ball, Capsule, Cuboid, Cylinder, HalfSpace, Shape, TriMesh, TriMeshFlags,
+};
+
+use super::CollideError;
+use crate::math::{Scalar, Vector, rotation_from_euler_deg};
+use crate::scene::{Obstacle, ObstacleShape};
+
+/// Half the side of the square drawn for a plane in the recording, m.
+const PLANE_DISPLAY_HALF_SIZE: Scalar = 3.0;
+
+/// A rigid obstacle the cloth collides with.
+pub struct Body {
+    /// Name for messages and the recording: `obstacle N (shape)`.
+    pub name: String,
+    /// The scene's shape keyword.
+    pub kind: ObstacleShape,
+    shape: Box<dyn Shape>,
+    /// Pose of the shape's local frame at t = 0 (includes the z-up fix of parry's y-axis cylinder).
+    pose0: Pose,
+    /// World position of the obstacle's origin at t = 0 (the rotation centre).
+    origin: Vector,
+    velocity: Vector,
+    /// Angular velocity vector (axis times rad/s).
+    omega: Vector,
+    /// Static friction coefficient.
+    pub mu_static: Scalar,
+    /// Kinetic friction coefficient.
+    pub mu_kinetic: Scalar,
+    /// Cloth thickness kept against this obstacle, m.
+    pub thickness: Scalar,
+    /// Local bounding box inflated by the thickness (quick rejection).
+    local_box: Aabb,
+}
+
+impl std::fmt::Debug for Body {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Body").field("name", &self.name).finish()
+    }
+}
+
+/// Where a point lies relative to an obstacle's surface (local frame).
+#[derive(Debug, Clone, Copy)]
+pub struct Probe {
+    /// Signed distance to the surface, m (negative inside the solid).
+    pub signed: Scalar,
+    /// Outward unit normal at the nearest surface point.
+    pub normal: Vector,
+}
+
+impl Body {
+    /// Builds obstacle `index` of a scene (OBJ paths are already resolved by the loader).
+    pub fn from_scene(index: usize, o: &Obstacle) -> Result<Body, CollideError> {
+        let need =
+            |v: Option<Scalar>, key: &'static str| v.ok_or(CollideError::Missing { index, key });
+        // parry's cylinder is along local y; ours stand along local z.
+        let y_to_z = glam::DQuat::from_rotation_x(std::f64::consts::FRAC_PI_2);
+        let mut fix = glam::DQuat::IDENTITY;
+        let shape: Box<dyn Shape> = match o.shape {
+            ObstacleShape::Sphere => Box::new(Ball::new(need(o.radius, "radius")?)),
+            ObstacleShape::Box => {
+                let h = o.half_extents.ok_or(CollideError::Missing {
+                    index,
+                    key: "half_extents",
+                })?;
+                Box::new(Cuboid::new(Vector::from_array(h)))
+            }
+            ObstacleShape::Plane => Box::new(HalfSpace::new(
+                Vector::from_array(o.normal).normalize_or(Vector::Z),
+            )),
+            ObstacleShape::Capsule => Box::new(Capsule::new_z(
+                need(o.half_height, "half_height")?,
+                need(o.radius, "radius")?,
+            )),
+            ObstacleShape::Cylinder => {
+                fix = y_to_z;
+                Box::new(Cylinder::new(
+                    need(o.half_height, "half_height")?,
+                    need(o.radius, "radius")?,
+                ))
+            }
+            ObstacleShape::Mesh => {
+                let path = o
+                    .path
+                    .as_deref()
+                    .ok_or(CollideError::Missing { index, key: "path" })?;
+                Box::new(load_mesh(index, Path::new(path), o.scale)?)
+            }
+        };
+        let rot = glam::DQuat::from_mat3(&rotation_from_euler_deg(o.rotation));
+        let origin = Vector::from_array(o.position);
+        let pose0 = Pose::from_parts(origin, rot * fix);
+        let axis = Vector::from_array(o.axis).normalize_or_zero();
+        let t = o.thickness;
+        let local = shape.compute_local_aabb();
+        let local_box = Aabb::new(local.mins - Vector::splat(t), local.maxs + Vector::splat(t));
+        Ok(Body {
+            name: format!("obstacle {index} ({})", shape_name(o.shape)),
+            kind: o.shape,
+            shape,
+            pose0,
+            origin,
+            velocity: Vector::from_array(o.velocity),
+            omega: axis * o.angular_velocity,
+            mu_static: o.friction_static,
+            mu_kinetic: o.friction_kinetic.unwrap_or(o.friction_static),
+            thickness: t,
+            local_box,
+        })
+    }
+
+    /// True when the obstacle moves.
+    pub fn is_moving(&self) -> bool {
+        self.velocity != Vector::ZERO || self.omega != Vector::ZERO
+    }
+
+    /// Pose of the local frame at time `t`: translated by `velocity t`, rotated by
+    /// `|omega| t` about the axis through the moving origin.
+    pub fn pose(&self, t: Scalar) -> Pose {
+        if !self.is_moving() {
+            return self.pose0;
+        }
+        let angle = self.omega.length() * t;
+        let spin = glam::DQuat::from_axis_angle(self.omega.normalize_or(Vector::Z), angle);
+        let centre = self.origin + self.velocity * t;
+        let offset = spin * (self.pose0.translation - self.origin);
+        Pose::from_parts(centre + offset, spin * self.pose0.rotation)
+    }
+
+    /// Velocity at time `t` of the obstacle's material point at world position `x`.
+    pub fn point_velocity(&self, t: Scalar, x: Vector) -> Vector {
+        self.velocity + self.omega.cross(x - (self.origin + self.velocity * t))
+    }
+
+    /// True when the local segment `a`-`b` may come within the thickness of the shape.
+    pub fn may_touch(&self, a: Vector, b: Vector) -> bool {
+        let seg = Aabb::new(a.min(b), a.max(b));
+        self.local_box.intersects(&seg)
+    }
+
+    /// Signed distance and outward normal of local point `q`.
+    pub fn probe(&self, q: Vector) -> Probe {
+        let proj = self.shape.project_local_point(q, false);
+        let d = q - proj.point;
+        let dist = d.length();
+        let normal = if dist > 1e-12 {
+            if proj.is_inside { -d / dist } else { d / dist }
+        } else {
+            // On the surface: ask parry for the normal of the feature there.
+            let (p, feature) = self.shape.project_local_point_and_get_feature(q);
+            self.shape
+                .feature_normal_at_point(p.subshape, feature, q)
+                .unwrap_or(Vector::Z)
+        };
+        Probe {
+            signed: if proj.is_inside { -dist } else { dist },
+            normal,
+        }
+    }
+
+    /// Where the local segment `a` -> `b` first enters the solid from outside:
+    /// `(fraction of the segment, outward normal)`.
+    pub fn first_entry(&self, a: Vector, b: Vector) -> Option<(Scalar, Vector)> {
+        let dir = b - a;
+        if dir.length_squared() == 0.0 {
+            return None;
+        }
+        let hit = self
+            .shape
+            .cast_local_ray_and_get_normal(&Ray::new(a, dir), 1.0, false)?;
+        (hit.normal.dot(dir) < 0.0).then_some((hit.time_of_impact, hit.normal))
+    }
+
+    /// A triangulation of the obstacle in its local frame, for display.
+    pub fn local_triangles(&self) -> (Vec<Vector>, Vec<[u32; 3]>) {
+        if let Some(b) = self.shape.as_shape::<Ball>() {
+            return b.to_trimesh(32, 16);
+        }
+        if let Some(c) = self.shape.as_shape::<Cuboid>() {
+            return c.to_trimesh();
+        }
+        if let Some(c) = self.shape.as_shape::<Capsule>() {
+            return c.to_trimesh(32, 8);
+        }
+        if let Some(c) = self.shape.as_shape::<Cylinder>() {
+            return c.to_trimesh(48);
+        }
+        if let Some(m) = self.shape.as_shape::<TriMesh>() {
+            return (m.vertices().to_vec(), m.indices().to_vec());
+        }
+        if let Some(h) = self.shape.as_shape::<HalfSpace>() {
+            let n = h.normal;
+            let u = n.any_orthonormal_vector() * PLANE_DISPLAY_HALF_SIZE;
+            let v = n.cross(u);
+            return (
+                vec![-u - v, u - v, u + v, -u + v],
+                vec![[0, 1, 2], [0, 2, 3]],
+            );
+        }
+        (Vec::new(), Vec::new())
+    }
+
+    /// The display triangulation in world coordinates at time `t`.
+    pub fn world_triangles(&self, t: Scalar) -> (Vec<Vector>, Vec<[u32; 3]>) {
+        let pose = self.pose(t);
+        let (mut v, i) = self.local_triangles();
+        for p in &mut v {
+            *p = pose.transform_point(*p);
+        }
+        (v, i)
+    }
+
+    /// The shape as a cylinder with a vertical axis: `(centre of the top face, radius)`.
+    pub fn vertical_cylinder_top(&self) -> Option<(Vector, Scalar)> {
+        let c = self.shape.as_shape::<Cylinder>()?;
+        let pose = self.pose(0.0);
+        let axis = pose.rotation * Vector::Y;
+        (axis.z.abs() > 1.0 - 1e-9)
+            .then(|| (pose.translation + Vector::Z * c.half_height, c.radius))
+    }
+}
+
+fn shape_name(s: ObstacleShape) -> &'static str {
+    match s {
+        ObstacleShape::Sphere => "sphere",
+        ObstacleShape::Box => "box",
+        ObstacleShape::Plane => "plane",
+        ObstacleShape::Capsule => "capsule",
+        ObstacleShape::Cylinder => "cylinder",
+        ObstacleShape::Mesh => "mesh",
+    }
+}
+
+/// Loads an obstacle mesh from OBJ (every object of the file, triangulated), scaled.
+fn load_mesh(index: usize, path: &Path, scale: Scalar) -> Result<TriMesh, CollideError> {
+    let err = |reason: String| CollideError::Obj {
+        index,
+        path: path.display().to_string(),
+        reason,
+    };
+    let opts = tobj::LoadOptions {
+        triangulate: true,
+        single_index: true,
+        ..Default::default()
+    };
+    let (models, _) = tobj::load_obj(path, &opts).map_err(|e| err(e.to_string()))?;
+    let mut vertices = Vec::new();
+    let mut indices = Vec::new();
+    for m in &models {
+        let base = vertices.len() as u32;
+        let p = &m.mesh.positions;
+        for c in p.chunks_exact(3) {
+            let v = Vector::new(c[0], c[1], c[2]) * scale;
+            if !v.is_finite() {
+                return Err(err("a vertex coordinate is not a finite number".into()));
+            }
+            vertices.push(v);
+        }
+        let count = (p.len() / 3) as u32;
+        for f in m.mesh.indices.chunks_exact(3) {
+            if f.iter().any(|&i| i >= count) {
+                return Err(err("a face references a vertex that does not exist".into()));
+            }
+            indices.push([base + f[0], base + f[1], base + f[2]]);
+        }
+    }
+    if indices.is_empty() {
+        return Err(err("the file has no triangles".into()));
+    }
+    TriMesh::with_flags(
+        vertices,
+        indices,
+        TriMeshFlags::ORIENTED | TriMeshFlags::MERGE_DUPLICATE_VERTICES,
+    )
+    .map_err(|e| err(format!("{e:?}")))
+}

@@ -1,0 +1,151 @@
+//! Checks of the collision sections, `[[obstacle]]` and `[self_collision]`; each check
+//! names the key path, which `parse.rs` turns into a line of the file or a `--set`.
+
+use toml::Table;
+
+use super::error::{Issue, KeyPath, SceneErrorKind as Kind, Seg, keys};
+use super::validate::{all_finite, allowed_for, finite, non_negative, out_of_range, positive};
+use super::{Obstacle, ObstacleShape, SelfCollision};
+
+/// Keys each obstacle shape needs, and the shape-specific keys that do not apply to it.
+fn shape_keys(shape: ObstacleShape) -> (&'static str, &'static [&'static str]) {
+    match shape {
+        ObstacleShape::Sphere => ("sphere", &["radius"]),
+        ObstacleShape::Box => ("box", &["half_extents"]),
+        ObstacleShape::Plane => ("plane", &[]),
+        ObstacleShape::Capsule => ("capsule", &["radius", "half_height"]),
+        ObstacleShape::Cylinder => ("cylinder", &["radius", "half_height"]),
+        ObstacleShape::Mesh => ("mesh", &["path"]),
+    }
+}
+
+/// Keys that only some shapes have; every other shape refuses them.
+const SHAPE_SPECIFIC: [(&str, &[ObstacleShape]); 6] = [
+    (
+        "radius",
+        &[
+            ObstacleShape::Sphere,
+            ObstacleShape::Capsule,
+            ObstacleShape::Cylinder,
+        ],
+    ),
+    (
+        "half_height",
+        &[ObstacleShape::Capsule, ObstacleShape::Cylinder],
+    ),
+    ("half_extents", &[ObstacleShape::Box]),
+    ("normal", &[ObstacleShape::Plane]),
+    ("path", &[ObstacleShape::Mesh]),
+    ("scale", &[ObstacleShape::Mesh]),
+];
+
+/// Checks obstacle `i`; `written` is its table as written (to tell keys from defaults).
+pub(super) fn obstacle(i: usize, o: &Obstacle, written: Option<&Table>) -> Result<(), Issue> {
+    let at = |k: &str| -> KeyPath {
+        vec![
+            Seg::Key("obstacle".into()),
+            Seg::Index(i),
+            Seg::Key(k.into()),
+        ]
+    };
+    let has = |k: &str| written.is_some_and(|t| t.contains_key(k));
+    let (shape, required) = shape_keys(o.shape);
+    if let Some((k, _)) = SHAPE_SPECIFIC
+        .iter()
+        .find(|(k, shapes)| has(k) && !shapes.contains(&o.shape))
+    {
+        let needs = if required.is_empty() {
+            "no size keys (position, rotation and normal place it)".to_string()
+        } else {
+            required.join(", ")
+        };
+        return Err(Issue::new(
+            at(k),
+            Kind::NotApplicable,
+            format!("`{k}` does not apply to shape = \"{shape}\""),
+        )
+        .allowed(format!("for shape = \"{shape}\": {needs}"))
+        .because(at("shape")));
+    }
+    if let Some(k) = required.iter().find(|k| !has(k)) {
+        return Err(Issue::new(
+            at(k),
+            Kind::MissingKey,
+            format!("missing required key `{k}` for shape = \"{shape}\""),
+        )
+        .allowed(allowed_for(&at(k)))
+        .because(at("shape")));
+    }
+    for (k, v) in [("radius", o.radius), ("half_height", o.half_height)] {
+        if let Some(x) = v {
+            positive(at(k), x)?;
+        }
+    }
+    if let Some(h) = o.half_extents {
+        all_finite(at("half_extents"), &h)?;
+        if h.iter().any(|&x| x <= 0.0) {
+            return Err(out_of_range(
+                at("half_extents"),
+                format!("{h:?} has a size that is not > 0"),
+            ));
+        }
+    }
+    direction(at("normal"), o.normal)?;
+    if o.path.as_deref().is_some_and(|p| p.trim().is_empty()) {
+        return Err(Issue::new(at("path"), Kind::BadValue, "the path is empty")
+            .allowed(allowed_for(&at("path"))));
+    }
+    positive(at("scale"), o.scale)?;
+    all_finite(at("position"), &o.position)?;
+    all_finite(at("rotation"), &o.rotation)?;
+    non_negative(at("friction_static"), o.friction_static)?;
+    if let Some(k) = o.friction_kinetic {
+        non_negative(at("friction_kinetic"), k)?;
+        if k > o.friction_static {
+            return Err(out_of_range(
+                at("friction_kinetic"),
+                format!(
+                    "{k} is larger than friction_static = {}: kinetic friction cannot exceed static friction",
+                    o.friction_static
+                ),
+            )
+            .because(at("friction_static")));
+        }
+    }
+    positive(at("thickness"), o.thickness)?;
+    all_finite(at("velocity"), &o.velocity)?;
+    finite(&at("angular_velocity"), o.angular_velocity)?;
+    if o.angular_velocity != 0.0 || has("axis") {
+        direction(at("axis"), o.axis)?;
+    }
+    Ok(())
+}
+
+/// A direction: finite and not zero.
+fn direction(path: KeyPath, v: [f64; 3]) -> Result<(), Issue> {
+    all_finite(path.clone(), &v)?;
+    let len2: f64 = v.iter().map(|a| a * a).sum();
+    if !(len2 > 0.0 && len2.is_finite()) {
+        return Err(out_of_range(
+            path,
+            format!("{v:?} has no usable direction (zero or overflowing length)"),
+        ));
+    }
+    Ok(())
+}
+
+/// Checks `[self_collision]`.
+pub(super) fn self_collision(s: &SelfCollision) -> Result<(), Issue> {
+    let at = |k: &str| keys(&["self_collision", k]);
+    positive(at("thickness"), s.thickness)?;
+    if s.iterations < 1 {
+        return Err(out_of_range(
+            at("iterations"),
+            "0 is out of range: must be >= 1",
+        ));
+    }
+    if let Some(p) = s.patch_size {
+        positive(at("patch_size"), p)?;
+    }
+    Ok(())
+}

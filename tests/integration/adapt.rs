@@ -1,0 +1,376 @@
+//! Adaptive meshing, method `red_green` (paper A): invariants under random
+//! operation sequences, exact undo, paper A's level rules, no thrashing, pins.
+
+use drape::adapt::red_green::RedGreenOp;
+use drape::adapt::transfer::lumped_masses;
+use drape::adapt::{AdaptConfig, Adapter, check_consistency};
+use drape::math::{Scalar, Vector};
+use drape::mesh;
+use drape::physics::pins::Pins;
+use drape::scene::{DiagonalPattern, Pin, PinMotion};
+use drape::world::World;
+use proptest::prelude::*;
+
+const DENSITY: Scalar = 0.15;
+
+fn config() -> AdaptConfig {
+    AdaptConfig {
+        refine_angle: 15.0,
+        coarsen_angle: 1.5,
+        max_level: 6,
+        min_edge_length: 0.0,
+        every: 1,
+        rollback: false,
+        max_rollbacks: 3,
+    }
+}
+
+/// A flat 1 m sheet at resolution `res` with deterministic pseudo-random velocities.
+fn world(res: u32, pattern: DiagonalPattern) -> World {
+    let m = mesh::rectangle(1.0, 1.0, res, pattern).unwrap();
+    let x = m.material.iter().map(|p| p.extend(0.0)).collect();
+    let mut w = World::new(m, x);
+    let mut s = 12345u64;
+    for v in &mut w.v {
+        let mut r = || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((s >> 11) as Scalar / (1u64 << 53) as Scalar) - 0.5
+        };
+        *v = Vector::new(r(), r(), r());
+    }
+    w
+}
+
+fn momentum(w: &World) -> (Vector, Scalar) {
+    let m = lumped_masses(&w.mesh.material, &w.mesh.triangles, DENSITY);
+    let p = w.v.iter().zip(&m).map(|(v, m)| *v * *m).sum();
+    let scale = w.v.iter().zip(&m).map(|(v, m)| v.length() * m).sum();
+    (p, scale)
+}
+
+fn boundary(w: &World) -> Scalar {
+    let m = &w.mesh;
+    m.edges
+        .iter()
+        .filter(|e| !e.is_interior())
+        .map(|e| m.material[e.vertices[0] as usize].distance(m.material[e.vertices[1] as usize]))
+        .sum()
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+
+    /// After any sequence of refine and coarsen operations the mesh is manifold and
+    /// conforming, rest areas are positive, mass is exact and momentum is conserved.
+    #[test]
+    fn random_refine_and_coarsen_keep_every_invariant(
+        ops in prop::collection::vec((any::<bool>(), any::<u16>()), 1..40),
+        alternating in any::<bool>(),
+    ) {
+        let pattern = if alternating { DiagonalPattern::Alternating } else { DiagonalPattern::Regular };
+        let mut w = world(4, pattern);
+        let (area, bound) = (w.mesh.total_rest_area(), boundary(&w));
+        let mut ad = Adapter::new(config(), &w, DENSITY);
+        let (p0, scale) = momentum(&w);
+        for (step, (refine, pick)) in ops.into_iter().enumerate() {
+            let h = ad.hierarchy();
+            let op = if refine {
+                let leaves: Vec<u32> = h.leaves().into_iter().filter(|&l| h.level(l) + 2 <= 6).collect();
+                if leaves.is_empty() { continue; }
+                RedGreenOp::Split(leaves[pick as usize % leaves.len()])
+            } else {
+                let parents = h.mergeable_parents();
+                if parents.is_empty() { continue; }
+                RedGreenOp::Merge(parents[pick as usize % parents.len()])
+            };
+            ad.apply(&mut w, &[(op, None)], step as u64).unwrap();
+            check_consistency(&w, DENSITY, area, bound).map_err(|e| TestCaseError::fail(format!("after {op:?}: {e}")))?;
+            let (p, _) = momentum(&w);
+            prop_assert!((p - p0).length() <= 1e-13 * scale, "momentum {p:?} vs {p0:?} after {op:?}");
+            prop_assert!(w.mesh.levels.iter().all(|&l| l <= 7));
+        }
+    }
+}
+
+#[test]
+fn refining_then_coarsening_a_flat_sheet_restores_the_original_mesh() {
+    for pattern in [DiagonalPattern::Regular, DiagonalPattern::Alternating] {
+        let mut w = world(6, pattern);
+        let original = w.mesh.clone();
+        let mut ad = Adapter::new(config(), &w, DENSITY);
+        // Refine around the centre twice (the second round splits children).
+        for round in 0..2 {
+            let centre: Vec<u32> = ad
+                .hierarchy()
+                .leaves()
+                .into_iter()
+                .filter(|&l| {
+                    let c = ad
+                        .hierarchy()
+                        .vertices(l)
+                        .iter()
+                        .map(|&v| w.mesh.material[v as usize])
+                        .sum::<drape::math::Vector2>()
+                        / 3.0;
+                    c.length() < 0.25
+                })
+                .collect();
+            let ops: Vec<_> = centre
+                .iter()
+                .map(|&l| (RedGreenOp::Split(l), None))
+                .collect();
+            ad.apply(&mut w, &ops, round).unwrap();
+        }
+        let refined = w.mesh.vertex_count();
+        assert!(
+            refined > original.vertex_count() + 20,
+            "refinement should add vertices: {refined}"
+        );
+        // Flat geometry: every angle is zero, so passes merge until nothing changes.
+        let mut passes = 0;
+        while ad.pass(&mut w, 10 + passes).unwrap() {
+            passes += 1;
+            assert!(passes < 20, "coarsening does not terminate");
+        }
+        println!(
+            "{pattern:?}: {} -> {refined} -> {} vertices in {passes} coarsening passes",
+            original.vertex_count(),
+            w.mesh.vertex_count()
+        );
+        assert_eq!(
+            w.mesh.material, original.material,
+            "{pattern:?}: same vertices"
+        );
+        assert_eq!(
+            w.mesh.triangles, original.triangles,
+            "{pattern:?}: same triangles"
+        );
+        assert!(w.mesh.levels.iter().all(|&l| l == 0));
+    }
+}
+
+/// Levels of the simulation triangles owned by each level, as a sorted histogram.
+fn level_counts(w: &World) -> Vec<(u8, usize)> {
+    let mut out: Vec<(u8, usize)> = Vec::new();
+    for &l in &w.mesh.levels {
+        match out.iter_mut().find(|(k, _)| *k == l) {
+            Some((_, n)) => *n += 1,
+            None => out.push((l, 1)),
+        }
+    }
+    out.sort();
+    out
+}
+
+#[test]
+fn paper_a_level_rules_on_hand_built_cases() {
+    // A 2 x 2 grid with regular diagonals: 8 triangles. Triangle 1-5-4 (in the
+    // lower-right square, touching the centre vertex 4) has three interior edges.
+    let mut w = world(2, DiagonalPattern::Regular);
+    let mut ad = Adapter::new(config(), &w, DENSITY);
+    let t = ad
+        .hierarchy()
+        .leaves()
+        .into_iter()
+        .find(|&l| {
+            let mut v = ad.hierarchy().vertices(l);
+            v.sort();
+            v == [1, 4, 5]
+        })
+        .expect("triangle 1-5-4");
+    // A single 1-4 split: four children at level 2; each neighbour across an edge
+    // gets one hanging node and is closed by a 1-2 split into two level-1 triangles.
+    ad.apply(&mut w, &[(RedGreenOp::Split(t), None)], 0)
+        .unwrap();
+    let neighbours = 3;
+    assert_eq!(
+        level_counts(&w),
+        vec![(0, 8 - 1 - neighbours), (1, 2 * neighbours), (2, 4)]
+    );
+    // Vertex levels are the highest of their triangles': the new midpoints are level 2.
+    let vertex_level = |v: usize| {
+        w.mesh
+            .triangles
+            .iter()
+            .zip(&w.mesh.levels)
+            .filter(|(t, _)| t.contains(&(v as u32)))
+            .map(|(_, &l)| l)
+            .max()
+            .unwrap()
+    };
+    let midpoints: Vec<usize> = (9..w.mesh.vertex_count()).collect();
+    assert_eq!(midpoints.len(), 3);
+    assert!(midpoints.iter().all(|&v| vertex_level(v) == 2));
+    // Splitting the middle child (level 2 -> 4) gives its three siblings one hanging
+    // node each: they become greens at level 3.
+    let middle = ad.hierarchy().children(t).unwrap()[3];
+    ad.apply(&mut w, &[(RedGreenOp::Split(middle), None)], 1)
+        .unwrap();
+    let counts = level_counts(&w);
+    assert!(counts.contains(&(4, 4)), "{counts:?}");
+    assert!(
+        counts.contains(&(3, 6)),
+        "three siblings closed by 1-2 splits: {counts:?}"
+    );
+    // Merging undoes the odd levels by one and the even levels by two (paper A rule 4).
+    ad.apply(&mut w, &[(RedGreenOp::Merge(middle), None)], 2)
+        .unwrap();
+    assert_eq!(
+        level_counts(&w),
+        vec![(0, 8 - 1 - neighbours), (1, 2 * neighbours), (2, 4)]
+    );
+    ad.apply(&mut w, &[(RedGreenOp::Merge(t), None)], 3)
+        .unwrap();
+    assert_eq!(level_counts(&w), vec![(0, 8)]);
+}
+
+#[test]
+fn a_split_first_splits_a_coarser_neighbour_to_keep_levels_within_one_split() {
+    let mut w = world(2, DiagonalPattern::Regular);
+    let mut ad = Adapter::new(config(), &w, DENSITY);
+    let t = ad.hierarchy().leaves()[3];
+    ad.apply(&mut w, &[(RedGreenOp::Split(t), None)], 0)
+        .unwrap();
+    // Split every corner child: their outer edges lie on coarser neighbours,
+    // which must be split first (forced), never leaving a quarter-point node.
+    let corners = ad.hierarchy().children(t).unwrap();
+    let ops: Vec<_> = corners[..3]
+        .iter()
+        .map(|&c| (RedGreenOp::Split(c), None))
+        .collect();
+    ad.apply(&mut w, &ops, 1).unwrap();
+    let (area, bound) = (1.0, 4.0);
+    check_consistency(&w, DENSITY, area, bound).unwrap();
+    assert!(
+        ad.stats.closure_splits > 0,
+        "coarser neighbours were split first"
+    );
+}
+
+fn pin(region: &str) -> Pin {
+    Pin {
+        region: region.into(),
+        box_min: None,
+        box_max: None,
+        motion: PinMotion::Fixed,
+        velocity: [0.0; 3],
+        acceleration: [0.0; 3],
+        center: [0.0; 3],
+        axis: [0.0, 0.0, 1.0],
+        angular_velocity: 0.0,
+        release_time: None,
+    }
+}
+
+#[test]
+fn pins_survive_refinement_and_coarsening() {
+    let mut w = world(4, DiagonalPattern::Alternating);
+    w.pins = Pins::select(&[pin("edge:top"), pin("corner:bottom_left")], &w.mesh, &w.x).unwrap();
+    let pinned_material = |w: &World| {
+        let mut m: Vec<(i64, i64)> = w
+            .pins
+            .anchors
+            .iter()
+            .map(|a| {
+                let p = w.mesh.material[a.vertex as usize];
+                ((p.x * 1e9).round() as i64, (p.y * 1e9).round() as i64)
+            })
+            .collect();
+        m.sort();
+        m
+    };
+    let before = pinned_material(&w);
+    let mut ad = Adapter::new(config(), &w, DENSITY);
+    let all: Vec<_> = ad
+        .hierarchy()
+        .leaves()
+        .into_iter()
+        .map(|l| (RedGreenOp::Split(l), None))
+        .collect();
+    ad.apply(&mut w, &all, 0).unwrap();
+    // Every vertex on the top edge is pinned, the new midpoints included.
+    let top = w
+        .mesh
+        .material
+        .iter()
+        .filter(|p| (p.y - 0.5).abs() < 1e-12)
+        .count();
+    let pinned_top = w
+        .pins
+        .anchors
+        .iter()
+        .filter(|a| (w.mesh.material[a.vertex as usize].y - 0.5).abs() < 1e-12)
+        .count();
+    assert_eq!(top, 9);
+    assert_eq!(pinned_top, 9);
+    assert_eq!(w.pins.anchors.len(), 10, "top edge plus the corner");
+    while ad.pass(&mut w, 1).unwrap() {}
+    assert_eq!(
+        pinned_material(&w),
+        before,
+        "the same material points are pinned after coarsening"
+    );
+}
+
+#[test]
+fn close_thresholds_do_not_thrash() {
+    // A sheet swinging from two corners with thresholds 14.9 / 15 degrees.
+    use drape::physics::{ExternalForces, MaterialParams, Model, Stepper};
+    use drape::scene::{BendingModel, Integrator, StiffnessRule};
+    let mut w = world(8, DiagonalPattern::Alternating);
+    w.v.iter_mut().for_each(|v| *v = Vector::ZERO);
+    w.pins = Pins::select(
+        &[pin("corner:top_left"), pin("corner:top_right")],
+        &w.mesh,
+        &w.x,
+    )
+    .unwrap();
+    let mat = MaterialParams {
+        density: DENSITY,
+        stretch: 200.0,
+        bending: 1e-5,
+        damping: 0.001,
+        bending_model: BendingModel::Dihedral,
+        stiffness_rule: StiffnessRule::Consistent,
+    };
+    let ext = ExternalForces {
+        gravity: Some(Vector::new(0.0, 0.0, -9.81)),
+        ..Default::default()
+    };
+    let model = Model {
+        material: mat,
+        external: ext,
+        integrator: Integrator::Implicit,
+        cg_tolerance: 1e-6,
+        cg_max_iterations: 500,
+    };
+    let mut st = Stepper::new(model, &w);
+    let cfg = AdaptConfig {
+        refine_angle: 15.0,
+        coarsen_angle: 14.9,
+        max_level: 4,
+        ..config()
+    };
+    let mut ad = Adapter::new(cfg, &w, DENSITY);
+    let steps = 150;
+    for step in 0..steps {
+        st.step(&mut w, 0.01);
+        if ad.pass(&mut w, step).unwrap() {
+            st.rebuild(&w);
+        }
+    }
+    let s = ad.stats;
+    let triangles = w.mesh.triangles.len() as u64;
+    println!(
+        "thresholds 14.9/15: {steps} passes, {} changed the mesh, {} splits, {} merges, at most {} operations in one pass, {triangles} triangles at the end",
+        s.changed_passes, s.splits, s.merges, s.max_ops_per_pass
+    );
+    assert!(s.splits > 0, "the swinging sheet should refine");
+    assert!(
+        s.max_ops_per_pass <= 4 * triangles,
+        "operations per pass stay bounded"
+    );
+    assert!(w.x.iter().all(|p| p.is_finite()));
+}
