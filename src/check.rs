@@ -108,7 +108,10 @@ pub fn describe(scene: &Scene) -> Result<String, BuildError> {
     if ext.wind.is_none() {
         absent.push("wind");
     }
-    absent.push("adaptive meshing");
+    let adapt = crate::adapt::AdaptConfig::from_scene(scene.adapt.as_ref());
+    if adapt.is_none() {
+        absent.push("adaptive meshing");
+    }
     let collider = Collider::from_scene(scene)?;
     if !collider.as_ref().is_some_and(Collider::has_obstacles) {
         absent.push("obstacles and collisions");
@@ -123,12 +126,36 @@ pub fn describe(scene: &Scene) -> Result<String, BuildError> {
             let _ = writeln!(s, "  {line}");
         }
     }
+    if let Some(a) = &adapt {
+        let _ = writeln!(
+            s,
+            "adaptive meshing: red_green (paper A), refine above {} deg, coarsen below {} deg (and below half the upper threshold), levels 0..{}, every {} steps{}{}",
+            a.refine_angle,
+            a.coarsen_angle,
+            a.max_level,
+            a.every,
+            if a.min_edge_length > 0.0 {
+                format!(", edges >= {} m", a.min_edge_length)
+            } else {
+                String::new()
+            },
+            if a.rollback {
+                format!(", rollback (up to {} per step)", a.max_rollbacks)
+            } else {
+                String::new()
+            }
+        );
+    }
     let interval = 1.0 / sim.frame_rate;
     let (target, how) = match sim.dt {
         TimeStep::Fixed(dt) => (dt, "fixed".to_string()),
         TimeStep::Auto => {
             let how = match sim.integrator {
                 Integrator::Implicit => "auto: implicit accuracy cap".to_string(),
+                _ if adapt.is_some() => format!(
+                    "auto: stability estimate {:.3e} s on the initial mesh, recomputed whenever the mesh changes",
+                    stepper.auto_dt(&world)
+                ),
                 _ => format!("auto: stability estimate {:.3e} s", stepper.auto_dt(&world)),
             };
             (stepper.auto_dt(&world), how)

@@ -9,7 +9,6 @@ use std::time::Instant;
 use crate::adapt::{AdaptConfig, AdaptStats, Adapter, EventKind, edge_angles};
 use crate::collide::{CollideError, Collider, CollisionStats};
 use crate::math::{Scalar, Vector, deterministic_sum};
-use crate::physics::timestep::fit_to_frame;
 use crate::physics::{Energy, Model, Stepper};
 use crate::record::{FrameView, RecordError, Recorder, obj::write_frame_obj};
 use crate::scene::{Scene, TimeStep};
@@ -137,16 +136,17 @@ fn run_in_pool(
         steps_done: 0,
         collider,
         collision: CollisionStats::default(),
+        fixed_dt: match scene.simulation.dt {
+            TimeStep::Fixed(dt) => Some(dt),
+            TimeStep::Auto => None,
+        },
+        auto_dt: None,
+        min_dt: Scalar::INFINITY,
     };
     let frame_interval = 1.0 / scene.simulation.frame_rate;
     let frames = (scene.simulation.duration * scene.simulation.frame_rate)
         .round()
         .max(1.0) as u64;
-    let target_dt = match scene.simulation.dt {
-        TimeStep::Fixed(dt) => dt,
-        TimeStep::Auto => pipe.stepper.auto_dt(&world),
-    };
-    let (steps_per_frame, dt) = fit_to_frame(target_dt, frame_interval);
 
     let mut tally = Tally::new(&world, &pipe.stepper);
     let started = Instant::now();
@@ -164,7 +164,7 @@ fn run_in_pool(
                 break;
             }
             let t0 = Instant::now();
-            match pipe.advance_frame(&mut world, steps_per_frame, dt) {
+            match pipe.advance_frame(&mut world, frame_interval) {
                 Ok(recoveries) => nan_recoveries += recoveries,
                 Err(RunError::StepFailed { last_dt }) => {
                     failure = Some((frame, last_dt));
@@ -186,7 +186,9 @@ fn run_in_pool(
         if let Some(rec) = recorder.as_mut() {
             world.vertex_normals(&mut normals);
             let pinned: Vec<u32> = world.pins.anchors.iter().map(|a| a.vertex).collect();
-            let mut scalars = frame_scalars(&world, energy, dt, sim_seconds, record_seconds, frame);
+            let dt_now = pipe.step_size(&world);
+            let mut scalars =
+                frame_scalars(&world, energy, dt_now, sim_seconds, record_seconds, frame);
             scalars.push(("adapt/max_angle_deg", max_angle));
             if pipe.adapter.is_some() {
                 let count = |k: EventKind| events.iter().filter(|e| e.kind == k).count() as f64;
@@ -250,7 +252,11 @@ fn run_in_pool(
         wall_time_s: started.elapsed().as_secs_f64(),
         sim_wall_s: sim_seconds,
         record_wall_s: record_seconds,
-        dt,
+        dt: if pipe.min_dt.is_finite() {
+            pipe.min_dt
+        } else {
+            pipe.step_size(&world)
+        },
         nan_recoveries,
         interrupted,
         recording,
@@ -267,7 +273,8 @@ fn run_in_pool(
             halvings: MAX_STEP_HALVINGS,
             dt: last_dt,
             cause: format!(
-                "step {dt:.3e} s with the {:?} integrator; try a smaller `simulation.dt`, `dt = \"auto\"`, or `integrator = \"implicit\"`",
+                "step {:.3e} s with the {:?} integrator; try a smaller `simulation.dt`, `dt = \"auto\"`, or `integrator = \"implicit\"`",
+                pipe.step_size(&world),
                 pipe.stepper.model.integrator
             ),
             summary: Box::new(summary),
@@ -286,6 +293,13 @@ struct Pipeline {
     collider: Option<Collider>,
     /// What the collision passes did.
     collision: CollisionStats,
+    /// The user's fixed step, or `None` for `dt = "auto"`.
+    fixed_dt: Option<Scalar>,
+    /// The automatic step for the current mesh (recomputed after remeshing,
+    /// since refinement lowers the explicit stability limit).
+    auto_dt: Option<Scalar>,
+    /// Smallest step taken so far.
+    min_dt: Scalar,
 }
 
 impl Pipeline {
@@ -296,24 +310,30 @@ impl Pipeline {
     fn advance_frame(
         &mut self,
         world: &mut World,
-        steps: u64,
-        dt: Scalar,
+        frame_interval: Scalar,
     ) -> Result<u64, RunError> {
         let start = world.clone();
         let adapter_start = self.adapter.clone();
         let steps_start = self.steps_done;
         let t0 = world.time;
         for halving in 0..=MAX_STEP_HALVINGS {
-            let (n, h) = (steps << halving, dt / (1u64 << halving) as Scalar);
+            let shrink = (1u64 << halving) as Scalar;
             let mut healthy = true;
-            for _ in 0..n {
+            let mut done = 0.0;
+            // Steps of the current mesh's size, the last ones evened out so the
+            // frame ends exactly on its time.
+            while done < frame_interval * (1.0 - 1e-12) {
+                let remaining = frame_interval - done;
+                let target = self.step_size(world) / shrink;
+                let h = remaining / (remaining / target * (1.0 - 1e-12)).ceil().max(1.0);
                 if !self.step(world, h)? {
                     healthy = false;
                     break;
                 }
+                self.min_dt = self.min_dt.min(h);
+                done += h;
             }
-            // Land exactly on the frame time whatever the rounding of n * h.
-            world.time = t0 + dt * steps as Scalar;
+            world.time = t0 + frame_interval;
             if healthy {
                 return Ok(halving as u64);
             }
@@ -321,10 +341,20 @@ impl Pipeline {
             self.adapter = adapter_start.clone();
             self.steps_done = steps_start;
             self.stepper.rebuild(world);
+            self.auto_dt = None;
         }
-        Err(RunError::StepFailed {
-            last_dt: dt / (1u64 << MAX_STEP_HALVINGS) as Scalar,
-        })
+        let last_dt = self.step_size(world) / (1u64 << MAX_STEP_HALVINGS) as Scalar;
+        Err(RunError::StepFailed { last_dt })
+    }
+
+    /// The step for the current mesh: the fixed one, or the automatic estimate.
+    fn step_size(&mut self, world: &World) -> Scalar {
+        if let Some(dt) = self.fixed_dt {
+            return dt;
+        }
+        *self
+            .auto_dt
+            .get_or_insert_with(|| self.stepper.auto_dt(world))
     }
 
     /// One step, in phases: integrate (forces and integrator), health check,
@@ -354,6 +384,7 @@ impl Pipeline {
                     ad.note_rollback(world, self.steps_done);
                     ad.refine(world, &marks, self.steps_done)?;
                     self.stepper.rebuild(world);
+                    self.auto_dt = None;
                     tries += 1;
                     continue;
                 }
@@ -366,6 +397,7 @@ impl Pipeline {
             && ad.pass(world, self.steps_done)?
         {
             self.stepper.rebuild(world);
+            self.auto_dt = None;
         }
         Ok(true)
     }

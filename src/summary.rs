@@ -78,7 +78,8 @@ pub struct Summary {
     pub simulation_wall_s: Scalar,
     /// Wall time spent recording (and exporting OBJ), s.
     pub recording_wall_s: Scalar,
-    /// The time step, s.
+    /// The smallest time step taken, s (with `dt = "auto"` and adaptivity the
+    /// step follows the finest triangles).
     pub dt: Scalar,
     /// Steps times mean vertices per second of stepping wall time.
     pub vertex_steps_per_s: Scalar,

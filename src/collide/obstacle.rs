@@ -251,7 +251,8 @@ fn load_mesh(index: usize, path: &Path, scale: Scalar) -> Result<TriMesh, Collid
         single_index: true,
         ..Default::default()
     };
-    let (models, _) = tobj::load_obj(path, &opts).map_err(|e| err(e.to_string()))?;
+    let (models, _) = tobj::load_obj(path, &opts)
+        .map_err(|e| err(format!("{e} (not a readable Wavefront OBJ file)")))?;
     let mut vertices = Vec::new();
     let mut indices = Vec::new();
     for m in &models {

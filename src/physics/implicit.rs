@@ -42,6 +42,9 @@ pub struct ImplicitScratch {
     z: Vec<Vector>,
     p: Vec<Vector>,
     ap: Vec<Vector>,
+    /// True when `dv` holds the previous step's solution on the same mesh, used
+    /// as the first guess (the velocity change varies slowly between steps).
+    pub(super) warm: bool,
 }
 
 /// One backward Euler step; returns the number of CG iterations used.
@@ -51,11 +54,15 @@ pub fn backward_euler(st: &mut Stepper, w: &mut World, h: Scalar) -> u32 {
     w.pins.held_at(t, &mut st.held);
     assemble(st, w, h);
     let s = &mut st.implicit;
+    if !s.warm || s.dv.len() != n {
+        s.dv.clear();
+    }
     for buf in [&mut s.dv, &mut s.r, &mut s.z, &mut s.p, &mut s.ap] {
         buf.resize(n, Vector::ZERO);
     }
-    // Prescribed velocity change of pinned vertices; zero elsewhere.
-    s.dv.fill(Vector::ZERO);
+    s.warm = true;
+    // Prescribed velocity change of pinned vertices; the free ones start from
+    // the previous step's solution.
     for a in &w.pins.anchors {
         if st.held[a.vertex as usize] {
             let (_, vel) = w.pins.target(a, t + h);

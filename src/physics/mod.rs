@@ -79,6 +79,7 @@ impl Stepper {
     pub fn rebuild(&mut self, world: &World) {
         self.elements = Elements::build(&world.mesh, &self.model.material);
         self.held.resize(world.mesh.vertex_count(), false);
+        self.implicit.warm = false;
     }
 
     /// Advances `world` by `dt` seconds with the model's integrator.

@@ -374,3 +374,38 @@ fn close_thresholds_do_not_thrash() {
     );
     assert!(w.x.iter().all(|p| p.is_finite()));
 }
+
+#[test]
+fn hanging_sheet_run_refines_rolls_back_and_reports_counts() {
+    use std::sync::atomic::AtomicBool;
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/hanging_sheet.toml");
+    let sets: Vec<String> = ["simulation.duration=0.5", "cloth.resolution=8"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    let scene = drape::scene::load_scene_file(&path, &sets).unwrap();
+    let opts = drape::run::RunOptions::default();
+    let summary = drape::run::run(&scene, &opts, &AtomicBool::new(false), &mut |_| {}).unwrap();
+    let a = summary.adapt.expect("adaptive run");
+    println!(
+        "hanging_sheet res 8, 0.5 s: {} splits ({} forced), {} merges, {} rollbacks, max level {}, vertices {:.0}..{:.0}",
+        summary.splits,
+        a.closure_splits,
+        summary.merges,
+        summary.rollbacks,
+        summary.max_level,
+        summary.vertices.min,
+        summary.vertices.max
+    );
+    assert!(summary.splits > 0 && summary.max_level >= 2);
+    assert!(
+        summary.rollbacks > 0,
+        "a falling sheet bends past 15 degrees within a step"
+    );
+    assert_eq!(
+        (summary.splits, summary.merges, summary.rollbacks),
+        (a.splits, a.merges, a.rollbacks)
+    );
+    assert!((summary.mass_final - summary.mass_initial).abs() < 1e-12 * summary.mass_initial);
+    assert!(summary.vertices.max > summary.vertices.min);
+}

@@ -3,6 +3,7 @@
 
 mod adapt;
 mod cli;
+mod collide;
 mod mesh;
 mod physics;
 mod recording;

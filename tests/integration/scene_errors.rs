@@ -583,7 +583,14 @@ fn shipped_scenes_are_valid() {
     assert!(s.air.is_some() && s.wind.is_none());
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
     let s = load_scene_file(&dir.join("hanging_sheet.toml"), &[]).expect("hanging_sheet");
-    assert_eq!((s.cloth.resolution, s.simulation.duration), (Some(32), 4.0));
+    assert_eq!((s.cloth.resolution, s.simulation.duration), (Some(16), 4.0));
+    assert!(
+        s.adapt
+            .as_ref()
+            .is_some_and(|a| a.method == drape::scene::AdaptMethod::RedGreen && a.rollback)
+    );
+    let u = load_scene_file(&dir.join("hanging_sheet_uniform.toml"), &[]).expect("uniform");
+    assert_eq!((u.cloth.resolution, u.adapt.is_none()), (Some(64), true));
     let s = load_scene_file(&dir.join("flag.toml"), &[]).expect("flag");
     assert_eq!(s.simulation.integrator, Integrator::Rk4);
     assert_eq!(s.cloth.rotation, [90.0, 0.0, 0.0]);
