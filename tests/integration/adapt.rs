@@ -7,8 +7,10 @@ use drape::adapt::{AdaptConfig, Adapter, check_consistency};
 use drape::math::{Scalar, Vector};
 use drape::mesh;
 use drape::physics::pins::Pins;
-use drape::scene::{DiagonalPattern, Pin, PinMotion};
+use drape::scene::DiagonalPattern;
 use drape::world::World;
+
+use crate::common::pin;
 use proptest::prelude::*;
 
 const DENSITY: Scalar = 0.15;
@@ -247,21 +249,6 @@ fn a_split_first_splits_a_coarser_neighbour_to_keep_levels_within_one_split() {
         ad.stats.closure_splits > 0,
         "coarser neighbours were split first"
     );
-}
-
-fn pin(region: &str) -> Pin {
-    Pin {
-        region: region.into(),
-        box_min: None,
-        box_max: None,
-        motion: PinMotion::Fixed,
-        velocity: [0.0; 3],
-        acceleration: [0.0; 3],
-        center: [0.0; 3],
-        axis: [0.0, 0.0, 1.0],
-        angular_velocity: 0.0,
-        release_time: None,
-    }
 }
 
 #[test]

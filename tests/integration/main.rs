@@ -4,6 +4,7 @@
 mod adapt;
 mod cli;
 mod collide;
+mod common;
 mod mesh;
 mod physics;
 mod recording;

@@ -6,8 +6,10 @@ use drape::mesh::{self, Mesh};
 use drape::physics::bending::dihedral_angle_and_gradient;
 use drape::physics::forces::{ForceScratch, element_pass, gather};
 use drape::physics::{Elements, ExternalForces, MaterialParams, Model, Stepper, WindForce};
-use drape::scene::{BendingModel, DiagonalPattern, Integrator, Pin, PinMotion, StiffnessRule};
+use drape::scene::{BendingModel, DiagonalPattern, Integrator, StiffnessRule};
 use drape::world::World;
+
+use crate::common::pin;
 
 const G: Vector = Vector::new(0.0, 0.0, -9.81);
 
@@ -51,21 +53,6 @@ impl Lcg {
     }
     fn vector(&mut self, scale: Scalar) -> Vector {
         Vector::new(self.next(), self.next(), self.next()) * scale
-    }
-}
-
-fn pin(region: &str) -> Pin {
-    Pin {
-        region: region.into(),
-        box_min: None,
-        box_max: None,
-        motion: PinMotion::Fixed,
-        velocity: [0.0; 3],
-        acceleration: [0.0; 3],
-        center: [0.0; 3],
-        axis: [0.0, 0.0, 1.0],
-        angular_velocity: 0.0,
-        release_time: None,
     }
 }
 
