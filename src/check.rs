@@ -129,7 +129,12 @@ pub fn describe(scene: &Scene) -> Result<String, BuildError> {
     if let Some(a) = &adapt {
         let _ = writeln!(
             s,
-            "adaptive meshing: red_green (paper A), refine above {} deg, coarsen below {} deg (and below half the upper threshold), levels 0..{}, every {} steps{}{}",
+            "adaptive meshing: {}, refine above {} deg, coarsen below {} deg (and below half the upper threshold), levels 0..{}, every {} steps{}{}",
+            match a.method {
+                crate::scene::AdaptMethod::Edge =>
+                    "edge (paper B: longest-edge splits, Delaunay flips, guarded collapses)",
+                _ => "red_green (paper A)",
+            },
             a.refine_angle,
             a.coarsen_angle,
             a.max_level,

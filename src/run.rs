@@ -196,7 +196,11 @@ fn run_in_pool(
                     "adapt/splits",
                     count(EventKind::Split) + count(EventKind::ClosureSplit),
                 ));
-                scalars.push(("adapt/merges", count(EventKind::Merge)));
+                scalars.push((
+                    "adapt/merges",
+                    count(EventKind::Merge) + count(EventKind::Collapse),
+                ));
+                scalars.push(("adapt/flips", count(EventKind::Flip)));
                 scalars.push(("adapt/rollbacks", count(EventKind::Rollback)));
             }
             if pipe.collider.is_some() {

@@ -7,10 +7,13 @@
 //! topology -> report events. The stepper must rebuild its elements afterwards.
 
 mod check;
+pub mod edge;
 pub mod red_green;
 pub mod transfer;
 
 pub use check::{ConsistencyError, check_consistency};
+
+use std::collections::HashMap;
 
 use rayon::prelude::*;
 
@@ -33,6 +36,10 @@ pub enum EventKind {
     Merge,
     /// A step restored, refined and integrated again.
     Rollback,
+    /// An edge flipped for quality (edge method).
+    Flip,
+    /// An edge collapsed (edge method).
+    Collapse,
 }
 
 /// One remeshing event.
@@ -58,8 +65,10 @@ pub struct AdaptStats {
     pub splits: u64,
     /// Of those, forced by closure or 1-irregularity.
     pub closure_splits: u64,
-    /// Merges.
+    /// Merges (red_green) or edge collapses (edge).
     pub merges: u64,
+    /// Edge flips (edge method).
+    pub flips: u64,
     /// Steps redone after refining.
     pub rollbacks: u64,
     /// Adaptation passes run.
@@ -73,6 +82,8 @@ pub struct AdaptStats {
 /// Adaptivity settings (the scene's `[adapt]`, resolved).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AdaptConfig {
+    /// The remeshing method (`red_green` or `edge`).
+    pub method: AdaptMethod,
     /// Upper threshold, degrees.
     pub refine_angle: Scalar,
     /// Lower threshold, degrees.
@@ -94,6 +105,7 @@ impl AdaptConfig {
     pub fn from_scene(a: Option<&Adapt>) -> Option<AdaptConfig> {
         let a = a?;
         (a.method != AdaptMethod::None).then(|| AdaptConfig {
+            method: a.method,
             refine_angle: a.refine_angle,
             coarsen_angle: a.coarsen_angle,
             max_level: a.max_level.min(254) as u8,
@@ -119,6 +131,8 @@ pub struct Adapter {
     /// Leaf of the hierarchy that owns each triangle of the world's mesh.
     owner: Vec<u32>,
     density: Scalar,
+    /// Limits of the edge method (`None` for red_green).
+    edge: Option<edge::Limits>,
 }
 
 /// Angle in degrees between the normals of the two triangles at each edge
@@ -149,6 +163,15 @@ impl Adapter {
     pub fn new(config: AdaptConfig, world: &World, density: Scalar) -> Adapter {
         let hierarchy = RedGreen::new(&world.mesh.triangles, &world.mesh.material);
         let owner = (0..world.mesh.triangles.len() as u32).collect();
+        let m = &world.mesh;
+        let edge = (config.method == AdaptMethod::Edge).then(|| {
+            edge::Limits::for_mesh(
+                &m.material,
+                &m.triangles,
+                config.max_level,
+                config.min_edge_length,
+            )
+        });
         Adapter {
             config,
             stats: AdaptStats::default(),
@@ -156,6 +179,7 @@ impl Adapter {
             hierarchy,
             owner,
             density,
+            edge,
         }
     }
 
@@ -172,6 +196,9 @@ impl Adapter {
     /// Leaves the angle criterion asks to split, with the angle that asked,
     /// from angles measured on the world's current shape.
     pub fn refinement_marks(&self, world: &World, angles: &[Scalar]) -> Vec<(u32, Scalar)> {
+        if self.edge.is_some() {
+            return Vec::new(); // rollback is paper A's, with red_green only
+        }
         let mut marks: Vec<(u32, Scalar)> = Vec::new();
         for (e, edge) in world.mesh.edges.iter().enumerate() {
             if angles[e] <= self.config.refine_angle {
@@ -229,6 +256,9 @@ impl Adapter {
     /// One adaptation pass on `world` after step `step`: merges, then splits,
     /// then closure; returns true when the mesh changed.
     pub fn pass(&mut self, world: &mut World, step: u64) -> Result<bool, MeshError> {
+        if let Some(limits) = self.edge {
+            return self.edge_pass(world, step, limits);
+        }
         let angles = edge_angles(world);
         let merges = self.merge_marks(world, &angles);
         let splits = self.refinement_marks(world, &angles);
@@ -374,5 +404,174 @@ impl Adapter {
         self.hierarchy.remap(&map, &material);
         self.owner = owner;
         Ok(())
+    }
+}
+
+impl Adapter {
+    /// The stated minimum angle of the edge method, degrees (`None` for red_green).
+    pub fn min_angle(&self) -> Option<Scalar> {
+        self.edge.map(|l| l.min_angle)
+    }
+
+    /// One pass of paper B's method: split edges above the upper threshold
+    /// (longest-edge bisection), flip around the new vertices for quality, then
+    /// collapse short edges at vertices whose every edge is flat.
+    fn edge_pass(
+        &mut self,
+        world: &mut World,
+        step: u64,
+        limits: edge::Limits,
+    ) -> Result<bool, MeshError> {
+        let angles = edge_angles(world);
+        self.stats.passes += 1;
+        let m = &world.mesh;
+        let mut soup = edge::Soup::new(&m.material, &m.triangles, &m.levels);
+        let mut ops = Vec::new();
+        let mut marks: Vec<(usize, Scalar)> = angles
+            .iter()
+            .enumerate()
+            .filter(|(_, a)| **a > self.config.refine_angle)
+            .map(|(e, a)| (e, *a))
+            .collect();
+        marks.sort_by(|x, y| y.1.total_cmp(&x.1).then(x.0.cmp(&y.0)));
+        let mut asked: HashMap<(u32, u32), Scalar> = HashMap::new();
+        for &(e, a) in &marks {
+            let [p, q] = m.edges[e].vertices;
+            asked.insert((p.min(q), p.max(q)), a);
+            soup.split(p, q, &limits, &mut ops, 0);
+        }
+        let seeds: Vec<u32> = (soup.first_new..soup.material.len() as u32).collect();
+        soup.flip_around(&seeds, &limits, &mut ops);
+        // Flat vertices: every edge at them below both thresholds' limit.
+        let flat_limit = self
+            .config
+            .coarsen_angle
+            .min(0.5 * self.config.refine_angle);
+        let mut vertex_max = vec![0.0 as Scalar; m.vertex_count()];
+        for (e, edge) in m.edges.iter().enumerate() {
+            for &v in &edge.vertices {
+                vertex_max[v as usize] = vertex_max[v as usize].max(angles[e]);
+            }
+        }
+        let mut pinned = vec![false; m.vertex_count()];
+        for a in &world.pins.anchors {
+            pinned[a.vertex as usize] = true;
+        }
+        let mut by_length: Vec<(Scalar, u32, u32)> = m
+            .edges
+            .iter()
+            .filter(|e| {
+                e.vertices
+                    .iter()
+                    .all(|&v| vertex_max[v as usize] < flat_limit)
+            })
+            .map(|e| {
+                let [a, b] = e.vertices;
+                (
+                    m.material[a as usize].distance(m.material[b as usize]),
+                    a,
+                    b,
+                )
+            })
+            .filter(|&(len, _, _)| len < limits.collapse_below)
+            .collect();
+        by_length.sort_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))));
+        for (_, a, b) in by_length {
+            // Remove the vertex made later (refinement vertices carry larger ids).
+            let (v, u) = if a > b { (a, b) } else { (b, a) };
+            if !soup.collapse(v, u, &pinned, &limits, &mut ops) {
+                soup.collapse(u, v, &pinned, &limits, &mut ops);
+            }
+        }
+        if ops.is_empty() {
+            return Ok(false);
+        }
+        let map = self.rebuild_from_soup(world, &soup)?;
+        for op in &ops {
+            let at = |v: u32| {
+                world
+                    .x
+                    .get(map[v as usize] as usize)
+                    .copied()
+                    .unwrap_or(Vector::ZERO)
+            };
+            let (kind, position, angle) = match *op {
+                edge::EdgeOp::Split(a, b) => {
+                    self.stats.splits += 1;
+                    (
+                        EventKind::Split,
+                        (at(a) + at(b)) * 0.5,
+                        asked.get(&(a.min(b), a.max(b))).copied(),
+                    )
+                }
+                edge::EdgeOp::Flip(a, b) => {
+                    self.stats.flips += 1;
+                    (EventKind::Flip, (at(a) + at(b)) * 0.5, None)
+                }
+                edge::EdgeOp::Collapse(_, u) => {
+                    self.stats.merges += 1;
+                    (EventKind::Collapse, at(u), None)
+                }
+            };
+            let level = world.mesh.levels.iter().copied().max().unwrap_or(0);
+            self.events.push(AdaptEvent {
+                kind,
+                position,
+                level,
+                angle,
+                step,
+            });
+        }
+        self.stats.changed_passes += 1;
+        self.stats.max_ops_per_pass = self.stats.max_ops_per_pass.max(ops.len() as u64);
+        Ok(true)
+    }
+
+    /// Compacts the soup's live vertices and moves the world onto it; returns the
+    /// map from soup vertex ids to new indices (`u32::MAX` for removed ones).
+    fn rebuild_from_soup(
+        &mut self,
+        world: &mut World,
+        soup: &edge::Soup,
+    ) -> Result<Vec<u32>, MeshError> {
+        let (tris, levels) = soup.live();
+        let all = soup.material.len();
+        let mut used = vec![false; all];
+        for t in &tris {
+            for &v in t {
+                used[v as usize] = true;
+            }
+        }
+        let mut map = vec![u32::MAX; all];
+        let mut next = 0u32;
+        for v in 0..all {
+            if used[v] {
+                map[v] = next;
+                next += 1;
+            }
+        }
+        let mut material = Vec::with_capacity(next as usize);
+        let mut origin = Vec::with_capacity(next as usize);
+        for v in (0..all).filter(|&v| used[v]) {
+            material.push(soup.material[v]);
+            origin.push(if (v as u32) < soup.first_new {
+                Origin::Old(v as u32)
+            } else {
+                let (a, b) = soup.created[v - soup.first_new as usize];
+                Origin::Midpoint(map[a as usize], map[b as usize])
+            });
+        }
+        let triangles = tris.iter().map(|t| t.map(|v| map[v as usize])).collect();
+        transfer(
+            world,
+            self.density,
+            Remeshed {
+                material,
+                triangles,
+                levels,
+                origin,
+            },
+        )?;
+        Ok(map)
     }
 }

@@ -382,12 +382,12 @@ fn adapt(a: &Adapt, integrator: Integrator) -> Result<(), Issue> {
             "0 is out of range: must be >= 1",
         ));
     }
-    if a.method == AdaptMethod::Edge {
-        let path = keys(&["adapt", "method"]);
+    if a.method == AdaptMethod::Edge && a.rollback {
+        let path = keys(&["adapt", "rollback"]);
         return Err(Issue::new(
             path,
-            Kind::Unsupported,
-            "method \"edge\" (paper B) is not implemented in this version of drape yet; use \"red_green\"",
+            Kind::NotApplicable,
+            "rollback is paper A's and works with method = \"red_green\" only",
         ));
     }
     if a.multirate {

@@ -17,6 +17,7 @@ const DENSITY: Scalar = 0.15;
 
 fn config() -> AdaptConfig {
     AdaptConfig {
+        method: drape::scene::AdaptMethod::RedGreen,
         refine_angle: 15.0,
         coarsen_angle: 1.5,
         max_level: 6,
@@ -395,4 +396,128 @@ fn hanging_sheet_run_refines_rolls_back_and_reports_counts() {
     );
     assert!((summary.mass_final - summary.mass_initial).abs() < 1e-12 * summary.mass_initial);
     assert!(summary.vertices.max > summary.vertices.min);
+}
+
+fn edge_config() -> AdaptConfig {
+    AdaptConfig {
+        method: drape::scene::AdaptMethod::Edge,
+        max_level: 6,
+        ..config()
+    }
+}
+
+/// Smallest angle of any triangle of the world's mesh, in material space.
+fn smallest_angle(w: &World) -> Scalar {
+    w.mesh
+        .triangles
+        .iter()
+        .map(|t| drape::adapt::edge::min_angle_deg(t.map(|v| w.mesh.material[v as usize])))
+        .fold(180.0, Scalar::min)
+}
+
+#[test]
+fn edge_method_never_goes_below_its_minimum_angle_and_keeps_the_invariants() {
+    use drape::physics::{ExternalForces, MaterialParams, Model, Stepper};
+    use drape::scene::{BendingModel, Integrator, StiffnessRule};
+    let mut w = world(8, DiagonalPattern::Alternating);
+    w.v.iter_mut().for_each(|v| *v = Vector::ZERO);
+    w.pins = Pins::select(
+        &[pin("corner:top_left"), pin("corner:top_right")],
+        &w.mesh,
+        &w.x,
+    )
+    .unwrap();
+    let (area, bound) = (w.mesh.total_rest_area(), boundary(&w));
+    let mat = MaterialParams {
+        density: DENSITY,
+        stretch: 200.0,
+        bending: 1e-5,
+        damping: 0.001,
+        bending_model: BendingModel::Dihedral,
+        stiffness_rule: StiffnessRule::Consistent,
+    };
+    let ext = ExternalForces {
+        gravity: Some(Vector::new(0.0, 0.0, -9.81)),
+        ..Default::default()
+    };
+    let model = Model {
+        material: mat,
+        external: ext,
+        integrator: Integrator::Implicit,
+        cg_tolerance: 1e-6,
+        cg_max_iterations: 500,
+    };
+    let mut st = Stepper::new(model, &w);
+    let mut ad = Adapter::new(edge_config(), &w, DENSITY);
+    let stated = ad.min_angle().expect("edge method");
+    let mut worst: Scalar = 180.0;
+    for step in 0..150 {
+        st.step(&mut w, 0.01);
+        if ad.pass(&mut w, step).unwrap() {
+            st.rebuild(&w);
+            check_consistency(&w, DENSITY, area, bound).unwrap();
+            worst = worst.min(smallest_angle(&w));
+            assert!(
+                worst >= stated - 1e-9,
+                "angle {worst} below the stated minimum {stated}"
+            );
+        }
+    }
+    let s = ad.stats;
+    println!(
+        "edge method, swinging sheet: stated minimum angle {stated:.2} deg, smallest seen {worst:.2} deg; {} splits, {} flips, {} collapses, {} vertices at the end",
+        s.splits,
+        s.flips,
+        s.merges,
+        w.mesh.vertex_count()
+    );
+    assert!(s.splits > 0, "the swinging sheet should refine");
+    assert!(w.x.iter().all(|p| p.is_finite()));
+}
+
+#[test]
+fn edge_method_refine_then_flatten_returns_near_the_original_vertex_count() {
+    let mut w = world(8, DiagonalPattern::Alternating);
+    let original = w.mesh.vertex_count();
+    let (area, bound) = (w.mesh.total_rest_area(), boundary(&w));
+    let mut ad = Adapter::new(edge_config(), &w, DENSITY);
+    // Bend the sheet sharply along a line so that edges there exceed 15 degrees.
+    let bend = |w: &mut World| {
+        for (x, m) in w.x.iter_mut().zip(&w.mesh.material) {
+            *x = Vector::new(m.x, m.y, 0.3 * (-(m.x * m.x) / 0.005).exp());
+        }
+    };
+    for step in 0..4 {
+        bend(&mut w);
+        ad.pass(&mut w, step).unwrap();
+    }
+    let refined = w.mesh.vertex_count();
+    let (p0, scale) = momentum(&w);
+    // Flatten and coarsen until nothing changes.
+    let mut passes = 0;
+    loop {
+        for (x, m) in w.x.iter_mut().zip(&w.mesh.material) {
+            *x = m.extend(0.0);
+        }
+        if !ad.pass(&mut w, 10 + passes).unwrap() {
+            break;
+        }
+        passes += 1;
+        assert!(passes < 50, "coarsening does not terminate");
+        check_consistency(&w, DENSITY, area, bound).unwrap();
+        let (p, _) = momentum(&w);
+        assert!(
+            (p - p0).length() <= 1e-13 * scale,
+            "momentum {p:?} vs {p0:?}"
+        );
+    }
+    let back = w.mesh.vertex_count();
+    println!(
+        "edge method: {original} -> {refined} -> {back} vertices ({passes} coarsening passes)"
+    );
+    assert!(refined > original + 10, "bending should refine: {refined}");
+    assert!(
+        (back as Scalar - original as Scalar).abs() <= 0.1 * original as Scalar,
+        "{back} vs {original}"
+    );
 }
