@@ -150,6 +150,12 @@ pub fn describe(scene: &Scene) -> Result<String, BuildError> {
                 String::new()
             }
         );
+        if scene.adapt.as_ref().is_some_and(|x| x.multirate) {
+            let _ = writeln!(
+                s,
+                "  multirate (paper A): level L takes 2^ceil(L/2) substeps per macro step; the time step below is the macro step"
+            );
+        }
     }
     let interval = 1.0 / sim.frame_rate;
     let (target, how) = match sim.dt {

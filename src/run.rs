@@ -126,7 +126,8 @@ fn run_in_pool(
     }
     let mut world = World::from_scene(scene)?;
     let model = Model::from_scene(scene);
-    let stepper = Stepper::new(model, &world);
+    let mut stepper = Stepper::new(model, &world);
+    stepper.multirate = scene.adapt.as_ref().is_some_and(|a| a.multirate);
     let adapter = AdaptConfig::from_scene(scene.adapt.as_ref())
         .map(|c| Adapter::new(c, &world, scene.material.density));
     let collider = Collider::from_scene(scene)?;

@@ -9,6 +9,7 @@ pub mod elements;
 pub mod explicit;
 pub mod forces;
 pub mod implicit;
+pub mod multirate;
 pub mod pins;
 pub mod timestep;
 
@@ -54,10 +55,14 @@ pub struct Stepper {
     pub elements: Elements,
     /// What has been done so far.
     pub stats: StepStats,
+    /// Paper A's multirate stepping (symplectic Euler only): each step is a
+    /// macro step in which every level takes its own substeps.
+    pub multirate: bool,
     held: Vec<bool>,
     forces: forces::ForceScratch,
     rk4: explicit::Rk4Scratch,
     implicit: implicit::ImplicitScratch,
+    levels: Option<multirate::Levels>,
 }
 
 impl Stepper {
@@ -68,10 +73,12 @@ impl Stepper {
             model,
             elements,
             stats: StepStats::default(),
+            multirate: false,
             held: vec![false; world.mesh.vertex_count()],
             forces: Default::default(),
             rk4: Default::default(),
             implicit: Default::default(),
+            levels: None,
         }
     }
 
@@ -80,11 +87,15 @@ impl Stepper {
         self.elements = Elements::build(&world.mesh, &self.model.material);
         self.held.resize(world.mesh.vertex_count(), false);
         self.implicit.warm = false;
+        self.levels = None;
     }
 
     /// Advances `world` by `dt` seconds with the model's integrator.
     pub fn step(&mut self, world: &mut World, dt: Scalar) {
         match self.model.integrator {
+            Integrator::SymplecticEuler if self.multirate => {
+                multirate::symplectic_multirate(self, world, dt)
+            }
             Integrator::SymplecticEuler => explicit::symplectic_euler(self, world, dt),
             Integrator::Rk4 => explicit::rk4(self, world, dt),
             Integrator::Implicit => {
@@ -104,8 +115,13 @@ impl Stepper {
         forces::energy(&self.elements, &self.model.external, &world.x, &world.v)
     }
 
-    /// The automatic time step for this model on the current mesh.
+    /// The automatic time step for this model on the current mesh (the macro
+    /// step when multirate).
     pub fn auto_dt(&self, world: &World) -> Scalar {
+        if self.multirate && self.model.integrator == Integrator::SymplecticEuler {
+            let drag = self.model.external.drag.unwrap_or(0.0);
+            return multirate::Levels::build(&world.mesh, &self.elements, drag).macro_dt;
+        }
         timestep::auto_dt(
             self.model.integrator,
             &world.mesh,

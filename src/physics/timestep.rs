@@ -44,6 +44,32 @@ pub fn auto_dt(
 
 /// Stability limit of symplectic Euler from the Gershgorin bounds above.
 pub fn symplectic_limit(mesh: &Mesh, el: &Elements, drag_per_area: Scalar) -> Scalar {
+    let (stiff, damp) = gershgorin_rows(mesh, el, drag_per_area);
+    let (mut omega2, mut zeta) = (0.0 as Scalar, 0.0 as Scalar);
+    for i in 0..stiff.len() {
+        omega2 = omega2.max(stiff[i]);
+        zeta = zeta.max(damp[i]);
+    }
+    limit(omega2, zeta)
+}
+
+/// Stability limit of symplectic Euler for each vertex on its own (its own row
+/// of the Gershgorin bounds), used by multirate stepping.
+pub fn vertex_limits(mesh: &Mesh, el: &Elements, drag_per_area: Scalar) -> Vec<Scalar> {
+    let (stiff, damp) = gershgorin_rows(mesh, el, drag_per_area);
+    stiff
+        .iter()
+        .zip(&damp)
+        .map(|(&o, &z)| limit(o, z))
+        .collect()
+}
+
+/// Per vertex: the Gershgorin bound of `M^-1 K` and the damping rate.
+fn gershgorin_rows(
+    mesh: &Mesh,
+    el: &Elements,
+    drag_per_area: Scalar,
+) -> (Vec<Scalar>, Vec<Scalar>) {
     let n = mesh.vertex_count();
     let mut stiff = vec![0.0; n];
     let mut damp = vec![0.0; n];
@@ -61,11 +87,15 @@ pub fn symplectic_limit(mesh: &Mesh, el: &Elements, drag_per_area: Scalar) -> Sc
             stiff[hg.v[k] as usize] += hg.k * g[k].length() * sum;
         }
     }
-    let (mut omega2, mut zeta) = (0.0 as Scalar, 0.0 as Scalar);
     for i in 0..n {
-        omega2 = omega2.max(stiff[i] / el.mass[i]);
-        zeta = zeta.max((damp[i] + drag_per_area * el.vertex_area[i]) / el.mass[i]);
+        stiff[i] /= el.mass[i];
+        damp[i] = (damp[i] + drag_per_area * el.vertex_area[i]) / el.mass[i];
     }
+    (stiff, damp)
+}
+
+/// The largest `h` with `h^2 omega2 + 2 h zeta <= 4`.
+fn limit(omega2: Scalar, zeta: Scalar) -> Scalar {
     if omega2 <= 0.0 {
         return if zeta > 0.0 {
             2.0 / zeta
