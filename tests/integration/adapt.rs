@@ -97,6 +97,39 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
+
+    /// Edge method: random bumps (refinement) and flattenings (coarsening) keep
+    /// the mesh manifold and conforming, mass exact, momentum conserved and every
+    /// angle at or above the stated minimum.
+    #[test]
+    fn edge_method_random_bends_and_flattenings_keep_every_invariant(
+        bumps in prop::collection::vec((-0.4f64..0.4, -0.4f64..0.4, 0.05f64..0.4, any::<bool>()), 1..8),
+    ) {
+        let mut w = world(6, DiagonalPattern::Regular);
+        let (area, bound) = (w.mesh.total_rest_area(), boundary(&w));
+        let mut ad = Adapter::new(edge_config(), &w, DENSITY);
+        let stated = ad.min_angle().unwrap();
+        let (p0, scale) = momentum(&w);
+        let mut refined = false;
+        for (step, (cx, cy, height, flatten)) in bumps.into_iter().enumerate() {
+            for (x, m) in w.x.iter_mut().zip(&w.mesh.material) {
+                let z = if flatten { 0.0 } else { height * (-((m.x - cx).powi(2) + (m.y - cy).powi(2)) / 0.01).exp() };
+                *x = Vector::new(m.x, m.y, z);
+            }
+            ad.pass(&mut w, step as u64).unwrap();
+            check_consistency(&w, DENSITY, area, bound).map_err(|e| TestCaseError::fail(format!("step {step}: {e}")))?;
+            prop_assert!(smallest_angle(&w) >= stated - 1e-9, "angle {} below {stated}", smallest_angle(&w));
+            let (p, _) = momentum(&w);
+            prop_assert!((p - p0).length() <= 1e-13 * scale, "momentum {p:?} vs {p0:?}");
+            refined |= !flatten && height > 0.1;
+        }
+        // A bump over 0.1 m on this 1/6 m grid bends well past 15 degrees.
+        prop_assert!(!refined || ad.stats.splits > 0, "a tall bump should refine");
+    }
+}
+
 #[test]
 fn refining_then_coarsening_a_flat_sheet_restores_the_original_mesh() {
     for pattern in [DiagonalPattern::Regular, DiagonalPattern::Alternating] {
