@@ -17,7 +17,7 @@ use std::collections::HashMap;
 
 use rayon::prelude::*;
 
-use crate::math::{Scalar, Vector};
+use crate::math::{Scalar, Vector, Vector2};
 use crate::mesh::MeshError;
 use crate::scene::{Adapt, AdaptMethod};
 use crate::world::World;
@@ -360,47 +360,10 @@ impl Adapter {
     /// transfers the world's state onto it.
     fn rebuild_world(&mut self, world: &mut World) -> Result<(), MeshError> {
         let (tris, levels, owner) = self.hierarchy.build();
-        let all = self.hierarchy.material().len();
-        let mut used = vec![false; all];
-        for t in &tris {
-            for &v in t {
-                used[v as usize] = true;
-            }
-        }
-        let mut map = vec![u32::MAX; all];
-        let mut next = 0u32;
-        for (v, &u) in used.iter().enumerate() {
-            if u {
-                map[v] = next;
-                next += 1;
-            }
-        }
         let (first_new, created) = self.hierarchy.created();
-        let mut material = Vec::with_capacity(next as usize);
-        let mut origin = Vec::with_capacity(next as usize);
-        for v in 0..all {
-            if !used[v] {
-                continue;
-            }
-            material.push(self.hierarchy.material()[v]);
-            origin.push(if (v as u32) < first_new {
-                Origin::Old(v as u32)
-            } else {
-                let (a, b) = created[v - first_new as usize];
-                Origin::Midpoint(map[a as usize], map[b as usize])
-            });
-        }
-        let triangles: Vec<[u32; 3]> = tris.iter().map(|t| t.map(|v| map[v as usize])).collect();
-        transfer(
-            world,
-            self.density,
-            Remeshed {
-                material: material.clone(),
-                triangles,
-                levels,
-                origin,
-            },
-        )?;
+        let (map, remeshed) = compact(self.hierarchy.material(), first_new, created, &tris, levels);
+        let material = remeshed.material.clone();
+        transfer(world, self.density, remeshed)?;
         self.hierarchy.remap(&map, &material);
         self.owner = owner;
         Ok(())
@@ -535,43 +498,51 @@ impl Adapter {
         soup: &edge::Soup,
     ) -> Result<Vec<u32>, MeshError> {
         let (tris, levels) = soup.live();
-        let all = soup.material.len();
-        let mut used = vec![false; all];
-        for t in &tris {
-            for &v in t {
-                used[v as usize] = true;
-            }
-        }
-        let mut map = vec![u32::MAX; all];
-        let mut next = 0u32;
-        for v in 0..all {
-            if used[v] {
-                map[v] = next;
-                next += 1;
-            }
-        }
-        let mut material = Vec::with_capacity(next as usize);
-        let mut origin = Vec::with_capacity(next as usize);
-        for v in (0..all).filter(|&v| used[v]) {
-            material.push(soup.material[v]);
-            origin.push(if (v as u32) < soup.first_new {
-                Origin::Old(v as u32)
-            } else {
-                let (a, b) = soup.created[v - soup.first_new as usize];
-                Origin::Midpoint(map[a as usize], map[b as usize])
-            });
-        }
-        let triangles = tris.iter().map(|t| t.map(|v| map[v as usize])).collect();
-        transfer(
-            world,
-            self.density,
-            Remeshed {
-                material,
-                triangles,
-                levels,
-                origin,
-            },
-        )?;
+        let (map, remeshed) = compact(&soup.material, soup.first_new, &soup.created, &tris, levels);
+        transfer(world, self.density, remeshed)?;
         Ok(map)
     }
+}
+
+/// Keeps the vertices the triangles use, in their order: returns the map from
+/// old ids to new indices (`u32::MAX` for dropped ones) and the new topology.
+/// Ids below `first_new` are old world vertices; `created[k]` is the parent edge
+/// of vertex `first_new + k`.
+fn compact(
+    material: &[Vector2],
+    first_new: u32,
+    created: &[(u32, u32)],
+    tris: &[[u32; 3]],
+    levels: Vec<u8>,
+) -> (Vec<u32>, Remeshed) {
+    let mut used = vec![false; material.len()];
+    for t in tris {
+        for &v in t {
+            used[v as usize] = true;
+        }
+    }
+    let mut map = vec![u32::MAX; material.len()];
+    let mut kept = Vec::new();
+    for (v, _) in used.iter().enumerate().filter(|(_, u)| **u) {
+        map[v] = kept.len() as u32;
+        kept.push(v);
+    }
+    let origin = kept
+        .iter()
+        .map(|&v| {
+            if (v as u32) < first_new {
+                Origin::Old(v as u32)
+            } else {
+                let (a, b) = created[v - first_new as usize];
+                Origin::Midpoint(map[a as usize], map[b as usize])
+            }
+        })
+        .collect();
+    let remeshed = Remeshed {
+        material: kept.iter().map(|&v| material[v]).collect(),
+        triangles: tris.iter().map(|t| t.map(|v| map[v as usize])).collect(),
+        levels,
+        origin,
+    };
+    (map, remeshed)
 }

@@ -46,6 +46,38 @@ fn world(res: u32, pattern: DiagonalPattern) -> World {
     w
 }
 
+/// A stepper with the fabric of the swinging-sheet tests (gravity only).
+fn swinging_stepper(
+    w: &World,
+    integrator: drape::scene::Integrator,
+    damping: Scalar,
+) -> drape::physics::Stepper {
+    use drape::physics::{ExternalForces, MaterialParams, Model, Stepper};
+    use drape::scene::{BendingModel, StiffnessRule};
+    let material = MaterialParams {
+        density: DENSITY,
+        stretch: 200.0,
+        bending: 1e-5,
+        damping,
+        bending_model: BendingModel::Dihedral,
+        stiffness_rule: StiffnessRule::Consistent,
+    };
+    let external = ExternalForces {
+        gravity: Some(Vector::new(0.0, 0.0, -9.81)),
+        ..Default::default()
+    };
+    Stepper::new(
+        Model {
+            material,
+            external,
+            integrator,
+            cg_tolerance: 1e-6,
+            cg_max_iterations: 500,
+        },
+        w,
+    )
+}
+
 fn momentum(w: &World) -> (Vector, Scalar) {
     let m = lumped_masses(&w.mesh.material, &w.mesh.triangles, DENSITY);
     let p = w.v.iter().zip(&m).map(|(v, m)| *v * *m).sum();
@@ -338,8 +370,7 @@ fn pins_survive_refinement_and_coarsening() {
 #[test]
 fn close_thresholds_do_not_thrash() {
     // A sheet swinging from two corners with thresholds 14.9 / 15 degrees.
-    use drape::physics::{ExternalForces, MaterialParams, Model, Stepper};
-    use drape::scene::{BendingModel, Integrator, StiffnessRule};
+    use drape::scene::Integrator;
     let mut w = world(8, DiagonalPattern::Alternating);
     w.v.iter_mut().for_each(|v| *v = Vector::ZERO);
     w.pins = Pins::select(
@@ -348,26 +379,7 @@ fn close_thresholds_do_not_thrash() {
         &w.x,
     )
     .unwrap();
-    let mat = MaterialParams {
-        density: DENSITY,
-        stretch: 200.0,
-        bending: 1e-5,
-        damping: 0.001,
-        bending_model: BendingModel::Dihedral,
-        stiffness_rule: StiffnessRule::Consistent,
-    };
-    let ext = ExternalForces {
-        gravity: Some(Vector::new(0.0, 0.0, -9.81)),
-        ..Default::default()
-    };
-    let model = Model {
-        material: mat,
-        external: ext,
-        integrator: Integrator::Implicit,
-        cg_tolerance: 1e-6,
-        cg_max_iterations: 500,
-    };
-    let mut st = Stepper::new(model, &w);
+    let mut st = swinging_stepper(&w, Integrator::Implicit, 0.001);
     let cfg = AdaptConfig {
         refine_angle: 15.0,
         coarsen_angle: 14.9,
@@ -450,8 +462,7 @@ fn smallest_angle(w: &World) -> Scalar {
 
 #[test]
 fn edge_method_never_goes_below_its_minimum_angle_and_keeps_the_invariants() {
-    use drape::physics::{ExternalForces, MaterialParams, Model, Stepper};
-    use drape::scene::{BendingModel, Integrator, StiffnessRule};
+    use drape::scene::Integrator;
     let mut w = world(8, DiagonalPattern::Alternating);
     w.v.iter_mut().for_each(|v| *v = Vector::ZERO);
     w.pins = Pins::select(
@@ -461,26 +472,7 @@ fn edge_method_never_goes_below_its_minimum_angle_and_keeps_the_invariants() {
     )
     .unwrap();
     let (area, bound) = (w.mesh.total_rest_area(), boundary(&w));
-    let mat = MaterialParams {
-        density: DENSITY,
-        stretch: 200.0,
-        bending: 1e-5,
-        damping: 0.001,
-        bending_model: BendingModel::Dihedral,
-        stiffness_rule: StiffnessRule::Consistent,
-    };
-    let ext = ExternalForces {
-        gravity: Some(Vector::new(0.0, 0.0, -9.81)),
-        ..Default::default()
-    };
-    let model = Model {
-        material: mat,
-        external: ext,
-        integrator: Integrator::Implicit,
-        cg_tolerance: 1e-6,
-        cg_max_iterations: 500,
-    };
-    let mut st = Stepper::new(model, &w);
+    let mut st = swinging_stepper(&w, Integrator::Implicit, 0.001);
     let mut ad = Adapter::new(edge_config(), &w, DENSITY);
     let stated = ad.min_angle().expect("edge method");
     let mut worst: Scalar = 180.0;
@@ -562,8 +554,7 @@ fn swinging_symplectic(
     dt_scale: Scalar,
     duration: Scalar,
 ) -> (Vec<Vector>, f64, u64) {
-    use drape::physics::{ExternalForces, MaterialParams, Model, Stepper};
-    use drape::scene::{BendingModel, Integrator, StiffnessRule};
+    use drape::scene::Integrator;
     let mut w = world(8, DiagonalPattern::Alternating);
     w.v.iter_mut().for_each(|v| *v = Vector::ZERO);
     w.pins = Pins::select(
@@ -573,26 +564,7 @@ fn swinging_symplectic(
     )
     .unwrap();
     let n0 = w.x.len();
-    let mat = MaterialParams {
-        density: DENSITY,
-        stretch: 200.0,
-        bending: 1e-5,
-        damping: 1e-4,
-        bending_model: BendingModel::Dihedral,
-        stiffness_rule: StiffnessRule::Consistent,
-    };
-    let ext = ExternalForces {
-        gravity: Some(Vector::new(0.0, 0.0, -9.81)),
-        ..Default::default()
-    };
-    let model = Model {
-        material: mat,
-        external: ext,
-        integrator: Integrator::SymplecticEuler,
-        cg_tolerance: 1e-6,
-        cg_max_iterations: 500,
-    };
-    let mut st = Stepper::new(model, &w);
+    let mut st = swinging_stepper(&w, Integrator::SymplecticEuler, 1e-4);
     st.multirate = multirate;
     let mut ad = Adapter::new(
         AdaptConfig {
@@ -629,30 +601,10 @@ fn swinging_symplectic(
 
 #[test]
 fn multirate_on_a_uniform_mesh_is_single_rate_exactly() {
-    use drape::physics::{ExternalForces, MaterialParams, Model, Stepper};
-    use drape::scene::{BendingModel, Integrator, StiffnessRule};
+    use drape::scene::Integrator;
     let run = |multirate: bool| {
         let mut w = world(8, DiagonalPattern::Alternating);
-        let mat = MaterialParams {
-            density: DENSITY,
-            stretch: 200.0,
-            bending: 1e-5,
-            damping: 1e-4,
-            bending_model: BendingModel::Dihedral,
-            stiffness_rule: StiffnessRule::Consistent,
-        };
-        let ext = ExternalForces {
-            gravity: Some(Vector::new(0.0, 0.0, -9.81)),
-            ..Default::default()
-        };
-        let model = Model {
-            material: mat,
-            external: ext,
-            integrator: Integrator::SymplecticEuler,
-            cg_tolerance: 1e-6,
-            cg_max_iterations: 500,
-        };
-        let mut st = Stepper::new(model, &w);
+        let mut st = swinging_stepper(&w, Integrator::SymplecticEuler, 1e-4);
         st.multirate = multirate;
         for _ in 0..50 {
             st.step(&mut w, 2e-4);
