@@ -1,5 +1,6 @@
-//! Paper A's multirate stepping for symplectic Euler: each level of the adapted
-//! mesh takes its own time step.
+//! Paper A's multirate stepping for the explicit integrators: each level of the
+//! adapted mesh takes its own time step. Symplectic Euler uses the kick-drift
+//! scheme below; RK4 is in [`rk4_multirate`].
 //!
 //! A vertex's level is the highest level of its triangles. Paper A divides the
 //! step by sqrt(2) per level, `t_L = t_0 / 2^(L/2)` (a 1-4 split adds two levels
@@ -43,6 +44,8 @@ struct Group {
     springs: Vec<u32>,
     hinges: Vec<u32>,
     triangles: Vec<u32>,
+    /// Vertices of other levels that the group's elements touch.
+    halo: Vec<u32>,
 }
 
 /// Level groups of the current mesh, finest first, and the macro step.
@@ -102,6 +105,19 @@ impl Levels {
                 t as u32,
                 |g| &mut g.triangles,
             );
+        }
+        for g in groups.iter_mut() {
+            let mut halo: Vec<u32> = g
+                .springs
+                .iter()
+                .flat_map(|&s| el.springs[s as usize].v)
+                .chain(g.hinges.iter().flat_map(|&h| el.hinges[h as usize].v))
+                .chain(g.triangles.iter().flat_map(|&t| mesh.triangles[t as usize]))
+                .filter(|&v| mark[v as usize] != g.level as usize)
+                .collect();
+            halo.sort_unstable();
+            halo.dedup();
+            g.halo = halo;
         }
         let limits = vertex_limits(mesh, el, drag_per_area);
         let mut macro_dt = Scalar::INFINITY;
@@ -264,4 +280,128 @@ fn level_forces(
                 wind_share(tri.map(|i| x[i as usize]), tri.map(|i| v[i as usize]), wind);
         }
     }
+}
+
+/// Scratch of the RK4 multirate step.
+#[derive(Debug, Clone, Default)]
+pub struct Rk4MultirateScratch {
+    xs: Vec<Vector>,
+    vs: Vec<Vector>,
+    x_new: Vec<Vector>,
+    v_new: Vec<Vector>,
+}
+
+/// One RK4 macro step of `big` seconds. Each level integrates its own vertices
+/// with RK4 at its own substep; the vertices of other levels that its elements
+/// touch move at their velocity from the start of the macro step (paper A:
+/// their motion is unchanged, zero acceleration). With one level this is RK4.
+pub fn rk4_multirate(st: &mut Stepper, w: &mut World, big: Scalar) {
+    let t = w.time;
+    w.pins.held_at(t, &mut st.held);
+    if st.levels.is_none() {
+        let drag = st.model.external.drag.unwrap_or(0.0);
+        st.levels = Some(Levels::build(&w.mesh, &st.elements, drag));
+    }
+    let Some(levels) = st.levels.take() else {
+        return;
+    };
+    let mut rk = std::mem::take(&mut st.rk4_multirate);
+    let n = w.x.len();
+    for (buf, src) in [
+        (&mut rk.xs, &w.x),
+        (&mut rk.vs, &w.v),
+        (&mut rk.x_new, &w.x),
+        (&mut rk.v_new, &w.v),
+    ] {
+        buf.clear();
+        buf.extend_from_slice(src);
+    }
+    debug_assert_eq!(rk.xs.len(), n);
+    let scratch = &mut st.forces;
+    scratch
+        .spring
+        .resize(st.elements.springs.len(), Vector::ZERO);
+    scratch
+        .hinge
+        .resize(4 * st.elements.hinges.len(), Vector::ZERO);
+    if st.model.external.wind.is_some() {
+        scratch
+            .triangle
+            .resize(w.mesh.triangles.len(), Vector::ZERO);
+    }
+    const WEIGHT: [Scalar; 4] = [1.0, 2.0, 2.0, 1.0];
+    const AT: [Scalar; 4] = [0.0, 0.5, 0.5, 1.0];
+    for g in &levels.groups {
+        let h = big / g.substeps as Scalar;
+        for sub in 0..g.substeps {
+            let t_sub = sub as Scalar * h;
+            // State of the group's vertices at the start of the substep.
+            let y0: Vec<(Vector, Vector)> = g
+                .vertices
+                .iter()
+                .map(|&i| (rk.x_new[i as usize], rk.v_new[i as usize]))
+                .collect();
+            let mut acc: Vec<(Vector, Vector)> = vec![(Vector::ZERO, Vector::ZERO); y0.len()];
+            let mut stage: Vec<(Vector, Vector)> = y0.clone();
+            for s in 0..4 {
+                // Other levels' vertices move at their macro-start velocity.
+                let tau = t_sub + AT[s] * h;
+                for &o in &g.halo {
+                    let o = o as usize;
+                    rk.xs[o] = w.x[o] + w.v[o] * tau;
+                    rk.vs[o] = w.v[o];
+                }
+                for (&i, &(x, v)) in g.vertices.iter().zip(&stage) {
+                    rk.xs[i as usize] = x;
+                    rk.vs[i as usize] = v;
+                }
+                level_forces(
+                    &st.elements,
+                    &st.model.external,
+                    &w.mesh.triangles,
+                    &rk.xs,
+                    &rk.vs,
+                    g,
+                    scratch,
+                );
+                let (el, ext, held, forces) =
+                    (&st.elements, &st.model.external, &st.held, &*scratch);
+                let derivs: Vec<(Vector, Vector)> = g
+                    .vertices
+                    .par_iter()
+                    .zip(stage.par_iter())
+                    .with_min_len(256)
+                    .map(|(&i, &(_, v))| {
+                        let i = i as usize;
+                        let a = if held[i] {
+                            Vector::ZERO
+                        } else {
+                            gather(el, ext, forces, i, v) / el.mass[i]
+                        };
+                        (v, a)
+                    })
+                    .collect();
+                for (k, &(dx, dv)) in derivs.iter().enumerate() {
+                    acc[k].0 += dx * WEIGHT[s];
+                    acc[k].1 += dv * WEIGHT[s];
+                    if s < 3 {
+                        let c = AT[s + 1] * h;
+                        stage[k] = (y0[k].0 + dx * c, y0[k].1 + dv * c);
+                    }
+                }
+            }
+            for (k, &i) in g.vertices.iter().enumerate() {
+                let i = i as usize;
+                if !st.held[i] {
+                    rk.x_new[i] = y0[k].0 + acc[k].0 * (h / 6.0);
+                    rk.v_new[i] = y0[k].1 + acc[k].1 * (h / 6.0);
+                }
+            }
+        }
+    }
+    std::mem::swap(&mut w.x, &mut rk.x_new);
+    std::mem::swap(&mut w.v, &mut rk.v_new);
+    st.rk4_multirate = rk;
+    st.levels = Some(levels);
+    w.pins.apply(t + big, &mut w.x, &mut w.v);
 }

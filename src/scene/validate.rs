@@ -390,13 +390,9 @@ fn adapt(a: &Adapt, integrator: Integrator) -> Result<(), Issue> {
             "rollback is paper A's and works with method = \"red_green\" only",
         ));
     }
-    if a.multirate && integrator != Integrator::SymplecticEuler {
+    if a.multirate && integrator == Integrator::Implicit {
         let path = keys(&["adapt", "multirate"]);
-        let why = if integrator == Integrator::Implicit {
-            "multirate stepping is for the explicit integrators; use integrator = \"symplectic_euler\""
-        } else {
-            "multirate stepping is implemented for integrator = \"symplectic_euler\" only in this version of drape (not rk4 yet)"
-        };
+        let why = "multirate stepping is for the explicit integrators (symplectic_euler, rk4)";
         return Err(Issue::new(path, Kind::Unsupported, why));
     }
     Ok(())

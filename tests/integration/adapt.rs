@@ -549,12 +549,12 @@ fn edge_method_refine_then_flatten_returns_near_the_original_vertex_count() {
 
 /// Runs the adaptive swinging sheet with symplectic Euler for `duration`;
 /// returns the original (level-0) vertices' positions, the wall time and steps.
-fn swinging_symplectic(
+fn swinging_explicit(
+    integrator: drape::scene::Integrator,
     multirate: bool,
     dt_scale: Scalar,
     duration: Scalar,
 ) -> (Vec<Vector>, f64, u64) {
-    use drape::scene::Integrator;
     let mut w = world(8, DiagonalPattern::Alternating);
     w.v.iter_mut().for_each(|v| *v = Vector::ZERO);
     w.pins = Pins::select(
@@ -564,7 +564,7 @@ fn swinging_symplectic(
     )
     .unwrap();
     let n0 = w.x.len();
-    let mut st = swinging_stepper(&w, Integrator::SymplecticEuler, 1e-4);
+    let mut st = swinging_stepper(&w, integrator, 1e-4);
     st.multirate = multirate;
     let mut ad = Adapter::new(
         AdaptConfig {
@@ -602,46 +602,57 @@ fn swinging_symplectic(
 #[test]
 fn multirate_on_a_uniform_mesh_is_single_rate_exactly() {
     use drape::scene::Integrator;
-    let run = |multirate: bool| {
-        let mut w = world(8, DiagonalPattern::Alternating);
-        let mut st = swinging_stepper(&w, Integrator::SymplecticEuler, 1e-4);
-        st.multirate = multirate;
-        for _ in 0..50 {
-            st.step(&mut w, 2e-4);
-        }
-        w.x
-    };
-    let (a, b) = (run(false), run(true));
-    assert!(
-        a.iter()
+    for integrator in [Integrator::SymplecticEuler, Integrator::Rk4] {
+        let run = |multirate: bool| {
+            let mut w = world(8, DiagonalPattern::Alternating);
+            let mut st = swinging_stepper(&w, integrator, 1e-4);
+            st.multirate = multirate;
+            for _ in 0..50 {
+                st.step(&mut w, 2e-4);
+            }
+            w.x
+        };
+        let (a, b) = (run(false), run(true));
+        let same = a
+            .iter()
             .zip(&b)
-            .all(|(p, q)| p.to_array().map(f64::to_bits) == q.to_array().map(f64::to_bits))
-    );
+            .all(|(p, q)| p.to_array().map(f64::to_bits) == q.to_array().map(f64::to_bits));
+        assert!(
+            same,
+            "{integrator:?}: multirate on one level differs from single rate"
+        );
+    }
 }
 
 #[test]
 fn multirate_against_single_rate_time_and_error() {
+    use drape::scene::Integrator;
     let duration = 0.6;
-    let (reference, _, ref_steps) = swinging_symplectic(false, 0.25, duration);
-    let (single, single_s, single_steps) = swinging_symplectic(false, 1.0, duration);
-    let (multi, multi_s, multi_steps) = swinging_symplectic(true, 1.0, duration);
-    let rms = |a: &[Vector]| {
-        (a.iter()
-            .zip(&reference)
-            .map(|(p, q)| p.distance_squared(*q))
-            .sum::<Scalar>()
-            / a.len() as Scalar)
-            .sqrt()
-    };
-    println!(
-        "multirate vs single rate, adaptive swinging sheet, {duration} s: single {single_steps} steps {single_s:.3} s, RMS error {:.3e} m; multirate {multi_steps} macro steps {multi_s:.3} s, RMS error {:.3e} m (reference: single rate, step / 4, {ref_steps} steps)",
-        rms(&single),
-        rms(&multi)
-    );
-    assert!(multi.iter().all(|p| p.is_finite()));
-    assert!(
-        rms(&multi) < 0.05,
-        "multirate stays close to the reference: {}",
-        rms(&multi)
-    );
+    for integrator in [Integrator::SymplecticEuler, Integrator::Rk4] {
+        let (reference, _, ref_steps) = swinging_explicit(integrator, false, 0.25, duration);
+        let (single, single_s, single_steps) = swinging_explicit(integrator, false, 1.0, duration);
+        let (multi, multi_s, multi_steps) = swinging_explicit(integrator, true, 1.0, duration);
+        let rms = |a: &[Vector]| {
+            (a.iter()
+                .zip(&reference)
+                .map(|(p, q)| p.distance_squared(*q))
+                .sum::<Scalar>()
+                / a.len() as Scalar)
+                .sqrt()
+        };
+        println!(
+            "{integrator:?} multirate vs single rate, adaptive swinging sheet, {duration} s: single {single_steps} steps {single_s:.3} s, RMS error {:.3e} m; multirate {multi_steps} macro steps {multi_s:.3} s, RMS error {:.3e} m (reference: single rate, step / 4, {ref_steps} steps)",
+            rms(&single),
+            rms(&multi)
+        );
+        assert!(multi.iter().all(|p| p.is_finite()));
+        // Holding the other levels still (tried first) drifted 0.48 m away; the
+        // schemes used stay within a few times the single-rate error.
+        assert!(
+            rms(&multi) < 4.0 * rms(&single).max(1e-4),
+            "{integrator:?}: multirate error {} vs single rate {}",
+            rms(&multi),
+            rms(&single)
+        );
+    }
 }
