@@ -21,7 +21,7 @@ use crate::math::{Scalar, Vector};
 
 /// Signed dihedral angle (radians) and its gradient with respect to `[a, b, p, q]`.
 /// A degenerate hinge (a wing of zero area) gives zero angle and gradient.
-#[inline]
+#[inline(always)]
 pub fn dihedral_angle_and_gradient(x: [Vector; 4]) -> (Scalar, [Vector; 4]) {
     let [a, b, p, q] = x;
     let e = b - a;
