@@ -10,7 +10,7 @@ use crate::adapt::{AdaptConfig, AdaptStats, Adapter, EventKind, edge_angles};
 use crate::collide::{CollideError, Collider, CollisionStats};
 use crate::math::{Scalar, Vector, deterministic_sum};
 use crate::physics::{Energy, Model, Stepper};
-use crate::record::{FrameView, RecordError, Recorder, obj::write_frame_obj};
+use crate::record::{EventMark, FrameView, RecordError, Recorder, obj::write_frame_obj};
 use crate::scene::{Scene, TimeStep};
 use crate::summary::{EnergySummary, Range, RecordingSummary, Summary};
 use crate::world::{BuildError, World};
@@ -181,6 +181,7 @@ fn run_in_pool(
             .as_mut()
             .map(Adapter::take_events)
             .unwrap_or_default();
+        let marks: Vec<EventMark> = events.iter().map(event_mark).collect();
         let max_angle = edge_angles(&world).into_iter().fold(0.0, Scalar::max);
         tally.observe(&world, energy);
         let t1 = Instant::now();
@@ -218,6 +219,7 @@ fn run_in_pool(
                 triangle_levels: &world.mesh.levels,
                 pinned: &pinned,
                 scalars: &scalars,
+                events: &marks,
             })?;
             if let Some(c) = &pipe.collider {
                 // Static obstacles once, moving ones every frame.
@@ -539,5 +541,24 @@ impl Tally {
                 .recording
                 .map(|(path, bytes)| RecordingSummary { path, bytes }),
         }
+    }
+}
+
+/// The recording's plain view of an adaptivity event.
+fn event_mark(e: &crate::adapt::AdaptEvent) -> EventMark {
+    let kind = match e.kind {
+        EventKind::Split => "split",
+        EventKind::ClosureSplit => "closure_split",
+        EventKind::Merge => "merge",
+        EventKind::Rollback => "rollback",
+        EventKind::Flip => "flip",
+        EventKind::Collapse => "collapse",
+    };
+    EventMark {
+        kind,
+        position: e.position,
+        level: e.level,
+        angle: e.angle,
+        step: e.step,
     }
 }

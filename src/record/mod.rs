@@ -32,8 +32,8 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use rerun::blueprint::{
-    Blueprint, BlueprintActivation, ContainerLike, Horizontal, Spatial3DView, TimeSeriesView,
-    Vertical,
+    Blueprint, BlueprintActivation, ContainerLike, Horizontal, Spatial3DView, TextLogView,
+    TimeSeriesView, Vertical,
 };
 use rerun::{EntityPath, RecordingStream, RecordingStreamBuilder};
 
@@ -109,6 +109,40 @@ pub struct FrameView<'a> {
     pub pinned: &'a [u32],
     /// Plot path -> value, e.g. `("energy/kinetic", 0.1)`, logged at `plots/<path>`.
     pub scalars: &'a [(&'a str, f64)],
+    /// Remeshing events since the previous frame, shown at `events/points` and
+    /// written one line each to `events/log`.
+    pub events: &'a [EventMark],
+}
+
+/// One remeshing event, as plain data for the recording.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EventMark {
+    /// What happened: `split`, `closure_split`, `merge`, `flip`, `collapse` or `rollback`.
+    pub kind: &'static str,
+    /// Where, in world coordinates (m).
+    pub position: Vector,
+    /// Level of the triangles it made.
+    pub level: u8,
+    /// The angle that triggered it, degrees, if any.
+    pub angle: Option<f64>,
+    /// The step after which it happened.
+    pub step: u64,
+}
+
+/// Entity of the event points (one point per event of the frame, labelled).
+pub const ENTITY_EVENT_POINTS: &str = "events/points";
+/// Entity of the event log (one text line per event).
+pub const ENTITY_EVENT_LOG: &str = "events/log";
+
+/// Colour of an event's point by kind, sRGB.
+fn event_color(kind: &str) -> [u8; 3] {
+    match kind {
+        "split" => [0xFF, 0x8F, 0x00],
+        "closure_split" => [0xFF, 0xD5, 0x4F],
+        "merge" | "collapse" => [0x42, 0xA5, 0xF5],
+        "flip" => [0xBD, 0xBD, 0xBD],
+        _ => [0xE5, 0x39, 0x35],
+    }
 }
 
 /// Boxed error from rerun, kept opaque so rerun's types stay inside this module.
@@ -325,6 +359,8 @@ impl Recorder {
             .log(self.pins_path.clone(), &pins)
             .map_err(|e| self.log_err(ENTITY_PINS, e))?;
 
+        self.record_events(frame.events)?;
+
         for &(name, value) in frame.scalars {
             let path = match self.scalar_paths.get(name) {
                 Some(path) => path.clone(),
@@ -398,8 +434,41 @@ impl Recorder {
         Ok(len)
     }
 
+    /// Logs the frame's events: labelled points (an empty set when there are none, so the
+    /// 3D view shows only the current frame's events) and one text line per event.
+    fn record_events(&mut self, events: &[EventMark]) -> Result<(), RecordError> {
+        let points = rerun::Points3D::new(events.iter().map(|e| convert::position(e.position)))
+            .with_colors(events.iter().map(|e| {
+                let [r, g, b] = event_color(e.kind);
+                rerun::Rgba32::from_rgb(r, g, b)
+            }))
+            .with_labels(events.iter().map(|e| e.kind))
+            .with_radii([rerun::Radius::new_ui_points(6.0)]);
+        self.stream
+            .log(ENTITY_EVENT_POINTS, &points)
+            .map_err(|e| self.log_err(ENTITY_EVENT_POINTS, e))?;
+        for e in events {
+            let angle = e
+                .angle
+                .map(|a| format!(", angle {a:.2} deg"))
+                .unwrap_or_default();
+            let line = format!(
+                "{} after step {}: level {}{angle}, at ({:.3}, {:.3}, {:.3}) m",
+                e.kind, e.step, e.level, e.position.x, e.position.y, e.position.z
+            );
+            let level = if e.kind == "rollback" { "WARN" } else { "INFO" };
+            self.stream
+                .log(
+                    ENTITY_EVENT_LOG,
+                    &rerun::TextLog::new(line).with_level(level),
+                )
+                .map_err(|err| self.log_err(ENTITY_EVENT_LOG, err))?;
+        }
+        Ok(())
+    }
+
     /// Sends the default blueprint: the 3D scene beside one time-series view per top-level
-    /// plot group (first segment of the scalar names).
+    /// plot group (first segment of the scalar names) and the event log.
     fn send_blueprint(&self, scalars: &[(&str, f64)]) -> Result<(), RecordError> {
         // rerun 0.36.3's `Blueprint::send` builds an internal stream that honours `RERUN=off`
         // and then panics on its empty output: skip the blueprint in that case.
@@ -421,7 +490,10 @@ impl Recorder {
                     .with_origin(format!("{ENTITY_PLOTS}/{g}"))
                     .into()
             });
-            Horizontal::new([scene, Vertical::new(plots).into()])
+            let log: ContainerLike = TextLogView::new("events")
+                .with_origin(ENTITY_EVENT_LOG)
+                .into();
+            Horizontal::new([scene, Vertical::new(plots.chain([log])).into()])
                 .with_column_shares([2.0_f32, 1.0])
                 .into()
         };

@@ -660,3 +660,38 @@ fn multirate_against_single_rate_time_and_error() {
         );
     }
 }
+
+#[test]
+fn recording_holds_one_event_log_line_per_engine_event() {
+    use std::sync::atomic::AtomicBool;
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/hanging_sheet.toml");
+    let sets: Vec<String> = ["simulation.duration=0.3", "cloth.resolution=8"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    let scene = drape::scene::load_scene_file(&path, &sets).unwrap();
+    let out = std::env::temp_dir().join(format!("drape-events-{}.rrd", std::process::id()));
+    let opts = drape::run::RunOptions {
+        record: Some(out.clone()),
+        ..Default::default()
+    };
+    let summary = drape::run::run(&scene, &opts, &AtomicBool::new(false), &mut |_| {}).unwrap();
+    let decoded = crate::recording::decode(&out);
+    std::fs::remove_file(&out).ok();
+    let a = summary.adapt.unwrap();
+    let engine_events = a.splits + a.merges + a.flips + a.rollbacks;
+    let logged = decoded.rows.get("/events/log").copied().unwrap_or(0) as u64;
+    println!(
+        "events: {} splits, {} merges, {} rollbacks -> {logged} log rows; {} point rows",
+        a.splits,
+        a.merges,
+        a.rollbacks,
+        decoded.rows.get("/events/points").copied().unwrap_or(0)
+    );
+    assert!(engine_events > 0);
+    assert_eq!(logged, engine_events);
+    assert_eq!(
+        decoded.rows.get("/events/points").copied(),
+        Some(summary.frames as usize)
+    );
+}

@@ -75,6 +75,7 @@ fn record_mesh(
             triangle_levels: &mesh.levels,
             pinned: &mesh.pinned,
             scalars: &scalars,
+            events: &[],
         })?;
         spent += start.elapsed();
         std::thread::sleep(pause);
@@ -265,6 +266,7 @@ fn dropped_recorder_leaves_valid_file() {
             triangle_levels: &sq.levels,
             pinned: &sq.pinned,
             scalars: &[],
+            events: &[],
         })?;
         // A later frame is invalid: `?` returns early and drops the recorder.
         rec.record_frame(&FrameView {
@@ -276,6 +278,7 @@ fn dropped_recorder_leaves_valid_file() {
             triangle_levels: &[0],
             pinned: &[],
             scalars: &[],
+            events: &[],
         })?;
         Ok(())
     })();
