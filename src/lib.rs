@@ -6,6 +6,7 @@
 //! stepper's scratch memory ([`physics::Stepper`]), as in rapier's sets and pipeline.
 
 pub mod adapt;
+pub mod bench;
 pub mod check;
 pub mod collide;
 pub mod math;

@@ -6,6 +6,7 @@ mod cli;
 mod collide;
 mod common;
 mod mesh;
+mod metric;
 mod physics;
 mod recording;
 mod scene_errors;

@@ -1,0 +1,125 @@
+//! The error metric of SPEC section 8.
+//!
+//! Fixed sample points in material space are located in each mesh through the
+//! material coordinates (the same cloth point on any mesh, uniform or adapted),
+//! and their world positions are interpolated barycentrically. The error of a
+//! run at a time is the RMS distance between its samples and the reference's,
+//! divided by the cloth's diagonal (in material space).
+
+use crate::math::{Scalar, Vector, Vector2};
+use crate::mesh::Mesh;
+
+/// Where a material point lies in a mesh: its triangle and barycentric weights.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Located {
+    /// Triangle index.
+    pub triangle: u32,
+    /// Barycentric weights of the triangle's three vertices (sum 1).
+    pub weights: [Scalar; 3],
+}
+
+/// Sample points on a regular `n` x `n` grid over the mesh's material bounds,
+/// kept where they fall inside the cloth (for a disk or an OBJ outline).
+pub fn grid_samples(mesh: &Mesh, n: usize) -> Vec<Vector2> {
+    let (lo, hi) = mesh.material_bounds();
+    let n = n.max(1);
+    let mut out = Vec::with_capacity(n * n);
+    for j in 0..n {
+        for i in 0..n {
+            // Cell centres: never exactly on the boundary.
+            let t = Vector2::new(
+                (i as Scalar + 0.5) / n as Scalar,
+                (j as Scalar + 0.5) / n as Scalar,
+            );
+            out.push(lo + (hi - lo) * t);
+        }
+    }
+    let located = locate(mesh, &out);
+    out.into_iter()
+        .zip(located)
+        .filter_map(|(p, l)| l.map(|_| p))
+        .collect()
+}
+
+/// Finds each point's triangle, or `None` outside the cloth. Uses a uniform
+/// bucket grid over the triangles' material bounding boxes.
+pub fn locate(mesh: &Mesh, points: &[Vector2]) -> Vec<Option<Located>> {
+    let (lo, hi) = mesh.material_bounds();
+    let cells = ((mesh.triangles.len() as Scalar).sqrt().ceil() as usize).max(1);
+    let size = (hi - lo).max(Vector2::splat(Scalar::MIN_POSITIVE)) / cells as Scalar;
+    let cell_of = |p: Vector2| {
+        let c = ((p - lo) / size).floor();
+        (
+            c.x.clamp(0.0, (cells - 1) as Scalar) as usize,
+            c.y.clamp(0.0, (cells - 1) as Scalar) as usize,
+        )
+    };
+    let mut buckets: Vec<Vec<u32>> = vec![Vec::new(); cells * cells];
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        let corners = tri.map(|v| mesh.material[v as usize]);
+        let (a, b) = (
+            corners[0].min(corners[1]).min(corners[2]),
+            corners[0].max(corners[1]).max(corners[2]),
+        );
+        let ((x0, y0), (x1, y1)) = (cell_of(a), cell_of(b));
+        for y in y0..=y1 {
+            for x in x0..=x1 {
+                buckets[y * cells + x].push(t as u32);
+            }
+        }
+    }
+    points
+        .iter()
+        .map(|&p| {
+            let (x, y) = cell_of(p);
+            buckets[y * cells + x].iter().find_map(|&t| {
+                let w = barycentric(mesh, t, p)?;
+                Some(Located {
+                    triangle: t,
+                    weights: w,
+                })
+            })
+        })
+        .collect()
+}
+
+/// Barycentric weights of `p` in triangle `t`, if it lies inside (with a small
+/// tolerance so that points on shared edges are found).
+fn barycentric(mesh: &Mesh, t: u32, p: Vector2) -> Option<[Scalar; 3]> {
+    let [a, b, c] = mesh.triangles[t as usize].map(|v| mesh.material[v as usize]);
+    let area = (b - a).perp_dot(c - a);
+    if area == 0.0 {
+        return None;
+    }
+    let wa = (b - p).perp_dot(c - p) / area;
+    let wb = (c - p).perp_dot(a - p) / area;
+    let wc = 1.0 - wa - wb;
+    let tol = -1e-12;
+    (wa >= tol && wb >= tol && wc >= tol).then_some([wa, wb, wc])
+}
+
+/// World positions of located samples for positions `x` of `mesh`'s vertices.
+pub fn sample_positions(mesh: &Mesh, x: &[Vector], located: &[Located]) -> Vec<Vector> {
+    located
+        .iter()
+        .map(|l| {
+            let tri = mesh.triangles[l.triangle as usize];
+            (0..3).map(|k| x[tri[k] as usize] * l.weights[k]).sum()
+        })
+        .collect()
+}
+
+/// RMS distance between two sample sets, divided by `scale` (the diagonal).
+pub fn relative_rms(a: &[Vector], b: &[Vector], scale: Scalar) -> Scalar {
+    if a.is_empty() {
+        return 0.0;
+    }
+    let sum: Scalar = a.iter().zip(b).map(|(p, q)| p.distance_squared(*q)).sum();
+    (sum / a.len() as Scalar).sqrt() / scale
+}
+
+/// The cloth's diagonal in material space, m.
+pub fn diagonal(mesh: &Mesh) -> Scalar {
+    let (lo, hi) = mesh.material_bounds();
+    lo.distance(hi)
+}

@@ -1,0 +1,114 @@
+//! The error metric: identical meshes give 0, a rigid offset gives exactly that
+//! offset, and samples are the same cloth points on a uniform and an adapted mesh.
+
+use drape::adapt::red_green::RedGreenOp;
+use drape::adapt::{AdaptConfig, Adapter};
+use drape::bench::metric::{diagonal, grid_samples, locate, relative_rms, sample_positions};
+use drape::math::{Scalar, Vector};
+use drape::mesh;
+use drape::scene::{AdaptMethod, DiagonalPattern};
+use drape::world::World;
+
+/// A 2 m x 1 m sheet bent into a smooth wave (so interpolation matters).
+fn wavy(res: u32) -> World {
+    let m = mesh::rectangle(2.0, 1.0, res, DiagonalPattern::Alternating).unwrap();
+    let x = m
+        .material
+        .iter()
+        .map(|p| Vector::new(p.x, p.y, 0.1 * (3.0 * p.x).sin() * p.y))
+        .collect();
+    World::new(m, x)
+}
+
+#[test]
+fn identical_meshes_have_zero_error() {
+    let w = wavy(16);
+    let samples = grid_samples(&w.mesh, 20);
+    assert_eq!(
+        samples.len(),
+        400,
+        "every grid sample lies inside a rectangle"
+    );
+    let located: Vec<_> = locate(&w.mesh, &samples)
+        .into_iter()
+        .map(Option::unwrap)
+        .collect();
+    let a = sample_positions(&w.mesh, &w.x, &located);
+    assert_eq!(relative_rms(&a, &a, diagonal(&w.mesh)), 0.0);
+}
+
+#[test]
+fn a_rigid_offset_gives_exactly_that_offset() {
+    let w = wavy(16);
+    let samples = grid_samples(&w.mesh, 20);
+    let located: Vec<_> = locate(&w.mesh, &samples)
+        .into_iter()
+        .map(Option::unwrap)
+        .collect();
+    let a = sample_positions(&w.mesh, &w.x, &located);
+    let shift = Vector::new(0.03, -0.04, 0.0); // 5 cm
+    let moved: Vec<Vector> = w.x.iter().map(|p| *p + shift).collect();
+    let b = sample_positions(&w.mesh, &moved, &located);
+    let diag = diagonal(&w.mesh);
+    let err = relative_rms(&a, &b, diag);
+    assert!(
+        (err - 0.05 / diag).abs() < 1e-14,
+        "{err} vs {}",
+        0.05 / diag
+    );
+}
+
+#[test]
+fn samples_are_the_same_cloth_points_on_an_adapted_mesh() {
+    // Refining a flat region keeps every sample's position: the new vertices lie
+    // on the old triangles, so interpolation gives the same points.
+    let mut w = wavy(8);
+    let flat: Vec<Vector> = w.mesh.material.iter().map(|p| p.extend(0.0)).collect();
+    w.x = flat;
+    let samples = grid_samples(&w.mesh, 25);
+    let before_loc: Vec<_> = locate(&w.mesh, &samples)
+        .into_iter()
+        .map(Option::unwrap)
+        .collect();
+    let before = sample_positions(&w.mesh, &w.x, &before_loc);
+    let cfg = AdaptConfig {
+        method: AdaptMethod::RedGreen,
+        refine_angle: 15.0,
+        coarsen_angle: 1.5,
+        max_level: 4,
+        min_edge_length: 0.0,
+        every: 1,
+        rollback: false,
+        max_rollbacks: 0,
+    };
+    let mut ad = Adapter::new(cfg, &w, 0.15);
+    let leaves: Vec<_> = ad
+        .hierarchy()
+        .leaves()
+        .into_iter()
+        .step_by(3)
+        .map(|l| (RedGreenOp::Split(l), None))
+        .collect();
+    ad.apply(&mut w, &leaves, 0).unwrap();
+    let after_loc: Vec<_> = locate(&w.mesh, &samples)
+        .into_iter()
+        .map(Option::unwrap)
+        .collect();
+    let after = sample_positions(&w.mesh, &w.x, &after_loc);
+    let err: Scalar = relative_rms(&before, &after, diagonal(&w.mesh));
+    assert!(err < 1e-15, "{err}");
+    assert!(w.mesh.vertex_count() > 45, "the mesh was refined");
+}
+
+#[test]
+fn points_outside_a_disk_are_not_located() {
+    let m = mesh::disk(0.5, 8).unwrap();
+    let samples = grid_samples(&m, 10);
+    assert!(
+        samples.len() < 100 && samples.len() > 50,
+        "{}",
+        samples.len()
+    );
+    let outside = locate(&m, &[drape::math::Vector2::new(0.49, 0.49)]);
+    assert!(outside[0].is_none());
+}
