@@ -40,3 +40,28 @@ where
         .collect();
     partial.iter().sum()
 }
+
+/// Two sums at once, each in exactly the association order of
+/// [`deterministic_sum`] (same chunks, same order), so each result is
+/// bit-identical to summing that component alone.
+pub fn deterministic_sum2<F>(len: usize, term: F) -> (Scalar, Scalar)
+where
+    F: Fn(usize) -> (Scalar, Scalar) + Sync,
+{
+    use rayon::prelude::*;
+    const CHUNK: usize = 2048;
+    let chunks = len.div_ceil(CHUNK);
+    let partial: Vec<(Scalar, Scalar)> = (0..chunks)
+        .into_par_iter()
+        .map(|c| {
+            let end = ((c + 1) * CHUNK).min(len);
+            // `Iterator::sum` for floats folds from -0.0; do the same.
+            (c * CHUNK..end)
+                .map(&term)
+                .fold((-0.0, -0.0), |(a, b), (x, y)| (a + x, b + y))
+        })
+        .collect();
+    let a = partial.iter().map(|p| p.0).sum();
+    let b = partial.iter().map(|p| p.1).sum();
+    (a, b)
+}

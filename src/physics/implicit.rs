@@ -22,7 +22,7 @@ use rayon::prelude::*;
 use super::Stepper;
 use super::bending::dihedral_angle_and_gradient;
 use super::forces::{PAR_MIN, spring_force, wind_share};
-use crate::math::{Matrix3, Scalar, Vector, deterministic_sum};
+use crate::math::{Matrix3, Scalar, Vector, deterministic_sum, deterministic_sum2};
 use crate::world::World;
 
 /// Scratch memory of the implicit step, kept between steps.
@@ -73,7 +73,7 @@ pub fn backward_euler(st: &mut Stepper, w: &mut World, h: Scalar) -> u32 {
     let held_owned = std::mem::take(&mut st.held);
     let held = &held_owned;
     // r = b - A dv, filtered.
-    apply_operator(st, Which::Solution);
+    apply_operator(st, Which::Solution, held);
     let s = &mut st.implicit;
     s.r.par_iter_mut()
         .zip(s.b.par_iter().zip(s.ap.par_iter()))
@@ -91,38 +91,40 @@ pub fn backward_euler(st: &mut Stepper, w: &mut World, h: Scalar) -> u32 {
     .sqrt();
     precondition(s);
     s.p.copy_from_slice(&s.z);
-    let mut rz = dot(&s.r, &s.z);
+    let (mut rz, mut rr) = dot2(&s.r, &s.z);
     let tol = st.model.cg_tolerance * b_norm;
     let mut iterations = 0;
     while iterations < st.model.cg_max_iterations {
-        let s = &st.implicit;
-        if dot(&s.r, &s.r).sqrt() <= tol {
+        if rr.sqrt() <= tol {
             break;
         }
-        apply_operator(st, Which::Direction);
+        apply_operator(st, Which::Direction, held);
         let s = &mut st.implicit;
-        s.ap.par_iter_mut().enumerate().for_each(|(i, ap)| {
-            if held[i] {
-                *ap = Vector::ZERO;
-            }
-        });
         let pap = dot(&s.p, &s.ap);
         if pap <= 0.0 || !pap.is_finite() {
             break;
         }
         let alpha = rz / pap;
+        // One pass: step the solution and the residual, precondition.
         s.dv.par_iter_mut()
-            .zip(s.p.par_iter())
-            .for_each(|(d, p)| *d += *p * alpha);
-        s.r.par_iter_mut()
-            .zip(s.ap.par_iter())
-            .for_each(|(r, ap)| *r -= *ap * alpha);
-        precondition(s);
-        let rz_new = dot(&s.r, &s.z);
+            .zip(s.r.par_iter_mut().zip(s.z.par_iter_mut()))
+            .zip(
+                s.p.par_iter()
+                    .zip(s.ap.par_iter().zip(s.inv_diag.par_iter())),
+            )
+            .with_min_len(PAR_MIN)
+            .for_each(|((d, (r, z)), (p, (ap, inv)))| {
+                *d += *p * alpha;
+                *r -= *ap * alpha;
+                *z = *r * *inv;
+            });
+        let rz_new;
+        (rz_new, rr) = dot2(&s.r, &s.z);
         let beta = rz_new / rz;
         rz = rz_new;
         s.p.par_iter_mut()
             .zip(s.z.par_iter())
+            .with_min_len(PAR_MIN)
             .for_each(|(p, z)| *p = *z + *p * beta);
         iterations += 1;
     }
@@ -257,7 +259,7 @@ enum Which {
 }
 
 /// `ap = A * (dv or p)`, matrix-free: element pass into slots, then gather.
-fn apply_operator(st: &mut Stepper, which: Which) {
+fn apply_operator(st: &mut Stepper, which: Which, held: &[bool]) {
     let el = &st.elements;
     let s = &mut st.implicit;
     let input: &Vec<Vector> = if which == Which::Solution {
@@ -290,6 +292,11 @@ fn apply_operator(st: &mut Stepper, which: Which) {
         .enumerate()
         .with_min_len(PAR_MIN)
         .for_each(|(i, out)| {
+            // Pinned rows are filtered out of the system.
+            if held[i] {
+                *out = Vector::ZERO;
+                return;
+            }
             let mut acc = input[i] * diag_mass[i];
             for &e in el.spring_first.of(i) {
                 acc += spring_slot[e as usize];
@@ -309,6 +316,11 @@ fn precondition(s: &mut ImplicitScratch) {
     s.z.par_iter_mut()
         .zip(s.r.par_iter().zip(s.inv_diag.par_iter()))
         .for_each(|(z, (r, inv))| *z = *r * *inv);
+}
+
+/// `r . z` and `r . r` in one pass, each bit-identical to its own [`dot`].
+fn dot2(r: &[Vector], z: &[Vector]) -> (Scalar, Scalar) {
+    deterministic_sum2(r.len(), |i| (r[i].dot(z[i]), r[i].dot(r[i])))
 }
 
 /// Dot product of two vector fields, deterministic at any thread count.
