@@ -89,6 +89,22 @@ pub enum RunError {
     },
 }
 
+/// The cloth's state at a frame, handed to the observer of [`run_observed`]
+/// (the benchmark samples its error metric from it).
+#[derive(Debug, Clone, Copy)]
+pub struct FrameState<'a> {
+    /// Frame index (0 is the initial state).
+    pub frame: u64,
+    /// Simulated time, s.
+    pub sim_time: Scalar,
+    /// World positions, m.
+    pub positions: &'a [Vector],
+    /// Material (rest) coordinates of the same vertices, m.
+    pub material: &'a [crate::math::Vector2],
+    /// Triangles (vertex indices).
+    pub triangles: &'a [[u32; 3]],
+}
+
 /// Runs `scene` to the end (or until `interrupt` is set), calling `progress`
 /// after every frame.
 pub fn run(
@@ -97,6 +113,18 @@ pub fn run(
     interrupt: &AtomicBool,
     progress: &mut (dyn FnMut(Progress) + Send),
 ) -> Result<Summary, RunError> {
+    run_observed(scene, opts, interrupt, progress, &mut |_| {})
+}
+
+/// [`run`], also handing every frame's state (after the step, before it is
+/// recorded) to `observe`.
+pub fn run_observed(
+    scene: &Scene,
+    opts: &RunOptions,
+    interrupt: &AtomicBool,
+    progress: &mut (dyn FnMut(Progress) + Send),
+    observe: &mut (dyn FnMut(&FrameState) + Send),
+) -> Result<Summary, RunError> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(opts.threads.unwrap_or(0))
         .build()
@@ -104,7 +132,7 @@ pub fn run(
             threads: opts.threads.unwrap_or(0),
             reason: e.to_string(),
         })?;
-    pool.install(|| run_in_pool(scene, opts, interrupt, progress))
+    pool.install(|| run_in_pool(scene, opts, interrupt, progress, observe))
 }
 
 fn run_in_pool(
@@ -112,6 +140,7 @@ fn run_in_pool(
     opts: &RunOptions,
     interrupt: &AtomicBool,
     progress: &mut (dyn FnMut(Progress) + Send),
+    observe: &mut (dyn FnMut(&FrameState) + Send),
 ) -> Result<Summary, RunError> {
     // Open the output first: an unwritable path fails before any simulation.
     let mut recorder = match &opts.record {
@@ -184,6 +213,13 @@ fn run_in_pool(
         let marks: Vec<EventMark> = events.iter().map(event_mark).collect();
         let max_angle = edge_angles(&world).into_iter().fold(0.0, Scalar::max);
         tally.observe(&world, energy);
+        observe(&FrameState {
+            frame,
+            sim_time: world.time,
+            positions: &world.x,
+            material: &world.mesh.material,
+            triangles: &world.mesh.triangles,
+        });
         let t1 = Instant::now();
         if let Some(rec) = recorder.as_mut() {
             world.vertex_normals(&mut normals);
