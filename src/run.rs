@@ -383,8 +383,7 @@ impl Pipeline {
             *world = start.clone();
             self.adapter = adapter_start.clone();
             self.steps_done = steps_start;
-            self.stepper.rebuild(world);
-            self.auto_dt = None;
+            self.mesh_changed(world);
         }
         let last_dt = self.step_size(world) / (1u64 << MAX_STEP_HALVINGS) as Scalar;
         Err(RunError::StepFailed { last_dt })
@@ -408,15 +407,8 @@ impl Pipeline {
         let mut tries = 0;
         loop {
             let before = rollback.then(|| (world.x.clone(), world.v.clone(), world.time));
-            if let Some(c) = self.collider.as_mut() {
-                c.begin_step(world);
-            }
-            self.stepper.step(world, h);
-            if !is_finite(&world.x) {
+            if !self.integrate(world, h) {
                 return Ok(false);
-            }
-            if let Some(c) = self.collider.as_mut() {
-                c.end_step(world, h, &mut self.collision);
             }
             if let (Some(ad), Some((x, v, t))) = (self.adapter.as_mut(), before)
                 && tries < ad.config.max_rollbacks
@@ -426,8 +418,7 @@ impl Pipeline {
                     (world.x, world.v, world.time) = (x, v, t);
                     ad.note_rollback(world, self.steps_done);
                     ad.refine(world, &marks, self.steps_done)?;
-                    self.stepper.rebuild(world);
-                    self.auto_dt = None;
+                    self.mesh_changed(world);
                     tries += 1;
                     continue;
                 }
@@ -439,10 +430,39 @@ impl Pipeline {
             && self.steps_done.is_multiple_of(ad.config.every)
             && ad.pass(world, self.steps_done)?
         {
-            self.stepper.rebuild(world);
-            self.auto_dt = None;
+            self.mesh_changed(world);
         }
         Ok(true)
+    }
+
+    /// The integrate and collide phases of a step; false when the state became
+    /// non-finite. The contacts the last step ended in go to the implicit solve
+    /// (filtered there, see [`crate::physics::implicit`]).
+    fn integrate(&mut self, world: &mut World, h: Scalar) -> bool {
+        let Some(c) = self.collider.as_mut() else {
+            self.stepper.step(world, h);
+            return is_finite(&world.x);
+        };
+        c.begin_step(world);
+        // Resting contacts from the last step: the vertices are on the surface now.
+        self.stepper.contacts.clear();
+        self.stepper.contacts.extend_from_slice(c.contacts());
+        self.stepper.step(world, h);
+        if !is_finite(&world.x) {
+            return false;
+        }
+        c.end_step(world, h, &self.stepper.contact_push, &mut self.collision);
+        true
+    }
+
+    /// After the world's mesh changed (remeshing, or a restored frame start): rebuild
+    /// the force elements, forget the step size and the (now stale) contacts.
+    fn mesh_changed(&mut self, world: &World) {
+        self.stepper.rebuild(world);
+        self.auto_dt = None;
+        if let Some(c) = self.collider.as_mut() {
+            c.forget_contacts();
+        }
     }
 }
 

@@ -40,6 +40,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::math::{Scalar, Vector};
+use crate::physics::Contact;
 use crate::scene::{ClothShape, ObstacleShape, Scene};
 use crate::world::World;
 use obstacle::Body;
@@ -136,6 +137,8 @@ pub struct Collider {
     self_collider: Option<SelfCollider>,
     x0: Vec<Vector>,
     held: Vec<bool>,
+    /// Per vertex: the obstacle contact the last step ended in (for the implicit solve).
+    contacts: Vec<Contact>,
     t0: Scalar,
 }
 
@@ -157,6 +160,7 @@ impl Collider {
             self_collider: scene.self_collision.as_ref().map(SelfCollider::new),
             x0: Vec::new(),
             held: Vec::new(),
+            contacts: Vec::new(),
             t0: 0.0,
         }))
     }
@@ -235,7 +239,16 @@ impl Collider {
     }
 
     /// Resolves collisions after an integrator step of `h` seconds (see the module docs).
-    pub fn end_step(&mut self, world: &mut World, h: Scalar, stats: &mut CollisionStats) {
+    /// `pushed` is the stepper's [`crate::physics::Stepper::contact_push`]: the normal
+    /// velocity change the implicit solve's contact filters imposed, per vertex (may be
+    /// empty), which counts as normal impulse for friction.
+    pub fn end_step(
+        &mut self,
+        world: &mut World,
+        h: Scalar,
+        pushed: &[Scalar],
+        stats: &mut CollisionStats,
+    ) {
         let (t0, t1) = (self.t0, world.time);
         let started = Instant::now();
         let poses: Vec<(Pose, Pose)> = self
@@ -247,19 +260,26 @@ impl Collider {
             0
         } else {
             let (bodies, x0, held) = (&self.bodies, &self.x0, &self.held);
+            self.contacts.clear();
+            self.contacts.resize(world.x.len(), Contact::default());
             world
                 .x
                 .par_iter_mut()
                 .zip(world.v.par_iter_mut())
+                .zip(self.contacts.par_iter_mut())
                 .enumerate()
                 .with_min_len(256)
-                .map(|(i, (x, v))| {
+                .map(|(i, ((x, v), contact))| {
                     if held[i] {
                         return 0u64;
                     }
                     let mut hit = false;
+                    let push = pushed.get(i).copied().unwrap_or(0.0);
                     for (b, pose) in bodies.iter().zip(&poses) {
-                        hit |= respond(b, pose, t1, h, x0[i], x, v);
+                        if let Some(c) = respond(b, pose, t1, h, push, x0[i], x, v) {
+                            *contact = c;
+                            hit = true;
+                        }
                     }
                     u64::from(hit)
                 })
@@ -310,6 +330,17 @@ impl Collider {
         stats.collision_wall_s += started.elapsed().as_secs_f64();
     }
 
+    /// The obstacle contacts the last step ended in, one per vertex (empty before the
+    /// first step); hand them to [`crate::physics::Stepper::contacts`].
+    pub fn contacts(&self) -> &[Contact] {
+        &self.contacts
+    }
+
+    /// Forgets the contacts (after the mesh changed, their vertex indices are stale).
+    pub fn forget_contacts(&mut self) {
+        self.contacts.clear();
+    }
+
     /// The Cusick drape measurements, when the scene is a disk specimen lying on a
     /// vertical cylinder (the support disk) centred under it.
     pub fn cusick(&self, scene: &Scene, world: &World) -> Option<cusick::CusickSummary> {
@@ -329,22 +360,29 @@ impl Collider {
     }
 }
 
+/// A vertex this close to a surface, in thicknesses, is in contact: resting cloth sits
+/// exactly one thickness out, and rounding must not let it flicker in and out of
+/// contact (and of the implicit solve's contact filter).
+const CONTACT_MARGIN: Scalar = 1.0 + 1e-6;
+
 /// Contact response of one vertex against one obstacle (module docs, steps 1-3).
 /// `p0` is the start-of-step position, `x`/`v` the state after the integrator.
-/// Returns true when the vertex touched the obstacle.
+/// Returns the contact when the vertex touched the obstacle.
+#[allow(clippy::too_many_arguments)]
 fn respond(
     b: &Body,
     (pose0, pose1): &(Pose, Pose),
     t1: Scalar,
     h: Scalar,
+    pushed: Scalar,
     p0: Vector,
     x: &mut Vector,
     v: &mut Vector,
-) -> bool {
+) -> Option<Contact> {
     let q0 = pose0.inverse_transform_point(p0);
     let q1 = pose1.inverse_transform_point(*x);
     if !b.may_touch(q0, q1) {
-        return false;
+        return None;
     }
     let thick = b.thickness;
     // The contact plane: outward normal and its offset n . s at the surface point s.
@@ -356,28 +394,28 @@ fn respond(
     }
     if plane.is_none() {
         let p = b.probe(q1);
-        if p.signed < thick {
+        if p.signed < thick * CONTACT_MARGIN {
             plane = Some((p.normal, p.normal.dot(q1) - p.signed));
         }
     }
-    let Some((n, offset)) = plane else {
-        return false;
-    };
+    let (n, offset) = plane?;
     let mut q = q1 + n * (offset + thick - n.dot(q1));
     let rot = pose1.rotation;
     let mut u = rot.inverse() * (*v - b.point_velocity(t1, pose1.transform_point(q)));
     let un = u.dot(n);
-    if un < 0.0 {
+    // Normal impulse per mass of the step: the approach removed here, plus what the
+    // implicit solve's contact filter already removed.
+    let dun = (-un).max(0.0) + pushed;
+    if dun > 0.0 {
         let ut = u - n * un;
         let speed = ut.length();
-        let dun = -un;
         let ut_new = if speed <= b.mu_static * dun {
             Vector::ZERO
         } else {
             ut * (1.0 - b.mu_kinetic * dun / speed)
         };
         q += (ut_new - ut) * h;
-        u = ut_new;
+        u = ut_new + n * un.max(0.0);
     }
     // Curved surfaces and corners: make sure the final point is a thickness outside.
     let f = b.probe(q);
@@ -385,8 +423,13 @@ fn respond(
         q += f.normal * (thick - f.signed);
     }
     *x = pose1.transform_point(q);
-    *v = rot * u + b.point_velocity(t1, *x);
-    true
+    let surface = b.point_velocity(t1, *x);
+    *v = rot * u + surface;
+    let normal = rot * n;
+    Some(Contact {
+        normal,
+        normal_speed: surface.dot(normal),
+    })
 }
 
 /// Pushes a vertex that came within the thickness back out along the normal and removes

@@ -16,7 +16,7 @@ pub mod timestep;
 pub use elements::{Elements, Hinge, MaterialParams, Spring};
 pub use forces::{Energy, ExternalForces, WindForce};
 
-use crate::math::Scalar;
+use crate::math::{Scalar, Vector};
 use crate::scene::Integrator;
 use crate::world::World;
 
@@ -46,6 +46,15 @@ pub struct StepStats {
     pub cg_capped: u64,
 }
 
+/// A vertex resting against an obstacle, as the collision pass left it.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Contact {
+    /// The obstacle's outward unit normal at the contact, or zero for no contact.
+    pub normal: Vector,
+    /// The obstacle surface's velocity along `normal` there, m/s.
+    pub normal_speed: Scalar,
+}
+
 /// Force elements of the current mesh plus scratch memory; no simulation state.
 #[derive(Debug, Clone)]
 pub struct Stepper {
@@ -58,6 +67,14 @@ pub struct Stepper {
     /// Paper A's multirate stepping (explicit integrators): each step is a
     /// macro step in which every level takes its own substeps.
     pub multirate: bool,
+    /// Obstacle contacts at the start of the next step, one per vertex (or empty),
+    /// set by the collision pass; the implicit integrator filters them (see
+    /// [`implicit`]). Cleared whenever the mesh changes.
+    pub contacts: Vec<Contact>,
+    /// Per vertex, after an implicit step: the normal velocity change its contact
+    /// filter imposed (m/s, >= 0; empty or zeros when none); the collision pass uses
+    /// it as the normal impulse for Coulomb friction.
+    pub contact_push: Vec<Scalar>,
     held: Vec<bool>,
     forces: forces::ForceScratch,
     rk4: explicit::Rk4Scratch,
@@ -75,6 +92,8 @@ impl Stepper {
             elements,
             stats: StepStats::default(),
             multirate: false,
+            contacts: Vec::new(),
+            contact_push: Vec::new(),
             held: vec![false; world.mesh.vertex_count()],
             forces: Default::default(),
             rk4: Default::default(),
@@ -88,6 +107,8 @@ impl Stepper {
     pub fn rebuild(&mut self, world: &World) {
         self.elements = Elements::build(&world.mesh, &self.model.material);
         self.held.resize(world.mesh.vertex_count(), false);
+        self.contacts.clear();
+        self.contact_push.clear();
         self.implicit.warm = false;
         self.levels = None;
     }
