@@ -116,6 +116,18 @@ fn cmd_run(args: RunArgs) -> Result<ExitCode> {
         obj_dir: args.obj_dir.clone(),
         threads: args.threads.map(|n| n as usize),
     };
+    // Create the OBJ directory before the recording is opened, so that an unusable
+    // one fails with its own message and leaves no recording behind.
+    if let Some(dir) = &args.obj_dir {
+        if dir.exists() && !dir.is_dir() {
+            anyhow::bail!(
+                "cannot create the OBJ directory {}: a file of that name exists",
+                dir.display()
+            );
+        }
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("cannot create the OBJ directory {}", dir.display()))?;
+    }
     // Open the summary now so that an unwritable path fails before a long run.
     let summary_file = match &args.summary {
         Some(path) => Some(
