@@ -116,6 +116,11 @@ fn cmd_run(args: RunArgs) -> Result<ExitCode> {
         obj_dir: args.obj_dir.clone(),
         threads: args.threads.map(|n| n as usize),
     };
+    // Build the cloth and the obstacles once before any output is opened: a bad
+    // OBJ or a pin that selects nothing fails here and leaves no empty recording
+    // behind (nor truncates an existing one).
+    drape::world::World::from_scene(&scene)?;
+    drape::collide::Collider::from_scene(&scene)?;
     // Create the OBJ directory before the recording is opened, so that an unusable
     // one fails with its own message and leaves no recording behind.
     if let Some(dir) = &args.obj_dir {

@@ -157,8 +157,8 @@ pub fn load_obj(path: &Path, uv_scale: Scalar) -> Result<ObjCloth, ObjError> {
 }
 
 /// Checks what tobj lets through, from the file's text: coordinates that are NaN or
-/// infinite, face indices of 0 (OBJ counts from 1; tobj reads a texture index 0 as
-/// the last one), and `vt` on some faces only (tobj fills a corner without `vt`
+/// infinite, face indices of 0 (OBJ counts from 1; tobj accepts a texture index
+/// 0, which OBJ does not define), and `vt` on some faces only (tobj fills a corner without `vt`
 /// with another corner's coordinates, so that is recognised from the text).
 fn scan_text(path: &Path, name: &str) -> Result<(), ObjError> {
     let read = |reason: String| ObjError::Read {
@@ -181,7 +181,7 @@ fn scan_text(path: &Path, name: &str) -> Result<(), ObjError> {
     for (n, line) in text.lines().enumerate() {
         let mut tokens = line.split_whitespace();
         match tokens.next() {
-            Some(kind @ ("v" | "vt" | "vn")) => {
+            Some(kind @ ("v" | "vt")) => {
                 let value = tokens
                     .filter_map(|t| t.parse::<f64>().ok())
                     .find(|x| !x.is_finite());

@@ -49,7 +49,11 @@ fn a_missing_obj_is_refused_at_its_line() {
     );
     std::fs::create_dir(dir.join("m.obj")).expect("a directory named m.obj");
     let out = drape(&dir, &["check", "o.toml"]);
-    refused(&out, 1, &["o.toml:6: key `cloth.path`: no such file"]);
+    refused(
+        &out,
+        1,
+        &["o.toml:6: key `cloth.path`: `m.obj` is a directory, not an OBJ file"],
+    );
     let dir2 = scene_dir("obstacle-missing");
     let out = drape(
         &dir2,
@@ -154,6 +158,25 @@ fn a_broken_obj_is_refused() {
         &bytes,
         &["cannot read OBJ: not a text file (it is not valid UTF-8)"],
     );
+}
+
+#[test]
+fn a_bad_obj_leaves_no_recording_behind() {
+    // `drape run` used to open the recording first and leave an empty `o.rrd`.
+    let dir = temp_dir("obj-run");
+    std::fs::write(dir.join("o.toml"), OBJ_SCENE).expect("write scene");
+    std::fs::write(dir.join("m.obj"), format!("{TRIANGLE}f 1 2 9\n")).expect("write OBJ");
+    std::fs::write(dir.join("old.rrd"), "keep").expect("an older recording");
+    for args in [
+        &["run", "o.toml"][..],
+        &["run", "o.toml", "--out", "old.rrd"],
+    ] {
+        refused(&drape(&dir, args), 1, &["m.obj", "index out of bounds"]);
+    }
+    assert!(!dir.join("o.rrd").exists(), "no empty recording");
+    let old = std::fs::read_to_string(dir.join("old.rrd")).expect("still there");
+    assert_eq!(old, "keep", "an existing recording is not truncated");
+    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]

@@ -1,7 +1,7 @@
 //! Property ("fuzz") tests of the two parsers that read user files: the scene
 //! parser and the OBJ loader never panic, whatever the text; they return a value
-//! or a proper error. Each runs a fixed number of cases (a few seconds in release)
-//! so that CI stays fast; `PROPTEST_CASES=N` runs more.
+//! or a proper error. Each runs a fixed number of cases ([`cases`]: about a second
+//! in release) so that CI stays fast; `PROPTEST_CASES=N` runs more.
 
 use std::path::{Path, PathBuf};
 
@@ -10,6 +10,14 @@ use drape::mesh::load_obj;
 use drape::scene::{Scene, load_scene_str};
 use drape::world::World;
 use proptest::prelude::*;
+
+/// Cases per fuzz test: 2000 (about a second each in release), or `PROPTEST_CASES`.
+fn cases() -> u32 {
+    std::env::var("PROPTEST_CASES")
+        .ok()
+        .and_then(|n| n.parse().ok())
+        .unwrap_or(2000)
+}
 
 /// Keys of the format (and a few that are not), for generated scenes and `--set`s.
 const KEYS: [&str; 40] = [
@@ -220,7 +228,7 @@ fn random_scene() -> impl Strategy<Value = String> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 400, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: cases(), ..ProptestConfig::default() })]
 
     /// Arbitrary text, mutated shipped scenes, and random key/value scenes and
     /// `--set`s: the scene parser returns a scene or a located error, never panics.
@@ -313,7 +321,7 @@ fn load_bytes(bytes: &[u8], uv_scale: f64, name: &str) -> Result<(), TestCaseErr
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 400, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: cases(), ..ProptestConfig::default() })]
 
     /// Random OBJ text, mutated test meshes and raw bytes: the OBJ loader returns a
     /// valid mesh or an error, never panics.
