@@ -78,6 +78,11 @@ fn command_line_usage_errors_exit_2() {
             "invalid value '0' for '--threads <N>'",
         ),
         (&["run", "--threads", "many"], "invalid value 'many'"),
+        // Used to be accepted and run for minutes (10000 threads on 2 cores).
+        (
+            &["run", "--threads", "10000"],
+            "invalid value '10000' for '--threads <N>': 10000 is not in 1..=256",
+        ),
         (
             &["run", "--out"],
             "a value is required for '--out <FILE.rrd>'",
