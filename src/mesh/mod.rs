@@ -75,6 +75,25 @@ pub enum MeshError {
         /// Number of connected pieces.
         components: usize,
     },
+    /// A material coordinate is NaN or infinite.
+    #[error("vertex {vertex} has a material coordinate that is not a finite number: {value}")]
+    NonFinite {
+        /// The vertex.
+        vertex: u32,
+        /// The offending coordinate.
+        value: Scalar,
+    },
+    /// The mesh is so large or so small that its squared lengths (areas) leave
+    /// double precision: overflow to infinity or underflow below the normal range.
+    #[error(
+        "the mesh spans {size:e} m in material space: its square is outside the normal \
+         double-precision range, so areas cannot be computed; allowed: a mesh about \
+         1.5e-154 m to 1.3e154 m across"
+    )]
+    OutOfScale {
+        /// Diagonal of the material-space bounding box, m.
+        size: Scalar,
+    },
     /// A vertex is used by no triangle.
     #[error("vertex {vertex} is not used by any triangle")]
     UnusedVertex {
@@ -104,6 +123,14 @@ impl Mesh {
         if triangles.is_empty() {
             return Err(MeshError::Empty);
         }
+        if let Some((vertex, value)) = material.iter().enumerate().find_map(|(v, p)| {
+            [p.x, p.y]
+                .into_iter()
+                .find(|c| !c.is_finite())
+                .map(|c| (v as u32, c))
+        }) {
+            return Err(MeshError::NonFinite { vertex, value });
+        }
         let n = material.len();
         for (t, tri) in triangles.iter().enumerate() {
             if let Some(&v) = tri.iter().find(|&&v| v as usize >= n) {
@@ -113,6 +140,11 @@ impl Mesh {
                     count: n,
                 });
             }
+        }
+        let (lo, hi) = bounds(&material);
+        let size = (hi.x - lo.x).hypot(hi.y - lo.y);
+        if size > 0.0 && !(size * size).is_normal() {
+            return Err(MeshError::OutOfScale { size });
         }
         // Degeneracy is relative to the mesh's scale: a triangle whose area is a
         // vanishing fraction of its longest edge squared is refused. Each triangle
@@ -198,14 +230,18 @@ impl Mesh {
 
     /// Axis-aligned bounding box of the material coordinates: (min, max).
     pub fn material_bounds(&self) -> (Vector2, Vector2) {
-        let mut lo = Vector2::splat(Scalar::INFINITY);
-        let mut hi = Vector2::splat(Scalar::NEG_INFINITY);
-        for p in &self.material {
-            lo = lo.min(*p);
-            hi = hi.max(*p);
-        }
-        (lo, hi)
+        bounds(&self.material)
     }
+}
+
+fn bounds(points: &[Vector2]) -> (Vector2, Vector2) {
+    let mut lo = Vector2::splat(Scalar::INFINITY);
+    let mut hi = Vector2::splat(Scalar::NEG_INFINITY);
+    for p in points {
+        lo = lo.min(*p);
+        hi = hi.max(*p);
+    }
+    (lo, hi)
 }
 
 /// Signed area of a triangle in material space (positive when counter-clockwise).

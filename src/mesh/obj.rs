@@ -21,6 +21,16 @@ pub enum ObjError {
         /// tobj's description.
         reason: String,
     },
+    /// A line of the file holds a value that cannot be part of a mesh.
+    #[error("{path}:{line}: {reason}")]
+    BadLine {
+        /// The file.
+        path: String,
+        /// 1-based line number.
+        line: usize,
+        /// What is wrong with it.
+        reason: String,
+    },
     /// Only some face corners have texture coordinates.
     #[error("{path}: some faces have texture coordinates and some do not; give all or none")]
     PartialTexcoords {
@@ -75,7 +85,7 @@ pub fn load_obj(path: &Path, uv_scale: Scalar) -> Result<ObjCloth, ObjError> {
         ignore_lines: true,
         ..Default::default()
     };
-    check_texcoords_everywhere_or_nowhere(path, &name)?;
+    scan_text(path, &name)?;
     let (models, _) = tobj::load_obj(path, &options).map_err(|e| ObjError::Read {
         path: name.clone(),
         reason: e.to_string(),
@@ -146,23 +156,57 @@ pub fn load_obj(path: &Path, uv_scale: Scalar) -> Result<ObjCloth, ObjError> {
     Ok(ObjCloth { mesh, positions })
 }
 
-/// tobj fills a face corner without `vt` with another corner's coordinates, so a
-/// file that gives `vt` on some faces only is recognised from its text.
-fn check_texcoords_everywhere_or_nowhere(path: &Path, name: &str) -> Result<(), ObjError> {
-    let Ok(text) = std::fs::read_to_string(path) else {
-        return Ok(()); // tobj reports unreadable files with its own message.
+/// Checks what tobj lets through, from the file's text: coordinates that are NaN or
+/// infinite, face indices of 0 (OBJ counts from 1; tobj accepts a texture index
+/// 0, which OBJ does not define), and `vt` on some faces only (tobj fills a corner without `vt`
+/// with another corner's coordinates, so that is recognised from the text).
+fn scan_text(path: &Path, name: &str) -> Result<(), ObjError> {
+    let read = |reason: String| ObjError::Read {
+        path: name.to_string(),
+        reason,
+    };
+    let text = match std::fs::read_to_string(path) {
+        Ok(text) => text,
+        Err(e) if e.kind() == std::io::ErrorKind::InvalidData => {
+            return Err(read("not a text file (it is not valid UTF-8)".into()));
+        }
+        Err(e) => return Err(read(e.to_string())),
+    };
+    let bad = |line: usize, reason: String| ObjError::BadLine {
+        path: name.to_string(),
+        line: line + 1,
+        reason,
     };
     let (mut with, mut without) = (0usize, 0usize);
-    for line in text.lines() {
+    for (n, line) in text.lines().enumerate() {
         let mut tokens = line.split_whitespace();
-        if tokens.next() != Some("f") {
-            continue;
-        }
-        for corner in tokens {
-            match corner.split('/').nth(1) {
-                Some(vt) if !vt.is_empty() => with += 1,
-                _ => without += 1,
+        match tokens.next() {
+            Some(kind @ ("v" | "vt")) => {
+                let value = tokens
+                    .filter_map(|t| t.parse::<f64>().ok())
+                    .find(|x| !x.is_finite());
+                if let Some(x) = value {
+                    return Err(bad(
+                        n,
+                        format!("`{kind}` has a coordinate that is not a finite number: {x}"),
+                    ));
+                }
             }
+            Some("f") => {
+                for corner in tokens {
+                    if corner.split('/').any(|i| i.parse::<i64>() == Ok(0)) {
+                        return Err(bad(
+                            n,
+                            format!("face corner `{corner}` has index 0; OBJ indices start at 1"),
+                        ));
+                    }
+                    match corner.split('/').nth(1) {
+                        Some(vt) if !vt.is_empty() => with += 1,
+                        _ => without += 1,
+                    }
+                }
+            }
+            _ => {}
         }
     }
     if with > 0 && without > 0 {

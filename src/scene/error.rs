@@ -142,3 +142,13 @@ impl Issue {
         self
     }
 }
+
+/// A number as a message shows it: plain when it is of everyday size, in
+/// scientific notation otherwise (`1e300` rather than 301 digits).
+pub(crate) fn num(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() || (1e-4..1e9).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}

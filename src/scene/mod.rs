@@ -7,6 +7,7 @@
 //! [`SceneError`] and `docs/scenes.md`.
 
 mod error;
+mod limits;
 pub mod model;
 mod overrides;
 mod parse;
@@ -19,6 +20,7 @@ mod validate_collide;
 use std::path::Path;
 
 pub use error::{SceneError, SceneErrorKind};
+pub use limits::{MAX_COUNT, MAX_RESOLUTION};
 pub use model::*;
 
 /// The built-in scene used when no scene file is given (`src/scene/default.toml`).

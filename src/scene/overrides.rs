@@ -57,9 +57,16 @@ fn set_in_table(
         t.insert((*first).to_owned(), value);
         return Ok(());
     }
-    let child = t
-        .entry((*first).to_owned())
-        .or_insert_with(|| Value::Table(Table::new()));
+    // A missing part followed by an index (`obstacle.0.shape` in a scene without
+    // obstacles) is an array of tables, to which index 0 appends the first one.
+    let next_is_index = rest.first().is_some_and(|p| p.parse::<usize>().is_ok());
+    let child = t.entry((*first).to_owned()).or_insert_with(|| {
+        if next_is_index {
+            Value::Array(Vec::new())
+        } else {
+            Value::Table(Table::new())
+        }
+    });
     set_in_value(child, rest, value, done)
 }
 
@@ -143,6 +150,14 @@ mod tests {
         assert_eq!(d["simulation"]["gravity"].as_array().map(Vec::len), Some(3));
         assert_eq!(d["pin"][0]["region"].as_str(), Some("corner:top_left"));
         assert_eq!(d["pin"][1]["region"].as_str(), Some("all"));
+    }
+
+    #[test]
+    fn an_index_into_a_missing_array_creates_it() {
+        let mut d = doc();
+        apply(&mut d, "obstacle.0.shape=sphere").expect("first obstacle");
+        assert_eq!(d["obstacle"][0]["shape"].as_str(), Some("sphere"));
+        assert!(apply(&mut d, "wind_tables.1.x=1").is_err(), "index 1 of 0");
     }
 
     #[test]

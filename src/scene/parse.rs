@@ -39,13 +39,7 @@ pub(crate) fn load(
             Some(dir) if !from_set => dir.join(p),
             _ => Path::new(p).to_path_buf(),
         };
-        if !resolved.is_file() {
-            let issue = Issue::new(
-                keys(&["cloth", "path"]),
-                SceneErrorKind::BadValue,
-                format!("no such file: `{}`", resolved.display()),
-            )
-            .allowed("an existing OBJ file; paths in a scene file are relative to its directory");
+        if let Some(issue) = not_a_file(keys(&["cloth", "path"]), &resolved) {
             return Err(ctx.locate(issue));
         }
         scene.cloth.path = Some(resolved.to_string_lossy().into_owned());
@@ -63,18 +57,27 @@ pub(crate) fn load(
             Some(dir) if ctx.set_for(&key).is_none() => dir.join(p),
             _ => Path::new(p).to_path_buf(),
         };
-        if !resolved.is_file() {
-            let issue = Issue::new(
-                key,
-                SceneErrorKind::BadValue,
-                format!("no such file: `{}`", resolved.display()),
-            )
-            .allowed("an existing OBJ file; paths in a scene file are relative to its directory");
+        if let Some(issue) = not_a_file(key, &resolved) {
             return Err(ctx.locate(issue));
         }
         scene.obstacle[i].path = Some(resolved.to_string_lossy().into_owned());
     }
     Ok(scene)
+}
+
+/// The issue at `key` if `path` is not an existing file (missing, or a directory).
+fn not_a_file(key: KeyPath, path: &Path) -> Option<Issue> {
+    let what = if path.is_file() {
+        return None;
+    } else if path.is_dir() {
+        format!("`{}` is a directory, not an OBJ file", path.display())
+    } else {
+        format!("no such file: `{}`", path.display())
+    };
+    Some(
+        Issue::new(key, SceneErrorKind::BadValue, what)
+            .allowed("an existing OBJ file; paths in a scene file are relative to its directory"),
+    )
 }
 
 /// What the messages need to say where a problem is.

@@ -5,7 +5,7 @@ use std::fmt::Display;
 
 use toml::{Table, Value};
 
-use super::error::{Issue, KeyPath, SceneErrorKind as Kind, Seg, dotted, keys};
+use super::error::{Issue, KeyPath, SceneErrorKind as Kind, Seg, dotted, keys, num};
 use super::schema;
 use super::{
     Adapt, AdaptMethod, Air, Cloth, ClothShape, Integrator, Material, Pin, PinMotion, Scene,
@@ -77,7 +77,7 @@ pub(super) fn positive(path: KeyPath, x: f64) -> Result<(), Issue> {
     } else {
         Err(out_of_range(
             path,
-            format!("{x} is out of range: must be > 0"),
+            format!("{} is out of range: must be > 0", num(x)),
         ))
     }
 }
@@ -89,7 +89,7 @@ pub(super) fn non_negative(path: KeyPath, x: f64) -> Result<(), Issue> {
     } else {
         Err(out_of_range(
             path,
-            format!("{x} is out of range: must be >= 0"),
+            format!("{} is out of range: must be >= 0", num(x)),
         ))
     }
 }
@@ -128,17 +128,22 @@ fn simulation(s: &Simulation) -> Result<(), Issue> {
         if dt > frame * (1.0 + 1e-12) {
             return Err(out_of_range(
                 at("dt"),
-                format!("{dt} s is longer than one frame (1/frame_rate = {frame} s)"),
+                format!(
+                    "{} s is longer than one frame (1/frame_rate = {} s)",
+                    num(dt),
+                    num(frame)
+                ),
             )
             .because(at("frame_rate")));
         }
     }
+    super::limits::counts(s)?;
     all_finite(at("gravity"), &s.gravity)?;
     finite(&at("cg_tolerance"), s.cg_tolerance)?;
     if !(s.cg_tolerance > 0.0 && s.cg_tolerance < 1.0) {
         return Err(out_of_range(
             at("cg_tolerance"),
-            format!("{} is out of range: must be in (0, 1)", s.cg_tolerance),
+            format!("{} is out of range: must be in (0, 1)", num(s.cg_tolerance)),
         ));
     }
     if s.cg_max_iterations < 1 {
@@ -215,6 +220,7 @@ fn cloth(c: &Cloth, written: Option<&Table>) -> Result<(), Issue> {
             "0 is out of range: must be >= 1",
         ));
     }
+    super::limits::resolution(c.resolution)?;
     if c.path.as_deref().is_some_and(|p| p.trim().is_empty()) {
         let allowed = allowed_for(&at("path"));
         return Err(Issue::new(at("path"), Kind::BadValue, "the path is empty").allowed(allowed));
@@ -353,7 +359,7 @@ fn adapt(a: &Adapt, integrator: Integrator) -> Result<(), Issue> {
         if x >= 180.0 {
             return Err(out_of_range(
                 keys(&["adapt", key]),
-                format!("{x} degrees is out of range: must be < 180"),
+                format!("{} degrees is out of range: must be < 180", num(x)),
             ));
         }
         Ok(())

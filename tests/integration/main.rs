@@ -2,9 +2,13 @@
 //! heavy dependencies (rerun) are linked once.
 
 mod adapt;
+mod bad_cli;
+mod bad_input;
+mod bad_obj;
 mod cli;
 mod collide;
 mod common;
+mod fuzz;
 mod mesh;
 mod metric;
 mod physics;

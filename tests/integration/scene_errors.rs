@@ -134,7 +134,7 @@ fn wrong_type_names_key_and_expectation() {
         "cloth.resolution",
         Kind::WrongType,
     );
-    assert!(e.to_string().contains("an integer >= 1"), "{e}");
+    assert!(e.to_string().contains("an integer from 1 to 2048"), "{e}");
     error_at(
         &edit("width = 1.0", "width = [1.0]"),
         6,
@@ -341,9 +341,22 @@ fn out_of_range_values_are_errors() {
         Kind::OutOfRange,
     );
     assert!(e.to_string().contains("frame_rate"), "{e}");
-    // No silent caps: a large resolution is accepted.
-    load_scene_str(&edit("resolution = 4", "resolution = 100000"), "t", &[])
-        .expect("no upper bound");
+    // The largest resolution is accepted; above it is an error, not an aborted
+    // allocation (resolution 100000 used to abort the process).
+    let max = drape::scene::MAX_RESOLUTION;
+    load_scene_str(
+        &edit("resolution = 4", &format!("resolution = {max}")),
+        "t",
+        &[],
+    )
+    .expect("the cap itself is allowed");
+    let e = error_at(
+        &edit("resolution = 4", "resolution = 100000"),
+        8,
+        "cloth.resolution",
+        Kind::OutOfRange,
+    );
+    assert!(e.to_string().contains(&format!("must be <= {max}")), "{e}");
 }
 
 #[test]
