@@ -7,7 +7,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use crate::adapt::{AdaptConfig, AdaptStats, Adapter, EventKind, edge_angles};
-use crate::collide::{CollideError, Collider, CollisionStats};
+use crate::collide::{CollideError, Collider, CollisionStats, StepCloth};
 use crate::math::{Scalar, Vector, deterministic_sum};
 use crate::physics::{Energy, Model, Stepper};
 use crate::record::{EventMark, FrameView, RecordError, Recorder, obj::write_frame_obj};
@@ -17,6 +17,38 @@ use crate::world::{BuildError, World};
 
 /// How often a failing frame is retried with half the step before giving up.
 pub const MAX_STEP_HALVINGS: u32 = 4;
+
+/// A step "explodes" when the cloth's kinetic plus gravitational energy exceeds the
+/// physical bound (initial energy plus the work of wind, pins and moving obstacles)
+/// by this many times the run's energy scale ([`EnergyBound`]): far beyond any
+/// discretisation error, only an instability gets there.
+pub const EXPLOSION_FACTOR: Scalar = 1.0;
+
+/// Why a step was rejected.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum StepFailure {
+    /// A position became NaN or infinite.
+    NonFinite,
+    /// The energy exceeded its bound by [`EXPLOSION_FACTOR`] energy scales.
+    Explosion {
+        /// Kinetic plus gravitational energy after the step, J.
+        energy: Scalar,
+        /// The bound it exceeded, J.
+        bound: Scalar,
+    },
+}
+
+impl std::fmt::Display for StepFailure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            StepFailure::NonFinite => write!(f, "positions became NaN or infinite"),
+            StepFailure::Explosion { energy, bound } => write!(
+                f,
+                "the energy exploded (kinetic + gravitational {energy:.4e} J, above the explosion limit {bound:.4e} J)"
+            ),
+        }
+    }
+}
 
 /// What to produce besides the simulation itself.
 #[derive(Debug, Clone, Default)]
@@ -56,10 +88,14 @@ pub enum RunError {
     #[error("adaptive remeshing: {0}")]
     Remesh(#[from] crate::mesh::MeshError),
     /// Internal: every step size tried in a frame failed (becomes `Numerical`).
-    #[error("all step sizes failed, down to {last_dt:.3e} s")]
+    #[error("all step sizes failed, down to {last_dt:.3e} s: {failure}")]
     StepFailed {
         /// The last step tried.
         last_dt: Scalar,
+        /// What went wrong with it.
+        failure: StepFailure,
+        /// The step (counted from the start of the run) that failed.
+        step: u64,
     },
     /// The thread pool could not be created.
     #[error("cannot start {threads} worker threads: {reason}")]
@@ -71,9 +107,13 @@ pub enum RunError {
     },
     /// The state became non-finite even with the smallest step tried.
     #[error(
-        "numerical failure in frame {frame} (t = {time:.4} s): positions became NaN or infinite even with the step halved {halvings} times to {dt:.3e} s; the run stopped and the recording holds every frame up to the last good one. Likely cause: the time step is too large for the stiffness ({cause})"
+        "numerical failure at step {step} in frame {frame} (t = {time:.4} s): {failure} even with the step halved {halvings} times to {dt:.3e} s; the run stopped and the recording holds every frame up to the last good one. Likely cause: the time step is too large for the stiffness ({cause})"
     )]
     Numerical {
+        /// The step (counted from the start of the run) that failed.
+        step: u64,
+        /// What went wrong.
+        failure: StepFailure,
         /// Frame whose steps failed.
         frame: u64,
         /// Simulated time at the start of that frame.
@@ -172,7 +212,16 @@ fn run_in_pool(
         },
         auto_dt: None,
         min_dt: Scalar::INFINITY,
+        external_work: 0.0,
+        air_power: None,
+        bound: EnergyBound {
+            initial: 0.0,
+            scale: 0.0,
+        },
+        failure: StepFailure::NonFinite,
+        excess_max: 0.0,
     };
+    pipe.bound = EnergyBound::new(&world, &pipe.stepper);
     let frame_interval = 1.0 / scene.simulation.frame_rate;
     let frames = (scene.simulation.duration * scene.simulation.frame_rate)
         .round()
@@ -196,8 +245,12 @@ fn run_in_pool(
             let t0 = Instant::now();
             match pipe.advance_frame(&mut world, frame_interval) {
                 Ok(recoveries) => nan_recoveries += recoveries,
-                Err(RunError::StepFailed { last_dt }) => {
-                    failure = Some((frame, last_dt));
+                Err(RunError::StepFailed {
+                    last_dt,
+                    failure: what,
+                    step,
+                }) => {
+                    failure = Some((frame, last_dt, what, step));
                     break;
                 }
                 Err(e) => return Err(e),
@@ -307,10 +360,14 @@ fn run_in_pool(
         adapt: pipe.adapter.as_ref().map(|a| a.stats),
         collision: pipe.collision,
         cusick: pipe.collider.as_ref().and_then(|c| c.cusick(scene, &world)),
+        external_work: pipe.work(),
+        excess_max: pipe.excess_max,
     });
     match failure {
         None => Ok(summary),
-        Some((frame, last_dt)) => Err(RunError::Numerical {
+        Some((frame, last_dt, what, step)) => Err(RunError::Numerical {
+            step,
+            failure: what,
             frame,
             time: world.time,
             halvings: MAX_STEP_HALVINGS,
@@ -343,6 +400,52 @@ struct Pipeline {
     auto_dt: Option<Scalar>,
     /// Smallest step taken so far.
     min_dt: Scalar,
+    /// Work done on the cloth by wind, moving air and moving pins so far, J
+    /// (moving obstacles' is in `collision`).
+    external_work: Scalar,
+    /// Power of the air at the end of the last step, W (`None`: not known).
+    air_power: Option<Scalar>,
+    /// The energy bound the explosion check holds the cloth to.
+    bound: EnergyBound,
+    /// Why the last rejected step failed.
+    failure: StepFailure,
+    /// Largest `E(t) - E(0) - W(t)` at the end of a frame so far, J.
+    excess_max: Scalar,
+}
+
+/// The energy the cloth may have: its initial total plus the external work, and the
+/// scale against which an excess counts as an explosion.
+#[derive(Debug, Clone, Copy)]
+struct EnergyBound {
+    /// Total energy at the start, J.
+    initial: Scalar,
+    /// `|E0| + KE0 + m |g| D` (D: the cloth's diagonal), J: the energies the run
+    /// naturally trades (a fall through the cloth's own size).
+    scale: Scalar,
+}
+
+impl EnergyBound {
+    fn new(world: &World, stepper: &Stepper) -> EnergyBound {
+        let e = stepper.energy(world);
+        let mass = stepper.elements.total_mass();
+        let g = stepper
+            .model
+            .external
+            .gravity
+            .unwrap_or(Vector::ZERO)
+            .length();
+        let (lo, hi) = world
+            .x
+            .iter()
+            .fold((Vector::INFINITY, Vector::NEG_INFINITY), |(lo, hi), p| {
+                (lo.min(*p), hi.max(*p))
+            });
+        let diagonal = (hi - lo).length();
+        EnergyBound {
+            initial: e.total(),
+            scale: e.total().abs() + e.kinetic + mass * g * diagonal.max(0.0),
+        }
+    }
 }
 
 impl Pipeline {
@@ -358,6 +461,7 @@ impl Pipeline {
         let start = world.clone();
         let adapter_start = self.adapter.clone();
         let steps_start = self.steps_done;
+        let (work_start, collision_start) = (self.external_work, self.collision);
         let t0 = world.time;
         for halving in 0..=MAX_STEP_HALVINGS {
             let shrink = (1u64 << halving) as Scalar;
@@ -378,15 +482,22 @@ impl Pipeline {
             }
             world.time = t0 + frame_interval;
             if healthy {
+                let e = self.stepper.energy(world).total();
+                self.excess_max = self.excess_max.max(e - self.bound.initial - self.work());
                 return Ok(halving as u64);
             }
             *world = start.clone();
             self.adapter = adapter_start.clone();
             self.steps_done = steps_start;
+            (self.external_work, self.collision) = (work_start, collision_start);
             self.mesh_changed(world);
         }
         let last_dt = self.step_size(world) / (1u64 << MAX_STEP_HALVINGS) as Scalar;
-        Err(RunError::StepFailed { last_dt })
+        Err(RunError::StepFailed {
+            last_dt,
+            failure: self.failure,
+            step: self.steps_done + 1,
+        })
     }
 
     /// The step for the current mesh: the fixed one, or the automatic estimate.
@@ -439,19 +550,56 @@ impl Pipeline {
     /// non-finite. The contacts the last step ended in go to the implicit solve
     /// (filtered there, see [`crate::physics::implicit`]).
     fn integrate(&mut self, world: &mut World, h: Scalar) -> bool {
-        let Some(c) = self.collider.as_mut() else {
-            self.stepper.step(world, h);
-            return is_finite(&world.x);
+        let air0 = match self.air_power.take() {
+            Some(p) => p,
+            None => self.stepper.air_power(world),
         };
-        c.begin_step(world);
-        // Resting contacts from the last step: the vertices are on the surface now.
-        self.stepper.contacts.clear();
-        self.stepper.contacts.extend_from_slice(c.contacts());
+        let pinned = self.stepper.pinned_start(world);
+        if let Some(c) = self.collider.as_mut() {
+            c.begin_step(world);
+            // Resting contacts from the last step: the vertices are on the surface now.
+            self.stepper.contacts.clear();
+            self.stepper.contacts.extend_from_slice(c.contacts());
+        }
         self.stepper.step(world, h);
         if !is_finite(&world.x) {
+            self.failure = StepFailure::NonFinite;
             return false;
         }
-        c.end_step(world, h, &self.stepper.contact_push, &mut self.collision);
+        if let Some(c) = self.collider.as_mut() {
+            let cloth = StepCloth {
+                pushed: &self.stepper.contact_push,
+                mass: &self.stepper.elements.mass,
+            };
+            c.end_step(world, h, cloth, &mut self.collision);
+        }
+        let air1 = self.stepper.air_power(world);
+        self.air_power = Some(air1);
+        self.external_work += 0.5 * h * (air0 + air1) + self.stepper.pin_work(&pinned, world, h);
+        self.explosion_check(world)
+    }
+
+    /// Work done on the cloth from outside so far, J.
+    fn work(&self) -> Scalar {
+        self.external_work + self.collision.obstacle_work
+    }
+
+    /// False (and the failure noted) when the kinetic plus gravitational energy
+    /// exceeds the bound by [`EXPLOSION_FACTOR`] scales. Elastic energy is left out
+    /// (it is never negative, so the test stays sound) because it costs a pass over
+    /// every element, where this costs one over the vertices.
+    fn explosion_check(&mut self, world: &World) -> bool {
+        let mass = &self.stepper.elements.mass;
+        let g = self.stepper.model.external.gravity.unwrap_or(Vector::ZERO);
+        let energy = deterministic_sum(world.x.len(), |i| {
+            mass[i] * (0.5 * world.v[i].length_squared() - g.dot(world.x[i]))
+        });
+        let work = self.work();
+        let bound = self.bound.initial + work + EXPLOSION_FACTOR * (self.bound.scale + work.abs());
+        if energy > bound || !energy.is_finite() {
+            self.failure = StepFailure::Explosion { energy, bound };
+            return false;
+        }
         true
     }
 
@@ -460,6 +608,7 @@ impl Pipeline {
     fn mesh_changed(&mut self, world: &World) {
         self.stepper.rebuild(world);
         self.auto_dt = None;
+        self.air_power = None;
         if let Some(c) = self.collider.as_mut() {
             c.forget_contacts();
         }
@@ -527,6 +676,8 @@ struct TallyEnd<'a> {
     adapt: Option<AdaptStats>,
     collision: CollisionStats,
     cusick: Option<crate::collide::cusick::CusickSummary>,
+    external_work: Scalar,
+    excess_max: Scalar,
 }
 
 impl Tally {
@@ -577,6 +728,8 @@ impl Tally {
                 initial: self.energy_initial,
                 r#final: self.energy_final,
                 max: self.energy_max,
+                external_work: end.external_work,
+                excess_max: end.excess_max,
             },
             nan_recoveries: end.nan_recoveries,
             solver: end.stepper.stats,

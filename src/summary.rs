@@ -50,6 +50,14 @@ pub struct EnergySummary {
     pub r#final: Scalar,
     /// Largest over the recorded frames.
     pub max: Scalar,
+    /// Work done on the cloth from outside over the run (wind and moving air, moving
+    /// pins, moving obstacles), J. Gravity is in the potential energy; drag in still
+    /// air, damping and friction only remove energy.
+    pub external_work: Scalar,
+    /// Largest excess of the total energy over its bound, `E(t) - E(0) - W(t)`, over
+    /// every frame, J: zero or negative when the energy never rose above its initial
+    /// value plus the external work.
+    pub excess_max: Scalar,
 }
 
 /// Where the recording went.
@@ -148,7 +156,8 @@ impl Summary {
         format!(
             "{}: {} frames, {} steps of {:.3e} s to t = {:.3} s in {:.2} s wall ({:.2} s stepping, {:.2} s recording); \
              {:.0} vertices, {:.0} triangles; {:.3e} vertex-steps/s. Mass {:.6} -> {:.6} kg; \
-             energy {:.4e} -> {:.4e} J (max {:.4e}); {} NaN recoveries; {} CG iterations ({} capped).{}{} {}",
+             energy {:.4e} -> {:.4e} J (max {:.4e}; external work {:.3e} J; largest excess over initial + work {:.3e} J); \
+             {} recoveries (frames retried with halved steps); {} CG iterations ({} capped).{}{} {}",
             self.scene,
             self.frames,
             self.steps,
@@ -165,6 +174,8 @@ impl Summary {
             self.energy.initial,
             self.energy.r#final,
             self.energy.max,
+            self.energy.external_work,
+            self.energy.excess_max,
             self.nan_recoveries,
             self.solver.cg_iterations,
             self.solver.cg_capped,

@@ -87,6 +87,8 @@ pub struct CollisionStats {
     pub self_pairs_tested: u64,
     /// Box-overlapping triangle pairs skipped by Volino culling, summed over the steps.
     pub self_pairs_culled: u64,
+    /// Work the moving obstacles did on the cloth, J (zero with static obstacles).
+    pub obstacle_work: Scalar,
     /// Self-collision primitive pairs that acted, summed over steps and iterations.
     pub self_resolved: u64,
     /// Wall time in obstacle passes, s.
@@ -115,6 +117,17 @@ impl CollisionStats {
             self.self_pairs_culled as Scalar / all as Scalar
         }
     }
+}
+
+/// What the collision pass needs from the stepper after a step.
+#[derive(Debug, Clone, Copy)]
+pub struct StepCloth<'a> {
+    /// [`crate::physics::Stepper::contact_push`]: the normal velocity change the
+    /// implicit solve's contact filters imposed, per vertex (may be empty), which
+    /// counts as normal impulse for friction.
+    pub pushed: &'a [Scalar],
+    /// Vertex masses, kg (for the work moving obstacles do on the cloth).
+    pub mass: &'a [Scalar],
 }
 
 /// A triangulated obstacle for display: world positions and triangles.
@@ -239,16 +252,14 @@ impl Collider {
     }
 
     /// Resolves collisions after an integrator step of `h` seconds (see the module docs).
-    /// `pushed` is the stepper's [`crate::physics::Stepper::contact_push`]: the normal
-    /// velocity change the implicit solve's contact filters imposed, per vertex (may be
-    /// empty), which counts as normal impulse for friction.
     pub fn end_step(
         &mut self,
         world: &mut World,
         h: Scalar,
-        pushed: &[Scalar],
+        cloth: StepCloth,
         stats: &mut CollisionStats,
     ) {
+        let StepCloth { pushed, mass } = cloth;
         let (t0, t1) = (self.t0, world.time);
         let started = Instant::now();
         let poses: Vec<(Pose, Pose)> = self
@@ -262,7 +273,8 @@ impl Collider {
             let (bodies, x0, held) = (&self.bodies, &self.x0, &self.held);
             self.contacts.clear();
             self.contacts.resize(world.x.len(), Contact::default());
-            world
+            let moving = self.bodies.iter().any(Body::is_moving);
+            let (contacts, work) = world
                 .x
                 .par_iter_mut()
                 .zip(world.v.par_iter_mut())
@@ -271,19 +283,32 @@ impl Collider {
                 .with_min_len(256)
                 .map(|(i, ((x, v), contact))| {
                     if held[i] {
-                        return 0u64;
+                        return (0u64, 0.0);
                     }
                     let mut hit = false;
                     let push = pushed.get(i).copied().unwrap_or(0.0);
+                    let mut work = 0.0;
                     for (b, pose) in bodies.iter().zip(&poses) {
+                        let before = *v;
                         if let Some(c) = respond(b, pose, t1, h, push, x0[i], x, v) {
+                            // A moving surface works on the cloth: impulse . surface velocity
+                            // (the filter's impulse included).
+                            if moving {
+                                let surface = b.point_velocity(t1, *x);
+                                let m = mass.get(i).copied().unwrap_or(0.0);
+                                work += m * ((*v - before).dot(surface) + push * c.normal_speed);
+                            }
                             *contact = c;
                             hit = true;
                         }
                     }
-                    u64::from(hit)
+                    (u64::from(hit), work)
                 })
-                .sum()
+                .collect::<Vec<_>>()
+                .into_iter()
+                .fold((0u64, 0.0), |(n, w), (a, b)| (n + a, w + b));
+            stats.obstacle_work += work;
+            contacts
         };
         stats.collision_wall_s += started.elapsed().as_secs_f64();
         if let Some(sc) = self.self_collider.as_mut() {

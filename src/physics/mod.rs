@@ -12,6 +12,7 @@ pub mod implicit;
 pub mod multirate;
 pub mod pins;
 pub mod timestep;
+pub mod work;
 
 pub use elements::{Elements, Hinge, MaterialParams, Spring};
 pub use forces::{Energy, ExternalForces, WindForce};

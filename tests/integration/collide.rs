@@ -2,7 +2,7 @@
 //! tunneling at 20 m/s through a 5 mm box for each integrator, Coulomb friction on an
 //! incline, self-collision after crumpling, Volino culling, determinism.
 
-use drape::collide::{Collider, CollisionStats};
+use drape::collide::{Collider, CollisionStats, StepCloth};
 use drape::math::{Scalar, Vector};
 use drape::physics::{Model, Stepper};
 use drape::scene::{Scene, load_scene_str};
@@ -66,12 +66,12 @@ impl Sim {
             .contacts
             .extend_from_slice(self.collider.contacts());
         self.stepper.step(&mut self.world, h);
-        self.collider.end_step(
-            &mut self.world,
-            h,
-            &self.stepper.contact_push,
-            &mut self.stats,
-        );
+        let cloth = StepCloth {
+            pushed: &self.stepper.contact_push,
+            mass: &self.stepper.elements.mass,
+        };
+        self.collider
+            .end_step(&mut self.world, h, cloth, &mut self.stats);
     }
 
     fn kinetic(&self) -> Scalar {
