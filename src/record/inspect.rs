@@ -85,6 +85,8 @@ pub struct FrameInfo {
     pub edges: Option<usize>,
     /// Largest `dihedral_angle_deg` at `cloth/edges`, degrees.
     pub max_edge_angle: Option<f64>,
+    /// Smallest `dihedral_angle_deg` at `cloth/edges`, degrees.
+    pub min_edge_angle: Option<f64>,
     /// `plots/<name>` values (name without the `plots/` prefix).
     pub scalars: BTreeMap<String, f64>,
     /// The lines of `events/log`, in logging order.
@@ -232,10 +234,10 @@ fn gather(out: &mut Inspection, chunk: &Chunk) {
             if let Some(p) = cell("vertex_positions") {
                 info.triangles = Some(p.len() / 3);
             }
-            if let Some(l) = cell(LEVEL_COMPONENT) {
-                if let Some(l) = l.as_primitive_opt::<UInt8Type>() {
-                    info.levels = l.values().to_vec();
-                }
+            if let Some(l) = cell(LEVEL_COMPONENT)
+                && let Some(l) = l.as_primitive_opt::<UInt8Type>()
+            {
+                info.levels = l.values().to_vec();
             }
         } else if entity == ENTITY_EDGES {
             if let Some(a) = cell(ANGLE_COMPONENT)
@@ -243,6 +245,7 @@ fn gather(out: &mut Inspection, chunk: &Chunk) {
             {
                 info.edges = Some(a.len());
                 info.max_edge_angle = a.values().iter().copied().reduce(f64::max);
+                info.min_edge_angle = a.values().iter().copied().reduce(f64::min);
             }
         } else if entity == ENTITY_EVENT_LOG {
             if let Some(t) = cell("text")

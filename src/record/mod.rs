@@ -34,7 +34,9 @@
 
 mod convert;
 pub mod edges;
+mod error;
 mod events;
+mod frame;
 pub mod inspect;
 mod layout;
 pub mod obj;
@@ -42,7 +44,7 @@ mod report;
 mod sink;
 
 use std::collections::HashMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::Arc;
 
 use rerun::external::arrow::array::UInt8Array;
@@ -50,6 +52,8 @@ use rerun::{AsComponents, EntityPath, RecordingStream, RecordingStreamBuilder};
 
 use crate::math::Vector;
 pub use edges::EdgeDisplay;
+pub use error::{BoxError, RecordError};
+pub use frame::{EventMark, FrameView};
 pub use sink::{LiveViewer, RecordTarget};
 /// Colour of each refinement level, as sRGB `[r, g, b]`.
 ///
@@ -106,107 +110,10 @@ const PIN_COLOR: [u8; 3] = [0xFF, 0xFF, 0xFF];
 /// Radius of the pin markers on screen, in UI points.
 const PIN_RADIUS_UI: f32 = 4.0;
 
-/// One recorded frame, as plain slices (no engine types).
-#[derive(Debug, Clone, Copy)]
-pub struct FrameView<'a> {
-    /// Frame index, on timeline `frame` (sequence).
-    pub frame: u64,
-    /// Simulated time in seconds, on timeline `sim_time` (duration). Must be finite.
-    pub sim_time: f64,
-    /// World positions, m.
-    pub positions: &'a [Vector],
-    /// Unit normal per vertex (same length as `positions`).
-    pub vertex_normals: &'a [Vector],
-    /// Triangles as vertex indices into `positions`.
-    pub triangles: &'a [[u32; 3]],
-    /// Refinement level per triangle (same length as `triangles`); 0 is the base mesh.
-    pub triangle_levels: &'a [u8],
-    /// Edges as vertex pairs (for `cloth/edges`); may be empty.
-    pub edges: &'a [[u32; 2]],
-    /// Dihedral angle per edge, degrees (same length as `edges`; 0 at boundary edges).
-    pub edge_angles: &'a [f64],
-    /// Indices of pinned vertices.
-    pub pinned: &'a [u32],
-    /// Plot path -> value, e.g. `("energy/kinetic", 0.1)`, logged at `plots/<path>`.
-    pub scalars: &'a [(&'a str, f64)],
-    /// Remeshing events since the previous frame, shown at `events/points` and
-    /// written one line each to `events/log`.
-    pub events: &'a [EventMark],
-}
-
-/// One remeshing event, as plain data for the recording.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct EventMark {
-    /// What happened: `split`, `closure_split`, `merge`, `flip`, `collapse` or `rollback`.
-    pub kind: &'static str,
-    /// Where, in world coordinates (m).
-    pub position: Vector,
-    /// Level of the triangles it made.
-    pub level: u8,
-    /// The angle that triggered it, degrees, if any.
-    pub angle: Option<f64>,
-    /// The step after which it happened.
-    pub step: u64,
-}
-
 /// Entity of the event points (one point per event of the frame, labelled).
 pub const ENTITY_EVENT_POINTS: &str = "events/points";
 /// Entity of the event log (one text line per event).
 pub const ENTITY_EVENT_LOG: &str = "events/log";
-
-/// Boxed error from rerun, kept opaque so rerun's types stay inside this module.
-pub(crate) type BoxError = Box<dyn std::error::Error + Send + Sync + 'static>;
-
-/// Everything that can go wrong while recording.
-#[derive(Debug, thiserror::Error)]
-pub enum RecordError {
-    /// The `.rrd` file could not be created (missing directory, no permission, ...) or the
-    /// viewer could not be started or reached.
-    #[error("cannot create recording {target}: {source}")]
-    Create {
-        /// Where the recording was to go ([`RecordTarget::describe`]).
-        target: String,
-        /// What rerun or the file system reported.
-        #[source]
-        source: BoxError,
-    },
-    /// Rerun refused to log an entity.
-    #[error("cannot log {entity} to recording {target}: {source}")]
-    Log {
-        /// Where the recording goes.
-        target: String,
-        /// The entity being logged.
-        entity: String,
-        /// What rerun reported.
-        #[source]
-        source: BoxError,
-    },
-    /// The frame data is inconsistent (length mismatch, index out of range, non-finite time).
-    #[error("invalid frame {frame}: {reason}")]
-    InvalidFrame {
-        /// The frame index.
-        frame: u64,
-        /// What is wrong with it.
-        reason: String,
-    },
-    /// Flushing or closing the `.rrd` file failed; the file may be incomplete.
-    #[error("cannot finish recording {target}: {message}")]
-    Finish {
-        /// Where the recording goes.
-        target: String,
-        /// What went wrong.
-        message: String,
-    },
-    /// An OBJ frame file could not be written.
-    #[error("cannot write OBJ file {}: {source}", .path.display())]
-    Obj {
-        /// The OBJ path.
-        path: PathBuf,
-        /// The I/O error.
-        #[source]
-        source: std::io::Error,
-    },
-}
 
 /// The recording id for a scene: the same scene name always gives the same id, so re-running a
 /// scene replaces its recording in the viewer instead of adding a new one.
@@ -341,7 +248,7 @@ impl Recorder {
     /// and the recorder stays usable. Vertices are converted straight from the slices into
     /// rerun's arrow buffers: no per-frame buffers of our own are needed.
     pub fn record_frame(&mut self, frame: &FrameView) -> Result<(), RecordError> {
-        let frame_index = validate(frame)?;
+        let frame_index = frame::validate(frame)?;
         if !self.blueprint_sent {
             let names: Vec<&str> = frame.scalars.iter().map(|(n, _)| *n).collect();
             layout::send_blueprint(&self.stream, &names)
@@ -528,63 +435,4 @@ impl Drop for Recorder {
         }
         drop(stream);
     }
-}
-
-/// Checks the frame's slices against each other; returns the frame index for the timeline.
-fn validate(frame: &FrameView) -> Result<i64, RecordError> {
-    let invalid = |reason: String| RecordError::InvalidFrame {
-        frame: frame.frame,
-        reason,
-    };
-    let n = frame.positions.len();
-    let index = i64::try_from(frame.frame)
-        .map_err(|_| invalid("frame index does not fit the `frame` timeline (i64)".into()))?;
-    if !frame.sim_time.is_finite() {
-        return Err(invalid(format!("sim_time is {}", frame.sim_time)));
-    }
-    if frame.vertex_normals.len() != n {
-        return Err(invalid(format!(
-            "{} vertex normals for {n} vertices",
-            frame.vertex_normals.len()
-        )));
-    }
-    if frame.triangle_levels.len() != frame.triangles.len() {
-        return Err(invalid(format!(
-            "{} triangle levels for {} triangles",
-            frame.triangle_levels.len(),
-            frame.triangles.len()
-        )));
-    }
-    if let Some((t, tri)) = frame
-        .triangles
-        .iter()
-        .enumerate()
-        .find(|(_, tri)| tri.iter().any(|&i| i as usize >= n))
-    {
-        return Err(invalid(format!(
-            "triangle {t} {tri:?} refers to a vertex past the {n} vertices"
-        )));
-    }
-    if frame.edge_angles.len() != frame.edges.len() {
-        return Err(invalid(format!(
-            "{} edge angles for {} edges",
-            frame.edge_angles.len(),
-            frame.edges.len()
-        )));
-    }
-    if let Some(e) = frame
-        .edges
-        .iter()
-        .find(|e| e.iter().any(|&i| i as usize >= n))
-    {
-        return Err(invalid(format!(
-            "edge {e:?} refers to a vertex past the {n} vertices"
-        )));
-    }
-    if let Some(&i) = frame.pinned.iter().find(|&&i| i as usize >= n) {
-        return Err(invalid(format!(
-            "pinned vertex {i} is past the {n} vertices"
-        )));
-    }
-    Ok(index)
 }

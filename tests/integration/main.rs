@@ -2,11 +2,14 @@
 //! heavy dependencies (rerun) are linked once.
 
 mod adapt;
+mod canonical;
 mod cli;
 mod collide;
 mod common;
+mod inspect_cli;
 mod mesh;
 mod metric;
 mod physics;
 mod recording;
+mod recording_run;
 mod scene_errors;
