@@ -20,6 +20,7 @@
 //!   ([`EdgeDisplay`]);
 //! - `cloth/pins` every frame: the pinned vertices as points;
 //! - `events/points` and `events/log`: the remeshing events since the previous recorded frame;
+//! - `legend` (static): a markdown text document naming the colours;
 //! - `plots/<name>` every frame for each scalar of [`FrameView::scalars`];
 //! - `obstacles/<name>`: obstacle meshes, static or per frame;
 //! - a default blueprint, sent with the first frame once the plot names are known (`layout.rs`).
@@ -96,6 +97,9 @@ pub const ENTITY_MESH: &str = "cloth/mesh";
 pub const ENTITY_EDGES: &str = "cloth/edges";
 /// Component name of the per-triangle level data on `cloth/mesh` (`u8`, one per triangle).
 pub const LEVEL_COMPONENT: &str = "triangle_level";
+/// Entity of the static legend (a markdown text document: level colours, angle scale, event
+/// colours).
+pub const ENTITY_LEGEND: &str = "legend";
 /// Entity of the pinned vertices.
 pub const ENTITY_PINS: &str = "cloth/pins";
 /// Parent entity of the scalar plots: scalar `name` is logged at `plots/<name>`.
@@ -229,6 +233,13 @@ impl Recorder {
             .stream
             .log_static("cloth", &convert::level_annotations())
             .map_err(|e| recorder.log_err("cloth", e))?;
+        recorder
+            .stream
+            .log_static(
+                ENTITY_LEGEND,
+                &rerun::TextDocument::from_markdown(layout::legend_markdown()),
+            )
+            .map_err(|e| recorder.log_err(ENTITY_LEGEND, e))?;
         Ok(recorder)
     }
 

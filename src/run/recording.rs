@@ -63,7 +63,7 @@ pub(super) fn record_state(
         ("timing/sim_ms", 1e3 * snap.timing.sim_s),
         ("timing/record_ms", 1e3 * snap.timing.record_s),
         (
-            "adapt/max_angle_deg",
+            "angle/max_deg",
             angles.iter().copied().fold(0.0, Scalar::max),
         ),
     ];
@@ -83,7 +83,7 @@ pub(super) fn record_state(
     if pipe.collider.is_some() {
         let c = &pipe.collision;
         scalars.push(("collision/contacts", c.last_contacts as f64));
-        scalars.push(("collision/max_penetration", c.last_penetration));
+        scalars.push(("penetration/max_m", c.last_penetration));
     }
     rec.record_frame(&FrameView {
         frame: snap.frame,

@@ -50,7 +50,7 @@ fn tablecloth_short() -> Scene {
 
 /// Every frame has one mesh row, one `triangle_level` per triangle, the triangle count of the
 /// `mesh/triangles` plot, and (a disk-like sheet) `V + T - 1` edges with the largest angle
-/// equal to the `adapt/max_angle_deg` plot.
+/// equal to the `angle/max_deg` plot.
 fn check_frames(ins: &Inspection) {
     for (n, f) in &ins.frames {
         assert_eq!(f.mesh_rows, 1, "frame {n}: one mesh row");
@@ -63,7 +63,7 @@ fn check_frames(ins: &Inspection) {
             Some(verts + tris - 1),
             "frame {n}: Euler's formula"
         );
-        let plotted = f.scalars["adapt/max_angle_deg"];
+        let plotted = f.scalars["angle/max_deg"];
         let max = f.max_edge_angle.expect("angles");
         assert!(
             (max - plotted).abs() <= 1e-12 * plotted.max(1.0),
@@ -99,6 +99,7 @@ fn adaptive_run_holds_the_whole_schema() {
         "/cloth/pins",
         "/events/points",
         "/events/log",
+        "/legend",
     ]
     .into_iter()
     .map(String::from)
@@ -113,13 +114,13 @@ fn adaptive_run_holds_the_whole_schema() {
         "time/dt",
         "timing/sim_ms",
         "timing/record_ms",
-        "adapt/max_angle_deg",
+        "angle/max_deg",
         "adapt/splits",
         "adapt/merges",
         "adapt/flips",
         "adapt/rollbacks",
         "collision/contacts",
-        "collision/max_penetration",
+        "penetration/max_m",
     ] {
         expected.insert(format!("/plots/{plot}"));
     }
