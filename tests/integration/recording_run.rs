@@ -256,6 +256,29 @@ fn numerical_failure_leaves_a_complete_recording() {
         *ins.frames.keys().next_back().expect("frames"),
         frame as i64 - 1
     );
+
+    // With --record-every 4 the last good frame is not a multiple of 4: it is recorded too.
+    assert_ne!(
+        (frame - 1) % 4,
+        0,
+        "the check below needs an unaligned last frame"
+    );
+    let opts = RunOptions {
+        record_every: 4,
+        ..RunOptions::default()
+    };
+    let err = record(&scene, &out, opts).expect_err("numerical failure");
+    let RunError::Numerical { frame: again, .. } = err else {
+        panic!("not a numerical failure: {err}");
+    };
+    assert_eq!(again, frame, "same failure");
+    let ins = inspect(&out).expect("decodes completely");
+    let got: Vec<i64> = ins.frames.keys().copied().collect();
+    let expected: Vec<i64> = (0..frame as i64)
+        .filter(|f| f % 4 == 0 || *f == frame as i64 - 1)
+        .collect();
+    println!("record_every 4, failure at frame {frame}: recorded {got:?}");
+    assert_eq!(got, expected);
     std::fs::remove_file(&out).ok();
 }
 
