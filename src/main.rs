@@ -10,6 +10,8 @@ use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 
+use drape::record::inspect::inspect;
+use drape::record::{EdgeDisplay, LiveViewer};
 use drape::run::{Progress, RunError, RunOptions, run};
 use drape::scene::{Scene, default_scene, load_scene_file};
 
@@ -27,6 +29,17 @@ enum Command {
     Run(RunArgs),
     /// Validate a scene and print the resolved model without simulating.
     Check(SceneArgs),
+    /// Decode a .rrd recording and print what it holds.
+    Inspect(InspectArgs),
+}
+
+#[derive(Args)]
+struct InspectArgs {
+    /// The recording to read.
+    file: PathBuf,
+    /// Print this frame's mesh statistics, plots and events instead of the overview.
+    #[arg(long, value_name = "N")]
+    frame: Option<i64>,
 }
 
 #[derive(Args)]
@@ -45,7 +58,7 @@ struct RunArgs {
     /// Output recording (default: the scene's name + `.rrd` in the current directory).
     #[arg(long, short, value_name = "FILE.rrd", conflicts_with = "no_record")]
     out: Option<PathBuf>,
-    /// Do not write a recording.
+    /// Do not write a recording file (with --spawn or --connect: stream to the viewer only).
     #[arg(long)]
     no_record: bool,
     /// Write a machine-readable summary (JSON) here.
@@ -54,6 +67,22 @@ struct RunArgs {
     /// Write every recorded frame as an OBJ file into this directory.
     #[arg(long, value_name = "DIR")]
     obj_dir: Option<PathBuf>,
+    /// Record (and export OBJ for) every K-th frame only; frame 0 and the last are always recorded.
+    #[arg(long, value_name = "K", default_value_t = 1,
+          value_parser = clap::value_parser!(u64).range(1..))]
+    record_every: u64,
+    /// Leave out `cloth/edges` (the per-edge dihedral angles).
+    #[arg(long, conflicts_with = "edge_threshold")]
+    no_edges: bool,
+    /// Record only the edges whose dihedral angle is above DEG degrees (default: every edge).
+    #[arg(long, value_name = "DEG", value_parser = non_negative_degrees)]
+    edge_threshold: Option<f64>,
+    /// Also start a Rerun viewer (`rerun` 0.36.3 on PATH) and stream the run to it live.
+    #[arg(long, conflicts_with = "connect")]
+    spawn: bool,
+    /// Also stream the run live to a running viewer, e.g. rerun+http://127.0.0.1:9876/proxy.
+    #[arg(long, value_name = "URL")]
+    connect: Option<String>,
     /// Worker threads, 1 to 256 (default: one per core). Results are identical at any count.
     // The cap: with --threads 10000 a 0.05 s run had not finished after 60 s on a
     // 2-core machine (thousands of threads scheduled every step): it looked like a hang.
@@ -69,6 +98,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Run(args) => cmd_run(args),
         Command::Check(args) => cmd_check(args),
+        Command::Inspect(args) => cmd_inspect(args),
     };
     match result {
         Ok(code) => code,
@@ -106,6 +136,24 @@ fn cmd_check(args: SceneArgs) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// A finite angle in degrees, at least 0 (for `--edge-threshold`).
+fn non_negative_degrees(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v.is_finite() && v >= 0.0 => Ok(v),
+        Ok(v) => Err(format!("{v} is not an angle of 0 degrees or more")),
+        Err(e) => Err(format!("{s:?} is not a number of degrees: {e}")),
+    }
+}
+
+fn cmd_inspect(args: InspectArgs) -> Result<ExitCode> {
+    let inspection = inspect(&args.file)?;
+    match args.frame {
+        Some(n) => print!("{}", inspection.frame_report(n)?),
+        None => print!("{}", inspection.report()),
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
 fn cmd_run(args: RunArgs) -> Result<ExitCode> {
     let scene = load(&args.scene)?;
     let record = (!args.no_record).then(|| {
@@ -117,6 +165,17 @@ fn cmd_run(args: RunArgs) -> Result<ExitCode> {
         record,
         obj_dir: args.obj_dir.clone(),
         threads: args.threads.map(|n| n as usize),
+        live: if args.spawn {
+            Some(LiveViewer::Spawn)
+        } else {
+            args.connect.clone().map(LiveViewer::Connect)
+        },
+        record_every: args.record_every,
+        edges: match (args.no_edges, args.edge_threshold) {
+            (true, _) => EdgeDisplay::Off,
+            (false, Some(deg)) => EdgeDisplay::Above(deg),
+            (false, None) => EdgeDisplay::All,
+        },
     };
     // Build the cloth and the obstacles once before any output is opened: a bad
     // OBJ or a pin that selects nothing fails here and leaves no empty recording

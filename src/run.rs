@@ -6,11 +6,15 @@ use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
-use crate::adapt::{AdaptConfig, AdaptStats, Adapter, EventKind, edge_angles};
+mod recording;
+
+use crate::adapt::{AdaptConfig, AdaptStats, Adapter, edge_angles};
 use crate::collide::{CollideError, Collider, CollisionStats, StepCloth};
 use crate::math::{Scalar, Vector, deterministic_sum};
 use crate::physics::{Energy, Model, Stepper};
-use crate::record::{EventMark, FrameView, RecordError, Recorder, obj::write_frame_obj};
+use crate::record::{
+    EdgeDisplay, LiveViewer, RecordError, RecordTarget, Recorder, obj::write_frame_obj,
+};
 use crate::scene::{Scene, TimeStep};
 use crate::summary::{EnergySummary, Range, RecordingSummary, Summary};
 use crate::world::{BuildError, World};
@@ -59,6 +63,14 @@ pub struct RunOptions {
     pub obj_dir: Option<PathBuf>,
     /// Worker threads (`None`: rayon's default, one per core).
     pub threads: Option<usize>,
+    /// Also stream the recording to a live viewer (with or without a file).
+    pub live: Option<LiveViewer>,
+    /// Record (and export OBJ for) every K-th frame only; 0 and 1 both mean every frame.
+    /// Frame 0 and the last frame are always recorded, and so is the last good frame of a run
+    /// stopped early; events of the frames left out go with the next recorded frame.
+    pub record_every: u64,
+    /// Which edges `cloth/edges` shows.
+    pub edges: EdgeDisplay,
 }
 
 /// Progress report after each frame.
@@ -183,10 +195,17 @@ fn run_in_pool(
     observe: &mut (dyn FnMut(&FrameState) + Send),
 ) -> Result<Summary, RunError> {
     // Open the output first: an unwritable path fails before any simulation.
-    let mut recorder = match &opts.record {
-        Some(path) => Some(Recorder::create(path, &scene.name)?),
-        None => None,
+    let mut recorder = match (&opts.record, &opts.live) {
+        (None, None) => None,
+        (file, live) => {
+            let target = RecordTarget {
+                file: file.clone(),
+                live: live.clone(),
+            };
+            Some(Recorder::open(&target, &scene.name, opts.edges)?)
+        }
     };
+    let every = opts.record_every.max(1);
     if let Some(dir) = &opts.obj_dir {
         std::fs::create_dir_all(dir).map_err(|source| RecordError::Obj {
             path: dir.clone(),
@@ -236,6 +255,10 @@ fn run_in_pool(
     let mut interrupted = false;
     let mut normals = Vec::new();
     let mut failure = None;
+    // Wall time of the last frame's stepping and of the last recorded frame's recording.
+    let mut timing = recording::FrameTiming::default();
+    let mut recorded_frames = 0u64;
+    let mut last_recorded = None;
     for frame in 0..=frames {
         if frame > 0 {
             if interrupt.load(Ordering::Relaxed) {
@@ -255,16 +278,10 @@ fn run_in_pool(
                 }
                 Err(e) => return Err(e),
             }
-            sim_seconds += t0.elapsed().as_secs_f64();
+            timing.sim_s = t0.elapsed().as_secs_f64();
+            sim_seconds += timing.sim_s;
         }
         let energy = pipe.stepper.energy(&world);
-        let events = pipe
-            .adapter
-            .as_mut()
-            .map(Adapter::take_events)
-            .unwrap_or_default();
-        let marks: Vec<EventMark> = events.iter().map(event_mark).collect();
-        let max_angle = edge_angles(&world).into_iter().fold(0.0, Scalar::max);
         tally.observe(&world, energy);
         observe(&FrameState {
             frame,
@@ -274,61 +291,34 @@ fn run_in_pool(
             triangles: &world.mesh.triangles,
         });
         let t1 = Instant::now();
-        if let Some(rec) = recorder.as_mut() {
-            world.vertex_normals(&mut normals);
-            let pinned: Vec<u32> = world.pins.anchors.iter().map(|a| a.vertex).collect();
-            let dt_now = pipe.step_size(&world);
-            let mut scalars =
-                frame_scalars(&world, energy, dt_now, sim_seconds, record_seconds, frame);
-            scalars.push(("adapt/max_angle_deg", max_angle));
-            if pipe.adapter.is_some() {
-                let count = |k: EventKind| events.iter().filter(|e| e.kind == k).count() as f64;
-                scalars.push((
-                    "adapt/splits",
-                    count(EventKind::Split) + count(EventKind::ClosureSplit),
-                ));
-                scalars.push((
-                    "adapt/merges",
-                    count(EventKind::Merge) + count(EventKind::Collapse),
-                ));
-                scalars.push(("adapt/flips", count(EventKind::Flip)));
-                scalars.push(("adapt/rollbacks", count(EventKind::Rollback)));
+        let record_now = frame % every == 0 || frame == frames;
+        if record_now {
+            if let Some(rec) = recorder.as_mut() {
+                let view = recording::Snapshot {
+                    frame,
+                    energy,
+                    timing,
+                };
+                recording::record_state(rec, &world, &mut pipe, &view, &mut normals)?;
+                recorded_frames += 1;
+                last_recorded = Some(frame);
             }
-            if pipe.collider.is_some() {
-                let c = &pipe.collision;
-                scalars.push(("collision/contacts", c.last_contacts as f64));
-                scalars.push(("collision/max_penetration", c.last_penetration));
+            if let Some(dir) = &opts.obj_dir {
+                write_frame_obj(
+                    dir,
+                    frame,
+                    &world.x,
+                    &world.mesh.material,
+                    &world.mesh.triangles,
+                )?;
             }
-            rec.record_frame(&FrameView {
-                frame,
-                sim_time: world.time,
-                positions: &world.x,
-                vertex_normals: &normals,
-                triangles: &world.mesh.triangles,
-                triangle_levels: &world.mesh.levels,
-                pinned: &pinned,
-                scalars: &scalars,
-                events: &marks,
-            })?;
-            if let Some(c) = &pipe.collider {
-                // Static obstacles once, moving ones every frame.
-                for m in c.obstacle_meshes(world.time) {
-                    if m.moving || frame == 0 {
-                        rec.record_obstacle(&m.name, &m.positions, &m.triangles, !m.moving)?;
-                    }
-                }
-            }
+            timing.record_s = t1.elapsed().as_secs_f64();
+            record_seconds += timing.record_s;
         }
-        if let Some(dir) = &opts.obj_dir {
-            write_frame_obj(
-                dir,
-                frame,
-                &world.x,
-                &world.mesh.material,
-                &world.mesh.triangles,
-            )?;
+        if recorder.is_none() {
+            // Nobody takes the events: drop them rather than let them pile up.
+            pipe.adapter.as_mut().map(Adapter::take_events);
         }
-        record_seconds += t1.elapsed().as_secs_f64();
         frames_done = frame + 1;
         progress(Progress {
             frame: frames_done,
@@ -336,8 +326,30 @@ fn run_in_pool(
             sim_time: world.time,
         });
     }
+    // A run stopped early (Ctrl-C, numerical failure) after frames left out by
+    // `record_every`: record the last good state too, with the pending events.
+    if let Some(rec) = recorder.as_mut()
+        && let Some(last) = frames_done.checked_sub(1)
+        && last_recorded != Some(last)
+    {
+        let t1 = Instant::now();
+        let energy = pipe.stepper.energy(&world);
+        let view = recording::Snapshot {
+            frame: last,
+            energy,
+            timing,
+        };
+        recording::record_state(rec, &world, &mut pipe, &view, &mut normals)?;
+        recorded_frames += 1;
+        record_seconds += t1.elapsed().as_secs_f64();
+    }
     let recording = match recorder {
-        Some(rec) => Some((opts.record.clone().unwrap_or_default(), rec.finish()?)),
+        Some(rec) => {
+            let bytes = rec.finish()?;
+            opts.record
+                .clone()
+                .map(|path| (path, bytes, recorded_frames))
+        }
         None => None,
     };
     let summary = tally.finish(TallyEnd {
@@ -620,34 +632,6 @@ fn is_finite(x: &[Vector]) -> bool {
     deterministic_sum(x.len(), |i| x[i].x + x[i].y + x[i].z).is_finite()
 }
 
-fn frame_scalars(
-    world: &World,
-    e: Energy,
-    dt: Scalar,
-    sim_s: Scalar,
-    rec_s: Scalar,
-    frame: u64,
-) -> Vec<(&'static str, f64)> {
-    let per_frame = |s: Scalar| {
-        if frame == 0 {
-            0.0
-        } else {
-            1e3 * s / frame as Scalar
-        }
-    };
-    vec![
-        ("mesh/vertices", world.x.len() as f64),
-        ("mesh/triangles", world.mesh.triangles.len() as f64),
-        ("energy/kinetic", e.kinetic),
-        ("energy/gravitational", e.gravitational),
-        ("energy/elastic", e.elastic),
-        ("energy/total", e.total()),
-        ("time/dt", dt),
-        ("timing/sim_ms_per_frame", per_frame(sim_s)),
-        ("timing/record_ms_per_frame", per_frame(rec_s)),
-    ]
-}
-
 /// Running statistics for the summary.
 struct Tally {
     vertices: Range,
@@ -671,7 +655,7 @@ struct TallyEnd<'a> {
     dt: Scalar,
     nan_recoveries: u64,
     interrupted: bool,
-    recording: Option<(PathBuf, u64)>,
+    recording: Option<(PathBuf, u64, u64)>,
     stepper: &'a Stepper,
     adapt: Option<AdaptStats>,
     collision: CollisionStats,
@@ -746,28 +730,11 @@ impl Tally {
             collision_wall_s: end.collision.collision_wall_s,
             self_collision_wall_s: end.collision.self_collision_wall_s,
             cusick: end.cusick,
-            recording: end
-                .recording
-                .map(|(path, bytes)| RecordingSummary { path, bytes }),
+            recording: end.recording.map(|(path, bytes, frames)| RecordingSummary {
+                path,
+                bytes,
+                frames,
+            }),
         }
-    }
-}
-
-/// The recording's plain view of an adaptivity event.
-fn event_mark(e: &crate::adapt::AdaptEvent) -> EventMark {
-    let kind = match e.kind {
-        EventKind::Split => "split",
-        EventKind::ClosureSplit => "closure_split",
-        EventKind::Merge => "merge",
-        EventKind::Rollback => "rollback",
-        EventKind::Flip => "flip",
-        EventKind::Collapse => "collapse",
-    };
-    EventMark {
-        kind,
-        position: e.position,
-        level: e.level,
-        angle: e.angle,
-        step: e.step,
     }
 }

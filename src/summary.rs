@@ -67,6 +67,8 @@ pub struct RecordingSummary {
     pub path: PathBuf,
     /// Its size in bytes.
     pub bytes: u64,
+    /// Frames in the file (fewer than `frames` with `--record-every`).
+    pub frames: u64,
 }
 
 /// Everything `--summary` writes.

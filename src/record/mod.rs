@@ -1,7 +1,9 @@
-//! Recording of a run to a Rerun `.rrd` file (SPEC section 7), and OBJ frame export.
+//! Recording of a run to a Rerun `.rrd` file or a live viewer (SPEC section 7), the `drape
+//! inspect` decoder, and OBJ frame export.
 //!
 //! This is the only module that imports `rerun`. The engine hands each frame over as plain
-//! slices ([`FrameView`]); every conversion to rerun types lives in `convert.rs`.
+//! slices ([`FrameView`]); every conversion to rerun types lives in this module's files.
+//! `docs/recording.md` documents the schema (every entity, type and unit) for users.
 //!
 //! What a recording holds:
 //! - timelines `frame` (sequence) and `sim_time` (duration, seconds), set before each frame
@@ -10,12 +12,18 @@
 //!   `cloth` that names and colours the refinement levels (`level 0`, `level 1`, ...);
 //! - `cloth/mesh` every frame: a `Mesh3D` whose vertices are un-shared (three per triangle, in
 //!   triangle order, no index buffer) so that each triangle carries its own colour from
-//!   [`LEVEL_PALETTE`], with per-vertex normals and the level as class id (data + legend);
+//!   [`LEVEL_PALETTE`], with per-vertex normals, the level as class id (legend), and the level
+//!   once per triangle as data (`triangle_level`, `u8`);
+//! - `cloth/edges` every frame unless turned off: the edges as line segments coloured by their
+//!   dihedral angle ([`edges::angle_rgb`]), with the angle (`dihedral_angle_deg`) and the vertex
+//!   pair (`edge_vertices`) of each segment as data; all edges or only those above a threshold
+//!   ([`EdgeDisplay`]);
 //! - `cloth/pins` every frame: the pinned vertices as points;
+//! - `events/points` and `events/log`: the remeshing events since the previous recorded frame;
+//! - `legend` (static): a markdown text document naming the colours;
 //! - `plots/<name>` every frame for each scalar of [`FrameView::scalars`];
-//! - a default blueprint, sent with the first frame once the plot names are known: a 3D view
-//!   of the whole scene beside one time-series view per top-level plot group (`plots/energy`,
-//!   `plots/mesh`, ...).
+//! - `obstacles/<name>`: obstacle meshes, static or per frame;
+//! - a default blueprint, sent with the first frame once the plot names are known (`layout.rs`).
 //!
 //! The recording is forced on: `RERUN=off` in the environment does not disable it (the builder
 //! uses `enabled(true)`, which rerun documents as ignoring the `RERUN` variable). One
@@ -26,19 +34,28 @@
 //! path; do not set it.
 
 mod convert;
+pub mod edges;
+mod error;
+mod events;
+mod frame;
+pub mod inspect;
+mod layout;
 pub mod obj;
+mod report;
+mod sink;
 
 use std::collections::HashMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
+use std::sync::Arc;
 
-use rerun::blueprint::{
-    Blueprint, BlueprintActivation, ContainerLike, Horizontal, Spatial3DView, TextLogView,
-    TimeSeriesView, Vertical,
-};
-use rerun::{EntityPath, RecordingStream, RecordingStreamBuilder};
+use rerun::external::arrow::array::UInt8Array;
+use rerun::{AsComponents, EntityPath, RecordingStream, RecordingStreamBuilder};
 
 use crate::math::Vector;
-
+pub use edges::EdgeDisplay;
+pub use error::{BoxError, RecordError};
+pub use frame::{EventMark, FrameView};
+pub use sink::{LiveViewer, RecordTarget};
 /// Colour of each refinement level, as sRGB `[r, g, b]`.
 ///
 /// | level | colour | hex |
@@ -76,6 +93,13 @@ pub const TIMELINE_FRAME: &str = "frame";
 pub const TIMELINE_SIM_TIME: &str = "sim_time";
 /// Entity of the cloth mesh.
 pub const ENTITY_MESH: &str = "cloth/mesh";
+/// Entity of the edges coloured by dihedral angle.
+pub const ENTITY_EDGES: &str = "cloth/edges";
+/// Component name of the per-triangle level data on `cloth/mesh` (`u8`, one per triangle).
+pub const LEVEL_COMPONENT: &str = "triangle_level";
+/// Entity of the static legend (a markdown text document: level colours, angle scale, event
+/// colours).
+pub const ENTITY_LEGEND: &str = "legend";
 /// Entity of the pinned vertices.
 pub const ENTITY_PINS: &str = "cloth/pins";
 /// Parent entity of the scalar plots: scalar `name` is logged at `plots/<name>`.
@@ -90,113 +114,10 @@ const PIN_COLOR: [u8; 3] = [0xFF, 0xFF, 0xFF];
 /// Radius of the pin markers on screen, in UI points.
 const PIN_RADIUS_UI: f32 = 4.0;
 
-/// One recorded frame, as plain slices (no engine types).
-#[derive(Debug, Clone, Copy)]
-pub struct FrameView<'a> {
-    /// Frame index, on timeline `frame` (sequence).
-    pub frame: u64,
-    /// Simulated time in seconds, on timeline `sim_time` (duration). Must be finite.
-    pub sim_time: f64,
-    /// World positions, m.
-    pub positions: &'a [Vector],
-    /// Unit normal per vertex (same length as `positions`).
-    pub vertex_normals: &'a [Vector],
-    /// Triangles as vertex indices into `positions`.
-    pub triangles: &'a [[u32; 3]],
-    /// Refinement level per triangle (same length as `triangles`); 0 is the base mesh.
-    pub triangle_levels: &'a [u8],
-    /// Indices of pinned vertices.
-    pub pinned: &'a [u32],
-    /// Plot path -> value, e.g. `("energy/kinetic", 0.1)`, logged at `plots/<path>`.
-    pub scalars: &'a [(&'a str, f64)],
-    /// Remeshing events since the previous frame, shown at `events/points` and
-    /// written one line each to `events/log`.
-    pub events: &'a [EventMark],
-}
-
-/// One remeshing event, as plain data for the recording.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct EventMark {
-    /// What happened: `split`, `closure_split`, `merge`, `flip`, `collapse` or `rollback`.
-    pub kind: &'static str,
-    /// Where, in world coordinates (m).
-    pub position: Vector,
-    /// Level of the triangles it made.
-    pub level: u8,
-    /// The angle that triggered it, degrees, if any.
-    pub angle: Option<f64>,
-    /// The step after which it happened.
-    pub step: u64,
-}
-
 /// Entity of the event points (one point per event of the frame, labelled).
 pub const ENTITY_EVENT_POINTS: &str = "events/points";
 /// Entity of the event log (one text line per event).
 pub const ENTITY_EVENT_LOG: &str = "events/log";
-
-/// Colour of an event's point by kind, sRGB.
-fn event_color(kind: &str) -> [u8; 3] {
-    match kind {
-        "split" => [0xFF, 0x8F, 0x00],
-        "closure_split" => [0xFF, 0xD5, 0x4F],
-        "merge" | "collapse" => [0x42, 0xA5, 0xF5],
-        "flip" => [0xBD, 0xBD, 0xBD],
-        _ => [0xE5, 0x39, 0x35],
-    }
-}
-
-/// Boxed error from rerun, kept opaque so rerun's types stay inside this module.
-type BoxError = Box<dyn std::error::Error + Send + Sync + 'static>;
-
-/// Everything that can go wrong while recording.
-#[derive(Debug, thiserror::Error)]
-pub enum RecordError {
-    /// The `.rrd` file could not be created (missing directory, no permission, ...).
-    #[error("cannot create recording file {}: {source}", .path.display())]
-    Create {
-        /// The requested `.rrd` path.
-        path: PathBuf,
-        /// What rerun or the file system reported.
-        #[source]
-        source: BoxError,
-    },
-    /// Rerun refused to log an entity.
-    #[error("cannot log {entity} to recording {}: {source}", .path.display())]
-    Log {
-        /// The `.rrd` path.
-        path: PathBuf,
-        /// The entity being logged.
-        entity: String,
-        /// What rerun reported.
-        #[source]
-        source: BoxError,
-    },
-    /// The frame data is inconsistent (length mismatch, index out of range, non-finite time).
-    #[error("invalid frame {frame}: {reason}")]
-    InvalidFrame {
-        /// The frame index.
-        frame: u64,
-        /// What is wrong with it.
-        reason: String,
-    },
-    /// Flushing or closing the `.rrd` file failed; the file may be incomplete.
-    #[error("cannot finish recording file {}: {message}", .path.display())]
-    Finish {
-        /// The `.rrd` path.
-        path: PathBuf,
-        /// What went wrong.
-        message: String,
-    },
-    /// An OBJ frame file could not be written.
-    #[error("cannot write OBJ file {}: {source}", .path.display())]
-    Obj {
-        /// The OBJ path.
-        path: PathBuf,
-        /// The I/O error.
-        #[source]
-        source: std::io::Error,
-    },
-}
 
 /// The recording id for a scene: the same scene name always gives the same id, so re-running a
 /// scene replaces its recording in the viewer instead of adding a new one.
@@ -222,15 +143,19 @@ pub fn recording_id(scene_name: &str) -> String {
     )
 }
 
-/// Writes one run to a `.rrd` file, frame by frame.
+/// Writes one run to a `.rrd` file and/or a live viewer, frame by frame.
 ///
 /// Dropping a `Recorder` without [`Recorder::finish`] (early return, `?`, panic unwinding)
 /// still flushes and closes the file, footer included, so it stays a valid `.rrd`.
 pub struct Recorder {
     /// The sole handle on the stream: dropping it joins rerun's threads and writes the footer.
     stream: RecordingStream,
-    path: PathBuf,
+    target: RecordTarget,
+    /// `target.describe()`, for error messages.
+    described: String,
+    edges: EdgeDisplay,
     mesh_path: EntityPath,
+    edges_path: EntityPath,
     pins_path: EntityPath,
     /// `plots/<name>` per scalar name, parsed once.
     scalar_paths: HashMap<String, EntityPath>,
@@ -240,32 +165,48 @@ pub struct Recorder {
 impl std::fmt::Debug for Recorder {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Recorder")
-            .field("path", &self.path)
+            .field("target", &self.target)
+            .field("edges", &self.edges)
             .finish_non_exhaustive()
     }
 }
 
 impl Recorder {
-    /// Opens `path` for writing and logs the static data.
-    ///
-    /// The file is created (truncated) immediately, so an unwritable path (missing directory,
-    /// no permission) fails here with [`RecordError::Create`]. The recording id derives from
-    /// `scene_name` ([`recording_id`]), which is also the recording's name. Logs once: view
-    /// coordinates (right-handed, z up) and the annotation context of the level colours. The
-    /// default blueprint follows with the first frame (see the module docs).
+    /// Opens `path` for writing, with every edge drawn; see [`Recorder::open`].
     pub fn create(path: &Path, scene_name: &str) -> Result<Recorder, RecordError> {
+        Recorder::open(&RecordTarget::file(path), scene_name, EdgeDisplay::All)
+    }
+
+    /// Opens the recording's destinations and logs the static data.
+    ///
+    /// The file, if any, is created (truncated) immediately, so an unwritable path (missing
+    /// directory, no permission) fails here with [`RecordError::Create`], before a viewer is
+    /// started and before any simulation. A viewer that cannot be spawned (no `rerun` on
+    /// `PATH`) or a URL that is not a viewer's proxy URL fails here too; a viewer that does not
+    /// answer does not (rerun keeps retrying in the background).
+    ///
+    /// The recording id derives from `scene_name` ([`recording_id`]), which is also the
+    /// recording's name. Logs once: view coordinates (right-handed, z up) and the annotation
+    /// context of the level colours. The default blueprint follows with the first frame.
+    pub fn open(
+        target: &RecordTarget,
+        scene_name: &str,
+        edges: EdgeDisplay,
+    ) -> Result<Recorder, RecordError> {
+        let described = target.describe();
         let create_err = |source: BoxError| RecordError::Create {
-            path: path.to_path_buf(),
+            target: described.clone(),
             source,
         };
+        let sinks = sink::open_sinks(target)?;
         let stream = RecordingStreamBuilder::new(APPLICATION_ID)
             .recording_id(recording_id(scene_name))
             // `recording_id` turns the properties chunk off; keep the name in the file.
             .send_properties(true)
             .recording_name(scene_name)
-            // Ignore `RERUN=off`: a requested file is always written.
+            // Ignore `RERUN=off`: a requested recording is always written.
             .enabled(true)
-            .save(path)
+            .set_sinks(sinks)
             .map_err(|e| create_err(Box::new(e)))?;
         if !stream.is_enabled() {
             return Err(create_err("rerun disabled the recording stream".into()));
@@ -275,8 +216,11 @@ impl Recorder {
         stream.set_log_time_enabled(false);
         let recorder = Recorder {
             stream,
-            path: path.to_path_buf(),
+            target: target.clone(),
+            described,
+            edges,
             mesh_path: EntityPath::from(ENTITY_MESH),
+            edges_path: EntityPath::from(ENTITY_EDGES),
             pins_path: EntityPath::from(ENTITY_PINS),
             scalar_paths: HashMap::new(),
             blueprint_sent: false,
@@ -289,26 +233,37 @@ impl Recorder {
             .stream
             .log_static("cloth", &convert::level_annotations())
             .map_err(|e| recorder.log_err("cloth", e))?;
+        recorder
+            .stream
+            .log_static(
+                ENTITY_LEGEND,
+                &rerun::TextDocument::from_markdown(layout::legend_markdown()),
+            )
+            .map_err(|e| recorder.log_err(ENTITY_LEGEND, e))?;
         Ok(recorder)
     }
 
-    /// The `.rrd` path being written.
-    pub fn path(&self) -> &Path {
-        &self.path
+    /// Where the recording goes.
+    pub fn target(&self) -> &RecordTarget {
+        &self.target
     }
 
     /// Logs one frame: sets the `frame` and `sim_time` timelines, then logs the mesh at
-    /// `cloth/mesh` (un-shared vertices coloured by level, normals, level as class id), the
-    /// pinned vertices at `cloth/pins` and each scalar at `plots/<name>`.
+    /// `cloth/mesh` (un-shared vertices coloured by level, normals, level as class id and as
+    /// `triangle_level` data), the edges at `cloth/edges` (unless [`EdgeDisplay::Off`]), the
+    /// pinned vertices at `cloth/pins`, the events at `events/points` and `events/log`, and each
+    /// scalar at `plots/<name>`.
     ///
     /// The data is validated first ([`RecordError::InvalidFrame`] on a length mismatch, an
     /// index out of range or a non-finite `sim_time`); nothing is logged for an invalid frame
     /// and the recorder stays usable. Vertices are converted straight from the slices into
     /// rerun's arrow buffers: no per-frame buffers of our own are needed.
     pub fn record_frame(&mut self, frame: &FrameView) -> Result<(), RecordError> {
-        let frame_index = validate(frame)?;
+        let frame_index = frame::validate(frame)?;
         if !self.blueprint_sent {
-            self.send_blueprint(frame.scalars)?;
+            let names: Vec<&str> = frame.scalars.iter().map(|(n, _)| *n).collect();
+            layout::send_blueprint(&self.stream, &names)
+                .map_err(|e| self.log_err("blueprint", e))?;
             self.blueprint_sent = true;
         }
 
@@ -342,9 +297,27 @@ impl Recorder {
                 .iter()
                 .flat_map(|&l| [convert::level_class_id(l); 3]),
         );
+        let levels = rerun::AnyValues::default().with_component_from_data(
+            LEVEL_COMPONENT,
+            Arc::new(UInt8Array::from(frame.triangle_levels.to_vec())),
+        );
         self.stream
-            .log(self.mesh_path.clone(), &mesh)
+            .log(
+                self.mesh_path.clone(),
+                &[&mesh as &dyn AsComponents, &levels],
+            )
             .map_err(|e| self.log_err(ENTITY_MESH, e))?;
+
+        if let Some((strips, data)) =
+            edges::edge_row(self.edges, positions, frame.edges, frame.edge_angles)
+        {
+            self.stream
+                .log(
+                    self.edges_path.clone(),
+                    &[&strips as &dyn AsComponents, &data],
+                )
+                .map_err(|e| self.log_err(ENTITY_EDGES, e))?;
+        }
 
         let [r, g, b] = PIN_COLOR;
         let pins = rerun::Points3D::new(
@@ -359,7 +332,14 @@ impl Recorder {
             .log(self.pins_path.clone(), &pins)
             .map_err(|e| self.log_err(ENTITY_PINS, e))?;
 
-        self.record_events(frame.events)?;
+        self.stream
+            .log(ENTITY_EVENT_POINTS, &events::event_points(frame.events))
+            .map_err(|e| self.log_err(ENTITY_EVENT_POINTS, e))?;
+        for e in frame.events {
+            self.stream
+                .log(ENTITY_EVENT_LOG, &events::event_line(e))
+                .map_err(|err| self.log_err(ENTITY_EVENT_LOG, err))?;
+        }
 
         for &(name, value) in frame.scalars {
             let path = match self.scalar_paths.get(name) {
@@ -414,7 +394,8 @@ impl Recorder {
         logged.map_err(|e| self.log_err(&entity, e))
     }
 
-    /// Flushes and closes the file, footer included, and returns its size in bytes.
+    /// Flushes and closes the stream (the file's footer included) and returns the size of the
+    /// `.rrd` file in bytes (0 when only streaming to a viewer).
     ///
     /// The stream is closed even when flushing fails; the error then says the file may be
     /// incomplete.
@@ -424,89 +405,16 @@ impl Recorder {
         // Last handle: this joins rerun's batcher and writer threads, which write the footer.
         drop(stream);
         let finish_err = |message: String| RecordError::Finish {
-            path: self.path.clone(),
+            target: self.described.clone(),
             message,
         };
         flushed.map_err(|e| finish_err(e.to_string()))?;
-        let len = std::fs::metadata(&self.path)
-            .map_err(|e| finish_err(format!("cannot read the file size: {e}")))?
-            .len();
-        Ok(len)
-    }
-
-    /// Logs the frame's events: labelled points (an empty set when there are none, so the
-    /// 3D view shows only the current frame's events) and one text line per event.
-    fn record_events(&mut self, events: &[EventMark]) -> Result<(), RecordError> {
-        let points = rerun::Points3D::new(events.iter().map(|e| convert::position(e.position)))
-            .with_colors(events.iter().map(|e| {
-                let [r, g, b] = event_color(e.kind);
-                rerun::Rgba32::from_rgb(r, g, b)
-            }))
-            .with_labels(events.iter().map(|e| e.kind))
-            .with_radii([rerun::Radius::new_ui_points(6.0)]);
-        self.stream
-            .log(ENTITY_EVENT_POINTS, &points)
-            .map_err(|e| self.log_err(ENTITY_EVENT_POINTS, e))?;
-        for e in events {
-            let angle = e
-                .angle
-                .map(|a| format!(", angle {a:.2} deg"))
-                .unwrap_or_default();
-            let line = format!(
-                "{} after step {}: level {}{angle}, at ({:.3}, {:.3}, {:.3}) m",
-                e.kind, e.step, e.level, e.position.x, e.position.y, e.position.z
-            );
-            let level = if e.kind == "rollback" { "WARN" } else { "INFO" };
-            self.stream
-                .log(
-                    ENTITY_EVENT_LOG,
-                    &rerun::TextLog::new(line).with_level(level),
-                )
-                .map_err(|err| self.log_err(ENTITY_EVENT_LOG, err))?;
+        match &self.target.file {
+            Some(path) => Ok(std::fs::metadata(path)
+                .map_err(|e| finish_err(format!("cannot read the file size: {e}")))?
+                .len()),
+            None => Ok(0),
         }
-        Ok(())
-    }
-
-    /// Sends the default blueprint: the 3D scene beside one time-series view per top-level
-    /// plot group (first segment of the scalar names) and the event log.
-    fn send_blueprint(&self, scalars: &[(&str, f64)]) -> Result<(), RecordError> {
-        // rerun 0.36.3's `Blueprint::send` builds an internal stream that honours `RERUN=off`
-        // and then panics on its empty output: skip the blueprint in that case.
-        if !rerun::decide_logging_enabled(true) {
-            return Ok(());
-        }
-        let mut groups: Vec<&str> = scalars
-            .iter()
-            .filter_map(|(name, _)| name.split('/').find(|s| !s.is_empty()))
-            .collect();
-        groups.sort_unstable();
-        groups.dedup();
-        let scene: ContainerLike = Spatial3DView::new("cloth").with_origin("/").into();
-        let root: ContainerLike = if groups.is_empty() {
-            scene
-        } else {
-            let plots = groups.iter().map(|g| {
-                TimeSeriesView::new(*g)
-                    .with_origin(format!("{ENTITY_PLOTS}/{g}"))
-                    .into()
-            });
-            let log: ContainerLike = TextLogView::new("events")
-                .with_origin(ENTITY_EVENT_LOG)
-                .into();
-            Horizontal::new([scene, Vertical::new(plots.chain([log])).into()])
-                .with_column_shares([2.0_f32, 1.0])
-                .into()
-        };
-        Blueprint::new(root)
-            .with_auto_views(false)
-            .send(
-                &self.stream,
-                BlueprintActivation {
-                    make_active: true,
-                    make_default: true,
-                },
-            )
-            .map_err(|e| self.log_err("blueprint", e))
     }
 
     fn log_err(
@@ -515,7 +423,7 @@ impl Recorder {
         source: impl std::error::Error + Send + Sync + 'static,
     ) -> RecordError {
         RecordError::Log {
-            path: self.path.clone(),
+            target: self.described.clone(),
             entity: entity.to_owned(),
             source: Box::new(source),
         }
@@ -533,52 +441,9 @@ impl Drop for Recorder {
         {
             eprintln!(
                 "drape: warning: recording {} may be incomplete: {e}",
-                self.path.display()
+                self.described
             );
         }
         drop(stream);
     }
-}
-
-/// Checks the frame's slices against each other; returns the frame index for the timeline.
-fn validate(frame: &FrameView) -> Result<i64, RecordError> {
-    let invalid = |reason: String| RecordError::InvalidFrame {
-        frame: frame.frame,
-        reason,
-    };
-    let n = frame.positions.len();
-    let index = i64::try_from(frame.frame)
-        .map_err(|_| invalid("frame index does not fit the `frame` timeline (i64)".into()))?;
-    if !frame.sim_time.is_finite() {
-        return Err(invalid(format!("sim_time is {}", frame.sim_time)));
-    }
-    if frame.vertex_normals.len() != n {
-        return Err(invalid(format!(
-            "{} vertex normals for {n} vertices",
-            frame.vertex_normals.len()
-        )));
-    }
-    if frame.triangle_levels.len() != frame.triangles.len() {
-        return Err(invalid(format!(
-            "{} triangle levels for {} triangles",
-            frame.triangle_levels.len(),
-            frame.triangles.len()
-        )));
-    }
-    if let Some((t, tri)) = frame
-        .triangles
-        .iter()
-        .enumerate()
-        .find(|(_, tri)| tri.iter().any(|&i| i as usize >= n))
-    {
-        return Err(invalid(format!(
-            "triangle {t} {tri:?} refers to a vertex past the {n} vertices"
-        )));
-    }
-    if let Some(&i) = frame.pinned.iter().find(|&&i| i as usize >= n) {
-        return Err(invalid(format!(
-            "pinned vertex {i} is past the {n} vertices"
-        )));
-    }
-    Ok(index)
 }

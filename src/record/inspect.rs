@@ -1,0 +1,266 @@
+//! `drape inspect`: decode a `.rrd` with rerun's decoder and gather what a reviewer wants
+//! first (frames, time span, entities, mesh sizes, events); `report.rs` formats it.
+//!
+//! The decoder reads every message of the file; a message that does not decode is an error
+//! ([`InspectError::Decode`]), so a successful [`inspect`] also proves the file decodes
+//! completely. Whether rerun wrote its stream footer (the last thing written when a recording
+//! is closed) is reported separately ([`Inspection::footer`]).
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+
+use rerun::external::arrow::array::{
+    Array, AsArray, ListArray, StringArray,
+    types::{Float64Type, UInt8Type},
+};
+use rerun::external::re_log_encoding::DecoderApp;
+use rerun::log::{Chunk, LogMsg};
+
+use super::{ENTITY_EDGES, ENTITY_EVENT_LOG, ENTITY_MESH, ENTITY_PLOTS, LEVEL_COMPONENT};
+use super::{TIMELINE_FRAME, TIMELINE_SIM_TIME, edges::ANGLE_COMPONENT};
+
+/// Why a file could not be inspected.
+#[derive(Debug, thiserror::Error)]
+pub enum InspectError {
+    /// The file could not be opened or read.
+    #[error("cannot read {}: {source}", .path.display())]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The file is not a Rerun recording (no `.rrd` header).
+    #[error("{} is not a Rerun .rrd recording: {reason}", .path.display())]
+    NotRrd {
+        /// The file.
+        path: PathBuf,
+        /// What the decoder said.
+        reason: String,
+    },
+    /// A message inside the recording does not decode (a damaged or truncated file).
+    #[error("{} does not decode completely: message {index}: {reason}", .path.display())]
+    Decode {
+        /// The file.
+        path: PathBuf,
+        /// Index of the failing message (0-based).
+        index: usize,
+        /// What the decoder said.
+        reason: String,
+    },
+    /// `--frame N` names a frame the recording does not hold.
+    #[error("frame {frame} is not in the recording (it holds frames {first} to {last})")]
+    NoFrame {
+        /// The requested frame.
+        frame: i64,
+        /// First recorded frame.
+        first: i64,
+        /// Last recorded frame.
+        last: i64,
+    },
+}
+
+/// Rows of one entity.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct EntityRows {
+    /// Rows on the timelines.
+    pub temporal: usize,
+    /// Static rows (logged once, for all times).
+    pub static_rows: usize,
+}
+
+/// What the recording holds at one value of the `frame` timeline.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct FrameInfo {
+    /// The `sim_time` of the frame, s.
+    pub sim_time: Option<f64>,
+    /// Rows of `cloth/mesh` at this frame (1 in a drape recording).
+    pub mesh_rows: usize,
+    /// Triangles of the mesh (its un-shared vertex positions / 3).
+    pub triangles: Option<usize>,
+    /// The `triangle_level` values of the mesh (one per triangle).
+    pub levels: Vec<u8>,
+    /// Segments at `cloth/edges`.
+    pub edges: Option<usize>,
+    /// Largest `dihedral_angle_deg` at `cloth/edges`, degrees.
+    pub max_edge_angle: Option<f64>,
+    /// Smallest `dihedral_angle_deg` at `cloth/edges`, degrees.
+    pub min_edge_angle: Option<f64>,
+    /// `plots/<name>` values (name without the `plots/` prefix).
+    pub scalars: BTreeMap<String, f64>,
+    /// The lines of `events/log`, in logging order.
+    pub events: Vec<String>,
+}
+
+impl FrameInfo {
+    /// Vertices of the simulated mesh, from the `mesh/vertices` plot.
+    pub fn vertices(&self) -> Option<f64> {
+        self.scalars.get("mesh/vertices").copied()
+    }
+}
+
+/// Everything [`inspect`] gathered from one recording.
+#[derive(Debug, Clone, Default)]
+pub struct Inspection {
+    /// The file.
+    pub path: PathBuf,
+    /// Its size, bytes.
+    pub bytes: u64,
+    /// Whether the file ends with rerun's stream footer (written when the recording is closed).
+    pub footer: bool,
+    /// Messages decoded (recording and blueprint).
+    pub messages: usize,
+    /// Messages of the blueprint store.
+    pub blueprint_messages: usize,
+    /// Application ids of the recording store.
+    pub application_ids: BTreeSet<String>,
+    /// Recording ids of the recording store.
+    pub recording_ids: BTreeSet<String>,
+    /// Rows per entity path (as rerun writes it, with a leading `/`).
+    pub entities: BTreeMap<String, EntityRows>,
+    /// Per value of the `frame` timeline.
+    pub frames: BTreeMap<i64, FrameInfo>,
+}
+
+impl Inspection {
+    /// Event counts by kind (the first word of each `events/log` line), over all frames.
+    pub fn event_counts(&self) -> BTreeMap<String, usize> {
+        let mut counts = BTreeMap::new();
+        for line in self.frames.values().flat_map(|f| &f.events) {
+            let kind = line.split_whitespace().next().unwrap_or("").to_owned();
+            *counts.entry(kind).or_insert(0) += 1;
+        }
+        counts
+    }
+
+    /// The frame `n`, or [`InspectError::NoFrame`].
+    pub fn frame(&self, n: i64) -> Result<&FrameInfo, InspectError> {
+        self.frames.get(&n).ok_or_else(|| InspectError::NoFrame {
+            frame: n,
+            first: self.frames.keys().next().copied().unwrap_or(0),
+            last: self.frames.keys().next_back().copied().unwrap_or(0),
+        })
+    }
+}
+
+/// Decodes the recording at `path` completely and gathers its contents.
+pub fn inspect(path: &Path) -> Result<Inspection, InspectError> {
+    let read_err = |source| InspectError::Read {
+        path: path.to_path_buf(),
+        source,
+    };
+    let bytes = std::fs::read(path).map_err(read_err)?;
+    let decoder = DecoderApp::decode_eager(bytes.as_slice()).map_err(|e| InspectError::NotRrd {
+        path: path.to_path_buf(),
+        reason: e.to_string(),
+    })?;
+    let mut out = Inspection {
+        path: path.to_path_buf(),
+        bytes: bytes.len() as u64,
+        footer: bytes.len() >= 12 && &bytes[bytes.len() - 12..bytes.len() - 4] == b"RRF2FOOT",
+        ..Inspection::default()
+    };
+    for (index, msg) in decoder.enumerate() {
+        let decode_err = |reason: String| InspectError::Decode {
+            path: path.to_path_buf(),
+            index,
+            reason,
+        };
+        let msg = msg.map_err(|e| decode_err(e.to_string()))?;
+        out.messages += 1;
+        let store = msg.store_id();
+        if store.kind() != rerun::StoreKind::Recording {
+            out.blueprint_messages += 1;
+            continue;
+        }
+        out.application_ids
+            .insert(store.application_id().to_string());
+        out.recording_ids.insert(store.recording_id().to_string());
+        if let LogMsg::ArrowMsg(_, arrow) = &msg {
+            let chunk = Chunk::from_arrow_msg(arrow).map_err(|e| decode_err(e.to_string()))?;
+            gather(&mut out, &chunk);
+        }
+    }
+    Ok(out)
+}
+
+/// Adds one chunk's rows to the inspection.
+fn gather(out: &mut Inspection, chunk: &Chunk) {
+    let entity = chunk.entity_path().to_string();
+    let rows = out.entities.entry(entity.clone()).or_default();
+    if chunk.is_static() {
+        rows.static_rows += chunk.num_rows();
+        return;
+    }
+    rows.temporal += chunk.num_rows();
+    let timeline = |name: &str| {
+        chunk
+            .timelines()
+            .iter()
+            .find(|(n, _)| n.as_str() == name)
+            .map(|(_, col)| col.times_raw().to_vec())
+    };
+    let Some(frames) = timeline(TIMELINE_FRAME) else {
+        return;
+    };
+    let sim_times = timeline(TIMELINE_SIM_TIME);
+    let entity = entity.trim_start_matches('/');
+    let columns: Vec<(String, &ListArray)> = chunk
+        .component_descriptors()
+        .filter_map(|d| {
+            let array = chunk.components().get_array(d.component)?;
+            Some((d.component.as_str().to_owned(), array))
+        })
+        .collect();
+    let column = |suffix: &str| {
+        columns
+            .iter()
+            .find(|(name, _)| name == suffix || name.ends_with(&format!(":{suffix}")))
+            .map(|(_, a)| *a)
+    };
+    for (row, &frame) in frames.iter().enumerate() {
+        let info = out.frames.entry(frame).or_default();
+        if let Some(t) = sim_times.as_ref().and_then(|t| t.get(row)) {
+            info.sim_time = Some(*t as f64 * 1e-9);
+        }
+        let cell = |suffix: &str| {
+            column(suffix)
+                .filter(|a| a.is_valid(row))
+                .map(|a| a.value(row))
+        };
+        if entity == ENTITY_MESH {
+            info.mesh_rows += 1;
+            if let Some(p) = cell("vertex_positions") {
+                info.triangles = Some(p.len() / 3);
+            }
+            if let Some(l) = cell(LEVEL_COMPONENT)
+                && let Some(l) = l.as_primitive_opt::<UInt8Type>()
+            {
+                info.levels = l.values().to_vec();
+            }
+        } else if entity == ENTITY_EDGES {
+            if let Some(a) = cell(ANGLE_COMPONENT)
+                && let Some(a) = a.as_primitive_opt::<Float64Type>()
+            {
+                info.edges = Some(a.len());
+                info.max_edge_angle = a.values().iter().copied().reduce(f64::max);
+                info.min_edge_angle = a.values().iter().copied().reduce(f64::min);
+            }
+        } else if entity == ENTITY_EVENT_LOG {
+            if let Some(t) = cell("text")
+                && let Some(t) = t.as_any().downcast_ref::<StringArray>()
+            {
+                info.events.extend(t.iter().flatten().map(str::to_owned));
+            }
+        } else if let Some(name) = entity
+            .strip_prefix(ENTITY_PLOTS)
+            .and_then(|n| n.strip_prefix('/'))
+            && let Some(v) = cell("scalars")
+            && let Some(v) = v.as_primitive_opt::<Float64Type>()
+            && let Some(&v) = v.values().first()
+        {
+            info.scalars.insert(name.to_owned(), v);
+        }
+    }
+}

@@ -1,0 +1,180 @@
+//! The text `drape inspect` prints: an overview of a recording, or one frame in detail.
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+
+use super::inspect::{InspectError, Inspection};
+
+/// How many of the busiest frames the overview names.
+const BUSIEST_FRAMES: usize = 5;
+
+/// `min to max` of some values, or `-` when there are none.
+fn range<T: PartialOrd + Copy + std::fmt::Display>(values: impl Iterator<Item = T>) -> String {
+    let mut lo_hi: Option<(T, T)> = None;
+    for v in values {
+        lo_hi = Some(match lo_hi {
+            None => (v, v),
+            Some((lo, hi)) => (if v < lo { v } else { lo }, if v > hi { v } else { hi }),
+        });
+    }
+    match lo_hi {
+        Some((lo, hi)) => format!("{lo} to {hi}"),
+        None => "-".to_owned(),
+    }
+}
+
+/// `kind n, kind n, ...`, or `none`.
+fn counts_line(counts: &BTreeMap<String, usize>) -> String {
+    if counts.is_empty() {
+        return "none".to_owned();
+    }
+    counts
+        .iter()
+        .map(|(k, n)| format!("{k} {n}"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+impl Inspection {
+    /// The overview: file, ids, frames and time span, mesh size range, event counts by kind,
+    /// the frames with the most events, and every entity path with its row counts.
+    pub fn report(&self) -> String {
+        let mut s = String::new();
+        let footer = if self.footer {
+            "complete (stream footer present)"
+        } else {
+            "NO stream footer (the recording was not closed)"
+        };
+        let _ = writeln!(
+            s,
+            "{}: {} bytes, {} messages decoded, {footer}",
+            self.path.display(),
+            self.bytes,
+            self.messages
+        );
+        let ids = |set: &std::collections::BTreeSet<String>| {
+            set.iter().cloned().collect::<Vec<_>>().join(", ")
+        };
+        let _ = writeln!(
+            s,
+            "application {}, recording id {}, blueprint messages {}",
+            ids(&self.application_ids),
+            ids(&self.recording_ids),
+            self.blueprint_messages
+        );
+        let first = self.frames.keys().next();
+        let last = self.frames.keys().next_back();
+        let times: Vec<f64> = self.frames.values().filter_map(|f| f.sim_time).collect();
+        match (first, last) {
+            (Some(a), Some(b)) => {
+                let _ = writeln!(
+                    s,
+                    "frames: {} recorded, {a} to {b}; sim_time {}",
+                    self.frames.len(),
+                    match (times.first(), times.last()) {
+                        (Some(t0), Some(t1)) => format!("{t0:.4} s to {t1:.4} s"),
+                        _ => "-".to_owned(),
+                    }
+                );
+            }
+            _ => {
+                let _ = writeln!(s, "frames: none");
+            }
+        }
+        let frames = self.frames.values();
+        let _ = writeln!(
+            s,
+            "vertices: {}; triangles: {}; levels: {}",
+            range(frames.clone().filter_map(|f| f.vertices())),
+            range(frames.clone().filter_map(|f| f.triangles)),
+            range(frames.clone().flat_map(|f| f.levels.iter().copied())),
+        );
+        if self.frames.values().any(|f| f.edges.is_some()) {
+            let _ = writeln!(
+                s,
+                "edges per frame: {}; largest angle {} deg",
+                range(frames.clone().filter_map(|f| f.edges)),
+                frames
+                    .clone()
+                    .filter_map(|f| f.max_edge_angle)
+                    .reduce(f64::max)
+                    .map_or("-".to_owned(), |a| format!("{a:.2}")),
+            );
+        }
+        let counts = self.event_counts();
+        let total: usize = counts.values().sum();
+        let _ = writeln!(s, "events: {total} ({})", counts_line(&counts));
+        let mut busy: Vec<(i64, usize)> = self
+            .frames
+            .iter()
+            .filter(|(_, f)| !f.events.is_empty())
+            .map(|(&n, f)| (n, f.events.len()))
+            .collect();
+        busy.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
+        if !busy.is_empty() {
+            let top: Vec<String> = busy
+                .iter()
+                .take(BUSIEST_FRAMES)
+                .map(|(n, c)| format!("{n} ({c})"))
+                .collect();
+            let _ = writeln!(s, "frames with the most events: {}", top.join(", "));
+        }
+        let _ = writeln!(s, "entities (rows on the timelines, static rows):");
+        let width = self.entities.keys().map(String::len).max().unwrap_or(0);
+        for (path, rows) in &self.entities {
+            let _ = writeln!(
+                s,
+                "  {path:<width$}  {:>7}  {:>3}",
+                rows.temporal, rows.static_rows
+            );
+        }
+        s
+    }
+
+    /// One frame in detail: its time, mesh statistics (triangles, vertices, triangles per
+    /// level), edges, every plot value, and its events.
+    pub fn frame_report(&self, n: i64) -> Result<String, InspectError> {
+        let f = self.frame(n)?;
+        let mut s = String::new();
+        let time = f.sim_time.map_or("-".to_owned(), |t| format!("{t:.4} s"));
+        let _ = writeln!(s, "frame {n}, sim_time {time}");
+        let tris = f.triangles.map_or("-".to_owned(), |t| t.to_string());
+        let verts = f.vertices().map_or("-".to_owned(), |v| format!("{v}"));
+        let _ = writeln!(s, "mesh: {tris} triangles, {verts} vertices");
+        let mut per_level: BTreeMap<u8, usize> = BTreeMap::new();
+        for &l in &f.levels {
+            *per_level.entry(l).or_insert(0) += 1;
+        }
+        let levels: Vec<String> = per_level
+            .iter()
+            .map(|(l, c)| format!("level {l}: {c}"))
+            .collect();
+        let _ = writeln!(
+            s,
+            "triangles per level ({} values): {}",
+            f.levels.len(),
+            if levels.is_empty() {
+                "-".to_owned()
+            } else {
+                levels.join(", ")
+            }
+        );
+        if let Some(e) = f.edges {
+            let _ = writeln!(
+                s,
+                "edges: {e} recorded, largest angle {}",
+                f.max_edge_angle
+                    .map_or("-".to_owned(), |a| format!("{a:.2} deg"))
+            );
+        }
+        let _ = writeln!(s, "plots:");
+        for (name, v) in &f.scalars {
+            let _ = writeln!(s, "  {name} = {v}");
+        }
+        let _ = writeln!(s, "events: {}", f.events.len());
+        for line in &f.events {
+            let _ = writeln!(s, "  {line}");
+        }
+        Ok(s)
+    }
+}

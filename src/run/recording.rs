@@ -1,0 +1,128 @@
+//! The per-frame recording block of a run: gathers the world's state, the pending remeshing
+//! events and the plots into a [`FrameView`] for the recorder.
+
+use crate::adapt::{AdaptEvent, Adapter, EventKind, edge_angles};
+use crate::math::Scalar;
+use crate::physics::Energy;
+use crate::record::{EventMark, FrameView, Recorder};
+use crate::world::World;
+
+use super::{Pipeline, RunError};
+
+/// Wall time of the latest frame's stepping and of the latest recorded frame's recording, s.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct FrameTiming {
+    /// Stepping the frame (forces, integration, collisions, remeshing).
+    pub sim_s: Scalar,
+    /// Recording the previous recorded frame (and its OBJ export): a frame cannot time its own
+    /// recording before logging it.
+    pub record_s: Scalar,
+}
+
+/// What the run loop knows about the frame being recorded.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Snapshot {
+    /// Frame index.
+    pub frame: u64,
+    /// The cloth's energies at the frame.
+    pub energy: Energy,
+    /// Wall times to plot.
+    pub timing: FrameTiming,
+}
+
+/// Records the world's current state as frame `snap.frame`, with the events since the previous
+/// recorded frame, the plots, and the obstacles (static ones with frame 0, moving ones every
+/// recorded frame).
+pub(super) fn record_state(
+    rec: &mut Recorder,
+    world: &World,
+    pipe: &mut Pipeline,
+    snap: &Snapshot,
+    normals: &mut Vec<crate::math::Vector>,
+) -> Result<(), RunError> {
+    let events = pipe
+        .adapter
+        .as_mut()
+        .map(Adapter::take_events)
+        .unwrap_or_default();
+    let marks: Vec<EventMark> = events.iter().map(event_mark).collect();
+    let angles = edge_angles(world);
+    let edges: Vec<[u32; 2]> = world.mesh.edges.iter().map(|e| e.vertices).collect();
+    world.vertex_normals(normals);
+    let pinned: Vec<u32> = world.pins.anchors.iter().map(|a| a.vertex).collect();
+    let dt_now = pipe.step_size(world);
+    let e = snap.energy;
+    let mut scalars = vec![
+        ("mesh/vertices", world.x.len() as f64),
+        ("mesh/triangles", world.mesh.triangles.len() as f64),
+        ("energy/kinetic", e.kinetic),
+        ("energy/gravitational", e.gravitational),
+        ("energy/elastic", e.elastic),
+        ("energy/total", e.total()),
+        ("time/dt", dt_now),
+        ("timing/sim_ms", 1e3 * snap.timing.sim_s),
+        ("timing/record_ms", 1e3 * snap.timing.record_s),
+        (
+            "angle/max_deg",
+            angles.iter().copied().fold(0.0, Scalar::max),
+        ),
+    ];
+    if pipe.adapter.is_some() {
+        let count = |k: EventKind| events.iter().filter(|e| e.kind == k).count() as f64;
+        scalars.push((
+            "adapt/splits",
+            count(EventKind::Split) + count(EventKind::ClosureSplit),
+        ));
+        scalars.push((
+            "adapt/merges",
+            count(EventKind::Merge) + count(EventKind::Collapse),
+        ));
+        scalars.push(("adapt/flips", count(EventKind::Flip)));
+        scalars.push(("adapt/rollbacks", count(EventKind::Rollback)));
+    }
+    if pipe.collider.is_some() {
+        let c = &pipe.collision;
+        scalars.push(("collision/contacts", c.last_contacts as f64));
+        scalars.push(("penetration/max_m", c.last_penetration));
+    }
+    rec.record_frame(&FrameView {
+        frame: snap.frame,
+        sim_time: world.time,
+        positions: &world.x,
+        vertex_normals: normals,
+        triangles: &world.mesh.triangles,
+        triangle_levels: &world.mesh.levels,
+        edges: &edges,
+        edge_angles: &angles,
+        pinned: &pinned,
+        scalars: &scalars,
+        events: &marks,
+    })?;
+    if let Some(c) = &pipe.collider {
+        for m in c.obstacle_meshes(world.time) {
+            if m.moving || snap.frame == 0 {
+                rec.record_obstacle(&m.name, &m.positions, &m.triangles, !m.moving)?;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The recording's plain view of an adaptivity event.
+fn event_mark(e: &AdaptEvent) -> EventMark {
+    let kind = match e.kind {
+        EventKind::Split => "split",
+        EventKind::ClosureSplit => "closure_split",
+        EventKind::Merge => "merge",
+        EventKind::Rollback => "rollback",
+        EventKind::Flip => "flip",
+        EventKind::Collapse => "collapse",
+    };
+    EventMark {
+        kind,
+        position: e.position,
+        level: e.level,
+        angle: e.angle,
+        step: e.step,
+    }
+}

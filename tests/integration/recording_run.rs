@@ -1,0 +1,360 @@
+//! Recordings of whole runs (SPEC 7, issue 5): the schema decoded back with rerun's decoder,
+//! event counts against the engine's counters, completeness after an error and after Ctrl-C,
+//! reproducibility, `--record-every` and the edge options.
+
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::sync::atomic::AtomicBool;
+use std::time::{Duration, Instant};
+
+use drape::record::EdgeDisplay;
+use drape::record::inspect::{Inspection, inspect};
+use drape::run::{RunError, RunOptions, run};
+use drape::scene::{Scene, default_scene, load_scene_file};
+use drape::summary::Summary;
+
+/// A fresh path in the temp dir, unique per process and call.
+fn temp_path(name: &str) -> PathBuf {
+    use std::sync::atomic::{AtomicU64, Ordering};
+    static COUNTER: AtomicU64 = AtomicU64::new(0);
+    let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+    std::env::temp_dir().join(format!("drape-rr-{}-{n}-{name}", std::process::id()))
+}
+
+fn scene_file(name: &str, sets: &[&str]) -> Scene {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes")
+        .join(name);
+    let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+    load_scene_file(&path, &sets).expect("scene")
+}
+
+/// Runs `scene` recording to `out` with `opts` (its `record` is set here).
+fn record(scene: &Scene, out: &Path, opts: RunOptions) -> Result<Summary, RunError> {
+    let opts = RunOptions {
+        record: Some(out.to_path_buf()),
+        ..opts
+    };
+    run(scene, &opts, &AtomicBool::new(false), &mut |_| {})
+}
+
+/// The short adaptive run with an obstacle that exercises every entity of the schema: the
+/// tablecloth at resolution 8 for 0.5 s (it lands on the table at about 0.2 s and folds).
+fn tablecloth_short() -> Scene {
+    scene_file(
+        "tablecloth.toml",
+        &["cloth.resolution=8", "simulation.duration=0.5"],
+    )
+}
+
+/// Every frame has one mesh row, one `triangle_level` per triangle, the triangle count of the
+/// `mesh/triangles` plot, and (a disk-like sheet) `V + T - 1` edges with the largest angle
+/// equal to the `angle/max_deg` plot.
+fn check_frames(ins: &Inspection) {
+    for (n, f) in &ins.frames {
+        assert_eq!(f.mesh_rows, 1, "frame {n}: one mesh row");
+        let tris = f.triangles.expect("mesh positions");
+        assert_eq!(f.levels.len(), tris, "frame {n}: one level per triangle");
+        assert_eq!(f.scalars.get("mesh/triangles"), Some(&(tris as f64)));
+        let verts = f.vertices().expect("vertex plot") as usize;
+        assert_eq!(
+            f.edges,
+            Some(verts + tris - 1),
+            "frame {n}: Euler's formula"
+        );
+        let plotted = f.scalars["angle/max_deg"];
+        let max = f.max_edge_angle.expect("angles");
+        assert!(
+            (max - plotted).abs() <= 1e-12 * plotted.max(1.0),
+            "{max} vs {plotted}"
+        );
+    }
+}
+
+/// `events/log` counts by kind against the summary's counters.
+fn check_event_counts(ins: &Inspection, summary: &Summary) {
+    let counts = ins.event_counts();
+    let n = |k: &str| counts.get(k).copied().unwrap_or(0) as u64;
+    let a = summary.adapt.expect("adaptive run");
+    println!("events in the file {counts:?}; engine {a:?}");
+    assert_eq!(n("split") + n("closure_split"), a.splits);
+    assert_eq!(n("merge") + n("collapse"), a.merges);
+    assert_eq!(n("rollback"), a.rollbacks);
+    assert_eq!(n("flip"), a.flips);
+}
+
+#[test]
+fn adaptive_run_holds_the_whole_schema() {
+    let out = temp_path("schema.rrd");
+    let summary = record(&tablecloth_short(), &out, RunOptions::default()).expect("run");
+    let ins = inspect(&out).expect("decodes");
+    print!("{}", ins.report());
+    assert!(ins.footer);
+    let mut expected: BTreeSet<String> = [
+        "/",
+        "/cloth",
+        "/cloth/mesh",
+        "/cloth/edges",
+        "/cloth/pins",
+        "/events/points",
+        "/events/log",
+        "/legend",
+    ]
+    .into_iter()
+    .map(String::from)
+    .collect();
+    for plot in [
+        "mesh/vertices",
+        "mesh/triangles",
+        "energy/kinetic",
+        "energy/gravitational",
+        "energy/elastic",
+        "energy/total",
+        "time/dt",
+        "timing/sim_ms",
+        "timing/record_ms",
+        "angle/max_deg",
+        "adapt/splits",
+        "adapt/merges",
+        "adapt/flips",
+        "adapt/rollbacks",
+        "collision/contacts",
+        "penetration/max_m",
+    ] {
+        expected.insert(format!("/plots/{plot}"));
+    }
+    let present: BTreeSet<String> = ins.entities.keys().cloned().collect();
+    let missing: Vec<_> = expected.difference(&present).collect();
+    assert!(missing.is_empty(), "missing entities {missing:?}");
+    let obstacles: Vec<_> = present
+        .iter()
+        .filter(|p| p.starts_with("/obstacles/"))
+        .collect();
+    assert!(!obstacles.is_empty(), "an obstacle entity");
+    assert!(obstacles.iter().all(|p| ins.entities[*p].static_rows == 1));
+    assert_eq!(ins.frames.len() as u64, summary.frames);
+    assert_eq!(ins.entities["/cloth/mesh"].temporal as u64, summary.frames);
+    let rec = summary.recording.as_ref().expect("recording");
+    assert_eq!(rec.frames, summary.frames);
+    assert_eq!(rec.bytes, ins.bytes);
+    assert!(summary.splits > 0, "the short run refines");
+    check_frames(&ins);
+    check_event_counts(&ins, &summary);
+    std::fs::remove_file(&out).ok();
+}
+
+#[test]
+fn record_every_thins_frames_and_keeps_every_event() {
+    let out = temp_path("every.rrd");
+    let scene = scene_file(
+        "hanging_sheet.toml",
+        &["cloth.resolution=8", "simulation.duration=0.5"],
+    );
+    let every = 4;
+    let opts = RunOptions {
+        record_every: every,
+        ..RunOptions::default()
+    };
+    let summary = record(&scene, &out, opts).expect("run");
+    let ins = inspect(&out).expect("decodes");
+    let last = summary.frames - 1;
+    let expected: Vec<i64> = (0..=last)
+        .filter(|f| f % every == 0 || *f == last)
+        .map(|f| f as i64)
+        .collect();
+    let got: Vec<i64> = ins.frames.keys().copied().collect();
+    println!("{} frames simulated, recorded {got:?}", summary.frames);
+    assert_eq!(got, expected);
+    assert!(got.len() < summary.frames as usize);
+    assert_eq!(
+        summary.recording.as_ref().map(|r| r.frames),
+        Some(got.len() as u64)
+    );
+    check_frames(&ins);
+    check_event_counts(&ins, &summary);
+    std::fs::remove_file(&out).ok();
+}
+
+#[test]
+fn edge_options_filter_or_drop_cloth_edges() {
+    let scene = scene_file(
+        "hanging_sheet.toml",
+        &["cloth.resolution=8", "simulation.duration=0.3"],
+    );
+    let (all, above, none) = (
+        temp_path("all.rrd"),
+        temp_path("above.rrd"),
+        temp_path("none.rrd"),
+    );
+    let threshold = 2.0;
+    for (path, edges) in [
+        (&all, EdgeDisplay::All),
+        (&above, EdgeDisplay::Above(threshold)),
+        (&none, EdgeDisplay::Off),
+    ] {
+        let opts = RunOptions {
+            edges,
+            ..RunOptions::default()
+        };
+        record(&scene, path, opts).expect("run");
+    }
+    let (all_i, above_i, none_i) = (
+        inspect(&all).expect("all"),
+        inspect(&above).expect("above"),
+        inspect(&none).expect("none"),
+    );
+    assert!(!none_i.entities.contains_key("/cloth/edges"));
+    let mut kept_some = false;
+    for (n, f) in &all_i.frames {
+        let g = &above_i.frames[n];
+        let kept = g.edges.expect("edges row");
+        assert!(kept <= f.edges.expect("edges row"));
+        if let Some(min) = g.min_edge_angle {
+            assert!(min > threshold, "frame {n}: kept an edge at {min} deg");
+            kept_some = true;
+        }
+        // The largest angle is the same whenever an edge is above the threshold.
+        if f.max_edge_angle.is_some_and(|m| m > threshold) {
+            assert_eq!(g.max_edge_angle, f.max_edge_angle);
+        } else {
+            assert_eq!(kept, 0, "frame {n}");
+        }
+    }
+    assert!(kept_some, "the run bends past {threshold} deg somewhere");
+    println!(
+        "bytes: all edges {}, above {threshold} deg {}, no edges {}",
+        all_i.bytes, above_i.bytes, none_i.bytes
+    );
+    for p in [all, above, none] {
+        std::fs::remove_file(p).ok();
+    }
+}
+
+#[test]
+fn numerical_failure_leaves_a_complete_recording() {
+    // An explicit integrator at a step so far past its stability limit that even the
+    // smallest retry (1/16 of it) is slightly unstable: each frame is saved by a retry
+    // while the unstable mode grows, until even the smallest step lets the energy
+    // explode (frame 7 here) and the run stops.
+    let scene = default_scene(&[
+        "simulation.integrator=symplectic_euler".into(),
+        "simulation.dt=0.025".into(),
+        "cloth.resolution=8".into(),
+    ])
+    .expect("scene");
+    let out = temp_path("numerical.rrd");
+    let err = record(&scene, &out, RunOptions::default()).expect_err("numerical failure");
+    println!("{err}");
+    let RunError::Numerical { frame, summary, .. } = err else {
+        panic!("not a numerical failure: {err}");
+    };
+    assert!(frame > 1, "failed mid-way, at frame {frame}");
+    let ins = inspect(&out).expect("decodes completely");
+    assert!(ins.footer, "footer written");
+    assert_eq!(ins.frames.len() as u64, summary.frames);
+    assert_eq!(
+        *ins.frames.keys().next_back().expect("frames"),
+        frame as i64 - 1
+    );
+
+    // With --record-every 4 the last good frame is not a multiple of 4: it is recorded too.
+    assert_ne!(
+        (frame - 1) % 4,
+        0,
+        "the check below needs an unaligned last frame"
+    );
+    let opts = RunOptions {
+        record_every: 4,
+        ..RunOptions::default()
+    };
+    let err = record(&scene, &out, opts).expect_err("numerical failure");
+    let RunError::Numerical { frame: again, .. } = err else {
+        panic!("not a numerical failure: {err}");
+    };
+    assert_eq!(again, frame, "same failure");
+    let ins = inspect(&out).expect("decodes completely");
+    let got: Vec<i64> = ins.frames.keys().copied().collect();
+    let expected: Vec<i64> = (0..frame as i64)
+        .filter(|f| f % 4 == 0 || *f == frame as i64 - 1)
+        .collect();
+    println!("record_every 4, failure at frame {frame}: recorded {got:?}");
+    assert_eq!(got, expected);
+    std::fs::remove_file(&out).ok();
+}
+
+/// Compares the decoded contents of two recordings row by row (see `canonical.rs`).
+#[test]
+fn same_scene_twice_gives_identical_decoded_contents() {
+    let scene = tablecloth_short();
+    let (a, b) = (temp_path("a.rrd"), temp_path("b.rrd"));
+    record(&scene, &a, RunOptions::default()).expect("run a");
+    record(&scene, &b, RunOptions::default()).expect("run b");
+    let (ba, bb) = (std::fs::read(&a).expect("a"), std::fs::read(&b).expect("b"));
+    println!(
+        "sizes {} and {} bytes; byte-identical: {}",
+        ba.len(),
+        bb.len(),
+        ba == bb
+    );
+    let (ra, rb) = (
+        crate::canonical::rows(&a, crate::canonical::WALL_CLOCK),
+        crate::canonical::rows(&b, crate::canonical::WALL_CLOCK),
+    );
+    assert!(ra.len() > 100, "{} rows", ra.len());
+    crate::canonical::assert_same(&ra, &rb);
+    for p in [a, b] {
+        std::fs::remove_file(p).ok();
+    }
+}
+
+#[test]
+fn sigint_leaves_a_complete_recording() {
+    let dir = temp_path("sigint");
+    std::fs::create_dir_all(&dir).expect("dir");
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/tablecloth.toml");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_drape"))
+        .args(["run", scene.to_str().expect("utf-8 path"), "-q"])
+        .args(["--out", "x.rrd", "--summary", "s.json"])
+        .current_dir(&dir)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn drape");
+    // Let it record a few frames (the file grows as rerun flushes), then interrupt.
+    let started = Instant::now();
+    let rrd = dir.join("x.rrd");
+    while std::fs::metadata(&rrd).map_or(0, |m| m.len()) < 100_000
+        && started.elapsed() < Duration::from_secs(60)
+    {
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    std::thread::sleep(Duration::from_millis(500));
+    let status = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .expect("kill -INT");
+    assert!(status.success());
+    let deadline = Instant::now() + Duration::from_secs(60);
+    let code = loop {
+        if let Some(s) = child.try_wait().expect("wait") {
+            break s.code();
+        }
+        assert!(Instant::now() < deadline, "drape did not stop after SIGINT");
+        std::thread::sleep(Duration::from_millis(50));
+    };
+    println!("interrupted after {:?}, exit {code:?}", started.elapsed());
+    assert_eq!(code, Some(130));
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("s.json")).expect("summary"))
+            .expect("json");
+    assert_eq!(summary["interrupted"], true);
+    let ins = inspect(&rrd).expect("decodes completely");
+    print!("{}", ins.report());
+    assert!(ins.footer, "footer written");
+    let frames = summary["frames"].as_u64().expect("frames");
+    assert!(frames < 121, "stopped early");
+    assert_eq!(ins.frames.len() as u64, frames);
+    assert_eq!(ins.entities["/cloth/mesh"].temporal as u64, frames);
+    std::fs::remove_dir_all(&dir).ok();
+}
