@@ -2,6 +2,7 @@
 //! heavy dependencies (rerun) are linked once.
 
 mod adapt;
+mod bench;
 mod cli;
 mod collide;
 mod common;
