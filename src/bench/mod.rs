@@ -34,7 +34,7 @@ pub enum BenchError {
         /// Which run.
         context: String,
         /// The scene error.
-        source: SceneError,
+        source: Box<SceneError>,
     },
     /// A file could not be read or written.
     #[error("{}: {source}", path.display())]
@@ -167,7 +167,7 @@ pub struct BenchResult {
 fn load(path: &Path, overrides: &[String], context: &str) -> Result<Scene, BenchError> {
     load_scene_file(path, overrides).map_err(|source| BenchError::Scene {
         context: context.to_owned(),
-        source,
+        source: Box::new(source),
     })
 }
 
