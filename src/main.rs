@@ -49,6 +49,9 @@ struct BenchArgs {
     /// Print the ladder's rungs (labels and overrides) and exit.
     #[arg(long)]
     list: bool,
+    /// Redraw DIR/SCENE.svg from an existing DIR/SCENE.csv without running anything.
+    #[arg(long)]
+    replot: bool,
     /// Repetitions of each run; the median wall time is reported.
     #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
     reps: u32,
@@ -238,6 +241,15 @@ fn cmd_bench(args: BenchArgs) -> Result<ExitCode> {
         for r in &ladder.rung {
             println!("{}: {}", r.label, r.set.join(" "));
         }
+        return Ok(ExitCode::SUCCESS);
+    }
+    if args.replot {
+        let name = load_scene_file(&args.scene, &args.overrides)?.name;
+        let rows = drape::bench::replot::read_csv(&args.out_dir.join(format!("{name}.csv")))?;
+        let svg = args.out_dir.join(format!("{name}.svg"));
+        std::fs::write(&svg, drape::bench::chart::svg(&name, &rows))
+            .with_context(|| format!("cannot write {}", svg.display()))?;
+        println!("wrote {}", svg.display());
         return Ok(ExitCode::SUCCESS);
     }
     let opts = BenchOptions {

@@ -1,6 +1,7 @@
 //! The benchmark's chart, hand-written SVG: mean error against wall time on
 //! log-log axes, uniform runs as blue circles, adaptive runs as orange
-//! squares, the Pareto front as a line through ringed points.
+//! squares, the Pareto front as a line through ringed points; points are
+//! numbered, with the key of numbers to labels on the right.
 
 use std::fmt::Write as _;
 
@@ -158,7 +159,10 @@ pub fn svg(scene: &str, rows: &[Row]) -> String {
             r#"<path d="{d}" fill="none" stroke="black" stroke-dasharray="5,3"/>"#
         );
     }
-    for r in &ok {
+    for (n, r) in rows.iter().enumerate() {
+        if !ok.iter().any(|o| std::ptr::eq(*o, r)) {
+            continue;
+        }
         let (x, y) = (px(r.wall_s), py(100.0 * r.mean_error));
         if r.pareto {
             let _ = writeln!(
@@ -182,12 +186,28 @@ pub fn svg(scene: &str, rows: &[Row]) -> String {
         let _ = writeln!(
             s,
             r##"<text x="{:.1}" y="{:.1}" font-size="10" fill="#333">{}</text>"##,
-            x + 8.0,
-            y - 6.0,
-            escape(&r.label)
+            x + 7.0,
+            y - 5.0,
+            n + 1
         );
     }
     legend(&mut s, rows.len() - ok.len());
+    // The key of the point numbers.
+    for (n, r) in rows.iter().enumerate() {
+        let failed = if ok.iter().any(|o| std::ptr::eq(*o, r)) {
+            ""
+        } else {
+            " (failed)"
+        };
+        let _ = writeln!(
+            s,
+            r#"<text x="{:.1}" y="{:.1}" font-size="11">{} {}{failed}</text>"#,
+            W - RIGHT + 20.0,
+            TOP + 100.0 + 15.0 * n as f64,
+            n + 1,
+            escape(&r.label)
+        );
+    }
     s.push_str("</svg>\n");
     s
 }

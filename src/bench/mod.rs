@@ -13,6 +13,7 @@ pub mod ladder;
 pub mod metric;
 pub mod pareto;
 pub mod reference;
+pub mod replot;
 pub mod report;
 pub mod sampling;
 

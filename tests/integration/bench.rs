@@ -6,6 +6,7 @@ use std::process::Command;
 use std::sync::atomic::AtomicBool;
 
 use drape::bench::pareto::pareto_front;
+use drape::bench::replot::read_csv;
 use drape::bench::report::{CSV_HEADER, csv, target_checks};
 use drape::bench::sampling::{FrameSamples, frame_error};
 use drape::bench::{BenchOptions, Ladder, Row, Rung, bench, median};
@@ -128,6 +129,23 @@ fn csv_has_one_row_per_run_with_every_column() {
     assert!(lines[2].starts_with("\"adaptive, quoted\",adaptive,red_green,4,8,"));
     // A failed run's numbers are empty, not NaN.
     assert!(!text.contains("NaN"));
+    // `--replot` reads it back: the same rows (NaN where empty).
+    let dir = temp_dir("csv");
+    let path = dir.join("rows.csv");
+    std::fs::write(&path, &text).expect("write csv");
+    let back = read_csv(&path).expect("read csv");
+    assert_eq!(back.len(), rows.len());
+    for (a, b) in back.iter().zip(&rows) {
+        assert_eq!(a.label, b.label);
+        assert_eq!(a.set, b.set);
+        assert_eq!(a.adaptive, b.adaptive);
+        assert_eq!(
+            (a.resolution, a.finest_resolution),
+            (b.resolution, b.finest_resolution)
+        );
+        assert_eq!(a.wall_s.to_bits(), b.wall_s.to_bits());
+        assert_eq!(a.mean_error.is_nan(), b.mean_error.is_nan());
+    }
 }
 
 #[test]
