@@ -7,10 +7,10 @@ use std::fmt::Write as _;
 
 use super::Row;
 
-const W: f64 = 760.0;
+const W: f64 = 820.0;
 const H: f64 = 500.0;
 const LEFT: f64 = 80.0;
-const RIGHT: f64 = 200.0;
+const RIGHT: f64 = 260.0;
 const TOP: f64 = 40.0;
 const BOTTOM: f64 = 60.0;
 
