@@ -31,6 +31,10 @@ enum Command {
     Check(SceneArgs),
     /// Decode a .rrd recording and print what it holds.
     Inspect(InspectArgs),
+    /// Speed against error: run a ladder of uniform and adaptive settings on a
+    /// scene (no recording), compare each with a fine cached reference, and
+    /// write OUT/SCENE.csv, OUT/SCENE-frames.csv, OUT/SCENE.md and OUT/SCENE.svg.
+    Bench(BenchArgs),
 }
 
 #[derive(Args)]
@@ -40,6 +44,48 @@ struct InspectArgs {
     /// Print this frame's mesh statistics, plots and events instead of the overview.
     #[arg(long, value_name = "N")]
     frame: Option<i64>,
+}
+
+#[derive(Args)]
+struct BenchArgs {
+    /// Scene file (TOML).
+    scene: PathBuf,
+    /// Override a scene value for every run and the reference, e.g. `--set simulation.frame_rate=15` (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    overrides: Vec<String>,
+    /// Ladder file: `[[rung]]` tables with `label` and `set = ["key=value", ...]`, and an optional `reference = [...]` (default: a ladder built from the scene, see README).
+    #[arg(long, value_name = "FILE.toml")]
+    ladder: Option<PathBuf>,
+    /// Run only these rungs of the ladder, by label (comma-separated).
+    #[arg(long, value_name = "LABEL,...", value_delimiter = ',')]
+    rungs: Vec<String>,
+    /// Print the ladder's rungs (labels and overrides) and exit.
+    #[arg(long)]
+    list: bool,
+    /// Redraw DIR/SCENE.svg from an existing DIR/SCENE.csv without running anything.
+    #[arg(long)]
+    replot: bool,
+    /// Repetitions of each run; the median wall time is reported.
+    #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
+    reps: u32,
+    /// Simulated time of every run and the reference, s (default: the scene's duration).
+    #[arg(long, value_name = "S")]
+    duration: Option<f64>,
+    /// Worker threads (default: one per core).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    threads: Option<u32>,
+    /// Output directory.
+    #[arg(long, value_name = "DIR", default_value = "bench-out")]
+    out_dir: PathBuf,
+    /// Recompute the reference even if DIR/cache/ holds it (the new one is not cached).
+    #[arg(long)]
+    no_cache: bool,
+    /// Segments of the reference's uniform mesh (default: 1.5 times the finest rung's, rounded up to even).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(2..))]
+    reference_resolution: Option<u32>,
+    /// Sample points per side of the material-space grid of the error metric.
+    #[arg(long, value_name = "N", default_value_t = 24, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    samples: u32,
 }
 
 #[derive(Args)]
@@ -99,6 +145,7 @@ fn main() -> ExitCode {
         Command::Run(args) => cmd_run(args),
         Command::Check(args) => cmd_check(args),
         Command::Inspect(args) => cmd_inspect(args),
+        Command::Bench(args) => cmd_bench(args),
     };
     match result {
         Ok(code) => code,
@@ -253,6 +300,61 @@ fn cmd_run(args: RunArgs) -> Result<ExitCode> {
     } else {
         ExitCode::SUCCESS
     })
+}
+
+fn cmd_bench(args: BenchArgs) -> Result<ExitCode> {
+    use drape::bench::{BenchOptions, Ladder, bench, ladder::default_ladder};
+    let ladder = match &args.ladder {
+        Some(path) => Some(Ladder::load(path)?),
+        None => None,
+    };
+    if args.list {
+        let mut ladder = match ladder {
+            Some(l) => l,
+            None => default_ladder(&load_scene_file(&args.scene, &args.overrides)?),
+        };
+        if !args.rungs.is_empty() {
+            ladder.select(&args.rungs)?;
+        }
+        for r in &ladder.rung {
+            println!("{}: {}", r.label, r.set.join(" "));
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
+    if args.replot {
+        let name = load_scene_file(&args.scene, &args.overrides)?.name;
+        let rows = drape::bench::replot::read_csv(&args.out_dir.join(format!("{name}.csv")))?;
+        let svg = args.out_dir.join(format!("{name}.svg"));
+        std::fs::write(&svg, drape::bench::chart::svg(&name, &rows))
+            .with_context(|| format!("cannot write {}", svg.display()))?;
+        println!("wrote {}", svg.display());
+        return Ok(ExitCode::SUCCESS);
+    }
+    let opts = BenchOptions {
+        scene: args.scene.clone(),
+        overrides: args.overrides.clone(),
+        ladder,
+        rungs: args.rungs.clone(),
+        reps: args.reps as usize,
+        duration: args.duration,
+        threads: args.threads.map(|n| n as usize),
+        out_dir: args.out_dir.clone(),
+        cache: !args.no_cache,
+        reference_resolution: args.reference_resolution,
+        grid: args.samples as usize,
+    };
+    let interrupt = Arc::new(AtomicBool::new(false));
+    {
+        let flag = interrupt.clone();
+        ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed))
+            .context("installing the Ctrl-C handler")?;
+    }
+    let result = bench(&opts, &interrupt, &mut |line| eprintln!("{line}"))?;
+    print!("{}", drape::bench::report::markdown(&result, &args.scene));
+    for f in &result.files {
+        println!("wrote {}", f.display());
+    }
+    Ok(ExitCode::SUCCESS)
 }
 
 fn write_json(mut f: std::fs::File, summary: &drape::summary::Summary) -> Result<()> {

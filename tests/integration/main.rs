@@ -5,6 +5,7 @@ mod adapt;
 mod bad_cli;
 mod bad_input;
 mod bad_obj;
+mod bench;
 mod canonical;
 mod cli;
 mod collide;

@@ -1,0 +1,93 @@
+//! Reading a benchmark's CSV back (for `drape bench --replot`, which redraws
+//! the chart without running anything).
+
+use std::path::Path;
+
+use super::report::CSV_HEADER;
+use super::{BenchError, Row};
+use crate::math::Scalar;
+
+/// Splits one CSV line into fields (double quotes quote, `""` is a quote).
+pub fn split_csv_line(line: &str) -> Vec<String> {
+    let mut fields = vec![String::new()];
+    let mut quoted = false;
+    let mut chars = line.chars().peekable();
+    while let Some(c) = chars.next() {
+        match c {
+            '"' if quoted && chars.peek() == Some(&'"') => {
+                chars.next();
+                if let Some(f) = fields.last_mut() {
+                    f.push('"');
+                }
+            }
+            '"' => quoted = !quoted,
+            ',' if !quoted => fields.push(String::new()),
+            _ => {
+                if let Some(f) = fields.last_mut() {
+                    f.push(c);
+                }
+            }
+        }
+    }
+    fields
+}
+
+/// Reads the rows of a CSV written by [`super::report::csv`] (the per-frame
+/// errors are not in it and stay empty).
+pub fn read_csv(path: &Path) -> Result<Vec<Row>, BenchError> {
+    let text = std::fs::read_to_string(path).map_err(|source| BenchError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let bad = |message: String| BenchError::Ladder {
+        path: path.to_path_buf(),
+        message,
+    };
+    let mut lines = text.lines();
+    if lines.next() != Some(CSV_HEADER) {
+        return Err(bad("not a `drape bench` CSV (unexpected header)".into()));
+    }
+    let columns = CSV_HEADER.split(',').count();
+    let mut rows = Vec::new();
+    for (i, line) in lines.enumerate() {
+        let f = split_csv_line(line);
+        if f.len() != columns {
+            return Err(bad(format!(
+                "line {}: {} fields, expected {columns}",
+                i + 2,
+                f.len()
+            )));
+        }
+        let num = |s: &str| s.parse::<Scalar>().unwrap_or(Scalar::NAN);
+        let int = |s: &str| s.parse::<u64>().unwrap_or(0);
+        rows.push(Row {
+            label: f[0].clone(),
+            adaptive: f[1] == "adaptive",
+            method: f[2].clone(),
+            resolution: int(&f[3]) as u32,
+            finest_resolution: int(&f[4]) as u32,
+            max_level: int(&f[5]) as u32,
+            refine_angle: num(&f[6]),
+            coarsen_angle: num(&f[7]),
+            integrator: f[8].clone(),
+            multirate: f[9] == "true",
+            dt: f[10].clone(),
+            status: f[11].clone(),
+            reps: int(&f[12]) as usize,
+            wall_s: num(&f[13]),
+            steps: int(&f[14]),
+            mean_vertices: num(&f[15]),
+            peak_vertices: num(&f[16]),
+            mean_error: num(&f[17]),
+            final_error: num(&f[18]),
+            pareto: f[19] == "true",
+            set: f[20]
+                .split(' ')
+                .filter(|s| !s.is_empty())
+                .map(str::to_owned)
+                .collect(),
+            errors: Vec::new(),
+        });
+    }
+    Ok(rows)
+}

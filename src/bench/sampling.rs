@@ -1,0 +1,139 @@
+//! Running a scene while sampling the cloth at fixed material points every
+//! recorded frame (the input of the error metric).
+
+use std::sync::atomic::AtomicBool;
+use std::time::Instant;
+
+use serde::{Deserialize, Serialize};
+
+use super::metric::{locate, relative_rms, sample_positions};
+use crate::math::{Scalar, Vector, Vector2};
+use crate::mesh::Mesh;
+use crate::run::{FrameState, Progress, RunError, RunOptions, run_observed};
+use crate::scene::Scene;
+use crate::summary::Summary;
+
+/// The world positions of the sample points at one recorded frame.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FrameSamples {
+    /// Frame index (0: the initial state).
+    pub frame: u64,
+    /// Simulated time, s.
+    pub time: Scalar,
+    /// World position of each sample point, m (`None`: not found in the mesh).
+    pub positions: Vec<Option<[Scalar; 3]>>,
+}
+
+/// A run's outcome with its samples.
+#[derive(Debug, Clone)]
+pub struct SampledRun {
+    /// The run's summary (also for a run that failed numerically).
+    pub summary: Summary,
+    /// Samples of every frame done.
+    pub frames: Vec<FrameSamples>,
+    /// Wall time spent sampling (to subtract from the run's wall time), s.
+    pub sampling_s: Scalar,
+    /// The numerical failure that stopped the run early, if any.
+    pub failure: Option<String>,
+}
+
+/// Runs `scene` without recording, sampling `points` (material coordinates)
+/// at every recorded frame.
+pub fn sampled_run(
+    scene: &Scene,
+    opts: &RunOptions,
+    points: &[Vector2],
+    interrupt: &AtomicBool,
+) -> Result<SampledRun, RunError> {
+    let mut frames = Vec::new();
+    let mut sampling_s = 0.0;
+    let mut observe = |f: &FrameState| {
+        let t0 = Instant::now();
+        frames.push(sample_frame(f, points));
+        sampling_s += t0.elapsed().as_secs_f64();
+    };
+    let outcome = run_observed(scene, opts, interrupt, &mut |_: Progress| {}, &mut observe);
+    let (summary, failure) = match outcome {
+        Ok(s) => (s, None),
+        Err(RunError::Numerical {
+            frame,
+            time,
+            summary,
+            ..
+        }) => (
+            *summary,
+            Some(format!(
+                "numerical failure in frame {frame} (t = {time:.3} s)"
+            )),
+        ),
+        Err(e) => return Err(e),
+    };
+    Ok(SampledRun {
+        summary,
+        frames,
+        sampling_s,
+        failure,
+    })
+}
+
+/// Samples one frame: locates the points in the frame's mesh by material
+/// coordinates and interpolates the world positions.
+pub fn sample_frame(f: &FrameState, points: &[Vector2]) -> FrameSamples {
+    let mesh = Mesh {
+        material: f.material.to_vec(),
+        triangles: f.triangles.to_vec(),
+        levels: Vec::new(),
+        edges: Vec::new(),
+    };
+    let located = locate(&mesh, points);
+    let positions = located
+        .iter()
+        .map(|l| {
+            l.map(|l| {
+                let p = sample_positions(&mesh, f.positions, &[l])[0];
+                p.to_array()
+            })
+        })
+        .collect();
+    FrameSamples {
+        frame: f.frame,
+        time: f.sim_time,
+        positions,
+    }
+}
+
+/// The error of one frame against the reference's frame: the relative RMS
+/// distance over the samples found in both, or `None` when the frames' times
+/// differ or no sample is found in both.
+pub fn frame_error(
+    run: &FrameSamples,
+    reference: &FrameSamples,
+    diagonal: Scalar,
+) -> Option<Scalar> {
+    let dt = (run.time - reference.time).abs();
+    if dt > 1e-9 * reference.time.abs().max(1.0) {
+        return None;
+    }
+    let (a, b): (Vec<Vector>, Vec<Vector>) = run
+        .positions
+        .iter()
+        .zip(&reference.positions)
+        .filter_map(|(p, q)| Some((Vector::from_array((*p)?), Vector::from_array((*q)?))))
+        .unzip();
+    (!a.is_empty()).then(|| relative_rms(&a, &b, diagonal))
+}
+
+/// Per-frame errors of a run against the reference (matched by frame index;
+/// frames without a counterpart are left out), as `(time, error)`.
+pub fn run_errors(
+    run: &[FrameSamples],
+    reference: &[FrameSamples],
+    diagonal: Scalar,
+) -> Vec<(Scalar, Scalar)> {
+    run.iter()
+        .filter_map(|f| {
+            let r = reference.iter().find(|r| r.frame == f.frame)?;
+            Some((f.time, frame_error(f, r, diagonal)?))
+        })
+        .collect()
+}

@@ -1,0 +1,313 @@
+//! `drape bench`: the Pareto front, the CSV, a tiny ladder end to end (files,
+//! cache hit, failed rung recorded), and the CLI.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::sync::atomic::AtomicBool;
+
+use drape::bench::pareto::pareto_front;
+use drape::bench::replot::read_csv;
+use drape::bench::report::{CSV_HEADER, csv, target_checks};
+use drape::bench::sampling::{FrameSamples, frame_error};
+use drape::bench::{BenchOptions, Ladder, Row, Rung, bench, median};
+
+/// A fresh empty directory in the temp dir, unique per process and name.
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("drape-bench-test-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    dir
+}
+
+/// A small hanging sheet (0.5 m, resolution 4, implicit) as a scene file.
+fn tiny_scene(dir: &Path) -> PathBuf {
+    let path = dir.join("tiny.toml");
+    std::fs::write(
+        &path,
+        r#"name = "tiny"
+[simulation]
+duration = 0.2
+frame_rate = 20
+integrator = "implicit"
+dt = 0.01
+[cloth]
+shape = "rectangle"
+width = 0.5
+height = 0.5
+resolution = 4
+position = [0.0, 0.0, 1.0]
+[material]
+density = 0.15
+stretch = 200.0
+bending = 1.0e-5
+damping = 0.001
+[[pin]]
+region = "corner:top_left"
+"#,
+    )
+    .expect("write scene");
+    path
+}
+
+fn rung(label: &str, set: &[&str]) -> Rung {
+    Rung {
+        label: label.into(),
+        set: set.iter().map(|s| (*s).to_owned()).collect(),
+    }
+}
+
+fn row(label: &str, adaptive: bool, res: u32, finest: u32, wall: f64, err: f64) -> Row {
+    Row {
+        label: label.into(),
+        set: vec!["cloth.resolution=4".into(), "a,b".into()],
+        adaptive,
+        method: if adaptive { "red_green" } else { "none" }.into(),
+        resolution: res,
+        finest_resolution: finest,
+        max_level: if adaptive { 2 } else { 0 },
+        refine_angle: f64::NAN,
+        coarsen_angle: f64::NAN,
+        integrator: "implicit".into(),
+        multirate: false,
+        dt: "auto".into(),
+        status: "ok".into(),
+        reps: 1,
+        wall_s: wall,
+        steps: 10,
+        mean_vertices: 25.0,
+        peak_vertices: 30.0,
+        mean_error: err,
+        final_error: err,
+        errors: vec![],
+        pareto: false,
+    }
+}
+
+#[test]
+fn pareto_front_of_hand_made_points() {
+    let pts = [
+        (1.0, 10.0),     // cheapest: on the front
+        (2.0, 5.0),      // on
+        (3.0, 6.0),      // dominated by (2, 5)
+        (4.0, 1.0),      // on
+        (4.0, 2.0),      // dominated by (4, 1) (same cost, worse error)
+        (f64::NAN, 0.1), // failed: never on the front, dominates nothing
+        (5.0, f64::NAN), // failed
+        (2.0, 5.0),      // a duplicate of a front point: also on it
+    ];
+    assert_eq!(
+        pareto_front(&pts),
+        vec![true, true, false, true, false, false, false, true]
+    );
+}
+
+#[test]
+fn csv_has_one_row_per_run_with_every_column() {
+    let rows = vec![
+        row("uniform 4", false, 4, 4, 0.5, 0.01),
+        row("adaptive, quoted", true, 4, 8, 0.2, 0.02),
+        row("failed", false, 8, 8, f64::NAN, f64::NAN),
+    ];
+    let text = csv(&rows);
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines[0], CSV_HEADER);
+    assert_eq!(lines.len(), 1 + rows.len());
+    let columns = CSV_HEADER.split(',').count();
+    for line in &lines[1..] {
+        // Count fields outside quotes.
+        let mut fields = 1;
+        let mut quoted = false;
+        for c in line.chars() {
+            match c {
+                '"' => quoted = !quoted,
+                ',' if !quoted => fields += 1,
+                _ => {}
+            }
+        }
+        assert_eq!(fields, columns, "{line}");
+    }
+    assert!(lines[2].starts_with("\"adaptive, quoted\",adaptive,red_green,4,8,"));
+    // A failed run's numbers are empty, not NaN.
+    assert!(!text.contains("NaN"));
+    // `--replot` reads it back: the same rows (NaN where empty).
+    let dir = temp_dir("csv");
+    let path = dir.join("rows.csv");
+    std::fs::write(&path, &text).expect("write csv");
+    let back = read_csv(&path).expect("read csv");
+    assert_eq!(back.len(), rows.len());
+    for (a, b) in back.iter().zip(&rows) {
+        assert_eq!(a.label, b.label);
+        assert_eq!(a.set, b.set);
+        assert_eq!(a.adaptive, b.adaptive);
+        assert_eq!(
+            (a.resolution, a.finest_resolution),
+            (b.resolution, b.finest_resolution)
+        );
+        assert_eq!(a.wall_s.to_bits(), b.wall_s.to_bits());
+        assert_eq!(a.mean_error.is_nan(), b.mean_error.is_nan());
+    }
+}
+
+#[test]
+fn target_check_pairs_adaptive_with_uniform_at_its_finest_resolution() {
+    let rows = vec![
+        row("uniform 8", false, 8, 8, 4.0, 0.010),
+        row("fast and accurate", true, 4, 8, 0.9, 0.009),
+        row("fast but worse", true, 4, 8, 0.5, 0.02),
+        row("no counterpart", true, 4, 16, 0.5, 0.001),
+    ];
+    let checks = target_checks(&rows);
+    assert_eq!(checks.len(), 2);
+    assert!(checks[0].met && checks[0].uniform == "uniform 8");
+    assert!(!checks[1].met);
+    assert!((checks[0].time_ratio - 0.225).abs() < 1e-12);
+}
+
+#[test]
+fn frame_error_needs_the_same_time_and_measures_an_offset() {
+    let a = FrameSamples {
+        frame: 1,
+        time: 0.1,
+        positions: vec![Some([0.0, 0.0, 0.0]), Some([1.0, 0.0, 0.0]), None],
+    };
+    let mut b = a.clone();
+    for p in b.positions.iter_mut().flatten() {
+        p[2] += 0.3;
+    }
+    let e = frame_error(&a, &b, 2.0).expect("same time");
+    assert!((e - 0.15).abs() < 1e-12, "{e}");
+    b.time = 0.2;
+    assert_eq!(frame_error(&a, &b, 2.0), None);
+    assert_eq!(median(&mut [3.0, 1.0, 2.0]), 2.0);
+    assert_eq!(median(&mut [4.0, 1.0, 2.0, 3.0]), 2.5);
+}
+
+#[test]
+fn tiny_ladder_end_to_end_with_cache_and_a_failed_rung() {
+    let dir = temp_dir("e2e");
+    let scene = tiny_scene(&dir);
+    let ladder = Ladder {
+        reference: None,
+        rung: vec![
+            rung("uniform 4", &["adapt.method=none", "cloth.resolution=4"]),
+            rung("uniform 6", &["adapt.method=none", "cloth.resolution=6"]),
+            rung(
+                "adaptive 4 L2",
+                &[
+                    "adapt.method=red_green",
+                    "cloth.resolution=4",
+                    "adapt.max_level=2",
+                ],
+            ),
+            // Far beyond the explicit stability limit even after 4 halvings.
+            rung(
+                "blows up",
+                &[
+                    "adapt.method=none",
+                    "simulation.integrator=symplectic_euler",
+                    "material.stretch=2e7",
+                    "simulation.dt=0.001",
+                ],
+            ),
+        ],
+    };
+    let opts = BenchOptions {
+        scene: scene.clone(),
+        overrides: vec![],
+        ladder: Some(ladder),
+        rungs: vec![],
+        reps: 2,
+        duration: Some(0.15),
+        threads: Some(1),
+        out_dir: dir.join("out"),
+        cache: true,
+        reference_resolution: None,
+        grid: 8,
+    };
+    let stop = AtomicBool::new(false);
+    let mut lines = Vec::new();
+    let first = bench(&opts, &stop, &mut |l| lines.push(l.to_owned())).expect("bench");
+    assert!(!first.cache_hit);
+    // Finest rung: 4 segments doubled once = 8; the reference is 1.5 x finer.
+    assert!(
+        first
+            .reference
+            .overrides
+            .contains(&"cloth.resolution=12".to_owned())
+    );
+    assert_eq!(first.reference.vertices, 13 * 13);
+    assert_eq!(first.rows.len(), 4);
+    for r in &first.rows[..3] {
+        assert_eq!(r.status, "ok", "{}", r.label);
+        assert_eq!(r.reps, 2);
+        assert!(
+            r.mean_error.is_finite() && r.mean_error > 0.0,
+            "{}",
+            r.label
+        );
+        // Frames 0..=3 at 20 fps over 0.15 s.
+        assert_eq!(r.errors.len(), 4);
+        assert!(
+            r.errors[0].1 < 1e-12,
+            "the initial states agree (to rounding)"
+        );
+    }
+    assert!(first.rows[2].adaptive && !first.rows[0].adaptive);
+    assert!(
+        first.rows[3].status.starts_with("failed"),
+        "{}",
+        first.rows[3].status
+    );
+    assert!(!first.rows[3].pareto);
+    for name in ["tiny.csv", "tiny-frames.csv", "tiny.md", "tiny.svg"] {
+        assert!(dir.join("out").join(name).is_file(), "{name}");
+    }
+    let text = std::fs::read_to_string(dir.join("out/tiny.csv")).expect("csv");
+    assert_eq!(text.lines().count(), 5);
+    assert!(text.contains(",failed: numerical failure"));
+    let svg = std::fs::read_to_string(dir.join("out/tiny.svg")).expect("svg");
+    assert!(svg.starts_with("<svg") && svg.contains("Pareto front") && svg.contains("uniform 6"));
+
+    // Second invocation: the reference comes from the cache, same errors.
+    let mut lines2 = Vec::new();
+    let second = bench(&opts, &stop, &mut |l| lines2.push(l.to_owned())).expect("bench");
+    assert!(second.cache_hit);
+    assert!(lines2.iter().any(|l| l.starts_with("reference: cached")));
+    // Same errors (JSON keeps the samples to the last bit or so).
+    for (a, b) in second.rows[0].errors.iter().zip(&first.rows[0].errors) {
+        assert_eq!(a.0, b.0);
+        assert!((a.1 - b.1).abs() <= 1e-12, "{a:?} {b:?}");
+    }
+    // Without the cache it is computed again.
+    let third = bench(
+        &BenchOptions {
+            cache: false,
+            rungs: vec!["uniform 4".into()],
+            ..opts.clone()
+        },
+        &stop,
+        &mut |_| {},
+    )
+    .expect("bench");
+    assert!(!third.cache_hit);
+    assert_eq!(third.rows.len(), 1);
+}
+
+#[test]
+fn bench_cli_lists_the_default_ladder_and_rejects_unknown_rungs() {
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/hanging_sheet.toml");
+    let out = Command::new(env!("CARGO_BIN_EXE_drape"))
+        .args(["bench", scene.to_str().expect("utf-8"), "--list"])
+        .output()
+        .expect("run drape");
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success());
+    assert!(text.contains("uniform 64: adapt.method=none cloth.resolution=64"));
+    assert!(text.contains("red_green 16 L4: "));
+    let out = Command::new(env!("CARGO_BIN_EXE_drape"))
+        .args(["bench", scene.to_str().expect("utf-8"), "--rungs", "nope"])
+        .output()
+        .expect("run drape");
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no rung labelled `nope`"));
+}
