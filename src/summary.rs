@@ -103,8 +103,12 @@ pub struct Summary {
     pub mass_final: Scalar,
     /// Total energy.
     pub energy: EnergySummary,
-    /// Frames retried with a smaller step after a non-finite state.
+    /// Frame attempts retried with halved steps: after a non-finite state, an energy
+    /// explosion, or an energy gain above the tolerance (the key keeps its first name).
     pub nan_recoveries: u64,
+    /// Of those retries, how many were for an energy gain above the tolerance
+    /// (`run::ENERGY_GAIN_TOLERANCE`) rather than a NaN or an explosion.
+    pub energy_retries: u64,
     /// CG iterations and capped solves of the implicit integrator.
     pub solver: StepStats,
     /// 1-4 splits made by adaptive meshing (including forced ones).
@@ -159,7 +163,7 @@ impl Summary {
             "{}: {} frames, {} steps of {:.3e} s to t = {:.3} s in {:.2} s wall ({:.2} s stepping, {:.2} s recording); \
              {:.0} vertices, {:.0} triangles; {:.3e} vertex-steps/s. Mass {:.6} -> {:.6} kg; \
              energy {:.4e} -> {:.4e} J (max {:.4e}; external work {:.3e} J; largest excess over initial + work {:.3e} J); \
-             {} recoveries (frames retried with halved steps); {} CG iterations ({} capped).{}{} {}",
+             {} recoveries (frame attempts retried with halved steps, {} for energy gain); {} CG iterations ({} capped).{}{} {}",
             self.scene,
             self.frames,
             self.steps,
@@ -179,6 +183,7 @@ impl Summary {
             self.energy.external_work,
             self.energy.excess_max,
             self.nan_recoveries,
+            self.energy_retries,
             self.solver.cg_iterations,
             self.solver.cg_capped,
             match &self.adapt {
