@@ -10,6 +10,7 @@ mod canonical;
 mod cli;
 mod collide;
 mod common;
+mod energy;
 mod fuzz;
 mod inspect_cli;
 mod mesh;
