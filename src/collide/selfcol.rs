@@ -166,13 +166,16 @@ impl SelfCollider {
             .into_par_iter()
             .map(|p| self.culling && pt.cannot_self_intersect(p, tris, x0, x))
             .collect();
+        // Leaves are numbered within their patch (0, 1, ...) and mapped back to triangles
+        // on query: parry 0.31's `Bvh::from_iter` indexes its leaf table by position for
+        // one or two leaves, so a small patch with global triangle ids panicked.
         let trees: Vec<Bvh> = pt
             .triangles
             .par_iter()
             .map(|ts| {
                 Bvh::from_iter(
                     BvhBuildStrategy::Binned,
-                    ts.iter().map(|&t| (t as usize, boxes[t as usize])),
+                    ts.iter().enumerate().map(|(k, &t)| (k, boxes[t as usize])),
                 )
             })
             .collect();
@@ -188,7 +191,8 @@ impl SelfCollider {
                 let mut pairs = Vec::new();
                 let mut skipped = 0u64;
                 for &t in &pt.triangles[p] {
-                    for u in trees[p].intersect_aabb(&boxes[t as usize]) {
+                    for k in trees[p].intersect_aabb(&boxes[t as usize]) {
+                        let u = pt.triangles[p][k as usize];
                         if u > t && disjoint(t, u) {
                             if culled[p] {
                                 skipped += 1;
@@ -206,7 +210,8 @@ impl SelfCollider {
                         if !patch_box[q].intersects(&boxes[t as usize]) {
                             continue;
                         }
-                        for u in trees[q].intersect_aabb(&boxes[t as usize]) {
+                        for k in trees[q].intersect_aabb(&boxes[t as usize]) {
+                            let u = pt.triangles[q][k as usize];
                             if disjoint(t, u) {
                                 pairs.push((t, u));
                             }

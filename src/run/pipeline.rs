@@ -211,6 +211,11 @@ impl Pipeline {
             self.failure = StepFailure::NonFinite;
             return false;
         }
+        // Before the collision passes too: an exploding state (finite but huge) must
+        // not reach the geometry code.
+        if self.collider.is_some() && !self.explosion_check(world) {
+            return false;
+        }
         if let Some(c) = self.collider.as_mut() {
             let cloth = StepCloth {
                 pushed: &self.stepper.contact_push,

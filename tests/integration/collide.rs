@@ -465,3 +465,22 @@ friction_kinetic = 0.4
     );
     assert!(max_strain < 0.2, "largest strain {max_strain}");
 }
+
+/// Regression: parry 0.31's `Bvh::from_iter` looks its leaves up by position when a
+/// tree has one or two of them, so a self-collision patch of one or two triangles
+/// whose ids were not 0 and 1 panicked (seen on an adapted crumpling sheet). Leaves
+/// are now numbered within their patch.
+#[test]
+fn self_collision_with_one_triangle_patches_does_not_panic() {
+    let s = scene(
+        0.2,
+        2,
+        0.1,
+        "[self_collision]\nthickness = 0.003\npatch_size = 0.001\n",
+    );
+    let mut sim = Sim::new(&s);
+    for _ in 0..5 {
+        sim.step(1e-3);
+    }
+    assert!(sim.world.x.iter().all(|p| p.is_finite()));
+}
