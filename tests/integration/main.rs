@@ -17,3 +17,4 @@ mod physics;
 mod recording;
 mod recording_run;
 mod scene_errors;
+mod stability;
