@@ -168,7 +168,9 @@ fn non_negative_degrees(s: &str) -> Result<f64, String> {
 }
 
 fn cmd_stability(args: StabilityArgs) -> Result<ExitCode> {
-    use drape::stability::{all_passed, integrator_name, run_variant, scene_for, select, table, variants};
+    use drape::stability::{
+        all_passed, integrator_name, run_variant, scene_for, select, table, variants,
+    };
     let cases = select(&args.cases)?;
     let variants = variants(&cases, args.quick);
     // Open the Markdown file first so that an unwritable path fails before the runs.

@@ -197,18 +197,18 @@ impl Row {
         if let Some(f) = &self.failure {
             out.push(format!("numerical failure: {f}"));
         }
-        if !(self.excess_ratio <= ENERGY_TOLERANCE) {
+        if !at_most(self.excess_ratio, ENERGY_TOLERANCE) {
             out.push(format!(
                 "energy excess {:.3} S > {ENERGY_TOLERANCE} S",
                 self.excess_ratio
             ));
         }
         if let (Some(p), Some(t)) = (self.max_penetration, self.thickness)
-            && !(p < t)
+            && !below(p, t)
         {
             out.push(format!("penetration {p:.2e} m >= thickness {t:.2e} m"));
         }
-        if !(self.mass_drift <= MASS_TOLERANCE) {
+        if !at_most(self.mass_drift, MASS_TOLERANCE) {
             out.push(format!("mass drift {:.2e}", self.mass_drift));
         }
         out
@@ -218,6 +218,16 @@ impl Row {
     pub fn passed(&self) -> bool {
         self.failures().is_empty()
     }
+}
+
+/// `x <= limit`; false for NaN.
+fn at_most(x: Scalar, limit: Scalar) -> bool {
+    x <= limit
+}
+
+/// `x < limit`; false for NaN.
+fn below(x: Scalar, limit: Scalar) -> bool {
+    x < limit
 }
 
 /// The integrator's name as written in scene files.

@@ -95,11 +95,9 @@ fn hard_crumple() {
 #[test]
 fn hard_cases_deterministic_across_threads() {
     for case in CASES {
-        let scene = drape::scene::load_scene_file(
-            &hard_dir().join(format!("{}.toml", case.name)),
-            &[],
-        )
-        .expect("scene");
+        let scene =
+            drape::scene::load_scene_file(&hard_dir().join(format!("{}.toml", case.name)), &[])
+                .expect("scene");
         let variant = Variant {
             case,
             integrator: scene.simulation.integrator,
