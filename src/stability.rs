@@ -195,7 +195,7 @@ impl Row {
     pub fn failures(&self) -> Vec<String> {
         let mut out = Vec::new();
         if let Some(f) = &self.failure {
-            out.push(format!("numerical failure: {f}"));
+            out.push(f.clone());
         }
         if !at_most(self.excess_ratio, ENERGY_TOLERANCE) {
             out.push(format!(
@@ -350,12 +350,23 @@ pub fn run_variant(
         }
     };
     let start = Instant::now();
-    let outcome = run_observed(scene, &opts, &interrupt, &mut |_| {}, &mut observe);
+    // An engine panic is a bug, but it must not take the rest of the suite down:
+    // it becomes a FAIL row naming the panic.
+    let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        run_observed(scene, &opts, &interrupt, &mut |_| {}, &mut observe)
+    }));
     let wall_s = start.elapsed().as_secs_f64();
+    let outcome = match outcome {
+        Ok(outcome) => outcome,
+        Err(payload) => return Ok(panicked_row(variant, wall_s, payload.as_ref())),
+    };
     let (summary, failure) = match outcome {
         Ok(s) => (s, None),
         Err(e) => match &e {
-            RunError::Numerical { summary, .. } => (summary.as_ref().clone(), Some(e.to_string())),
+            RunError::Numerical { summary, .. } => (
+                summary.as_ref().clone(),
+                Some(format!("numerical failure: {e}")),
+            ),
             _ => {
                 return Err(StabilityError::Run {
                     case: variant.case.name.to_string(),
@@ -385,6 +396,30 @@ pub fn run_variant(
         failure,
         hash,
     })
+}
+
+/// The FAIL row of a run that panicked (an engine bug).
+fn panicked_row(variant: &Variant, wall_s: Scalar, payload: &(dyn std::any::Any + Send)) -> Row {
+    let message = payload
+        .downcast_ref::<String>()
+        .map(String::as_str)
+        .or_else(|| payload.downcast_ref::<&str>().copied())
+        .unwrap_or("(no message)");
+    Row {
+        case: variant.case.name.to_string(),
+        integrator: integrator_name(variant.integrator).to_string(),
+        adaptive: variant.adaptive,
+        steps: 0,
+        retries: 0,
+        energy_scale: Scalar::NAN,
+        excess_ratio: Scalar::NAN,
+        max_penetration: None,
+        thickness: None,
+        mass_drift: Scalar::NAN,
+        wall_s,
+        failure: Some(format!("the engine panicked: {message}")),
+        hash: 0,
+    }
 }
 
 /// The table of `rows` as Markdown (also readable as plain text).
