@@ -197,6 +197,13 @@ impl Row {
         if let Some(f) = &self.failure {
             out.push(f.clone());
         }
+        if self.energy_scale.is_nan() {
+            // The run panicked: there is no summary to judge.
+            if out.is_empty() {
+                out.push("no energy scale (NaN)".to_string());
+            }
+            return out;
+        }
         if !at_most(self.excess_ratio, ENERGY_TOLERANCE) {
             out.push(format!(
                 "energy excess {:.3} S > {ENERGY_TOLERANCE} S",

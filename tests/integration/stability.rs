@@ -155,6 +155,17 @@ fn failing_rows_fail_the_suite() {
             mass_drift: 1e-6,
             ..good.clone()
         },
+        Row {
+            energy_scale: f64::NAN,
+            ..good.clone()
+        },
+        Row {
+            energy_scale: f64::NAN,
+            excess_ratio: f64::NAN,
+            mass_drift: f64::NAN,
+            failure: Some("the engine panicked: key not present".into()),
+            ..good.clone()
+        },
     ];
     for b in &bad {
         assert!(!b.passed(), "{b:?} should fail");
@@ -190,4 +201,23 @@ fn stability_cli() {
     assert_eq!(out.status.code(), Some(1), "{stderr}");
     assert!(stderr.contains("no hard case named `nosuch`"), "{stderr}");
     assert!(stderr.contains("stiff, impact"), "{stderr}");
+}
+
+/// The full `crumple` case (resolution 16, 2 s) with its own integrator and
+/// adaptivity on. Known engine bug (2026-11-21): self-collision on an adapted
+/// mesh panics inside parry's BVH (`key not present`, from
+/// `SelfCollider::resolve`) after about 1 s of wall time; `scenes/crumple.toml
+/// --set adapt.method=red_green` panics the same way. Ignored until fixed in
+/// `src/collide/`; run with `cargo test --release -- --ignored`.
+#[test]
+#[ignore = "engine bug: self-collision on an adapted mesh panics in parry's BVH"]
+fn crumple_full_adaptive() {
+    let variant = Variant {
+        case: select(&["crumple".to_string()]).expect("known case")[0],
+        integrator: drape::scene::Integrator::Implicit,
+        adaptive: true,
+    };
+    let scene = scene_for(&hard_dir(), &variant, false).expect("scene");
+    let row = run_variant(&scene, &variant, Some(2)).expect("run");
+    assert!(row.passed(), "{:?}", row.failures());
 }
