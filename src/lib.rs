@@ -15,5 +15,6 @@ pub mod physics;
 pub mod record;
 pub mod run;
 pub mod scene;
+pub mod stability;
 pub mod summary;
 pub mod world;

@@ -35,6 +35,27 @@ enum Command {
     /// scene (no recording), compare each with a fine cached reference, and
     /// write OUT/SCENE.csv, OUT/SCENE-frames.csv, OUT/SCENE.md and OUT/SCENE.svg.
     Bench(BenchArgs),
+    /// Run the hard-case stability suite (scenes/hard/) and print a pass/fail table.
+    Stability(StabilityArgs),
+}
+
+#[derive(Args)]
+struct StabilityArgs {
+    /// Shortened durations and coarser meshes, so that the whole suite runs in a few minutes.
+    #[arg(long)]
+    quick: bool,
+    /// Run only this case (repeatable), e.g. `--case impact`; default: every case.
+    #[arg(long = "case", value_name = "NAME")]
+    cases: Vec<String>,
+    /// Worker threads per run, 1 to 256 (default: one per core). Results are identical at any count.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=256))]
+    threads: Option<u32>,
+    /// Also write the table (Markdown) to this file.
+    #[arg(long, value_name = "FILE.md")]
+    markdown: Option<PathBuf>,
+    /// Directory of the hard-case scenes.
+    #[arg(long, value_name = "DIR", default_value = "scenes/hard")]
+    scenes: PathBuf,
 }
 
 #[derive(Args)]
@@ -146,6 +167,7 @@ fn main() -> ExitCode {
         Command::Check(args) => cmd_check(args),
         Command::Inspect(args) => cmd_inspect(args),
         Command::Bench(args) => cmd_bench(args),
+        Command::Stability(args) => cmd_stability(args),
     };
     match result {
         Ok(code) => code,
@@ -190,6 +212,52 @@ fn non_negative_degrees(s: &str) -> Result<f64, String> {
         Ok(v) => Err(format!("{v} is not an angle of 0 degrees or more")),
         Err(e) => Err(format!("{s:?} is not a number of degrees: {e}")),
     }
+}
+
+fn cmd_stability(args: StabilityArgs) -> Result<ExitCode> {
+    use drape::stability::{
+        all_passed, integrator_name, run_variant, scene_for, select, table, variants,
+    };
+    let cases = select(&args.cases)?;
+    let variants = variants(&cases, args.quick);
+    // Open the Markdown file first so that an unwritable path fails before the runs.
+    let markdown = match &args.markdown {
+        Some(path) => Some(
+            std::fs::File::create(path)
+                .with_context(|| format!("cannot write {}", path.display()))?,
+        ),
+        None => None,
+    };
+    let mut rows = Vec::with_capacity(variants.len());
+    for (i, variant) in variants.iter().enumerate() {
+        eprint!(
+            "[{}/{}] {} {} adaptive {} ... ",
+            i + 1,
+            variants.len(),
+            variant.case.name,
+            integrator_name(variant.integrator),
+            if variant.adaptive { "on" } else { "off" }
+        );
+        let scene = scene_for(&args.scenes, variant, args.quick)?;
+        let row = run_variant(&scene, variant, args.threads.map(|n| n as usize))?;
+        eprintln!(
+            "{} in {:.1} s",
+            if row.passed() { "pass" } else { "FAIL" },
+            row.wall_s
+        );
+        rows.push(row);
+    }
+    let text = table(&rows);
+    print!("{text}");
+    if let (Some(mut file), Some(path)) = (markdown, &args.markdown) {
+        file.write_all(text.as_bytes())
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    Ok(if all_passed(&rows) {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    })
 }
 
 fn cmd_inspect(args: InspectArgs) -> Result<ExitCode> {

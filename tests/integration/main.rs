@@ -19,3 +19,4 @@ mod physics;
 mod recording;
 mod recording_run;
 mod scene_errors;
+mod stability;
