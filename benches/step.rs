@@ -45,6 +45,7 @@ fn setup(resolution: u32, bending_model: BendingModel) -> (World, Stepper, Scala
         integrator: Integrator::SymplecticEuler,
         cg_tolerance: 1e-6,
         cg_max_iterations: 500,
+        solver: drape::physics::SolverSettings::default(),
     };
     let stepper = Stepper::new(model, &world);
     let dt = stepper.auto_dt(&world);
@@ -72,7 +73,11 @@ fn step_default_pool(c: &mut Criterion) {
             let vertices = world.mesh.vertex_count() as u64;
             group.throughput(Throughput::Elements(vertices));
             group.bench_function(BenchmarkId::new(label(model), vertices), |b| {
-                b.iter(|| stepper.step(black_box(&mut world), dt))
+                b.iter(|| {
+                    stepper
+                        .step(black_box(&mut world), dt)
+                        .expect("explicit steps cannot fail")
+                })
             });
         }
     }
@@ -94,7 +99,13 @@ fn step_thread_scaling(c: &mut Criterion) {
         let (mut world, mut stepper, dt) = setup(256, BendingModel::HingeSpring);
         group.throughput(Throughput::Elements(world.mesh.vertex_count() as u64));
         group.bench_function(BenchmarkId::new("threads", threads), |b| {
-            pool.install(|| b.iter(|| stepper.step(black_box(&mut world), dt)))
+            pool.install(|| {
+                b.iter(|| {
+                    stepper
+                        .step(black_box(&mut world), dt)
+                        .expect("explicit steps cannot fail")
+                })
+            })
         });
     }
     group.finish();
@@ -110,7 +121,9 @@ fn consistency_check(spec: &str) {
     };
     let (mut world, mut stepper, dt) = setup(resolution, BendingModel::HingeSpring);
     for _ in 0..steps {
-        stepper.step(&mut world, dt);
+        stepper
+            .step(&mut world, dt)
+            .expect("explicit steps cannot fail");
     }
     let n = world.x.len();
     let mean = |f: &dyn Fn(usize) -> Scalar| (0..n).map(f).sum::<Scalar>() / n as Scalar;

@@ -175,10 +175,28 @@ pub fn describe(scene: &Scene) -> Result<String, BuildError> {
     let (steps, dt) = fit_to_frame(target, interval);
     let _ = writeln!(s, "integrator: {:?}", sim.integrator);
     if sim.integrator == Integrator::Implicit {
+        let solver = match sim.solver {
+            crate::scene::Solver::Direct => format!(
+                "direct (sparse Cholesky, reused as the preconditioner of conjugate gradients, refactored after {} iterations)",
+                sim.refactor_iterations
+            ),
+            crate::scene::Solver::Cg => "cg (matrix-free, Jacobi preconditioner)".to_string(),
+        };
+        let _ = writeln!(s, "  linear solver: {solver}");
         let _ = writeln!(
             s,
-            "  conjugate gradients: tolerance {:e}, at most {} iterations",
+            "  linear solves: relative residual {:e}, at most {} iterations (else the step fails and is retried)",
             sim.cg_tolerance, sim.cg_max_iterations
+        );
+        let _ = writeln!(
+            s,
+            "  Newton iterations: at most {}{}",
+            sim.newton_iterations,
+            if sim.newton_iterations > 1 {
+                format!(", relative residual {:e}", sim.newton_tolerance)
+            } else {
+                " (the linearised step)".to_string()
+            }
         );
     }
     let _ = writeln!(s, "time step: {dt:.4e} s ({how}); {steps} steps per frame");

@@ -48,6 +48,8 @@ pub const EXPLOSION_FACTOR: Scalar = 1.0;
 pub enum StepFailure {
     /// A position became NaN or infinite.
     NonFinite,
+    /// The implicit step's equations could not be solved.
+    Solver(crate::physics::SolveFailure),
     /// The energy exceeded its bound by [`EXPLOSION_FACTOR`] energy scales.
     Explosion {
         /// Kinetic plus gravitational energy after the step, J.
@@ -61,6 +63,7 @@ impl std::fmt::Display for StepFailure {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             StepFailure::NonFinite => write!(f, "positions became NaN or infinite"),
+            StepFailure::Solver(why) => write!(f, "{why}"),
             StepFailure::Explosion { energy, bound } => write!(
                 f,
                 "the energy exploded (kinetic + gravitational {energy:.4e} J, above the explosion limit {bound:.4e} J)"
@@ -402,11 +405,26 @@ fn run_in_pool(
             halvings: MAX_STEP_HALVINGS,
             dt: last_dt,
             cause: format!(
-                "step {:.3e} s with the {:?} integrator; try a smaller `simulation.dt`, `dt = \"auto\"`, or `integrator = \"implicit\"`",
+                "step {:.3e} s with the {:?} integrator; try a smaller `simulation.dt`, `dt = \"auto\"`, or `integrator = \"implicit\"`{}",
                 pipe.step_size(&world),
-                pipe.stepper.model.integrator
+                pipe.stepper.model.integrator,
+                solver_hint(&what)
             ),
             summary: Box::new(summary),
         }),
+    }
+}
+
+/// What else to try when the implicit solver failed.
+fn solver_hint(failure: &StepFailure) -> &'static str {
+    use crate::physics::SolveFailure;
+    match failure {
+        StepFailure::Solver(SolveFailure::NotConverged { .. }) => {
+            "; or let the linear solve converge: `simulation.solver = \"direct\"`, a larger `simulation.cg_max_iterations` or `simulation.cg_tolerance`"
+        }
+        StepFailure::Solver(SolveFailure::NewtonNotConverged { .. }) => {
+            "; or allow more `simulation.newton_iterations` or a larger `simulation.newton_tolerance`"
+        }
+        _ => "",
     }
 }

@@ -163,7 +163,7 @@ impl Summary {
             "{}: {} frames, {} steps of {:.3e} s to t = {:.3} s in {:.2} s wall ({:.2} s stepping, {:.2} s recording); \
              {:.0} vertices, {:.0} triangles; {:.3e} vertex-steps/s. Mass {:.6} -> {:.6} kg; \
              energy {:.4e} -> {:.4e} J (max {:.4e}; external work {:.3e} J; largest excess over initial + work {:.3e} J); \
-             {} recoveries (frame attempts retried with halved steps, {} for energy gain); {} CG iterations ({} capped).{}{} {}",
+             {} recoveries (frame attempts retried with halved steps, {} for energy gain); {}.{}{} {}",
             self.scene,
             self.frames,
             self.steps,
@@ -184,8 +184,7 @@ impl Summary {
             self.energy.excess_max,
             self.nan_recoveries,
             self.energy_retries,
-            self.solver.cg_iterations,
-            self.solver.cg_capped,
+            self.solver.describe(),
             match &self.adapt {
                 Some(a) => format!(
                     " Adaptive: {} splits ({} forced), {} merges, {} rollbacks, max level {}.",

@@ -8,7 +8,7 @@ use std::path::Path;
 use crate::math::{Scalar, Vector, rotation_from_euler_deg};
 use crate::mesh::{self, Mesh, MeshError, ObjError};
 use crate::physics::pins::{PinError, Pins};
-use crate::physics::{ExternalForces, MaterialParams, Model, WindForce};
+use crate::physics::{ExternalForces, MaterialParams, Model, SolverSettings, WindForce};
 use crate::scene::{ClothShape, DEFAULT_AIR_DENSITY, Scene};
 
 /// Why a world could not be built from a scene.
@@ -156,6 +156,12 @@ impl Model {
             integrator: scene.simulation.integrator,
             cg_tolerance: scene.simulation.cg_tolerance,
             cg_max_iterations: scene.simulation.cg_max_iterations,
+            solver: SolverSettings {
+                solver: scene.simulation.solver,
+                refactor_iterations: scene.simulation.refactor_iterations,
+                newton_iterations: scene.simulation.newton_iterations,
+                newton_tolerance: scene.simulation.newton_tolerance,
+            },
         }
     }
 }

@@ -1,6 +1,6 @@
-//! Implicit backward Euler with one Newton step (Baraff and Witkin 1998).
+//! Implicit backward Euler (Baraff and Witkin 1998), with optional Newton iterations.
 //!
-//! Solve `A dv = b` with
+//! The first (and by default only) Newton step solves `A dv = b` with
 //! `A = M + h (D + drag) + h^2 K` and `b = h f(x0, v0) - h^2 K v0`,
 //! then `v1 = v0 + dv`, `x1 = x0 + h v1`. Here `K = -df/dx` and `D = -df/dv`.
 //!
@@ -10,12 +10,36 @@
 //!   semi-definite; `D_e = c n n^T`. Both act on `p_a - p_b`.
 //! * Dihedral hinge with gradient `g` of its angle: Gauss-Newton `K_h = k g g^T`
 //!   (the curvature term of the exact Hessian is dropped; it is indefinite).
-//! * Wind is treated explicitly (only in `b`).
+//! * Wind is treated explicitly (only in `b`, evaluated at the start of the step).
 //!
-//! `A` is never assembled: each CG iteration applies it matrix-free with the same
-//! element pass + per-vertex gather as the forces, so results are deterministic.
+//! # Newton iterations
+//! With `newton_iterations` > 1, the step goes on to solve the backward Euler
+//! equations `g(v) = M (v - v0) - h f(x0 + h v, v) = 0` themselves: iteration k
+//! linearises at the current iterate, `A(x_k, v_k) dv = h f(x_k, v_k) - M (v_k - v0)`,
+//! and stops when `|g|` (pinned and contact-filtered rows left out) falls below
+//! `newton_tolerance` times the first right-hand side's norm. A step that has not
+//! converged after `newton_iterations` fails (see below).
+//!
+//! # Linear solvers
+//! * `direct` (default, [`assembled`]): `A` assembled into a fixed block pattern and
+//!   factored by a sparse Cholesky; the factor is kept and used to precondition
+//!   conjugate gradients in the following steps, and the matrix is factored anew
+//!   when they need more than `refactor_iterations` (the stiffer the cloth and the
+//!   larger the step, the more Jacobi-preconditioned CG needs; a factor of a nearby
+//!   matrix needs a few iterations whatever the stiffness).
+//! * `cg` ([`cg`]): matrix-free conjugate gradients with the diagonal of `A` as the
+//!   preconditioner, applied with the same element pass + per-vertex gather as the
+//!   forces.
+//!
+//! A linear solve that does not reach `cg_tolerance` (relative residual) within
+//! `cg_max_iterations`, a matrix that is not positive definite, or Newton iterations
+//! that do not converge make the step fail with a [`SolveFailure`]: the run retries
+//! the frame with halved steps, and stops with a message when that does not help.
+//! No unconverged solve is ever accepted.
+//!
+//! # Pins and contacts
 //! Pinned vertices are handled by filtering (their `dv` is prescribed by the pin
-//! script and their residual is zeroed). Preconditioner: the diagonal of `A`.
+//! script and their residual is zeroed).
 //!
 //! Obstacle contact is filtered the same way, one direction instead of three
 //! (Baraff and Witkin 1998, section 5): a vertex the collision pass left in contact
@@ -28,53 +52,114 @@
 //! a cloth that sank, and each step of resting contact stretches the springs around
 //! it (with 4 ms steps a tablecloth gained more energy than it started with). A
 //! vertex pulled away from the surface (`b . n >= 0`) is left free, so cloth lifts off.
+//! The direct solver factors the projected matrix `S A S + (I - S) m`, which is
+//! positive definite on all of space and whose solution has the prescribed parts
+//! unchanged.
+
+mod assembled;
+mod cg;
 
 use rayon::prelude::*;
 
 use super::bending::dihedral_angle_and_gradient;
 use super::forces::{PAR_MIN, spring_force, wind_share};
 use super::{Contact, Stepper};
-use crate::math::{Matrix3, Scalar, Vector, deterministic_sum, deterministic_sum2};
+use crate::math::{Matrix3, Scalar, Vector, deterministic_sum};
+use crate::scene::Solver;
 use crate::world::World;
+
+/// Why an implicit step could not be solved.
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+pub enum SolveFailure {
+    /// The linear solve stopped at its iteration cap above its tolerance.
+    #[error(
+        "the linear solve did not converge (relative residual {residual:.3e} after {iterations} iterations, tolerance {tolerance:.1e})"
+    )]
+    NotConverged {
+        /// Iterations done.
+        iterations: u32,
+        /// Relative residual reached.
+        residual: Scalar,
+        /// Relative residual asked for.
+        tolerance: Scalar,
+    },
+    /// The system matrix was not numerically positive definite.
+    #[error("the implicit system matrix is not positive definite")]
+    NotPositiveDefinite,
+    /// Newton iterations did not reach their tolerance.
+    #[error(
+        "Newton iterations did not converge (relative residual {residual:.3e} after {iterations} iterations, tolerance {tolerance:.1e})"
+    )]
+    NewtonNotConverged {
+        /// Newton iterations done.
+        iterations: u32,
+        /// Relative residual of the implicit equations reached.
+        residual: Scalar,
+        /// Relative residual asked for.
+        tolerance: Scalar,
+    },
+    /// The sparse factorization could not be set up (memory).
+    #[error("the sparse factorization could not be set up (out of memory or too large)")]
+    Setup,
+}
 
 /// Scratch memory of the implicit step, kept between steps.
 #[derive(Debug, Default, Clone)]
 pub struct ImplicitScratch {
-    block: Vec<Matrix3>,
+    /// Per spring: `h^2 K_e + h D_e`.
+    spring_block: Vec<Matrix3>,
     spring_slot: Vec<Vector>,
     hinge_grad: Vec<Vector>,
     hinge_coef: Vec<Scalar>,
     hinge_slot: Vec<Vector>,
     tri_slot: Vec<Vector>,
+    /// Per vertex: mass plus `h` times its drag coefficient.
     diag_mass: Vec<Scalar>,
     inv_diag: Vec<Vector>,
+    /// Right-hand side of the current linear solve.
     b: Vec<Vector>,
+    /// Solution of the current linear solve; on entry the first guess, with the
+    /// prescribed (pinned, contact-normal) parts already set.
     dv: Vec<Vector>,
-    r: Vec<Vector>,
-    z: Vec<Vector>,
-    p: Vec<Vector>,
-    ap: Vec<Vector>,
     /// Per vertex: the contact normal whose direction is filtered out of the
     /// solve, or zero (see the module docs).
     filter: Vec<Vector>,
+    /// Positions and velocities at the start of the step.
+    x0: Vec<Vector>,
+    v0: Vec<Vector>,
     /// True when `dv` holds the previous step's solution on the same mesh, used
     /// as the first guess (the velocity change varies slowly between steps).
-    pub(super) warm: bool,
+    warm: bool,
+    cg: cg::CgScratch,
+    assembled: assembled::AssembledScratch,
 }
 
-/// One backward Euler step; returns the number of CG iterations used.
-pub fn backward_euler(st: &mut Stepper, w: &mut World, h: Scalar) -> u32 {
+impl ImplicitScratch {
+    /// Forgets everything tied to the mesh (warm start, pattern, factorization).
+    pub fn mesh_changed(&mut self) {
+        self.warm = false;
+        self.assembled.mesh_changed();
+    }
+}
+
+/// One backward Euler step (module docs).
+pub fn backward_euler(st: &mut Stepper, w: &mut World, h: Scalar) -> Result<(), SolveFailure> {
     let t = w.time;
     let n = w.x.len();
     w.pins.held_at(t, &mut st.held);
-    assemble(st, w, h);
+    {
+        let s = &mut st.implicit;
+        s.x0.clear();
+        s.x0.extend_from_slice(&w.x);
+        s.v0.clear();
+        s.v0.extend_from_slice(&w.v);
+    }
+    assemble(st, w, h, false);
     let s = &mut st.implicit;
     if !s.warm || s.dv.len() != n {
         s.dv.clear();
     }
-    for buf in [&mut s.dv, &mut s.r, &mut s.z, &mut s.p, &mut s.ap] {
-        buf.resize(n, Vector::ZERO);
-    }
+    s.dv.resize(n, Vector::ZERO);
     s.warm = true;
     // Prescribed velocity change of pinned vertices; the free ones start from
     // the previous step's solution.
@@ -85,90 +170,121 @@ pub fn backward_euler(st: &mut Stepper, w: &mut World, h: Scalar) -> u32 {
         }
     }
     contact_filters(s, &st.contacts, &st.held, &w.v);
-    // Taken out for the solve so that `apply_operator` can borrow the stepper.
-    let held_owned = std::mem::take(&mut st.held);
-    let held = &held_owned;
-    // r = b - A dv, filtered.
-    apply_operator(st, Which::Solution, held);
-    let s = &mut st.implicit;
-    s.r.par_iter_mut()
-        .zip(s.b.par_iter().zip(s.ap.par_iter()))
-        .enumerate()
-        .for_each(|(i, (r, (b, ap)))| {
-            *r = if held[i] { Vector::ZERO } else { *b - *ap };
+    // Taken out for the solve so that the solvers can borrow the stepper.
+    let held = std::mem::take(&mut st.held);
+    let result = newton(st, w, h, &held);
+    st.held = held;
+    result?;
+    w.pins.apply(t + h, &mut w.x, &mut w.v);
+    Ok(())
+}
+
+/// The Newton iterations of a step, the first one set up by the caller.
+fn newton(st: &mut Stepper, w: &mut World, h: Scalar, held: &[bool]) -> Result<(), SolveFailure> {
+    let settings = st.model.solver;
+    let reference = filtered_norm(&st.implicit, held);
+    let single = settings.newton_iterations <= 1;
+    linear_solve(st, held, reference, single)?;
+    st.stats.newton_iterations += 1;
+    update_state(&st.implicit, w, h);
+    if single {
+        return Ok(());
+    }
+    let mut residual = Scalar::INFINITY;
+    for k in 1..=settings.newton_iterations {
+        assemble(st, w, h, true);
+        residual = filtered_norm(&st.implicit, held) / reference.max(Scalar::MIN_POSITIVE);
+        if residual <= settings.newton_tolerance || k == settings.newton_iterations {
+            break;
+        }
+        // The prescribed parts are already met: the correction is zero there.
+        let s = &mut st.implicit;
+        s.dv.iter_mut().for_each(|d| *d = Vector::ZERO);
+        linear_solve(st, held, reference, false)?;
+        st.stats.newton_iterations += 1;
+        let s = &mut st.implicit;
+        let v0 = std::mem::take(&mut s.v0);
+        // Accumulate into v (update_state expects dv relative to v0).
+        s.dv.par_iter_mut()
+            .zip(w.v.par_iter().zip(v0.par_iter()))
+            .with_min_len(PAR_MIN)
+            .for_each(|(d, (v, v0))| *d += *v - *v0);
+        s.v0 = v0;
+        update_state(&st.implicit, w, h);
+    }
+    // The normal impulse each contact needed: minus the normal residual.
+    let s = &st.implicit;
+    let mass = &st.elements.mass;
+    st.contact_push.clear();
+    st.contact_push.extend((0..s.filter.len()).map(|i| {
+        let f = s.filter[i];
+        if f == Vector::ZERO {
+            0.0
+        } else {
+            (-f.dot(s.b[i]) / mass[i]).max(0.0)
+        }
+    }));
+    if residual > settings.newton_tolerance {
+        return Err(SolveFailure::NewtonNotConverged {
+            iterations: settings.newton_iterations,
+            residual,
+            tolerance: settings.newton_tolerance,
         });
-    filter_rows(&s.filter, &mut s.r);
-    let b_norm = deterministic_sum(n, |i| {
+    }
+    Ok(())
+}
+
+/// `v = v0 + dv`, `x = x0 + h v`.
+fn update_state(s: &ImplicitScratch, w: &mut World, h: Scalar) {
+    w.x.par_iter_mut()
+        .zip(w.v.par_iter_mut())
+        .zip(s.dv.par_iter().zip(s.x0.par_iter().zip(s.v0.par_iter())))
+        .with_min_len(PAR_MIN)
+        .for_each(|((x, v), (dv, (x0, v0)))| {
+            *v = *v0 + *dv;
+            *x = *x0 + *v * h;
+        });
+}
+
+/// Solves `A dv = b` with the scene's solver; `contact_push`: also compute the
+/// contacts' normal impulses from the linear residual.
+fn linear_solve(
+    st: &mut Stepper,
+    held: &[bool],
+    reference: Scalar,
+    contact_push: bool,
+) -> Result<(), SolveFailure> {
+    match st.model.solver.solver {
+        Solver::Cg => cg::solve(st, held, reference, contact_push),
+        Solver::Direct => assembled::solve(st, held, reference, contact_push),
+    }
+}
+
+/// `|S b|` over the free rows: the scale the linear tolerance is relative to.
+fn filtered_norm(s: &ImplicitScratch, held: &[bool]) -> Scalar {
+    deterministic_sum(s.b.len(), |i| {
         if held[i] {
             0.0
         } else {
             without(s.filter[i], s.b[i]).length_squared()
         }
     })
-    .sqrt();
-    precondition(s);
-    s.p.copy_from_slice(&s.z);
-    let (mut rz, mut rr) = dot2(&s.r, &s.z);
-    let tol = st.model.cg_tolerance * b_norm;
-    let mut iterations = 0;
-    while iterations < st.model.cg_max_iterations {
-        if rr.sqrt() <= tol {
-            break;
-        }
-        apply_operator(st, Which::Direction, held);
-        let s = &mut st.implicit;
-        let pap = dot(&s.p, &s.ap);
-        if pap <= 0.0 || !pap.is_finite() {
-            break;
-        }
-        let alpha = rz / pap;
-        // One pass: step the solution and the residual, precondition.
-        s.dv.par_iter_mut()
-            .zip(s.r.par_iter_mut().zip(s.z.par_iter_mut()))
-            .zip(
-                s.p.par_iter()
-                    .zip(s.ap.par_iter().zip(s.inv_diag.par_iter())),
-            )
-            .zip(s.filter.par_iter())
-            .with_min_len(PAR_MIN)
-            .for_each(|(((d, (r, z)), (p, (ap, inv))), n)| {
-                *d += *p * alpha;
-                *r -= *ap * alpha;
-                *z = without(*n, *r * *inv);
-            });
-        let rz_new;
-        (rz_new, rr) = dot2(&s.r, &s.z);
-        let beta = rz_new / rz;
-        rz = rz_new;
-        s.p.par_iter_mut()
-            .zip(s.z.par_iter())
-            .with_min_len(PAR_MIN)
-            .for_each(|(p, z)| *p = *z + *p * beta);
-        iterations += 1;
-    }
-    contact_pressure(st, held);
-    let s = &st.implicit;
-    w.x.par_iter_mut()
-        .zip(w.v.par_iter_mut())
-        .zip(s.dv.par_iter())
-        .for_each(|((x, v), dv)| {
-            *v += *dv;
-            *x += *v * h;
-        });
-    w.pins.apply(t + h, &mut w.x, &mut w.v);
-    st.held = held_owned;
-    iterations
+    .sqrt()
 }
 
-/// Builds the per-element blocks, the right-hand side `b` and the preconditioner.
-fn assemble(st: &mut Stepper, w: &World, h: Scalar) {
+/// Builds the per-element blocks, the right-hand side `b` and the diagonal. With
+/// `newton`, `b` is the residual `h f(x, v) - M (v - v0)` at the current iterate
+/// instead of Baraff and Witkin's `h f(x0, v0) - h^2 K v0`.
+fn assemble(st: &mut Stepper, w: &World, h: Scalar, newton: bool) {
+    let started = std::time::Instant::now();
     let (el, ext) = (&st.elements, &st.model.external);
     let (x, v) = (&w.x, &w.v);
     let s = &mut st.implicit;
     let n = x.len();
-    s.block.resize(el.springs.len(), Matrix3::ZERO);
+    let k_term = if newton { 0.0 } else { 1.0 };
+    s.spring_block.resize(el.springs.len(), Matrix3::ZERO);
     s.spring_slot.resize(el.springs.len(), Vector::ZERO);
-    s.block
+    s.spring_block
         .par_iter_mut()
         .zip(s.spring_slot.par_iter_mut())
         .zip(el.springs.par_iter())
@@ -187,7 +303,7 @@ fn assemble(st: &mut Stepper, w: &World, h: Scalar) {
             };
             let stiff = (nn + (Matrix3::IDENTITY - nn) * transverse) * sp.k;
             *block = stiff * (h * h) + nn * (h * sp.c);
-            *slot = f * h - stiff * (v[a] - v[b]) * (h * h);
+            *slot = f * h - stiff * (v[a] - v[b]) * (h * h * k_term);
         });
     let hinges = el.hinges.len();
     s.hinge_grad.resize(4 * hinges, Vector::ZERO);
@@ -205,10 +321,13 @@ fn assemble(st: &mut Stepper, w: &World, h: Scalar) {
             *coef = h * h * hg.k;
             for k in 0..4 {
                 grad[k] = g[k];
-                slot[k] = g[k] * (-h * hg.k * theta - *coef * gv);
+                slot[k] = g[k] * (-h * hg.k * theta - *coef * gv * k_term);
             }
         });
-    if let Some(wind) = &ext.wind {
+    // Wind is explicit: its force at the start of the step serves every Newton
+    // iteration (re-evaluated at each iterate, without its derivative in `A`, the
+    // iterations diverged on a flag at 10 ms steps).
+    if let Some(wind) = ext.wind.as_ref().filter(|_| !newton) {
         s.tri_slot.resize(w.mesh.triangles.len(), Vector::ZERO);
         s.tri_slot
             .par_iter_mut()
@@ -221,13 +340,14 @@ fn assemble(st: &mut Stepper, w: &World, h: Scalar) {
     s.b.resize(n, Vector::ZERO);
     s.diag_mass.resize(n, 0.0);
     s.inv_diag.resize(n, Vector::ZERO);
-    let (spring_slot, block, hinge_slot, hinge_grad, hinge_coef, tri_slot) = (
+    let (spring_slot, block, hinge_slot, hinge_grad, hinge_coef, tri_slot, v0) = (
         &s.spring_slot,
-        &s.block,
+        &s.spring_block,
         &s.hinge_slot,
         &s.hinge_grad,
         &s.hinge_coef,
         &s.tri_slot,
+        &s.v0,
     );
     s.b.par_iter_mut()
         .zip(s.diag_mass.par_iter_mut().zip(s.inv_diag.par_iter_mut()))
@@ -262,129 +382,20 @@ fn assemble(st: &mut Stepper, w: &World, h: Scalar) {
                 rhs -= (v[i] - ext.air_velocity) * (drag * el.vertex_area[i] * h);
                 m += h * drag * el.vertex_area[i];
             }
+            if newton {
+                rhs -= (v[i] - v0[i]) * el.mass[i];
+            }
             *b = rhs;
             *dm = m;
             *inv = Vector::ONE / (diag + Vector::splat(m));
         });
-}
-
-/// Which vector the operator is applied to.
-#[derive(Clone, Copy, PartialEq)]
-enum Which {
-    /// The current solution `dv`.
-    Solution,
-    /// The search direction `p`.
-    Direction,
-}
-
-/// `ap = A * (dv or p)`, matrix-free: element pass into slots, then gather.
-fn apply_operator(st: &mut Stepper, which: Which, held: &[bool]) {
-    apply_operator_rows(st, which, held, true);
-}
-
-/// `ap = A * (dv or p)`; `filtered`: with the contact filters applied to the rows.
-fn apply_operator_rows(st: &mut Stepper, which: Which, held: &[bool], filtered: bool) {
-    let el = &st.elements;
-    let s = &mut st.implicit;
-    let input: &Vec<Vector> = if which == Which::Solution {
-        &s.dv
-    } else {
-        &s.p
-    };
-    s.spring_slot
-        .par_iter_mut()
-        .zip(s.block.par_iter())
-        .zip(el.springs.par_iter())
-        .with_min_len(PAR_MIN)
-        .for_each(|((q, block), sp)| {
-            *q = *block * (input[sp.v[0] as usize] - input[sp.v[1] as usize]);
-        });
-    s.hinge_slot
-        .par_chunks_exact_mut(4)
-        .zip(s.hinge_grad.par_chunks_exact(4))
-        .zip(s.hinge_coef.par_iter())
-        .zip(el.hinges.par_iter())
-        .with_min_len(PAR_MIN / 4)
-        .for_each(|(((slot, g), coef), hg)| {
-            let gp: Scalar = (0..4).map(|k| g[k].dot(input[hg.v[k] as usize])).sum();
-            for k in 0..4 {
-                slot[k] = g[k] * (coef * gp);
-            }
-        });
-    let (spring_slot, hinge_slot, diag_mass, filter) =
-        (&s.spring_slot, &s.hinge_slot, &s.diag_mass, &s.filter);
-    s.ap.par_iter_mut()
-        .enumerate()
-        .with_min_len(PAR_MIN)
-        .for_each(|(i, out)| {
-            // Pinned rows are filtered out of the system.
-            if held[i] {
-                *out = Vector::ZERO;
-                return;
-            }
-            let mut acc = input[i] * diag_mass[i];
-            for &e in el.spring_first.of(i) {
-                acc += spring_slot[e as usize];
-            }
-            for &e in el.spring_second.of(i) {
-                acc -= spring_slot[e as usize];
-            }
-            for &k in el.hinge_slots.of(i) {
-                acc += hinge_slot[k as usize];
-            }
-            *out = if filtered {
-                without(filter[i], acc)
-            } else {
-                acc
-            };
-        });
-}
-
-/// `z = S P^-1 r` with the diagonal preconditioner and the contact filters.
-fn precondition(s: &mut ImplicitScratch) {
-    s.z.par_iter_mut()
-        .zip(s.r.par_iter().zip(s.inv_diag.par_iter()))
-        .zip(s.filter.par_iter())
-        .for_each(|((z, (r, inv)), n)| *z = without(*n, *r * *inv));
+    st.stats.assembly_s += started.elapsed().as_secs_f64();
 }
 
 /// `v` without its component along the unit vector `n` (`v` itself when `n` is zero).
 #[inline(always)]
 fn without(n: Vector, v: Vector) -> Vector {
     v - n * n.dot(v)
-}
-
-/// Projects every row by its contact filter.
-fn filter_rows(filter: &[Vector], rows: &mut [Vector]) {
-    rows.par_iter_mut()
-        .zip(filter.par_iter())
-        .with_min_len(PAR_MIN)
-        .for_each(|(r, n)| *r = without(*n, *r));
-}
-
-/// The normal velocity change each filtered contact imposed in the solve,
-/// `n . (A dv - b) / m` (positive: the obstacle pushed), into
-/// [`Stepper::contact_push`]; the collision pass turns it into friction.
-fn contact_pressure(st: &mut Stepper, held: &[bool]) {
-    let n = st.implicit.filter.len();
-    st.contact_push.clear();
-    st.contact_push.resize(n, 0.0);
-    if st.implicit.filter.iter().all(|f| *f == Vector::ZERO) {
-        return;
-    }
-    apply_operator_rows(st, Which::Solution, held, false);
-    let s = &st.implicit;
-    let mass = &st.elements.mass;
-    st.contact_push
-        .par_iter_mut()
-        .enumerate()
-        .with_min_len(PAR_MIN)
-        .for_each(|(i, push)| {
-            let f = s.filter[i];
-            if f != Vector::ZERO {
-                *push = (f.dot(s.ap[i] - s.b[i]) / mass[i]).max(0.0);
-            }
-        });
 }
 
 /// Chooses the contact filters (module docs) and prescribes the filtered vertices'
@@ -406,16 +417,6 @@ fn contact_filters(s: &mut ImplicitScratch, contacts: &[Contact], held: &[bool],
         // (v0 + dv) . n = u_n, the tangential part of the warm start kept.
         s.dv[i] = without(c.normal, s.dv[i]) + c.normal * (c.normal_speed - v[i].dot(c.normal));
     }
-}
-
-/// `r . z` and `r . r` in one pass, each bit-identical to its own [`dot`].
-fn dot2(r: &[Vector], z: &[Vector]) -> (Scalar, Scalar) {
-    deterministic_sum2(r.len(), |i| (r[i].dot(z[i]), r[i].dot(r[i])))
-}
-
-/// Dot product of two vector fields, deterministic at any thread count.
-fn dot(a: &[Vector], b: &[Vector]) -> Scalar {
-    deterministic_sum(a.len(), |i| a[i].dot(b[i]))
 }
 
 fn outer(a: Vector, b: Vector) -> Matrix3 {

@@ -5,6 +5,8 @@
 //! advances a [`World`] by one step with the chosen integrator.
 
 pub mod bending;
+pub mod block;
+pub mod direct;
 pub mod elements;
 pub mod explicit;
 pub mod forces;
@@ -14,8 +16,10 @@ pub mod pins;
 pub mod timestep;
 pub mod work;
 
+pub use crate::scene::Solver;
 pub use elements::{Elements, Hinge, MaterialParams, Spring};
 pub use forces::{Energy, ExternalForces, WindForce};
+pub use implicit::SolveFailure;
 
 use crate::math::{Scalar, Vector};
 use crate::scene::Integrator;
@@ -34,17 +38,89 @@ pub struct Model {
     pub cg_tolerance: Scalar,
     /// CG iteration cap (implicit only).
     pub cg_max_iterations: u32,
+    /// Linear solver and Newton settings (implicit only).
+    pub solver: SolverSettings,
+}
+
+/// How the implicit integrator solves its equations.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SolverSettings {
+    /// The linear solver.
+    pub solver: Solver,
+    /// Direct solver: iterations allowed with an earlier step's factorization
+    /// before refactoring.
+    pub refactor_iterations: u32,
+    /// Newton iterations per step (1: Baraff and Witkin's linearised step).
+    pub newton_iterations: u32,
+    /// Relative residual at which Newton iterations stop.
+    pub newton_tolerance: Scalar,
+}
+
+impl Default for SolverSettings {
+    /// The scene defaults: direct solver, refactor after 4 iterations, one Newton step.
+    fn default() -> SolverSettings {
+        SolverSettings {
+            solver: Solver::Direct,
+            refactor_iterations: 4,
+            newton_iterations: 1,
+            newton_tolerance: 1e-3,
+        }
+    }
 }
 
 /// Counters of what the stepper did.
 #[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
 pub struct StepStats {
-    /// Steps taken.
+    /// Steps taken (including steps of frames that were retried).
     pub steps: u64,
-    /// CG iterations over all implicit steps.
+    /// Conjugate-gradient iterations over all implicit linear solves (with the direct
+    /// solver: iterations preconditioned by a factorization).
     pub cg_iterations: u64,
-    /// Implicit steps whose CG stopped at the iteration cap.
+    /// Linear solves that reached `cg_max_iterations` without converging (each one
+    /// failed its step, which was retried).
     pub cg_capped: u64,
+    /// Implicit steps that failed: an unconverged linear solve, a matrix that was not
+    /// positive definite, or Newton iterations that did not converge.
+    pub failed_solves: u64,
+    /// Newton iterations (linear solves) over all implicit steps.
+    pub newton_iterations: u64,
+    /// Symbolic analyses (orderings) of the sparse system: one per mesh topology.
+    pub symbolic_analyses: u64,
+    /// Numerical Cholesky factorizations.
+    pub factorizations: u64,
+    /// Solves with a Cholesky factor (one per preconditioned iteration, plus one per
+    /// solve to start it).
+    pub factor_solves: u64,
+    /// Wall time spent assembling the system matrix and right-hand side, s.
+    pub assembly_s: f64,
+    /// Wall time spent in symbolic analyses and numerical factorizations, s.
+    pub factorization_s: f64,
+    /// Wall time spent in the iterations of the linear solves, s.
+    pub solve_s: f64,
+}
+
+impl StepStats {
+    /// One clause for the run summary: the implicit solver's work and failures.
+    pub fn describe(&self) -> String {
+        if self.newton_iterations == 0 && self.failed_solves == 0 {
+            return "no implicit solves".to_string();
+        }
+        let mut s = format!(
+            "{} linear solves, {} CG iterations",
+            self.newton_iterations, self.cg_iterations
+        );
+        if self.factorizations > 0 {
+            s += &format!(
+                ", {} factorizations ({} orderings); assembly {:.2} s, factorization {:.2} s, solves {:.2} s",
+                self.factorizations,
+                self.symbolic_analyses,
+                self.assembly_s,
+                self.factorization_s,
+                self.solve_s
+            );
+        }
+        s + &format!(", {} failed solves", self.failed_solves)
+    }
 }
 
 /// A vertex resting against an obstacle, as the collision pass left it.
@@ -110,12 +186,15 @@ impl Stepper {
         self.held.resize(world.mesh.vertex_count(), false);
         self.contacts.clear();
         self.contact_push.clear();
-        self.implicit.warm = false;
+        self.implicit.mesh_changed();
         self.levels = None;
     }
 
-    /// Advances `world` by `dt` seconds with the model's integrator.
-    pub fn step(&mut self, world: &mut World, dt: Scalar) {
+    /// Advances `world` by `dt` seconds with the model's integrator. An implicit step
+    /// whose equations could not be solved returns the reason; the world is then
+    /// left in an unspecified state and must be restored by the caller.
+    pub fn step(&mut self, world: &mut World, dt: Scalar) -> Result<(), SolveFailure> {
+        self.stats.steps += 1;
         match self.model.integrator {
             Integrator::SymplecticEuler if self.multirate => {
                 multirate::symplectic_multirate(self, world, dt)
@@ -124,15 +203,17 @@ impl Stepper {
             Integrator::Rk4 if self.multirate => multirate::rk4_multirate(self, world, dt),
             Integrator::Rk4 => explicit::rk4(self, world, dt),
             Integrator::Implicit => {
-                let iterations = implicit::backward_euler(self, world, dt);
-                self.stats.cg_iterations += iterations as u64;
-                if iterations >= self.model.cg_max_iterations {
-                    self.stats.cg_capped += 1;
+                if let Err(failure) = implicit::backward_euler(self, world, dt) {
+                    self.stats.failed_solves += 1;
+                    if matches!(failure, SolveFailure::NotConverged { .. }) {
+                        self.stats.cg_capped += 1;
+                    }
+                    return Err(failure);
                 }
             }
         }
         world.time += dt;
-        self.stats.steps += 1;
+        Ok(())
     }
 
     /// Energies of the world's current state.

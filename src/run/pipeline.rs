@@ -206,7 +206,10 @@ impl Pipeline {
             self.stepper.contacts.clear();
             self.stepper.contacts.extend_from_slice(c.contacts());
         }
-        self.stepper.step(world, h);
+        if let Err(why) = self.stepper.step(world, h) {
+            self.failure = StepFailure::Solver(why);
+            return false;
+        }
         if !is_finite(&world.x) {
             self.failure = StepFailure::NonFinite;
             return false;

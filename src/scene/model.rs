@@ -55,9 +55,38 @@ pub struct Simulation {
     /// Relative residual at which the implicit integrator's conjugate gradients stop.
     #[serde(default = "default_cg_tolerance")]
     pub cg_tolerance: f64,
-    /// Iteration cap of the implicit integrator's conjugate gradients (reported when hit).
+    /// Iteration cap of the implicit integrator's conjugate gradients: a solve that
+    /// reaches it without meeting `cg_tolerance` is a failed step (retried with halved
+    /// steps, then the run stops).
     #[serde(default = "default_cg_max_iterations")]
     pub cg_max_iterations: u32,
+    /// Linear solver of the implicit integrator.
+    #[serde(default)]
+    pub solver: Solver,
+    /// Direct solver: preconditioned iterations allowed with a factorization from an
+    /// earlier step before the matrix is factored anew.
+    #[serde(default = "default_refactor_iterations")]
+    pub refactor_iterations: u32,
+    /// Newton iterations per implicit step (1: the linearised step of Baraff and Witkin).
+    #[serde(default = "default_newton_iterations")]
+    pub newton_iterations: u32,
+    /// Relative residual of the implicit equations at which Newton iterations stop
+    /// (used when `newton_iterations` > 1).
+    #[serde(default = "default_newton_tolerance")]
+    pub newton_tolerance: f64,
+}
+
+/// The linear solver of the implicit integrator.
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum Solver {
+    /// Sparse Cholesky factorization (faer), reused over steps as the preconditioner
+    /// of conjugate gradients and refactored when they need more than
+    /// `refactor_iterations`.
+    #[default]
+    Direct,
+    /// Matrix-free conjugate gradients with a Jacobi (diagonal) preconditioner.
+    Cg,
 }
 
 /// The time integrator.
@@ -418,6 +447,15 @@ fn default_cg_tolerance() -> f64 {
 }
 fn default_cg_max_iterations() -> u32 {
     500
+}
+fn default_refactor_iterations() -> u32 {
+    4
+}
+fn default_newton_iterations() -> u32 {
+    1
+}
+fn default_newton_tolerance() -> f64 {
+    1e-3
 }
 fn default_one() -> f64 {
     1.0

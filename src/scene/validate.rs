@@ -152,6 +152,31 @@ fn simulation(s: &Simulation) -> Result<(), Issue> {
             "0 is out of range: must be >= 1",
         ));
     }
+    if s.refactor_iterations < 1 {
+        return Err(out_of_range(
+            at("refactor_iterations"),
+            "0 is out of range: must be >= 1",
+        ));
+    }
+    if !(1..=100).contains(&s.newton_iterations) {
+        return Err(out_of_range(
+            at("newton_iterations"),
+            format!(
+                "{} is out of range: must be from 1 to 100",
+                s.newton_iterations
+            ),
+        ));
+    }
+    finite(&at("newton_tolerance"), s.newton_tolerance)?;
+    if !(s.newton_tolerance > 0.0 && s.newton_tolerance < 1.0) {
+        return Err(out_of_range(
+            at("newton_tolerance"),
+            format!(
+                "{} is out of range: must be in (0, 1)",
+                num(s.newton_tolerance)
+            ),
+        ));
+    }
     Ok(())
 }
 

@@ -73,6 +73,7 @@ fn swinging_stepper(
             integrator,
             cg_tolerance: 1e-6,
             cg_max_iterations: 500,
+            solver: drape::physics::SolverSettings::default(),
         },
         w,
     )
@@ -392,7 +393,7 @@ fn close_thresholds_do_not_thrash() {
         let mut ad = Adapter::new(cfg, &w, DENSITY);
         let steps = 150;
         for step in 0..steps {
-            st.step(&mut w, 0.01);
+            st.step(&mut w, 0.01).expect("the step is solved");
             if ad.pass(&mut w, step).unwrap() {
                 st.rebuild(&w);
             }
@@ -481,7 +482,7 @@ fn edge_method_never_goes_below_its_minimum_angle_and_keeps_the_invariants() {
     let stated = ad.min_angle().expect("edge method");
     let mut worst: Scalar = 180.0;
     for step in 0..150 {
-        st.step(&mut w, 0.01);
+        st.step(&mut w, 0.01).expect("the step is solved");
         if ad.pass(&mut w, step).unwrap() {
             st.rebuild(&w);
             check_consistency(&w, DENSITY, area, bound).unwrap();
@@ -583,7 +584,7 @@ fn swinging_explicit(
     let mut steps = 0;
     while w.time < duration - 1e-12 {
         let h = (st.auto_dt(&w) * dt_scale).min(duration - w.time);
-        st.step(&mut w, h);
+        st.step(&mut w, h).expect("the step is solved");
         steps += 1;
         if steps % 20 == 0 && ad.pass(&mut w, steps).unwrap() {
             st.rebuild(&w);
@@ -612,7 +613,7 @@ fn multirate_on_a_uniform_mesh_is_single_rate_exactly() {
             let mut st = swinging_stepper(&w, integrator, 1e-4);
             st.multirate = multirate;
             for _ in 0..50 {
-                st.step(&mut w, 2e-4);
+                st.step(&mut w, 2e-4).expect("the step is solved");
             }
             w.x
         };

@@ -65,7 +65,9 @@ impl Sim {
         self.stepper
             .contacts
             .extend_from_slice(self.collider.contacts());
-        self.stepper.step(&mut self.world, h);
+        self.stepper
+            .step(&mut self.world, h)
+            .expect("the step is solved");
         let cloth = StepCloth {
             pushed: &self.stepper.contact_push,
             mass: &self.stepper.elements.mass,

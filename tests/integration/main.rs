@@ -19,4 +19,5 @@ mod physics;
 mod recording;
 mod recording_run;
 mod scene_errors;
+mod solver;
 mod stability;

@@ -1,0 +1,159 @@
+//! One implicit (backward Euler) step with each linear solver, at about 4k and 16k
+//! vertices.
+//!
+//! The case: a 1 m sheet of the default fabric (0.15 kg/m^2, 200 N/m, 1e-5 N m,
+//! damping 0.001 s, drag) pinned at two corners and swinging under gravity, at
+//! `dt = 1/120` s (the step of `drape_sphere`). Each benchmark iteration is one step
+//! of a running simulation (the state moves on, as in a run), after 30 warm-up
+//! steps so the sheet is already falling and folding. Solvers: `direct` (sparse
+//! Cholesky reused as the preconditioner, refactored after 4 iterations: the
+//! default), `direct_every_step` (`refactor_iterations = 1`, close to a fresh
+//! factorization every step) and `cg` (matrix-free Jacobi CG).
+//!
+//! After the Criterion groups, the time split per step (assembly, factorization,
+//! solve, the rest) of 60 further steps is printed for each case.
+//!
+//! Run with `cargo bench --bench implicit`; `docs/performance.md` has the figures.
+
+use std::hint::black_box;
+use std::time::{Duration, Instant};
+
+use criterion::{BenchmarkId, Criterion, Throughput, criterion_group};
+use drape::math::{Scalar, Vector};
+use drape::physics::{
+    ExternalForces, MaterialParams, Model, Solver, SolverSettings, StepStats, Stepper,
+};
+use drape::scene::{BendingModel, DiagonalPattern, Integrator, Pin, PinMotion, StiffnessRule};
+use drape::world::World;
+
+const DT: Scalar = 1.0 / 120.0;
+
+/// The solver cases: label, solver, refactor_iterations.
+const CASES: [(&str, Solver, u32); 3] = [
+    ("direct", Solver::Direct, 4),
+    ("direct_every_step", Solver::Direct, 1),
+    ("cg", Solver::Cg, 4),
+];
+
+fn corner(region: &str) -> Pin {
+    Pin {
+        region: region.into(),
+        box_min: None,
+        box_max: None,
+        motion: PinMotion::Fixed,
+        velocity: [0.0; 3],
+        acceleration: [0.0; 3],
+        center: [0.0; 3],
+        axis: [0.0, 0.0, 1.0],
+        angular_velocity: 0.0,
+        release_time: None,
+    }
+}
+
+/// The swinging sheet at `resolution` after 30 steps, with its stepper.
+fn setup(resolution: u32, solver: Solver, refactor_iterations: u32) -> (World, Stepper) {
+    let mesh = drape::mesh::rectangle(1.0, 1.0, resolution, DiagonalPattern::Alternating)
+        .expect("valid rectangle");
+    let x = mesh.material.iter().map(|p| p.extend(1.0)).collect();
+    let mut world = World::new(mesh, x);
+    let pins = [corner("corner:top_left"), corner("corner:top_right")];
+    world.pins = drape::physics::pins::Pins::select(&pins, &world.mesh, &world.x).expect("pins");
+    let model = Model {
+        material: MaterialParams {
+            density: 0.15,
+            stretch: 200.0,
+            bending: 1e-5,
+            damping: 0.001,
+            bending_model: BendingModel::Dihedral,
+            stiffness_rule: StiffnessRule::Consistent,
+        },
+        external: ExternalForces {
+            gravity: Some(Vector::new(0.0, 0.0, -9.81)),
+            drag: Some(0.02),
+            ..Default::default()
+        },
+        integrator: Integrator::Implicit,
+        cg_tolerance: 1e-6,
+        cg_max_iterations: 5000,
+        solver: SolverSettings {
+            solver,
+            refactor_iterations,
+            ..SolverSettings::default()
+        },
+    };
+    let mut stepper = Stepper::new(model, &world);
+    for _ in 0..30 {
+        stepper.step(&mut world, DT).expect("solved");
+    }
+    (world, stepper)
+}
+
+fn implicit_step(c: &mut Criterion) {
+    let mut group = c.benchmark_group("implicit_step");
+    group
+        .warm_up_time(Duration::from_secs(1))
+        .measurement_time(Duration::from_secs(4))
+        .sample_size(10);
+    for resolution in [63u32, 127] {
+        for (label, solver, refactor) in CASES {
+            let (mut world, mut stepper) = setup(resolution, solver, refactor);
+            let vertices = world.mesh.vertex_count() as u64;
+            group.throughput(Throughput::Elements(vertices));
+            group.bench_function(BenchmarkId::new(label, vertices), |b| {
+                b.iter(|| stepper.step(black_box(&mut world), DT).expect("solved"))
+            });
+        }
+    }
+    group.finish();
+}
+
+/// Per-step time split over 60 steps after the warm-up, for each case.
+fn time_split() {
+    println!("time split per step over 60 steps (after 30 warm-up steps), dt = 1/120 s:");
+    for resolution in [63u32, 127] {
+        for (label, solver, refactor) in CASES {
+            let (mut world, mut stepper) = setup(resolution, solver, refactor);
+            let before = stepper.stats;
+            let started = Instant::now();
+            for _ in 0..60 {
+                stepper.step(&mut world, DT).expect("solved");
+            }
+            let wall = started.elapsed().as_secs_f64();
+            let d = difference(&stepper.stats, &before);
+            let ms = |s: f64| 1e3 * s / 60.0;
+            println!(
+                "  {:>5} vertices {label:>17}: {:.2} ms/step = assembly {:.2} + factorization {:.2} + solve {:.2} + rest {:.2}; \
+                 {:.2} factorizations, {:.2} CG iterations per step",
+                world.mesh.vertex_count(),
+                ms(wall),
+                ms(d.assembly_s),
+                ms(d.factorization_s),
+                ms(d.solve_s),
+                ms(wall - d.assembly_s - d.factorization_s - d.solve_s),
+                d.factorizations as f64 / 60.0,
+                d.cg_iterations as f64 / 60.0
+            );
+        }
+    }
+}
+
+fn difference(a: &StepStats, b: &StepStats) -> StepStats {
+    StepStats {
+        factorizations: a.factorizations - b.factorizations,
+        cg_iterations: a.cg_iterations - b.cg_iterations,
+        assembly_s: a.assembly_s - b.assembly_s,
+        factorization_s: a.factorization_s - b.factorization_s,
+        solve_s: a.solve_s - b.solve_s,
+        ..StepStats::default()
+    }
+}
+
+criterion_group!(benches, implicit_step);
+
+fn main() {
+    if std::env::var_os("DRAPE_BENCH_SPLIT_ONLY").is_none() {
+        benches();
+        Criterion::default().configure_from_args().final_summary();
+    }
+    time_split();
+}

@@ -1,0 +1,425 @@
+//! The implicit system matrix assembled into a fixed 3x3-block sparsity pattern.
+//!
+//! [`BlockPattern`] is built once per mesh topology: one block per vertex pair
+//! coupled by a spring or a hinge (both triangles stored, columns sorted per row),
+//! and for every block of the lower triangle the list of element terms that sum
+//! into it, in element order. Assembly ([`BlockPattern::gather`]) then needs no
+//! triplets, no sorting and no atomics: each lower block sums its own sources in a
+//! fixed order (parallel over rows), and each upper block copies the transpose of its
+//! mirror, so the values are identical at any thread count.
+//!
+//! The pattern also carries the scalar compressed-column (CSC) structure of the
+//! lower triangle that the sparse Cholesky factorization reads ([`super::direct`]),
+//! with, for every scalar entry, the block and the component it comes from.
+//!
+//! # The factored matrix
+//! The factorization reads only the blocks of vertex pairs joined by a spring (and
+//! the diagonal). The only other blocks are the couplings between the two wing tips
+//! `p`, `q` of a hinge, and keeping them more than doubles the factor: on a 65 x 65
+//! grid its stored values go from 0.80 to 1.99 million and a numerical factorization
+//! from 11 to 45 ms (measured on this machine with a probe that factored a test matrix on the pattern). So the
+//! factored matrix is `A` without the `p`-`q` blocks, made positive semi-definite
+//! again by adding `c g_p g_p^T` to block `(p, p)` and `c g_q g_q^T` to `(q, q)` for
+//! each hinge: with `alpha = g_a.x_a + g_b.x_b`, `beta = g_p.x_p`, `gamma = g_q.x_q`,
+//! the hinge's quadratic form becomes `c ((alpha + beta + gamma)^2 - 2 beta gamma +
+//! beta^2 + gamma^2) = c ((alpha + beta + gamma)^2 + (beta - gamma)^2) >= 0`. The
+//! difference is a bending term, small against mass and stretch on fabrics; the
+//! conjugate gradients that use the factor as their preconditioner apply the exact
+//! `A` and remove it in a few iterations. Where bending dominates (a stiff strip at
+//! fine resolution) it is not small: a cantilever strip of 969 vertices needed 100
+//! iterations a step with the fresh factor. So the solver switches to factoring
+//! every block (`factor_tips`) as soon as a fresh factor needs more than 10
+//! iterations (see `TIPS_AFTER` in the implicit module's direct solver).
+//!
+//! Tried first: triplets summed by faer's `try_new_from_triplets` at every step. It
+//! sorts about 1.6 million triplets at 4k vertices, which alone took longer than a
+//! numerical factorization, so the pattern is kept instead.
+
+use rayon::prelude::*;
+
+use super::elements::Elements;
+use super::forces::PAR_MIN;
+use crate::math::{Matrix3, Scalar, Vector};
+
+/// One element term summed into a lower block.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Source {
+    /// `+K_e` of spring `e` (a diagonal block of one of its ends).
+    SpringDiagonal(u32),
+    /// `-K_e` of spring `e` (the block coupling its ends).
+    SpringCoupling(u32),
+    /// `c_h g_k g_l^T` of hinge `h`, `k` and `l` its local vertices.
+    Hinge { hinge: u32, k: u8, l: u8 },
+}
+
+/// The per-element matrix terms of one implicit step, computed by the caller.
+#[derive(Debug, Clone, Copy)]
+pub struct ElementBlocks<'a> {
+    /// Per spring: `h^2 K_e + h D_e`, acting on `x_a - x_b`.
+    pub springs: &'a [Matrix3],
+    /// Per hinge, four gradients of its angle (one per vertex).
+    pub hinge_gradients: &'a [Vector],
+    /// Per hinge: `h^2 k` (its Gauss-Newton block is `coef g g^T`).
+    pub hinge_coefficients: &'a [Scalar],
+    /// Per vertex: mass plus `h` times its drag coefficient, kg.
+    pub diagonal_mass: &'a [Scalar],
+}
+
+/// A fixed 3x3-block sparsity pattern for one mesh topology (module docs).
+#[derive(Debug, Clone, Default)]
+pub struct BlockPattern {
+    /// Start of each block row in `columns`; length `vertices + 1`.
+    row_start: Vec<u32>,
+    /// Block row of each block.
+    rows: Vec<u32>,
+    /// Block column of each block, sorted within a row.
+    columns: Vec<u32>,
+    /// Per vertex: the index of its diagonal block.
+    diagonal: Vec<u32>,
+    /// Per block: the block holding its transpose.
+    mirror: Vec<u32>,
+    /// Per block: true when the factorization reads it (diagonal or spring pair).
+    factored: Vec<bool>,
+    /// Per vertex, CSC-like: the hinge slots `4 h + k` (k a wing tip) whose
+    /// dropped tip-tip coupling is compensated on this vertex's diagonal.
+    compensation_start: Vec<u32>,
+    compensation: Vec<u32>,
+    /// Per block (lower blocks only; empty range for upper ones): its sources.
+    source_start: Vec<u32>,
+    sources: Vec<Source>,
+    /// Scalar CSC structure of the lower triangle: column pointers.
+    csc_column_start: Vec<u32>,
+    /// Scalar CSC row indices.
+    csc_rows: Vec<u32>,
+    /// Per CSC entry: `block * 9 + column * 3 + row` of the block it reads.
+    csc_source: Vec<u32>,
+}
+
+impl BlockPattern {
+    /// The pattern of `elements`' springs and hinges on `vertices` vertices;
+    /// `factor_tips`: the factorization reads the hinge tip-tip blocks too (module
+    /// docs), otherwise they are compensated on the diagonal.
+    pub fn build(vertices: usize, elements: &Elements, factor_tips: bool) -> BlockPattern {
+        let n = vertices;
+        // Every coupled pair, both ways, and the diagonal.
+        let mut pairs: Vec<(u32, u32)> = (0..n as u32).map(|i| (i, i)).collect();
+        for sp in &elements.springs {
+            let [a, b] = sp.v;
+            pairs.extend([(a, b), (b, a)]);
+        }
+        for hg in &elements.hinges {
+            for k in 0..4 {
+                for l in 0..4 {
+                    if k != l {
+                        pairs.push((hg.v[k], hg.v[l]));
+                    }
+                }
+            }
+        }
+        pairs.sort_unstable();
+        pairs.dedup();
+        let mut row_start = vec![0u32; n + 1];
+        for &(i, _) in &pairs {
+            row_start[i as usize + 1] += 1;
+        }
+        for i in 0..n {
+            row_start[i + 1] += row_start[i];
+        }
+        let mut p = BlockPattern {
+            row_start,
+            rows: pairs.iter().map(|&(i, _)| i).collect(),
+            columns: pairs.iter().map(|&(_, j)| j).collect(),
+            ..Default::default()
+        };
+        p.diagonal = (0..n as u32).map(|i| p.slot(i, i)).collect();
+        p.mirror = pairs.iter().map(|&(i, j)| p.slot(j, i)).collect();
+        p.factored = pairs.iter().map(|&(i, j)| i == j || factor_tips).collect();
+        for sp in &elements.springs {
+            let [a, b] = sp.v;
+            for (i, j) in [(a, b), (b, a)] {
+                let s = p.slot(i, j) as usize;
+                p.factored[s] = true;
+            }
+        }
+        let mut tips: Vec<(u32, u32)> = Vec::new();
+        for (h, hg) in elements.hinges.iter().enumerate() {
+            let (tip_p, tip_q) = (hg.v[2], hg.v[3]);
+            if !p.factored[p.slot(tip_p, tip_q) as usize] {
+                tips.push((tip_p, 4 * h as u32 + 2));
+                tips.push((tip_q, 4 * h as u32 + 3));
+            }
+        }
+        tips.sort_by_key(|&(v, _)| v);
+        p.compensation_start = vec![0; n + 1];
+        for &(v, _) in &tips {
+            p.compensation_start[v as usize + 1] += 1;
+        }
+        for i in 0..n {
+            p.compensation_start[i + 1] += p.compensation_start[i];
+        }
+        p.compensation = tips.into_iter().map(|(_, k)| k).collect();
+        p.build_sources(elements);
+        p.build_csc();
+        p
+    }
+
+    /// Number of vertices (block rows).
+    pub fn vertices(&self) -> usize {
+        self.row_start.len().saturating_sub(1)
+    }
+
+    /// Number of stored blocks (both triangles).
+    pub fn blocks(&self) -> usize {
+        self.columns.len()
+    }
+
+    /// The block index of `(i, j)`; the pair must be in the pattern.
+    fn slot(&self, i: u32, j: u32) -> u32 {
+        let (s, e) = (
+            self.row_start[i as usize] as usize,
+            self.row_start[i as usize + 1] as usize,
+        );
+        let found = self.columns[s..e].binary_search(&j);
+        debug_assert!(found.is_ok(), "block ({i}, {j}) missing from the pattern");
+        (s + found.unwrap_or(0)) as u32
+    }
+
+    /// The element terms of every lower block, in element order.
+    fn build_sources(&mut self, elements: &Elements) {
+        let mut tagged: Vec<(u32, Source)> = Vec::new();
+        let lower = |s: &Self, i: u32, j: u32| if j <= i { s.slot(i, j) } else { s.slot(j, i) };
+        for (e, sp) in elements.springs.iter().enumerate() {
+            let [a, b] = sp.v;
+            let e = e as u32;
+            tagged.push((self.diagonal[a as usize], Source::SpringDiagonal(e)));
+            tagged.push((self.diagonal[b as usize], Source::SpringDiagonal(e)));
+            tagged.push((lower(self, a, b), Source::SpringCoupling(e)));
+        }
+        for (h, hg) in elements.hinges.iter().enumerate() {
+            for k in 0..4u8 {
+                for l in 0..4u8 {
+                    let (i, j) = (hg.v[k as usize], hg.v[l as usize]);
+                    if j <= i {
+                        let hinge = h as u32;
+                        tagged.push((self.slot(i, j), Source::Hinge { hinge, k, l }));
+                    }
+                }
+            }
+        }
+        // Stable: the sources of a block stay in element order.
+        tagged.sort_by_key(|&(slot, _)| slot);
+        self.source_start = vec![0; self.blocks() + 1];
+        for &(slot, _) in &tagged {
+            self.source_start[slot as usize + 1] += 1;
+        }
+        for b in 0..self.blocks() {
+            self.source_start[b + 1] += self.source_start[b];
+        }
+        self.sources = tagged.into_iter().map(|(_, s)| s).collect();
+    }
+
+    /// The scalar CSC structure of the lower triangle. Scalar entry (row 3i+p,
+    /// column 3j+q), i >= j, is component (p, q) of block (i, j), i.e. component
+    /// (q, p) of block (j, i), which is stored in block row j: so column 3j+q is read
+    /// from block row j's blocks with column i >= j, in ascending order.
+    fn build_csc(&mut self) {
+        let n = self.vertices();
+        let mut start = Vec::with_capacity(3 * n + 1);
+        let (mut rows, mut source) = (Vec::new(), Vec::new());
+        start.push(0u32);
+        for j in 0..n {
+            let (s, e) = (self.row_start[j] as usize, self.row_start[j + 1] as usize);
+            for q in 0..3u32 {
+                for slot in s..e {
+                    let i = self.columns[slot];
+                    if (i as usize) < j || !self.factored[slot] {
+                        continue;
+                    }
+                    let first = if i as usize == j { q } else { 0 };
+                    for p in first..3 {
+                        rows.push(3 * i + p);
+                        // Component (row q, column p) of block (j, i).
+                        source.push(slot as u32 * 9 + p * 3 + q);
+                    }
+                }
+                start.push(rows.len() as u32);
+            }
+        }
+        self.csc_column_start = start;
+        self.csc_rows = rows;
+        self.csc_source = source;
+    }
+
+    /// Column pointers and row indices of the lower triangle's scalar CSC form.
+    pub fn csc_structure(&self) -> (&[u32], &[u32]) {
+        (&self.csc_column_start, &self.csc_rows)
+    }
+
+    /// Fills `values` (one per CSC entry) from the blocks, adding `extra[i]` to
+    /// each diagonal block `(i, i)` (the compensation of [`Self::compensation`]).
+    pub fn csc_values(&self, blocks: &[Matrix3], extra: &[Matrix3], values: &mut Vec<Scalar>) {
+        values.resize(self.csc_source.len(), 0.0);
+        values
+            .par_iter_mut()
+            .zip(self.csc_source.par_iter())
+            .with_min_len(8 * PAR_MIN)
+            .for_each(|(v, &src)| {
+                let (b, c, r) = (
+                    (src / 9) as usize,
+                    (src % 9) as usize / 3,
+                    (src % 9) as usize % 3,
+                );
+                let (i, j) = (self.rows[b] as usize, self.columns[b] as usize);
+                *v = blocks[b].col(c)[r];
+                if i == j {
+                    *v += extra[i].col(c)[r];
+                }
+            });
+    }
+
+    /// Per vertex: the diagonal compensation of the dropped tip-tip blocks (module
+    /// docs), projected like the system (`S c g g^T S`).
+    pub fn compensation(
+        &self,
+        terms: &ElementBlocks<'_>,
+        projection: &[Option<Vector>],
+        extra: &mut Vec<Matrix3>,
+    ) {
+        extra.resize(self.vertices(), Matrix3::ZERO);
+        extra
+            .par_iter_mut()
+            .enumerate()
+            .with_min_len(PAR_MIN)
+            .for_each(|(i, out)| {
+                let range =
+                    self.compensation_start[i] as usize..self.compensation_start[i + 1] as usize;
+                let mut m = Matrix3::ZERO;
+                for &k in &self.compensation[range] {
+                    let g = terms.hinge_gradients[k as usize];
+                    m += outer(g, g) * terms.hinge_coefficients[k as usize / 4];
+                }
+                *out = match projection[i] {
+                    None => m,
+                    Some(n) if n == Vector::ZERO => Matrix3::ZERO,
+                    Some(n) => {
+                        let s = Matrix3::IDENTITY - outer(n, n);
+                        s * m * s
+                    }
+                };
+            });
+    }
+
+    /// Sums the element terms into `blocks` (module docs): `M + h D + h^2 K`.
+    pub fn gather(&self, terms: &ElementBlocks<'_>, blocks: &mut Vec<Matrix3>) {
+        blocks.resize(self.blocks(), Matrix3::ZERO);
+        // Each block from its own sources (an upper block from its lower mirror's,
+        // transposed), so every row is written by one task and nothing is shared.
+        blocks
+            .par_iter_mut()
+            .enumerate()
+            .with_min_len(PAR_MIN)
+            .for_each(|(slot, out)| {
+                let (i, j) = (self.rows[slot] as usize, self.columns[slot] as usize);
+                let lower = if j <= i {
+                    slot
+                } else {
+                    self.mirror[slot] as usize
+                };
+                let mut m = Matrix3::ZERO;
+                let range =
+                    self.source_start[lower] as usize..self.source_start[lower + 1] as usize;
+                for src in &self.sources[range] {
+                    m += match *src {
+                        Source::SpringDiagonal(e) => terms.springs[e as usize],
+                        Source::SpringCoupling(e) => -terms.springs[e as usize],
+                        Source::Hinge { hinge, k, l } => {
+                            let g = &terms.hinge_gradients[4 * hinge as usize..];
+                            outer(g[k as usize], g[l as usize])
+                                * terms.hinge_coefficients[hinge as usize]
+                        }
+                    };
+                }
+                *out = if j == i {
+                    m + Matrix3::from_diagonal(Vector::splat(terms.diagonal_mass[i]))
+                } else if j < i {
+                    m
+                } else {
+                    m.transpose()
+                };
+            });
+    }
+
+    /// The projected system `S A S + (I - S) m` of the module docs of
+    /// [`super::implicit`]: `filter[i]` is `None` for a free vertex, `Some(0)` for a
+    /// held one (all three directions prescribed) and `Some(n)` for a contact whose
+    /// normal `n` is prescribed. `scale[i]` is the diagonal put back on the
+    /// prescribed directions (the vertex's mass, so the matrix keeps its scale).
+    pub fn project(
+        &self,
+        raw: &[Matrix3],
+        projection: &[Option<Vector>],
+        scale: &[Scalar],
+        out: &mut Vec<Matrix3>,
+    ) {
+        out.resize(raw.len(), Matrix3::ZERO);
+        let s = |i: usize| match projection[i] {
+            None => None,
+            Some(n) if n == Vector::ZERO => Some(Matrix3::ZERO),
+            Some(n) => Some(Matrix3::IDENTITY - outer(n, n)),
+        };
+        out.par_iter_mut()
+            .enumerate()
+            .with_min_len(PAR_MIN)
+            .for_each(|(slot, out)| {
+                let (i, j) = (self.rows[slot] as usize, self.columns[slot] as usize);
+                let si = s(i);
+                let mut m = raw[slot];
+                if let Some(si) = si {
+                    m = si * m;
+                }
+                if let Some(sj) = s(j) {
+                    m *= sj;
+                }
+                if i == j
+                    && let Some(si) = si
+                {
+                    m += (Matrix3::IDENTITY - si) * scale[i];
+                }
+                *out = m;
+            });
+    }
+
+    /// A diagonally dominant test matrix on this pattern (probes and tests).
+    pub fn fill_test_matrix(&self, blocks: &mut [Matrix3]) {
+        for (slot, b) in blocks.iter_mut().enumerate() {
+            let (i, j) = (self.rows[slot], self.columns[slot]);
+            *b = if i == j {
+                Matrix3::from_diagonal(Vector::splat(40.0))
+            } else {
+                Matrix3::from_diagonal(Vector::splat(-1.0))
+                    + outer(Vector::X, Vector::Y) * 0.1
+                    + outer(Vector::Y, Vector::X) * 0.1
+            };
+        }
+    }
+
+    /// `y = A x` with the blocks `a` of this pattern, by rows (deterministic).
+    pub fn multiply(&self, a: &[Matrix3], x: &[Vector], y: &mut [Vector]) {
+        y.par_iter_mut()
+            .enumerate()
+            .with_min_len(PAR_MIN)
+            .for_each(|(i, out)| {
+                let range = self.row_start[i] as usize..self.row_start[i + 1] as usize;
+                let mut acc = Vector::ZERO;
+                for s in range {
+                    acc += a[s] * x[self.columns[s] as usize];
+                }
+                *out = acc;
+            });
+    }
+}
+
+/// `a b^T`.
+pub(super) fn outer(a: Vector, b: Vector) -> Matrix3 {
+    Matrix3::from_cols(a * b.x, a * b.y, a * b.z)
+}

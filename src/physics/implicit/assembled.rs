@@ -1,0 +1,342 @@
+//! The direct solver (`solver = "direct"`): `A` assembled into a fixed block pattern
+//! ([`crate::physics::block`]), its projection factored by a sparse Cholesky
+//! ([`crate::physics::direct`]), and conjugate gradients preconditioned by that
+//! factor.
+//!
+//! Every step solves `A_s y = b_s` for the free part `y` of `dv = dv_c + y`, where
+//! `dv_c` holds the prescribed parts (pinned vertices' velocity change, contacts'
+//! normal velocity change), `A_s = S A S + (I - S) m` and `b_s = S (b - A dv_c)`
+//! (`S`: identity for a free vertex, zero for a held one, `I - n n^T` for a contact).
+//! `A_s` is symmetric positive definite on all of space and its solution has no
+//! prescribed component, so any factor of a nearby `A_s` is a good preconditioner.
+//!
+//! The factor is reused from step to step. The first preconditioned iterate is the
+//! solve with it; while the factor is fresh (this step's matrix) that is exact up to
+//! rounding and the residual test passes at once. With an older factor, conjugate
+//! gradients correct the difference; when they have not converged after
+//! `refactor_iterations`, the current matrix is factored and the iteration restarts
+//! from where it is. So the cost per step adapts to how fast the matrix changes:
+//! falling, folding cloth refactors often, cloth at rest almost never.
+//!
+//! Measured on `drape_sphere` (resolution 64, 4,225 vertices, dt 1/120 s) while
+//! choosing `refactor_iterations` (docs/performance.md has the table): refactoring at
+//! every step costs a factorization per step; with the reuse, most steps need 1 to 4
+//! preconditioned iterations.
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use rayon::prelude::*;
+
+use super::cg::dot;
+use super::{ImplicitScratch, SolveFailure};
+use crate::math::{Matrix3, Scalar, Vector};
+use crate::physics::Stepper;
+use crate::physics::block::{BlockPattern, ElementBlocks};
+use crate::physics::direct::{FactorError, Factorization};
+use crate::physics::forces::PAR_MIN;
+
+/// Iterations with a fresh factor of the reduced matrix (block module docs) after
+/// which the tip-tip blocks are factored too. A factor with them costs about three
+/// solves more than one without (65 x 65 grid: 0.80 against 1.99 million stored
+/// values), while a fresh reduced factor needs about 3 iterations on fabrics
+/// (`drape_sphere`) and 27 to 200 on a bending-dominated strip (resolutions 14 to
+/// 112): 10 separates the two with room on both sides.
+const TIPS_AFTER: u32 = 10;
+
+/// The direct solver's scratch: pattern, matrices, factor and iteration vectors.
+#[derive(Debug, Default, Clone)]
+pub(super) struct AssembledScratch {
+    /// Block pattern of the current mesh (`None`: not built yet).
+    pattern: Option<Arc<BlockPattern>>,
+    /// Factor the hinge tip-tip blocks too (block module docs): set for the rest of
+    /// the run once a fresh factor without them needed more than
+    /// `refactor_iterations` iterations.
+    factor_tips: bool,
+    /// `A` as assembled.
+    raw: Vec<Matrix3>,
+    /// `A_s`, the projected matrix.
+    system: Vec<Matrix3>,
+    /// Per vertex: the diagonal compensation added to the factored matrix.
+    compensation: Vec<Matrix3>,
+    /// Per vertex: `None` free, `Some(0)` held, `Some(n)` contact normal.
+    projection: Vec<Option<Vector>>,
+    factorization: Factorization,
+    prescribed: Vec<Vector>,
+    /// `b_s`.
+    rhs: Vec<Vector>,
+    y: Vec<Vector>,
+    r: Vec<Vector>,
+    z: Vec<Vector>,
+    p: Vec<Vector>,
+    ap: Vec<Vector>,
+}
+
+impl AssembledScratch {
+    /// Forgets the pattern and the factorization (the mesh changed).
+    pub(super) fn mesh_changed(&mut self) {
+        self.pattern = None;
+        self.factorization.reset();
+    }
+}
+
+/// Solves `A dv = b` (module docs) in place of the first guess `dv`, whose
+/// prescribed parts are kept; `reference`: the norm the tolerance is relative to.
+pub(super) fn solve(
+    st: &mut Stepper,
+    held: &[bool],
+    reference: Scalar,
+    contact_push: bool,
+) -> Result<(), SolveFailure> {
+    let started = Instant::now();
+    let n = st.implicit.dv.len();
+    let a = &mut st.implicit.assembled;
+    if a.pattern.is_none() {
+        a.pattern = Some(Arc::new(BlockPattern::build(
+            n,
+            &st.elements,
+            a.factor_tips,
+        )));
+        a.factorization.reset();
+    }
+    let s = &mut st.implicit;
+    let pattern = s.assembled.pattern.clone().unwrap_or_default();
+    let terms = ElementBlocks {
+        springs: &s.spring_block,
+        hinge_gradients: &s.hinge_grad,
+        hinge_coefficients: &s.hinge_coef,
+        diagonal_mass: &s.diag_mass,
+    };
+    let a = &mut s.assembled;
+    pattern.gather(&terms, &mut a.raw);
+    split_prescribed(s, held);
+    let terms = ElementBlocks {
+        springs: &s.spring_block,
+        hinge_gradients: &s.hinge_grad,
+        hinge_coefficients: &s.hinge_coef,
+        diagonal_mass: &s.diag_mass,
+    };
+    pattern.compensation(
+        &terms,
+        &s.assembled.projection,
+        &mut s.assembled.compensation,
+    );
+    let a = &mut s.assembled;
+    // b_s = S (b - A dv_c).
+    a.ap.resize(n, Vector::ZERO);
+    pattern.multiply(&a.raw, &a.prescribed, &mut a.ap);
+    a.rhs.resize(n, Vector::ZERO);
+    a.rhs
+        .par_iter_mut()
+        .zip(s.b.par_iter().zip(a.ap.par_iter()))
+        .zip(a.projection.par_iter())
+        .with_min_len(PAR_MIN)
+        .for_each(|((r, (b, ap)), proj)| *r = project(*proj, *b - *ap));
+    pattern.project(&a.raw, &a.projection, &st.elements.mass, &mut a.system);
+    st.stats.assembly_s += started.elapsed().as_secs_f64();
+    let outcome = iterate(st, &pattern, reference);
+    let s = &mut st.implicit;
+    let a = &mut s.assembled;
+    // dv = dv_c + y.
+    s.dv.par_iter_mut()
+        .zip(a.prescribed.par_iter().zip(a.y.par_iter()))
+        .with_min_len(PAR_MIN)
+        .for_each(|(d, (c, y))| *d = *c + *y);
+    if outcome.is_ok() && contact_push {
+        contact_pressure(st, &pattern);
+    }
+    outcome
+}
+
+/// Splits the first guess `dv` into its prescribed part and the free first guess
+/// `y`, and sets the projections.
+fn split_prescribed(s: &mut ImplicitScratch, held: &[bool]) {
+    let n = s.dv.len();
+    let a = &mut s.assembled;
+    a.projection.resize(n, None);
+    a.prescribed.resize(n, Vector::ZERO);
+    a.y.resize(n, Vector::ZERO);
+    a.projection
+        .par_iter_mut()
+        .zip(a.prescribed.par_iter_mut().zip(a.y.par_iter_mut()))
+        .zip(s.dv.par_iter().zip(s.filter.par_iter()))
+        .enumerate()
+        .with_min_len(PAR_MIN)
+        .for_each(|(i, ((proj, (c, y)), (dv, f)))| {
+            if held[i] {
+                (*proj, *c, *y) = (Some(Vector::ZERO), *dv, Vector::ZERO);
+            } else if *f != Vector::ZERO {
+                let normal = *f * f.dot(*dv);
+                (*proj, *c, *y) = (Some(*f), normal, *dv - normal);
+            } else {
+                (*proj, *c, *y) = (None, Vector::ZERO, *dv);
+            }
+        });
+}
+
+/// `S v` for one vertex's projection.
+#[inline(always)]
+fn project(proj: Option<Vector>, v: Vector) -> Vector {
+    match proj {
+        None => v,
+        Some(n) if n == Vector::ZERO => Vector::ZERO,
+        Some(n) => v - n * n.dot(v),
+    }
+}
+
+/// Preconditioned conjugate gradients on `A_s y = b_s`,
+/// refactoring when the factor is stale (module docs).
+fn iterate(
+    st: &mut Stepper,
+    pattern: &BlockPattern,
+    reference: Scalar,
+) -> Result<(), SolveFailure> {
+    let tolerance = st.model.cg_tolerance;
+    let goal = tolerance * reference;
+    let refactor_after = st.model.solver.refactor_iterations;
+    let cap = st.model.cg_max_iterations;
+    let a = &mut st.implicit.assembled;
+    let mut fresh = false;
+    if !a.factorization.is_valid() {
+        refactor(a, pattern, &mut st.stats)?;
+        fresh = true;
+    }
+    // r = b_s - A_s y.
+    let mut started = Instant::now();
+    residual(a, pattern);
+    let mut total = 0u32;
+    let mut since_factor = 0u32;
+    let outcome = 'restart: loop {
+        a.z.resize(a.r.len(), Vector::ZERO);
+        a.factorization.solve(&a.r, &mut a.z);
+        st.stats.factor_solves += 1;
+        a.p.clone_from(&a.z);
+        let mut rz = dot(&a.r, &a.z);
+        loop {
+            let rr = dot(&a.r, &a.r);
+            if rr.sqrt() <= goal {
+                break 'restart Ok(());
+            }
+            if since_factor >= cap {
+                break 'restart Err(SolveFailure::NotConverged {
+                    iterations: total,
+                    residual: rr.sqrt() / reference.max(Scalar::MIN_POSITIVE),
+                    tolerance,
+                });
+            }
+            if fresh && since_factor >= TIPS_AFTER && !a.factor_tips {
+                // Even a fresh factor of the reduced matrix is a poor preconditioner
+                // here: factor every block from now on.
+                // (Same blocks, so `pattern` still serves the products.)
+                st.stats.solve_s += started.elapsed().as_secs_f64();
+                let full = Arc::new(BlockPattern::build(pattern.vertices(), &st.elements, true));
+                a.factor_tips = true;
+                a.pattern = Some(full.clone());
+                a.compensation.iter_mut().for_each(|m| *m = Matrix3::ZERO);
+                a.factorization.reset();
+                refactor(a, &full, &mut st.stats)?;
+                started = Instant::now();
+                since_factor = 0;
+                continue 'restart;
+            }
+            if !fresh && since_factor >= refactor_after {
+                st.stats.solve_s += started.elapsed().as_secs_f64();
+                refactor(a, pattern, &mut st.stats)?;
+                started = Instant::now();
+                fresh = true;
+                since_factor = 0;
+                residual(a, pattern);
+                continue 'restart;
+            }
+            pattern.multiply(&a.system, &a.p, &mut a.ap);
+            let pap = dot(&a.p, &a.ap);
+            if pap <= 0.0 || !pap.is_finite() {
+                break 'restart Err(SolveFailure::NotPositiveDefinite);
+            }
+            let alpha = rz / pap;
+            a.y.par_iter_mut()
+                .zip(a.r.par_iter_mut())
+                .zip(a.p.par_iter().zip(a.ap.par_iter()))
+                .with_min_len(PAR_MIN)
+                .for_each(|((y, r), (p, ap))| {
+                    *y += *p * alpha;
+                    *r -= *ap * alpha;
+                });
+            a.factorization.solve(&a.r, &mut a.z);
+            st.stats.factor_solves += 1;
+            let rz_new = dot(&a.r, &a.z);
+            let beta = rz_new / rz;
+            rz = rz_new;
+            a.p.par_iter_mut()
+                .zip(a.z.par_iter())
+                .with_min_len(PAR_MIN)
+                .for_each(|(p, z)| *p = *z + *p * beta);
+            total += 1;
+            since_factor += 1;
+        }
+    };
+    st.stats.cg_iterations += total as u64;
+    st.stats.solve_s += started.elapsed().as_secs_f64();
+    outcome
+}
+
+/// `r = b_s - A_s y`.
+fn residual(a: &mut AssembledScratch, pattern: &BlockPattern) {
+    let n = a.rhs.len();
+    a.ap.resize(n, Vector::ZERO);
+    a.r.resize(n, Vector::ZERO);
+    pattern.multiply(&a.system, &a.y, &mut a.ap);
+    a.r.par_iter_mut()
+        .zip(a.rhs.par_iter().zip(a.ap.par_iter()))
+        .with_min_len(PAR_MIN)
+        .for_each(|(r, (b, ap))| *r = *b - *ap);
+}
+
+/// Factors `A_s`, analysing the pattern first when needed.
+fn refactor(
+    a: &mut AssembledScratch,
+    pattern: &BlockPattern,
+    stats: &mut crate::physics::StepStats,
+) -> Result<(), SolveFailure> {
+    let started = Instant::now();
+    let map = |e: FactorError| match e {
+        FactorError::NotPositiveDefinite => SolveFailure::NotPositiveDefinite,
+        FactorError::Setup => SolveFailure::Setup,
+    };
+    if !a.factorization.is_analysed() {
+        a.factorization.analyse(pattern).map_err(map)?;
+        stats.symbolic_analyses += 1;
+    }
+    let result = a
+        .factorization
+        .factor(pattern, &a.system, &a.compensation)
+        .map_err(map);
+    stats.factorizations += 1;
+    stats.factorization_s += started.elapsed().as_secs_f64();
+    result
+}
+
+/// The normal velocity change each filtered contact imposed in the solve,
+/// `n . (A dv - b) / m` with the unprojected `A`, into [`Stepper::contact_push`].
+fn contact_pressure(st: &mut Stepper, pattern: &BlockPattern) {
+    let s = &mut st.implicit;
+    let n = s.filter.len();
+    st.contact_push.clear();
+    st.contact_push.resize(n, 0.0);
+    if s.filter.iter().all(|f| *f == Vector::ZERO) {
+        return;
+    }
+    let a = &mut s.assembled;
+    pattern.multiply(&a.raw, &s.dv, &mut a.ap);
+    let mass = &st.elements.mass;
+    st.contact_push
+        .par_iter_mut()
+        .enumerate()
+        .with_min_len(PAR_MIN)
+        .for_each(|(i, push)| {
+            let f = s.filter[i];
+            if f != Vector::ZERO {
+                *push = (f.dot(a.ap[i] - s.b[i]) / mass[i]).max(0.0);
+            }
+        });
+}
