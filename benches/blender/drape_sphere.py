@@ -315,6 +315,8 @@ def main():
             "median": statistics.median(per_frame) if per_frame else None,
             "max": max(per_frame) if per_frame else None,
             "first": per_frame[0] if per_frame else None,
+            "sum_of_top10": sum(sorted(per_frame)[-10:]) if per_frame else None,
+            "all": [round(x, 5) for x in per_frame],
         },
         "cg_iterations": {
             "per_frame_avg_mean": statistics.fmean(iters_avg) if iters_avg else None,

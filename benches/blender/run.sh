@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Blender peer benchmark of scenes/drape_sphere.toml: runs drape_sphere.py N
-# times (no `nice`: this is the measurement) and prints the raw wall times and
-# their median. Usage:
+# times (no `nice`: this is the measurement) and prints the raw wall times, their
+# median, min and max. Usage:
 #
 #   benches/blender/run.sh [-n RUNS] [-o OUTDIR] [-t THREADS] [-- drape_sphere.py options]
 #
@@ -66,5 +66,5 @@ print(f"blender {d['blender_version']} model={d['model']} diagonals={d['diagonal
       f"frames={d['frames']} quality={d['quality']} substeps={d['substeps_total']} "
       f"threads={d['threads']['render_threads']}")
 print("raw wall_s: " + " ".join(f"{w:.3f}" for w in walls))
-print(f"median wall_s: {statistics.median(walls):.3f}")
+print(f"median wall_s: {statistics.median(walls):.3f}  (min {min(walls):.3f}, max {max(walls):.3f})")
 EOF
