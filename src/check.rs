@@ -48,6 +48,14 @@ pub fn describe(scene: &Scene) -> Result<String, BuildError> {
     );
     if mat.bending > 0.0 {
         match mat.bending_model {
+            BendingModel::Hessian => {
+                let _ = writeln!(
+                    s,
+                    "  bending: hessian (quadratic-fit patch per triangle), {} patches, rigidity {} N m",
+                    el.patches.len(),
+                    mat.bending
+                );
+            }
             BendingModel::Dihedral => {
                 let _ = writeln!(
                     s,

@@ -25,7 +25,14 @@
 //!   edge with `k = B / d0^2` (d0 the rest distance of the tips, times 2^(n/2)
 //!   under `paper_a`). Its energy grows with theta^4, so no constant makes it
 //!   match a bending rigidity; the tests print how far it deviates.
+//! * Hessian bending (the default, [`super::hessian`]): one quadratic-fit patch
+//!   per triangle, energy `(B/2) A_t |d^2 x/du^2|^2`; converges to the plate with
+//!   Poisson ratio 0 (the textile cantilever's rigidity) on any mesh. The dihedral
+//!   hinges above are kept as `bending_model = "dihedral"`: they reproduce a
+//!   cylinder imposed on a grid, but a loaded strip is about 20% too soft (see
+//!   `hessian.rs` for why and the numbers).
 
+use super::hessian::{BendPatch, PATCH_MAX, build_patches};
 use crate::math::{Scalar, Vector2};
 use crate::mesh::Mesh;
 use crate::scene::{BendingModel, StiffnessRule};
@@ -115,12 +122,17 @@ pub struct Elements {
     pub springs: Vec<Spring>,
     /// Dihedral hinges (only with the dihedral model and non-zero rigidity).
     pub hinges: Vec<Hinge>,
+    /// Hessian bending patches, one per triangle (only with the hessian model and
+    /// non-zero rigidity).
+    pub patches: Vec<BendPatch>,
     /// Springs where the vertex is the first end (`v[0]`).
     pub spring_first: Incidence,
     /// Springs where the vertex is the second end (`v[1]`).
     pub spring_second: Incidence,
     /// Hinge slots `4 * hinge + k` where the vertex is `v[k]`.
     pub hinge_slots: Incidence,
+    /// Patch slots `PATCH_MAX * patch + k` where the vertex is `v[k]` (k < n).
+    pub patch_slots: Incidence,
     /// Triangles at each vertex (for per-triangle forces such as wind).
     pub vertex_triangles: Incidence,
 }
@@ -169,7 +181,12 @@ impl Elements {
             });
         }
         let mut hinges = Vec::new();
-        if mat.bending > 0.0 {
+        let patches = if mat.bending > 0.0 && mat.bending_model == BendingModel::Hessian {
+            build_patches(mesh, &area, mat.bending)
+        } else {
+            Vec::new()
+        };
+        if mat.bending > 0.0 && mat.bending_model != BendingModel::Hessian {
             for (e, edge) in mesh
                 .edges
                 .iter()
@@ -191,6 +208,7 @@ impl Elements {
                         let k = mat.bending * len * len / (area[t0 as usize] + area[t1 as usize]);
                         hinges.push(Hinge { v: [a, b, p, q], k });
                     }
+                    BendingModel::Hessian => unreachable!("patches are built above"),
                     BendingModel::HingeSpring => {
                         let rest = material_distance(&mesh.material, p, q);
                         let k = mat.bending / (rest * rest) * level_factor(level);
@@ -225,6 +243,15 @@ impl Elements {
                 .enumerate()
                 .flat_map(|(h, hg)| (0..4).map(move |k| (hg.v[k], (4 * h + k) as u32))),
         );
+        let patch_slots = Incidence::from_pairs(
+            n,
+            patches.iter().enumerate().flat_map(|(p, pt)| {
+                pt.vertices()
+                    .iter()
+                    .enumerate()
+                    .map(move |(k, &v)| (v, (PATCH_MAX * p + k) as u32))
+            }),
+        );
         let vertex_triangles = Incidence::from_pairs(
             n,
             mesh.triangles
@@ -237,9 +264,11 @@ impl Elements {
             vertex_area,
             springs,
             hinges,
+            patches,
             spring_first,
             spring_second,
             hinge_slots,
+            patch_slots,
             vertex_triangles,
         }
     }

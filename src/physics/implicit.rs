@@ -10,6 +10,8 @@
 //!   semi-definite; `D_e = c n n^T`. Both act on `p_a - p_b`.
 //! * Dihedral hinge with gradient `g` of its angle: Gauss-Newton `K_h = k g g^T`
 //!   (the curvature term of the exact Hessian is dropped; it is indefinite).
+//! * Hessian bending patch (`hessian.rs`), energy `sum_r c_r/2 |sum_k w_rk x_k|^2`:
+//!   its exact, constant Hessian `K_p = sum_r c_r w_r w_r^T (x) I_3`.
 //! * Wind is treated explicitly (only in `b`).
 //!
 //! `A` is never assembled: each CG iteration applies it matrix-free with the same
@@ -33,6 +35,7 @@ use rayon::prelude::*;
 
 use super::bending::dihedral_angle_and_gradient;
 use super::forces::{PAR_MIN, spring_force, wind_share};
+use super::hessian::PATCH_MAX;
 use super::{Contact, Stepper};
 use crate::math::{Matrix3, Scalar, Vector, deterministic_sum, deterministic_sum2};
 use crate::world::World;
@@ -45,6 +48,9 @@ pub struct ImplicitScratch {
     hinge_grad: Vec<Vector>,
     hinge_coef: Vec<Scalar>,
     hinge_slot: Vec<Vector>,
+    patch_slot: Vec<Vector>,
+    /// `h^2` of the step being solved (scales the patches' constant Hessian).
+    h2: Scalar,
     tri_slot: Vec<Vector>,
     diag_mass: Vec<Scalar>,
     inv_diag: Vec<Vector>,
@@ -208,6 +214,20 @@ fn assemble(st: &mut Stepper, w: &World, h: Scalar) {
                 slot[k] = g[k] * (-h * hg.k * theta - *coef * gv);
             }
         });
+    // Patches: slot = h f - h^2 K v with f = -K x (the energy is quadratic).
+    s.h2 = h * h;
+    s.patch_slot.resize(PATCH_MAX * el.patches.len(), Vector::ZERO);
+    s.patch_slot
+        .par_chunks_exact_mut(PATCH_MAX)
+        .zip(el.patches.par_iter())
+        .with_min_len(PAR_MIN / PATCH_MAX)
+        .for_each(|(slot, p)| {
+            let (hx, hv) = (p.second_derivatives(x), p.second_derivatives(v));
+            p.spread(
+                [0, 1, 2].map(|r| (hx[r] * h + hv[r] * (h * h)) * -p.c[r]),
+                slot,
+            );
+        });
     if let Some(wind) = &ext.wind {
         s.tri_slot.resize(w.mesh.triangles.len(), Vector::ZERO);
         s.tri_slot
@@ -221,13 +241,14 @@ fn assemble(st: &mut Stepper, w: &World, h: Scalar) {
     s.b.resize(n, Vector::ZERO);
     s.diag_mass.resize(n, 0.0);
     s.inv_diag.resize(n, Vector::ZERO);
-    let (spring_slot, block, hinge_slot, hinge_grad, hinge_coef, tri_slot) = (
+    let (spring_slot, block, hinge_slot, hinge_grad, hinge_coef, tri_slot, patch_slot) = (
         &s.spring_slot,
         &s.block,
         &s.hinge_slot,
         &s.hinge_grad,
         &s.hinge_coef,
         &s.tri_slot,
+        &s.patch_slot,
     );
     s.b.par_iter_mut()
         .zip(s.diag_mass.par_iter_mut().zip(s.inv_diag.par_iter_mut()))
@@ -248,6 +269,11 @@ fn assemble(st: &mut Stepper, w: &World, h: Scalar) {
                 rhs += hinge_slot[k as usize];
                 let g = hinge_grad[k as usize];
                 diag += g * g * hinge_coef[k as usize / 4];
+            }
+            for &k in el.patch_slots.of(i) {
+                rhs += patch_slot[k as usize];
+                let (p, slot) = (k as usize / PATCH_MAX, k as usize % PATCH_MAX);
+                diag += Vector::splat(h * h * el.patches[p].diagonal(slot));
             }
             if ext.wind.is_some() {
                 for &t in el.vertex_triangles.of(i) {
@@ -311,8 +337,22 @@ fn apply_operator_rows(st: &mut Stepper, which: Which, held: &[bool], filtered: 
                 slot[k] = g[k] * (coef * gp);
             }
         });
-    let (spring_slot, hinge_slot, diag_mass, filter) =
-        (&s.spring_slot, &s.hinge_slot, &s.diag_mass, &s.filter);
+    let h2 = s.h2;
+    s.patch_slot
+        .par_chunks_exact_mut(PATCH_MAX)
+        .zip(el.patches.par_iter())
+        .with_min_len(PAR_MIN / PATCH_MAX)
+        .for_each(|(slot, p)| {
+            let hp = p.second_derivatives(input);
+            p.spread([0, 1, 2].map(|r| hp[r] * (h2 * p.c[r])), slot);
+        });
+    let (spring_slot, hinge_slot, patch_slot, diag_mass, filter) = (
+        &s.spring_slot,
+        &s.hinge_slot,
+        &s.patch_slot,
+        &s.diag_mass,
+        &s.filter,
+    );
     s.ap.par_iter_mut()
         .enumerate()
         .with_min_len(PAR_MIN)
@@ -331,6 +371,9 @@ fn apply_operator_rows(st: &mut Stepper, which: Which, held: &[bool], filtered: 
             }
             for &k in el.hinge_slots.of(i) {
                 acc += hinge_slot[k as usize];
+            }
+            for &k in el.patch_slots.of(i) {
+                acc += patch_slot[k as usize];
             }
             *out = if filtered {
                 without(filter[i], acc)

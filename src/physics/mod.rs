@@ -8,6 +8,7 @@ pub mod bending;
 pub mod elements;
 pub mod explicit;
 pub mod forces;
+pub mod hessian;
 pub mod implicit;
 pub mod multirate;
 pub mod pins;
@@ -15,6 +16,7 @@ pub mod timestep;
 pub mod work;
 
 pub use elements::{Elements, Hinge, MaterialParams, Spring};
+pub use hessian::{BendPatch, PATCH_MAX};
 pub use forces::{Energy, ExternalForces, WindForce};
 
 use crate::math::{Scalar, Vector};

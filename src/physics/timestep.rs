@@ -87,6 +87,14 @@ fn gershgorin_rows(
             stiff[hg.v[k] as usize] += hg.k * g[k].length() * sum;
         }
     }
+    for p in &el.patches {
+        for r in 0..3 {
+            let sum: Scalar = p.w[r].iter().map(|w| w.abs()).sum();
+            for (k, &v) in p.vertices().iter().enumerate() {
+                stiff[v as usize] += p.c[r] * p.w[r][k].abs() * sum;
+            }
+        }
+    }
     for i in 0..n {
         stiff[i] /= el.mass[i];
         damp[i] = (damp[i] + drag_per_area * el.vertex_area[i]) / el.mass[i];
