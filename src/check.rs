@@ -48,11 +48,11 @@ pub fn describe(scene: &Scene) -> Result<String, BuildError> {
     );
     if mat.bending > 0.0 {
         match mat.bending_model {
-            BendingModel::Hessian => {
+            BendingModel::ShapeOperator => {
                 let _ = writeln!(
                     s,
-                    "  bending: hessian (quadratic-fit patch per triangle), {} patches, rigidity {} N m",
-                    el.patches.len(),
+                    "  bending: shape operator (curvature tensor per triangle from its edge angles), {} triangles, rigidity {} N m",
+                    el.shape_triangles.len(),
                     mat.bending
                 );
             }

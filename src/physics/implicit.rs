@@ -10,8 +10,9 @@
 //!   semi-definite; `D_e = c n n^T`. Both act on `p_a - p_b`.
 //! * Dihedral hinge with gradient `g` of its angle: Gauss-Newton `K_h = k g g^T`
 //!   (the curvature term of the exact Hessian is dropped; it is indefinite).
-//! * Hessian bending patch (`hessian.rs`), energy `sum_r c_r/2 |sum_k w_rk x_k|^2`:
-//!   its exact, constant Hessian `K_p = sum_r c_r w_r w_r^T (x) I_3`.
+//! * Shape triangle (`shape.rs`), energy `theta^T M theta / 2` over its three edge
+//!   angles with Jacobian `J` (rows: angle gradients): Gauss-Newton `K_t = J^T M J`
+//!   (constant `M`; the curvature term is dropped as for the hinges).
 //! * Wind is treated explicitly (only in `b`).
 //!
 //! `A` is never assembled: each CG iteration applies it matrix-free with the same
@@ -35,7 +36,7 @@ use rayon::prelude::*;
 
 use super::bending::dihedral_angle_and_gradient;
 use super::forces::{PAR_MIN, spring_force, wind_share};
-use super::hessian::PATCH_MAX;
+use super::shape::{SHAPE_SLOTS, ShapeJacobian, rates, spread};
 use super::{Contact, Stepper};
 use crate::math::{Matrix3, Scalar, Vector, deterministic_sum, deterministic_sum2};
 use crate::world::World;
@@ -48,8 +49,9 @@ pub struct ImplicitScratch {
     hinge_grad: Vec<Vector>,
     hinge_coef: Vec<Scalar>,
     hinge_slot: Vec<Vector>,
-    patch_slot: Vec<Vector>,
-    /// `h^2` of the step being solved (scales the patches' constant Hessian).
+    shape_slot: Vec<Vector>,
+    shape_grad: Vec<ShapeJacobian>,
+    /// `h^2` of the step being solved (scales the shape triangles' `M`).
     h2: Scalar,
     tri_slot: Vec<Vector>,
     diag_mass: Vec<Scalar>,
@@ -214,19 +216,23 @@ fn assemble(st: &mut Stepper, w: &World, h: Scalar) {
                 slot[k] = g[k] * (-h * hg.k * theta - *coef * gv);
             }
         });
-    // Patches: slot = h f - h^2 K v with f = -K x (the energy is quadratic).
+    // Shape triangles: slot = J^T (-h M theta - h^2 M J v).
     s.h2 = h * h;
-    s.patch_slot.resize(PATCH_MAX * el.patches.len(), Vector::ZERO);
-    s.patch_slot
-        .par_chunks_exact_mut(PATCH_MAX)
-        .zip(el.patches.par_iter())
-        .with_min_len(PAR_MIN / PATCH_MAX)
-        .for_each(|(slot, p)| {
-            let (hx, hv) = (p.second_derivatives(x), p.second_derivatives(v));
-            p.spread(
-                [0, 1, 2].map(|r| (hx[r] * h + hv[r] * (h * h)) * -p.c[r]),
-                slot,
-            );
+    let shapes = el.shape_triangles.len();
+    s.shape_slot.resize(SHAPE_SLOTS * shapes, Vector::ZERO);
+    s.shape_grad
+        .resize(shapes, [[Vector::ZERO; SHAPE_SLOTS]; 3]);
+    s.shape_slot
+        .par_chunks_exact_mut(SHAPE_SLOTS)
+        .zip(s.shape_grad.par_iter_mut())
+        .zip(el.shape_triangles.par_iter())
+        .with_min_len(PAR_MIN / SHAPE_SLOTS)
+        .for_each(|((slot, grad), t)| {
+            let (theta, jac) = t.angles(x);
+            let jv = rates(t, &jac, v);
+            let c = t.times_m([0, 1, 2].map(|a| -h * theta[a] - h * h * jv[a]));
+            spread(&jac, c, slot);
+            *grad = jac;
         });
     if let Some(wind) = &ext.wind {
         s.tri_slot.resize(w.mesh.triangles.len(), Vector::ZERO);
@@ -241,15 +247,16 @@ fn assemble(st: &mut Stepper, w: &World, h: Scalar) {
     s.b.resize(n, Vector::ZERO);
     s.diag_mass.resize(n, 0.0);
     s.inv_diag.resize(n, Vector::ZERO);
-    let (spring_slot, block, hinge_slot, hinge_grad, hinge_coef, tri_slot, patch_slot) = (
+    let (spring_slot, block, hinge_slot, hinge_grad, hinge_coef, tri_slot, shape_slot) = (
         &s.spring_slot,
         &s.block,
         &s.hinge_slot,
         &s.hinge_grad,
         &s.hinge_coef,
         &s.tri_slot,
-        &s.patch_slot,
+        &s.shape_slot,
     );
+    let shape_grad = &s.shape_grad;
     s.b.par_iter_mut()
         .zip(s.diag_mass.par_iter_mut().zip(s.inv_diag.par_iter_mut()))
         .enumerate()
@@ -270,10 +277,15 @@ fn assemble(st: &mut Stepper, w: &World, h: Scalar) {
                 let g = hinge_grad[k as usize];
                 diag += g * g * hinge_coef[k as usize / 4];
             }
-            for &k in el.patch_slots.of(i) {
-                rhs += patch_slot[k as usize];
-                let (p, slot) = (k as usize / PATCH_MAX, k as usize % PATCH_MAX);
-                diag += Vector::splat(h * h * el.patches[p].diagonal(slot));
+            for &k in el.shape_slots.of(i) {
+                rhs += shape_slot[k as usize];
+                let (t, slot) = (k as usize / SHAPE_SLOTS, k as usize % SHAPE_SLOTS);
+                let (m, jac) = (&el.shape_triangles[t].m, &shape_grad[t]);
+                for a in 0..3 {
+                    for b in 0..3 {
+                        diag += jac[a][slot] * jac[b][slot] * (h * h * m[a][b]);
+                    }
+                }
             }
             if ext.wind.is_some() {
                 for &t in el.vertex_triangles.of(i) {
@@ -338,18 +350,19 @@ fn apply_operator_rows(st: &mut Stepper, which: Which, held: &[bool], filtered: 
             }
         });
     let h2 = s.h2;
-    s.patch_slot
-        .par_chunks_exact_mut(PATCH_MAX)
-        .zip(el.patches.par_iter())
-        .with_min_len(PAR_MIN / PATCH_MAX)
-        .for_each(|(slot, p)| {
-            let hp = p.second_derivatives(input);
-            p.spread([0, 1, 2].map(|r| hp[r] * (h2 * p.c[r])), slot);
+    s.shape_slot
+        .par_chunks_exact_mut(SHAPE_SLOTS)
+        .zip(s.shape_grad.par_iter())
+        .zip(el.shape_triangles.par_iter())
+        .with_min_len(PAR_MIN / SHAPE_SLOTS)
+        .for_each(|((slot, jac), t)| {
+            let c = t.times_m(rates(t, jac, input));
+            spread(jac, c.map(|c| c * h2), slot);
         });
-    let (spring_slot, hinge_slot, patch_slot, diag_mass, filter) = (
+    let (spring_slot, hinge_slot, shape_slot, diag_mass, filter) = (
         &s.spring_slot,
         &s.hinge_slot,
-        &s.patch_slot,
+        &s.shape_slot,
         &s.diag_mass,
         &s.filter,
     );
@@ -372,8 +385,8 @@ fn apply_operator_rows(st: &mut Stepper, which: Which, held: &[bool], filtered: 
             for &k in el.hinge_slots.of(i) {
                 acc += hinge_slot[k as usize];
             }
-            for &k in el.patch_slots.of(i) {
-                acc += patch_slot[k as usize];
+            for &k in el.shape_slots.of(i) {
+                acc += shape_slot[k as usize];
             }
             *out = if filtered {
                 without(filter[i], acc)

@@ -8,16 +8,16 @@ pub mod bending;
 pub mod elements;
 pub mod explicit;
 pub mod forces;
-pub mod hessian;
 pub mod implicit;
 pub mod multirate;
 pub mod pins;
+pub mod shape;
 pub mod timestep;
 pub mod work;
 
 pub use elements::{Elements, Hinge, MaterialParams, Spring};
-pub use hessian::{BendPatch, PATCH_MAX};
 pub use forces::{Energy, ExternalForces, WindForce};
+pub use shape::{SHAPE_SLOTS, ShapeTriangle};
 
 use crate::math::{Scalar, Vector};
 use crate::scene::Integrator;
@@ -89,7 +89,11 @@ pub struct Stepper {
 impl Stepper {
     /// A stepper for `model` on the world's current mesh.
     pub fn new(model: Model, world: &World) -> Stepper {
-        let elements = Elements::build(&world.mesh, &model.material);
+        let elements = Elements::build_clamped(
+            &world.mesh,
+            &model.material,
+            &world.pins.clamped(world.mesh.vertex_count()),
+        );
         Stepper {
             model,
             elements,
@@ -108,7 +112,11 @@ impl Stepper {
 
     /// Rebuilds the force elements after the world's mesh changed.
     pub fn rebuild(&mut self, world: &World) {
-        self.elements = Elements::build(&world.mesh, &self.model.material);
+        self.elements = Elements::build_clamped(
+            &world.mesh,
+            &self.model.material,
+            &world.pins.clamped(world.mesh.vertex_count()),
+        );
         self.held.resize(world.mesh.vertex_count(), false);
         self.contacts.clear();
         self.contact_push.clear();

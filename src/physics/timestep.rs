@@ -87,11 +87,15 @@ fn gershgorin_rows(
             stiff[hg.v[k] as usize] += hg.k * g[k].length() * sum;
         }
     }
-    for p in &el.patches {
-        for r in 0..3 {
-            let sum: Scalar = p.w[r].iter().map(|w| w.abs()).sum();
-            for (k, &v) in p.vertices().iter().enumerate() {
-                stiff[v as usize] += p.c[r] * p.w[r][k].abs() * sum;
+    for t in &el.shape_triangles {
+        // Gershgorin bound of J^T M J at the flat rest state.
+        let (_, jac) = t.angles(&flat);
+        let row: [Scalar; 3] = [0, 1, 2].map(|a| jac[a].iter().map(|g| g.length()).sum());
+        for (k, v) in t.slots() {
+            for a in 0..3 {
+                for b in 0..3 {
+                    stiff[v as usize] += (t.m[a][b] * jac[a][k].length() * row[b]).abs();
+                }
             }
         }
     }

@@ -179,10 +179,11 @@ impl Material {
 #[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq, Default)]
 #[serde(rename_all = "snake_case")]
 pub enum BendingModel {
-    /// The Hessian energy `(B/2) |d^2 x/du^2|^2` on per-triangle quadratic-fit
-    /// patches: converges to the textile cantilever's rigidity on any mesh.
+    /// Per triangle, the curvature tensor from its three edge angles and the
+    /// plate energy `(B/2) A |S|^2`: a loaded strip follows the textile
+    /// cantilever's rigidity (the heavy elastica) at every resolution.
     #[default]
-    Hessian,
+    ShapeOperator,
     /// Discrete dihedral-angle hinges scaled so that an imposed cylinder has the
     /// right energy (loaded strips are about 20% too soft).
     Dihedral,

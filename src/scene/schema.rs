@@ -34,7 +34,7 @@ pub(crate) fn allowed(path: &str) -> Option<&'static str> {
             "a finite number > 0 (m), instead of `bending` (not both); needs non-zero gravity"
         }
         "material.damping" => "a finite number >= 0 (s)",
-        "material.bending_model" => "\"hessian\", \"dihedral\" or \"hinge_spring\"",
+        "material.bending_model" => "\"shape_operator\", \"dihedral\" or \"hinge_spring\"",
         "material.stiffness_rule" => "\"consistent\" or \"paper_a\"",
         "pin" => "an array of tables [[pin]]",
         "pin.region" => REGIONS,

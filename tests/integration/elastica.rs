@@ -39,9 +39,8 @@ pub fn heavy_elastica(lambda: Scalar) -> (Scalar, Scalar) {
         let mut y = [0.0, a, 0.0, 0.0];
         for i in 0..steps {
             let s = i as Scalar * h;
-            let add = |y: [Scalar; 4], k: [Scalar; 4], c: Scalar| {
-                [0, 1, 2, 3].map(|j| y[j] + c * k[j])
-            };
+            let add =
+                |y: [Scalar; 4], k: [Scalar; 4], c: Scalar| [0, 1, 2, 3].map(|j| y[j] + c * k[j]);
             let k1 = rhs(s, y);
             let k2 = rhs(s + h / 2.0, add(y, k1, h / 2.0));
             let k3 = rhs(s + h / 2.0, add(y, k2, h / 2.0));
@@ -64,7 +63,10 @@ pub fn heavy_elastica(lambda: Scalar) -> (Scalar, Scalar) {
         }
     }
     let (end_slope, drop, reach) = shoot(0.5 * (lo + hi));
-    assert!(end_slope.abs() < 1e-9, "shooting did not converge: {end_slope}");
+    assert!(
+        end_slope.abs() < 1e-9,
+        "shooting did not converge: {end_slope}"
+    );
     (drop, reach)
 }
 
@@ -104,13 +106,21 @@ fn strip_mesh(overhang: Scalar, res: u32) -> Mesh {
 fn settle_on(m: &Mesh, x: &mut [Vector], mat: &MaterialParams, overhang: Scalar) -> Settled {
     let (lo, hi) = m.material_bounds();
     let clamp = lo.x + overhang / 8.0;
-    let fixed: Vec<bool> = m.material.iter().map(|p| p.x <= clamp + 1e-9 * overhang).collect();
+    let fixed: Vec<bool> = m
+        .material
+        .iter()
+        .map(|p| p.x <= clamp + 1e-9 * overhang)
+        .collect();
     for (i, p) in m.material.iter().enumerate() {
         if fixed[i] {
             x[i] = p.extend(0.0);
         }
     }
-    let el = Elements::build(m, mat);
+    let clamp_pins: Vec<u32> = fixed
+        .iter()
+        .map(|&f| if f { 0 } else { u32::MAX })
+        .collect();
+    let el = Elements::build_clamped(m, mat, &clamp_pins);
     let ext = ExternalForces {
         gravity: Some(Vector::new(0.0, 0.0, -G)),
         ..Default::default()
@@ -183,7 +193,10 @@ fn heavy_elastica_reference() {
     // Small load: beam theory's lambda / 8; overhang of twice the bending length:
     // Peirce's 41.5 deg.
     let (drop, _) = heavy_elastica(1e-4);
-    println!("elastica lambda 1e-4: drop/L {drop:.6e}, beam theory {:.6e}", 1e-4 / 8.0);
+    println!(
+        "elastica lambda 1e-4: drop/L {drop:.6e}, beam theory {:.6e}",
+        1e-4 / 8.0
+    );
     assert!((drop / (1e-4 / 8.0) - 1.0).abs() < 1e-6);
     let (drop, reach) = heavy_elastica(8.0);
     let angle = drop.atan2(reach).to_degrees();
@@ -199,11 +212,12 @@ fn cantilever_chord_angle_matches_the_elastica() {
     let mut worst: Scalar = 0.0;
     let mut failures = Vec::new();
     for res in [Some(8), Some(16), Some(32), Some(64), None] {
-        let (angle, exact, verts) = large(BendingModel::Hessian, StiffnessRule::Consistent, res);
+        let (angle, exact, verts) =
+            large(BendingModel::ShapeOperator, StiffnessRule::Consistent, res);
         let err = angle - exact;
         let label = res.map_or("adaptive".to_string(), |r| format!("res {r}"));
         println!(
-            "hessian {label:>9}: chord angle {angle:.3} deg, elastica {exact:.3} deg, error {err:+.3} deg ({verts} vertices)"
+            "shape_operator {label:>9}: chord angle {angle:.3} deg, elastica {exact:.3} deg, error {err:+.3} deg ({verts} vertices)"
         );
         let allowed = if res == Some(8) { 3.0 } else { 1.5 };
         if err.abs() >= allowed {
@@ -211,7 +225,10 @@ fn cantilever_chord_angle_matches_the_elastica() {
         }
         worst = worst.max(err.abs());
     }
-    println!("worst error {worst:.3} deg; {:.1} s", t0.elapsed().as_secs_f64());
+    println!(
+        "worst error {worst:.3} deg; {:.1} s",
+        t0.elapsed().as_secs_f64()
+    );
     assert!(failures.is_empty(), "{failures:?}");
 }
 
@@ -225,11 +242,15 @@ fn cantilever_tip_deflection_matches_beam_theory() {
     println!("beam theory {beam:.6e} m, elastica {exact:.6e} m (lambda {lambda:.4})");
     let mut failures = Vec::new();
     for res in [8, 16, 32, 64] {
-        let mat = strip_material(bending, BendingModel::Hessian, StiffnessRule::Consistent);
+        let mat = strip_material(
+            bending,
+            BendingModel::ShapeOperator,
+            StiffnessRule::Consistent,
+        );
         let s = settle(overhang, res, &mat);
         let ratio = s.drop / beam;
         println!(
-            "hessian res {res:2}: tip drop {:.6e} m = {ratio:.4} x beam theory, {:.4} x elastica",
+            "shape_operator res {res:2}: tip drop {:.6e} m = {ratio:.4} x beam theory, {:.4} x elastica",
             s.drop,
             s.drop / exact
         );

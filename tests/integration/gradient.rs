@@ -17,7 +17,11 @@ fn place(p: drape::math::Vector2, i: usize) -> Vector {
     let rough = ((i * 7919 % 104729) as Scalar / 104729.0 - 0.5) * 2e-3;
     let (r, s) = (0.4, 1.03);
     let a = s * p.x / r;
-    Vector::new(r * a.sin(), 0.98 * p.y + 0.1 * p.x * p.y, r * (1.0 - a.cos()) + rough)
+    Vector::new(
+        r * a.sin(),
+        0.98 * p.y + 0.1 * p.x * p.y,
+        r * (1.0 - a.cos()) + rough,
+    )
 }
 
 /// A mesh adapted by red-green refinement around a bent fold.
@@ -56,10 +60,13 @@ fn total_force_is_minus_the_energy_gradient() {
         ("disk", mesh::disk(0.5, 9).unwrap()),
         ("adapted", adapted_mesh()),
     ];
-    assert!(meshes[2].1.levels.iter().any(|&l| l > 0), "mesh not adapted");
+    assert!(
+        meshes[2].1.levels.iter().any(|&l| l > 0),
+        "mesh not adapted"
+    );
     for (name, m) in &meshes {
         for model in [
-            BendingModel::Hessian,
+            BendingModel::ShapeOperator,
             BendingModel::Dihedral,
             BendingModel::HingeSpring,
         ] {
