@@ -95,12 +95,14 @@ pub fn elastica_chord_angle_deg(lambda: Scalar) -> Scalar {
 }
 
 /// The bending length over the overhang, `c / l = lambda^(-1/3)`, for which the
-/// exact elastica has chord angle `angle_deg` (NaN outside 1e-6..89 deg).
+/// exact elastica has chord angle `angle_deg`; NaN outside `c / l` from 0.1 to
+/// 100 (lambda 1e-6 to 1e3; beyond, the shooting loses accuracy).
 pub fn bending_length_ratio(angle_deg: Scalar) -> Scalar {
-    if !(1e-6..89.0).contains(&angle_deg) {
+    let (lo_l, hi_l): (Scalar, Scalar) = (1e-6, 1e3);
+    if !(elastica_chord_angle_deg(lo_l)..elastica_chord_angle_deg(hi_l)).contains(&angle_deg) {
         return Scalar::NAN;
     }
-    let (mut lo, mut hi) = ((1e-9 as Scalar).ln(), (1e6 as Scalar).ln());
+    let (mut lo, mut hi) = (lo_l.ln(), hi_l.ln());
     for _ in 0..80 {
         let mid = 0.5 * (lo + hi);
         if elastica_chord_angle_deg(mid.exp()) > angle_deg {

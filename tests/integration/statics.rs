@@ -167,7 +167,7 @@ pub fn solve(
         let mut f = forces(x, &mut scratch);
         for _ in 0..200 {
             residual = f.iter().map(|v| v.length()).fold(0.0, Scalar::max);
-            if residual <= 1e-9 * weight {
+            if residual <= 1e-7 * weight {
                 break;
             }
             iterations += 1;
@@ -225,7 +225,7 @@ pub fn solve(
             }
         }
     }
-    if residual > 1e-6 * weight {
+    if residual > 1e-5 * weight {
         return Err(format!(
             "no equilibrium: residual {residual:.3e} N vs weight per vertex {weight:.3e} N"
         ));
