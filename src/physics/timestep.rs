@@ -92,9 +92,9 @@ fn gershgorin_rows(
         let (_, jac) = t.angles(&flat);
         let row: [Scalar; 3] = [0, 1, 2].map(|a| jac[a].iter().map(|g| g.length()).sum());
         for (k, v) in t.slots() {
-            for a in 0..3 {
-                for b in 0..3 {
-                    stiff[v as usize] += (t.m[a][b] * jac[a][k].length() * row[b]).abs();
+            for (ma, ja) in t.m.iter().zip(&jac) {
+                for (mab, rb) in ma.iter().zip(&row) {
+                    stiff[v as usize] += (mab * ja[k].length() * rb).abs();
                 }
             }
         }

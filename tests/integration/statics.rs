@@ -71,16 +71,22 @@ impl Envelope {
     fn solve(&self, b: &mut [Scalar]) {
         let n = b.len();
         for i in 0..n {
-            let mut s = b[i];
-            for k in self.first[i]..i {
-                s -= self.at(i, k) * b[k];
-            }
+            let lo = self.first[i];
+            let row = &self.val[self.start[i]..self.start[i] + i - lo];
+            let s: Scalar = b[i]
+                - row
+                    .iter()
+                    .zip(&b[lo..i])
+                    .map(|(l, x)| l * x)
+                    .sum::<Scalar>();
             b[i] = s / self.at(i, i);
         }
         for i in (0..n).rev() {
             b[i] /= self.at(i, i);
-            for k in self.first[i]..i {
-                b[k] -= self.at(i, k) * b[i];
+            let (lo, bi) = (self.first[i], b[i]);
+            let row = &self.val[self.start[i]..self.start[i] + i - lo];
+            for (bk, l) in b[lo..i].iter_mut().zip(row) {
+                *bk -= l * bi;
             }
         }
     }
