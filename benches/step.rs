@@ -57,6 +57,7 @@ fn label(model: BendingModel) -> &'static str {
     match model {
         BendingModel::HingeSpring => "hinge_spring",
         BendingModel::Dihedral => "dihedral",
+        BendingModel::ShapeOperator => "shape_operator",
     }
 }
 
@@ -68,7 +69,11 @@ fn step_default_pool(c: &mut Criterion) {
         .measurement_time(Duration::from_secs(3))
         .sample_size(20);
     for resolution in [63u32, 256] {
-        for model in [BendingModel::HingeSpring, BendingModel::Dihedral] {
+        for model in [
+            BendingModel::HingeSpring,
+            BendingModel::Dihedral,
+            BendingModel::ShapeOperator,
+        ] {
             let (mut world, mut stepper, dt) = setup(resolution, model);
             let vertices = world.mesh.vertex_count() as u64;
             group.throughput(Throughput::Elements(vertices));

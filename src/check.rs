@@ -48,6 +48,14 @@ pub fn describe(scene: &Scene) -> Result<String, BuildError> {
     );
     if mat.bending > 0.0 {
         match mat.bending_model {
+            BendingModel::ShapeOperator => {
+                let _ = writeln!(
+                    s,
+                    "  bending: shape operator (curvature tensor per triangle from its edge angles), {} triangles, rigidity {} N m",
+                    el.shape_triangles.len(),
+                    mat.bending
+                );
+            }
             BendingModel::Dihedral => {
                 let _ = writeln!(
                     s,

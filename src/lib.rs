@@ -7,6 +7,7 @@
 
 pub mod adapt;
 pub mod bench;
+pub mod cantilever;
 pub mod check;
 pub mod collide;
 pub mod math;

@@ -391,6 +391,7 @@ fn run_in_pool(
         adapt: pipe.adapter.as_ref().map(|a| a.stats),
         collision: pipe.collision,
         cusick: pipe.collider.as_ref().and_then(|c| c.cusick(scene, &world)),
+        cantilever: crate::cantilever::for_run(scene, &world, &pipe.stepper.model.material),
         external_work: pipe.work(),
         excess_max: pipe.excess_max,
         energy_retries: pipe.energy_retries,

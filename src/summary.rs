@@ -137,6 +137,9 @@ pub struct Summary {
     /// Cusick drape measurements at the end, when the scene is a disk specimen on a
     /// vertical support cylinder (see `collide::cusick`).
     pub cusick: Option<crate::collide::cusick::CusickSummary>,
+    /// Cantilever bending test measurements at the end, when the scene is a
+    /// rectangle held by fixed pins over one end (see `cantilever`).
+    pub cantilever: Option<crate::cantilever::CantileverSummary>,
     /// True when Ctrl-C ended the run early.
     pub interrupted: bool,
     /// The recording, if one was written.
@@ -163,7 +166,7 @@ impl Summary {
             "{}: {} frames, {} steps of {:.3e} s to t = {:.3} s in {:.2} s wall ({:.2} s stepping, {:.2} s recording); \
              {:.0} vertices, {:.0} triangles; {:.3e} vertex-steps/s. Mass {:.6} -> {:.6} kg; \
              energy {:.4e} -> {:.4e} J (max {:.4e}; external work {:.3e} J; largest excess over initial + work {:.3e} J); \
-             {} recoveries (frame attempts retried with halved steps, {} for energy gain); {}.{}{} {}",
+             {} recoveries (frame attempts retried with halved steps, {} for energy gain); {}.{}{}{} {}",
             self.scene,
             self.frames,
             self.steps,
@@ -189,6 +192,18 @@ impl Summary {
                 Some(a) => format!(
                     " Adaptive: {} splits ({} forced), {} merges, {} rollbacks, max level {}.",
                     a.splits, a.closure_splits, a.merges, a.rollbacks, self.max_level
+                ),
+                None => String::new(),
+            },
+            match &self.cantilever {
+                Some(c) => format!(
+                    " Cantilever: overhang {:.4} m, chord angle {:.2} deg (elastica for the material: {:.2} deg), bending length {:.4} m (material {:.4} m; Peirce's formula {:.4} m).",
+                    c.overhang,
+                    c.chord_angle_deg,
+                    c.elastica_chord_angle_deg,
+                    c.bending_length,
+                    c.material_bending_length,
+                    c.bending_length_peirce
                 ),
                 None => String::new(),
             },

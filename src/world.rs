@@ -147,7 +147,7 @@ impl Model {
             material: MaterialParams {
                 density: m.density,
                 stretch: m.stretch,
-                bending: m.bending,
+                bending: m.rigidity(scene.simulation.gravity),
                 damping: m.damping,
                 bending_model: m.bending_model,
                 stiffness_rule: m.stiffness_rule,

@@ -39,6 +39,7 @@ use rayon::prelude::*;
 
 use super::elements::Elements;
 use super::forces::PAR_MIN;
+use super::shape::{ShapeJacobian, ShapeTriangle};
 use crate::math::{Matrix3, Scalar, Vector};
 
 /// One element term summed into a lower block.
@@ -50,6 +51,8 @@ enum Source {
     SpringCoupling(u32),
     /// `c_h g_k g_l^T` of hinge `h`, `k` and `l` its local vertices.
     Hinge { hinge: u32, k: u8, l: u8 },
+    /// `h^2 sum_ab M_ab J_ak J_bl^T` of shape triangle `tri`, slots `k` and `l`.
+    Shape { tri: u32, k: u8, l: u8 },
 }
 
 /// The per-element matrix terms of one implicit step, computed by the caller.
@@ -63,6 +66,26 @@ pub struct ElementBlocks<'a> {
     pub hinge_coefficients: &'a [Scalar],
     /// Per vertex: mass plus `h` times its drag coefficient, kg.
     pub diagonal_mass: &'a [Scalar],
+    /// The shape triangles (constant `M`) and, per triangle, the angle gradients.
+    pub shape_triangles: &'a [ShapeTriangle],
+    /// Per shape triangle: the gradients of its three angles.
+    pub shape_jacobians: &'a [ShapeJacobian],
+    /// `h^2`, the scale of the shape triangles' blocks.
+    pub h2: Scalar,
+}
+
+impl ElementBlocks<'_> {
+    /// Block `(k, l)` of shape triangle `tri`: `h^2 sum_ab M_ab J_ak J_bl^T`.
+    fn shape_block(&self, tri: usize, k: usize, l: usize) -> Matrix3 {
+        let (m, jac) = (&self.shape_triangles[tri].m, &self.shape_jacobians[tri]);
+        let mut out = Matrix3::ZERO;
+        for (a, row) in m.iter().enumerate() {
+            // sum_b M_ab J_bl
+            let right = jac[0][l] * row[0] + jac[1][l] * row[1] + jac[2][l] * row[2];
+            out += outer(jac[a][k], right);
+        }
+        out * self.h2
+    }
 }
 
 /// A fixed 3x3-block sparsity pattern for one mesh topology (module docs).
@@ -84,6 +107,12 @@ pub struct BlockPattern {
     /// dropped tip-tip coupling is compensated on this vertex's diagonal.
     compensation_start: Vec<u32>,
     compensation: Vec<u32>,
+    /// Per vertex, CSC-like: the shape-triangle blocks `(tri, k, l)` of row `i` that
+    /// the factorization drops; each is compensated by its Frobenius norm on the
+    /// diagonal (`[[s I, -B], [-B^T, s I]]` is positive semi-definite for
+    /// `s >= |B|`), so the factored matrix stays positive definite.
+    shape_dropped_start: Vec<u32>,
+    shape_dropped: Vec<(u32, u8, u8)>,
     /// Per block (lower blocks only; empty range for upper ones): its sources.
     source_start: Vec<u32>,
     sources: Vec<Source>,
@@ -112,6 +141,15 @@ impl BlockPattern {
                 for l in 0..4 {
                     if k != l {
                         pairs.push((hg.v[k], hg.v[l]));
+                    }
+                }
+            }
+        }
+        for t in &elements.shape_triangles {
+            for (k, i) in t.slots() {
+                for (l, j) in t.slots() {
+                    if k != l && i != j {
+                        pairs.push((i, j));
                     }
                 }
             }
@@ -158,6 +196,25 @@ impl BlockPattern {
             p.compensation_start[i + 1] += p.compensation_start[i];
         }
         p.compensation = tips.into_iter().map(|(_, k)| k).collect();
+        let mut dropped: Vec<(u32, (u32, u8, u8))> = Vec::new();
+        for (ti, t) in elements.shape_triangles.iter().enumerate() {
+            for (k, i) in t.slots() {
+                for (l, j) in t.slots() {
+                    if i != j && !p.factored[p.slot(i, j) as usize] {
+                        dropped.push((i, (ti as u32, k as u8, l as u8)));
+                    }
+                }
+            }
+        }
+        dropped.sort_by_key(|&(v, _)| v);
+        p.shape_dropped_start = vec![0; n + 1];
+        for &(v, _) in &dropped {
+            p.shape_dropped_start[v as usize + 1] += 1;
+        }
+        for i in 0..n {
+            p.shape_dropped_start[i + 1] += p.shape_dropped_start[i];
+        }
+        p.shape_dropped = dropped.into_iter().map(|(_, e)| e).collect();
         p.build_sources(elements);
         p.build_csc();
         p
@@ -202,6 +259,16 @@ impl BlockPattern {
                     if j <= i {
                         let hinge = h as u32;
                         tagged.push((self.slot(i, j), Source::Hinge { hinge, k, l }));
+                    }
+                }
+            }
+        }
+        for (ti, t) in elements.shape_triangles.iter().enumerate() {
+            for (k, i) in t.slots() {
+                for (l, j) in t.slots() {
+                    if j <= i {
+                        let (tri, k, l) = (ti as u32, k as u8, l as u8);
+                        tagged.push((self.slot(i, j), Source::Shape { tri, k, l }));
                     }
                 }
             }
@@ -298,6 +365,17 @@ impl BlockPattern {
                     let g = terms.hinge_gradients[k as usize];
                     m += outer(g, g) * terms.hinge_coefficients[k as usize / 4];
                 }
+                let range =
+                    self.shape_dropped_start[i] as usize..self.shape_dropped_start[i + 1] as usize;
+                let mut sigma = 0.0;
+                for &(tri, k, l) in &self.shape_dropped[range] {
+                    let b = terms.shape_block(tri as usize, k as usize, l as usize);
+                    sigma += (b.x_axis.length_squared()
+                        + b.y_axis.length_squared()
+                        + b.z_axis.length_squared())
+                    .sqrt();
+                }
+                m += Matrix3::from_diagonal(Vector::splat(sigma));
                 *out = match projection[i] {
                     None => m,
                     Some(n) if n == Vector::ZERO => Matrix3::ZERO,
@@ -336,6 +414,9 @@ impl BlockPattern {
                             let g = &terms.hinge_gradients[4 * hinge as usize..];
                             outer(g[k as usize], g[l as usize])
                                 * terms.hinge_coefficients[hinge as usize]
+                        }
+                        Source::Shape { tri, k, l } => {
+                            terms.shape_block(tri as usize, k as usize, l as usize)
                         }
                     };
                 }

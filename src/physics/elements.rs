@@ -25,7 +25,14 @@
 //!   edge with `k = B / d0^2` (d0 the rest distance of the tips, times 2^(n/2)
 //!   under `paper_a`). Its energy grows with theta^4, so no constant makes it
 //!   match a bending rigidity; the tests print how far it deviates.
+//! * Shape-operator bending (the default, [`super::shape`]): per triangle the
+//!   curvature tensor from its three edge angles, energy `(B/2) A_t |S_t|^2`, the
+//!   plate with Poisson ratio 0 whose beam rigidity is the textile cantilever's.
+//!   The dihedral hinges above are kept as `bending_model = "dihedral"`: they
+//!   reproduce a cylinder imposed on a grid, but a loaded strip is about 20% too
+//!   soft (see `shape.rs` for why and the numbers).
 
+use super::shape::{SHAPE_SLOTS, ShapeTriangle, build_shape_triangles};
 use crate::math::{Scalar, Vector2};
 use crate::mesh::Mesh;
 use crate::scene::{BendingModel, StiffnessRule};
@@ -115,19 +122,34 @@ pub struct Elements {
     pub springs: Vec<Spring>,
     /// Dihedral hinges (only with the dihedral model and non-zero rigidity).
     pub hinges: Vec<Hinge>,
+    /// Shape-operator bending elements, one per triangle (only with that model and
+    /// non-zero rigidity).
+    pub shape_triangles: Vec<ShapeTriangle>,
     /// Springs where the vertex is the first end (`v[0]`).
     pub spring_first: Incidence,
     /// Springs where the vertex is the second end (`v[1]`).
     pub spring_second: Incidence,
     /// Hinge slots `4 * hinge + k` where the vertex is `v[k]`.
     pub hinge_slots: Incidence,
+    /// Shape-triangle slots `SHAPE_SLOTS * element + k` where the vertex is `v[k]`
+    /// (used slots only).
+    pub shape_slots: Incidence,
     /// Triangles at each vertex (for per-triangle forces such as wind).
     pub vertex_triangles: Incidence,
 }
 
 impl Elements {
-    /// Builds masses, springs and hinges for `mesh` from the material.
+    /// Builds masses, springs and bending elements for `mesh` from the material,
+    /// with no clamp.
     pub fn build(mesh: &Mesh, mat: &MaterialParams) -> Elements {
+        Self::build_clamped(mesh, mat, &[])
+    }
+
+    /// As [`Elements::build`], with `clamped[i]` the pin that holds vertex i for
+    /// good, or `u32::MAX` (or an empty slice: no clamp). A triangle held by one
+    /// such pin cannot bend; the shape-operator model gives the bend at its edges
+    /// wholly to the free side (see `shape.rs`).
+    pub fn build_clamped(mesh: &Mesh, mat: &MaterialParams, clamped: &[u32]) -> Elements {
         let n = mesh.vertex_count();
         let area: Vec<Scalar> = (0..mesh.triangles.len())
             .map(|t| mesh.rest_area(t))
@@ -169,7 +191,13 @@ impl Elements {
             });
         }
         let mut hinges = Vec::new();
-        if mat.bending > 0.0 {
+        let shape_triangles =
+            if mat.bending > 0.0 && mat.bending_model == BendingModel::ShapeOperator {
+                build_shape_triangles(mesh, &area, mat.bending, clamped)
+            } else {
+                Vec::new()
+            };
+        if mat.bending > 0.0 && mat.bending_model != BendingModel::ShapeOperator {
             for (e, edge) in mesh
                 .edges
                 .iter()
@@ -191,6 +219,7 @@ impl Elements {
                         let k = mat.bending * len * len / (area[t0 as usize] + area[t1 as usize]);
                         hinges.push(Hinge { v: [a, b, p, q], k });
                     }
+                    BendingModel::ShapeOperator => unreachable!("built above"),
                     BendingModel::HingeSpring => {
                         let rest = material_distance(&mesh.material, p, q);
                         let k = mat.bending / (rest * rest) * level_factor(level);
@@ -225,6 +254,15 @@ impl Elements {
                 .enumerate()
                 .flat_map(|(h, hg)| (0..4).map(move |k| (hg.v[k], (4 * h + k) as u32))),
         );
+        let shape_pairs: Vec<(u32, u32)> = shape_triangles
+            .iter()
+            .enumerate()
+            .flat_map(|(p, st)| {
+                st.slots()
+                    .map(move |(k, v)| (v, (SHAPE_SLOTS * p + k) as u32))
+            })
+            .collect();
+        let shape_slots = Incidence::from_pairs(n, shape_pairs.iter().copied());
         let vertex_triangles = Incidence::from_pairs(
             n,
             mesh.triangles
@@ -237,9 +275,11 @@ impl Elements {
             vertex_area,
             springs,
             hinges,
+            shape_triangles,
             spring_first,
             spring_second,
             hinge_slots,
+            shape_slots,
             vertex_triangles,
         }
     }

@@ -6,12 +6,13 @@
 //!
 //! The result does not depend on the number of threads. A force the scene does not
 //! declare is not computed at all: absent wind means no triangle pass, zero
-//! bending means no hinges, no drag means no drag term.
+//! bending means no hinges or shape triangles, no drag means no drag term.
 
 use rayon::prelude::*;
 
 use super::bending::dihedral_angle_and_gradient;
 use super::elements::Elements;
+use super::shape::SHAPE_SLOTS;
 use crate::math::{Scalar, Vector, deterministic_sum};
 
 /// Element count below which a pass runs on one thread (splitting costs more).
@@ -48,6 +49,8 @@ pub struct ForceScratch {
     pub spring: Vec<Vector>,
     /// Force on each hinge vertex, 4 per hinge.
     pub hinge: Vec<Vector>,
+    /// Force on each shape triangle's slots, `SHAPE_SLOTS` per element.
+    pub shape: Vec<Vector>,
     /// A third of each triangle's wind force (the share of each of its vertices).
     pub triangle: Vec<Vector>,
 }
@@ -120,6 +123,15 @@ pub fn element_pass(
                 f[k] = g[k] * (-h.k * theta);
             }
         });
+    scratch
+        .shape
+        .resize(SHAPE_SLOTS * el.shape_triangles.len(), Vector::ZERO);
+    scratch
+        .shape
+        .par_chunks_exact_mut(SHAPE_SLOTS)
+        .with_min_len(PAR_MIN / SHAPE_SLOTS)
+        .zip(el.shape_triangles.par_iter())
+        .for_each(|(f, t)| t.forces(x, f));
     if let Some(wind) = &ext.wind {
         scratch.triangle.resize(triangles.len(), Vector::ZERO);
         scratch
@@ -152,6 +164,9 @@ pub fn gather(
     for &s in el.hinge_slots.of(i) {
         f += scratch.hinge[s as usize];
     }
+    for &s in el.shape_slots.of(i) {
+        f += scratch.shape[s as usize];
+    }
     if ext.wind.is_some() {
         for &t in el.vertex_triangles.of(i) {
             f += scratch.triangle[t as usize];
@@ -173,7 +188,7 @@ pub struct Energy {
     pub kinetic: Scalar,
     /// Gravitational potential energy (zero at the world origin).
     pub gravitational: Scalar,
-    /// Elastic energy of springs and hinges.
+    /// Elastic energy of springs, hinges and shape triangles.
     pub elastic: Scalar,
 }
 
@@ -201,9 +216,12 @@ pub fn energy(el: &Elements, ext: &ExternalForces, x: &[Vector], v: &[Vector]) -
         let (theta, _) = dihedral_angle_and_gradient(hg.v.map(|i| x[i as usize]));
         0.5 * hg.k * theta * theta
     });
+    let shape = deterministic_sum(el.shape_triangles.len(), |t| {
+        el.shape_triangles[t].energy(x)
+    });
     Energy {
         kinetic,
         gravitational,
-        elastic: stretch + bend,
+        elastic: stretch + bend + shape,
     }
 }

@@ -10,6 +10,9 @@
 //!   semi-definite; `D_e = c n n^T`. Both act on `p_a - p_b`.
 //! * Dihedral hinge with gradient `g` of its angle: Gauss-Newton `K_h = k g g^T`
 //!   (the curvature term of the exact Hessian is dropped; it is indefinite).
+//! * Shape triangle (`shape.rs`), energy `theta^T M theta / 2` over its three edge
+//!   angles with Jacobian `J` (rows: angle gradients): Gauss-Newton `K_t = J^T M J`
+//!   (constant `M`; the curvature term is dropped as for the hinges).
 //! * Wind is treated explicitly (only in `b`, evaluated at the start of the step).
 //!
 //! # Newton iterations
@@ -63,6 +66,7 @@ use rayon::prelude::*;
 
 use super::bending::dihedral_angle_and_gradient;
 use super::forces::{PAR_MIN, spring_force, wind_share};
+use super::shape::{SHAPE_SLOTS, ShapeJacobian, rates, spread};
 use super::{Contact, Stepper};
 use crate::math::{Matrix3, Scalar, Vector, deterministic_sum};
 use crate::scene::Solver;
@@ -112,6 +116,10 @@ pub struct ImplicitScratch {
     hinge_grad: Vec<Vector>,
     hinge_coef: Vec<Scalar>,
     hinge_slot: Vec<Vector>,
+    shape_slot: Vec<Vector>,
+    shape_grad: Vec<ShapeJacobian>,
+    /// `h^2` of the step being solved (scales the shape triangles' `M`).
+    h2: Scalar,
     tri_slot: Vec<Vector>,
     /// Per vertex: mass plus `h` times its drag coefficient.
     diag_mass: Vec<Scalar>,
@@ -324,6 +332,24 @@ fn assemble(st: &mut Stepper, w: &World, h: Scalar, newton: bool) {
                 slot[k] = g[k] * (-h * hg.k * theta - *coef * gv * k_term);
             }
         });
+    // Shape triangles: slot = J^T (-h M theta - h^2 M J v).
+    s.h2 = h * h;
+    let shapes = el.shape_triangles.len();
+    s.shape_slot.resize(SHAPE_SLOTS * shapes, Vector::ZERO);
+    s.shape_grad
+        .resize(shapes, [[Vector::ZERO; SHAPE_SLOTS]; 3]);
+    s.shape_slot
+        .par_chunks_exact_mut(SHAPE_SLOTS)
+        .zip(s.shape_grad.par_iter_mut())
+        .zip(el.shape_triangles.par_iter())
+        .with_min_len(PAR_MIN / SHAPE_SLOTS)
+        .for_each(|((slot, grad), t)| {
+            let (theta, jac) = t.angles(x);
+            let jv = rates(t, &jac, v);
+            let c = t.times_m([0, 1, 2].map(|a| -h * theta[a] - h * h * jv[a] * k_term));
+            spread(&jac, c, slot);
+            *grad = jac;
+        });
     // Wind is explicit: its force at the start of the step serves every Newton
     // iteration (re-evaluated at each iterate, without its derivative in `A`, the
     // iterations diverged on a flag at 10 ms steps).
@@ -340,7 +366,7 @@ fn assemble(st: &mut Stepper, w: &World, h: Scalar, newton: bool) {
     s.b.resize(n, Vector::ZERO);
     s.diag_mass.resize(n, 0.0);
     s.inv_diag.resize(n, Vector::ZERO);
-    let (spring_slot, block, hinge_slot, hinge_grad, hinge_coef, tri_slot, v0) = (
+    let (spring_slot, block, hinge_slot, hinge_grad, hinge_coef, tri_slot, v0, shape_slot) = (
         &s.spring_slot,
         &s.spring_block,
         &s.hinge_slot,
@@ -348,7 +374,9 @@ fn assemble(st: &mut Stepper, w: &World, h: Scalar, newton: bool) {
         &s.hinge_coef,
         &s.tri_slot,
         &s.v0,
+        &s.shape_slot,
     );
+    let shape_grad = &s.shape_grad;
     s.b.par_iter_mut()
         .zip(s.diag_mass.par_iter_mut().zip(s.inv_diag.par_iter_mut()))
         .enumerate()
@@ -368,6 +396,16 @@ fn assemble(st: &mut Stepper, w: &World, h: Scalar, newton: bool) {
                 rhs += hinge_slot[k as usize];
                 let g = hinge_grad[k as usize];
                 diag += g * g * hinge_coef[k as usize / 4];
+            }
+            for &k in el.shape_slots.of(i) {
+                rhs += shape_slot[k as usize];
+                let (t, slot) = (k as usize / SHAPE_SLOTS, k as usize % SHAPE_SLOTS);
+                let (m, jac) = (&el.shape_triangles[t].m, &shape_grad[t]);
+                for a in 0..3 {
+                    for b in 0..3 {
+                        diag += jac[a][slot] * jac[b][slot] * (h * h * m[a][b]);
+                    }
+                }
             }
             if ext.wind.is_some() {
                 for &t in el.vertex_triangles.of(i) {

@@ -13,6 +13,7 @@ pub mod forces;
 pub mod implicit;
 pub mod multirate;
 pub mod pins;
+pub mod shape;
 pub mod timestep;
 pub mod work;
 
@@ -20,6 +21,7 @@ pub use crate::scene::Solver;
 pub use elements::{Elements, Hinge, MaterialParams, Spring};
 pub use forces::{Energy, ExternalForces, WindForce};
 pub use implicit::SolveFailure;
+pub use shape::{SHAPE_SLOTS, ShapeTriangle};
 
 use crate::math::{Scalar, Vector};
 use crate::scene::Integrator;
@@ -163,7 +165,11 @@ pub struct Stepper {
 impl Stepper {
     /// A stepper for `model` on the world's current mesh.
     pub fn new(model: Model, world: &World) -> Stepper {
-        let elements = Elements::build(&world.mesh, &model.material);
+        let elements = Elements::build_clamped(
+            &world.mesh,
+            &model.material,
+            &world.pins.clamped(world.mesh.vertex_count()),
+        );
         Stepper {
             model,
             elements,
@@ -182,7 +188,11 @@ impl Stepper {
 
     /// Rebuilds the force elements after the world's mesh changed.
     pub fn rebuild(&mut self, world: &World) {
-        self.elements = Elements::build(&world.mesh, &self.model.material);
+        self.elements = Elements::build_clamped(
+            &world.mesh,
+            &self.model.material,
+            &world.pins.clamped(world.mesh.vertex_count()),
+        );
         self.held.resize(world.mesh.vertex_count(), false);
         self.contacts.clear();
         self.contact_push.clear();

@@ -20,7 +20,7 @@
 //! symplectic Euler exactly. (Holding the other levels still instead was tried
 //! first and is unstable at the level interfaces.)
 //!
-//! A kick computes only the springs, hinges and wind triangles that touch the
+//! A kick computes only the springs, hinges, shape triangles and wind triangles that touch the
 //! level's vertices. Element forces are computed in parallel and written back
 //! in a fixed order, so results do not depend on the thread count.
 
@@ -30,6 +30,7 @@ use super::Stepper;
 use super::bending::dihedral_angle_and_gradient;
 use super::elements::Elements;
 use super::forces::{ForceScratch, gather, spring_force, wind_share};
+use super::shape::SHAPE_SLOTS;
 use super::timestep::{SAFETY, vertex_limits};
 use crate::math::{Scalar, Vector};
 use crate::mesh::Mesh;
@@ -43,6 +44,7 @@ struct Group {
     vertices: Vec<u32>,
     springs: Vec<u32>,
     hinges: Vec<u32>,
+    shape: Vec<u32>,
     triangles: Vec<u32>,
     /// Vertices of other levels that the group's elements touch.
     halo: Vec<u32>,
@@ -98,6 +100,14 @@ impl Levels {
                 |g| &mut g.hinges,
             );
         }
+        for (p, st) in el.shape_triangles.iter().enumerate() {
+            touch(
+                &mut groups,
+                st.slots().map(|(_, v)| mark[v as usize]),
+                p as u32,
+                |g| &mut g.shape,
+            );
+        }
         for (t, tri) in mesh.triangles.iter().enumerate() {
             touch(
                 &mut groups,
@@ -112,6 +122,11 @@ impl Levels {
                 .iter()
                 .flat_map(|&s| el.springs[s as usize].v)
                 .chain(g.hinges.iter().flat_map(|&h| el.hinges[h as usize].v))
+                .chain(
+                    g.shape
+                        .iter()
+                        .flat_map(|&p| el.shape_triangles[p as usize].slots().map(|(_, v)| v)),
+                )
                 .chain(g.triangles.iter().flat_map(|&t| mesh.triangles[t as usize]))
                 .filter(|&v| mark[v as usize] != g.level as usize)
                 .collect();
@@ -151,12 +166,12 @@ fn touch(
     e: u32,
     list: impl Fn(&mut Group) -> &mut Vec<u32>,
 ) {
-    let mut seen: [usize; 4] = [usize::MAX; 4];
+    let mut seen: [usize; SHAPE_SLOTS] = [usize::MAX; SHAPE_SLOTS];
     for (k, l) in levels.enumerate() {
-        if l != usize::MAX && !seen[..k.min(4)].contains(&l) {
+        if l != usize::MAX && !seen[..k.min(SHAPE_SLOTS)].contains(&l) {
             list(&mut groups[l]).push(e);
         }
-        if k < 4 {
+        if k < SHAPE_SLOTS {
             seen[k] = l;
         }
     }
@@ -179,6 +194,10 @@ pub fn symplectic_multirate(st: &mut Stepper, w: &mut World, big: Scalar) {
     scratch
         .hinge
         .resize(4 * st.elements.hinges.len(), Vector::ZERO);
+    scratch.shape.resize(
+        SHAPE_SLOTS * st.elements.shape_triangles.len(),
+        Vector::ZERO,
+    );
     if st.model.external.wind.is_some() {
         scratch
             .triangle
@@ -273,6 +292,19 @@ fn level_forces(
     for (&h, f) in g.hinges.iter().zip(hinges) {
         scratch.hinge[4 * h as usize..4 * h as usize + 4].copy_from_slice(&f);
     }
+    let shape: Vec<[Vector; SHAPE_SLOTS]> = g
+        .shape
+        .par_iter()
+        .with_min_len(128)
+        .map(|&p| {
+            let mut f = [Vector::ZERO; SHAPE_SLOTS];
+            el.shape_triangles[p as usize].forces(x, &mut f);
+            f
+        })
+        .collect();
+    for (&p, f) in g.shape.iter().zip(shape) {
+        scratch.shape[SHAPE_SLOTS * p as usize..SHAPE_SLOTS * (p as usize + 1)].copy_from_slice(&f);
+    }
     if let Some(wind) = &ext.wind {
         for &t in &g.triangles {
             let tri = triangles[t as usize];
@@ -324,6 +356,10 @@ pub fn rk4_multirate(st: &mut Stepper, w: &mut World, big: Scalar) {
     scratch
         .hinge
         .resize(4 * st.elements.hinges.len(), Vector::ZERO);
+    scratch.shape.resize(
+        SHAPE_SLOTS * st.elements.shape_triangles.len(),
+        Vector::ZERO,
+    );
     if st.model.external.wind.is_some() {
         scratch
             .triangle

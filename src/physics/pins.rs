@@ -146,6 +146,18 @@ impl Pins {
         Ok(Pins { scripts, anchors })
     }
 
+    /// Per vertex: the pin that holds it for good (never lets go), or
+    /// `u32::MAX`. Vertices of one such pin move rigidly for the whole run.
+    pub fn clamped(&self, vertices: usize) -> Vec<u32> {
+        let mut out = vec![u32::MAX; vertices];
+        for a in &self.anchors {
+            if self.scripts[a.pin as usize].release_time.is_none() {
+                out[a.vertex as usize] = a.pin;
+            }
+        }
+        out
+    }
+
     /// Marks in `held` (one flag per vertex) the vertices pinned at time `t`.
     pub fn held_at(&self, t: Scalar, held: &mut [bool]) {
         held.fill(false);

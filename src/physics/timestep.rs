@@ -87,6 +87,18 @@ fn gershgorin_rows(
             stiff[hg.v[k] as usize] += hg.k * g[k].length() * sum;
         }
     }
+    for t in &el.shape_triangles {
+        // Gershgorin bound of J^T M J at the flat rest state.
+        let (_, jac) = t.angles(&flat);
+        let row: [Scalar; 3] = [0, 1, 2].map(|a| jac[a].iter().map(|g| g.length()).sum());
+        for (k, v) in t.slots() {
+            for (ma, ja) in t.m.iter().zip(&jac) {
+                for (mab, rb) in ma.iter().zip(&row) {
+                    stiff[v as usize] += (mab * ja[k].length() * rb).abs();
+                }
+            }
+        }
+    }
     for i in 0..n {
         stiff[i] /= el.mass[i];
         damp[i] = (damp[i] + drag_per_area * el.vertex_area[i]) / el.mass[i];

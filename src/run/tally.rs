@@ -37,6 +37,7 @@ pub(super) struct TallyEnd<'a> {
     pub(super) adapt: Option<AdaptStats>,
     pub(super) collision: CollisionStats,
     pub(super) cusick: Option<crate::collide::cusick::CusickSummary>,
+    pub(super) cantilever: Option<crate::cantilever::CantileverSummary>,
     pub(super) external_work: Scalar,
     pub(super) excess_max: Scalar,
     pub(super) energy_retries: u64,
@@ -109,6 +110,7 @@ impl Tally {
             collision_wall_s: end.collision.collision_wall_s,
             self_collision_wall_s: end.collision.self_collision_wall_s,
             cusick: end.cusick,
+            cantilever: end.cantilever,
             recording: end.recording.map(|(path, bytes, frames)| RecordingSummary {
                 path,
                 bytes,

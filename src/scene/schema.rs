@@ -34,8 +34,11 @@ pub(crate) fn allowed(path: &str) -> Option<&'static str> {
         "material.density" => "a finite number > 0 (kg/m^2)",
         "material.stretch" => "a finite number > 0 (N/m)",
         "material.bending" => "a finite number >= 0 (N m)",
+        "material.bending_length" => {
+            "a finite number > 0 (m), instead of `bending` (not both); needs non-zero gravity"
+        }
         "material.damping" => "a finite number >= 0 (s)",
-        "material.bending_model" => "\"dihedral\" or \"hinge_spring\"",
+        "material.bending_model" => "\"shape_operator\", \"dihedral\" or \"hinge_spring\"",
         "material.stiffness_rule" => "\"consistent\" or \"paper_a\"",
         "pin" => "an array of tables [[pin]]",
         "pin.region" => REGIONS,

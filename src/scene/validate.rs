@@ -18,7 +18,11 @@ pub(crate) fn validate(scene: &Scene, doc: &Table) -> Result<(), Issue> {
     name(&scene.name)?;
     simulation(&scene.simulation)?;
     cloth(&scene.cloth, section(doc, "cloth"))?;
-    material(&scene.material)?;
+    material(
+        &scene.material,
+        section(doc, "material"),
+        scene.simulation.gravity,
+    )?;
     let pins = doc.get("pin").and_then(Value::as_array);
     for (i, pin) in scene.pin.iter().enumerate() {
         let written = pins.and_then(|a| a.get(i)).and_then(Value::as_table);
@@ -255,11 +259,32 @@ fn cloth(c: &Cloth, written: Option<&Table>) -> Result<(), Issue> {
     all_finite(at("rotation"), &c.rotation)
 }
 
-fn material(m: &Material) -> Result<(), Issue> {
+fn material(m: &Material, written: Option<&Table>, gravity: [f64; 3]) -> Result<(), Issue> {
     let at = |k: &str| keys(&["material", k]);
     positive(at("density"), m.density)?;
     positive(at("stretch"), m.stretch)?;
     non_negative(at("bending"), m.bending)?;
+    if let Some(c) = m.bending_length {
+        if written.is_some_and(|t| t.contains_key("bending")) {
+            return Err(Issue::new(
+                at("bending_length"),
+                Kind::NotApplicable,
+                "`bending_length` and `bending` both given: they set the same rigidity",
+            )
+            .allowed("exactly one of `bending` (N m) and `bending_length` (m)")
+            .because(at("bending")));
+        }
+        positive(at("bending_length"), c)?;
+        if gravity.iter().all(|&g| g == 0.0) {
+            return Err(Issue::new(
+                at("bending_length"),
+                Kind::NotApplicable,
+                "`bending_length` needs gravity to convert to a rigidity (B = density |g| c^3), and gravity is zero",
+            )
+            .allowed("`bending` (N m) in a scene without gravity")
+            .because(keys(&["simulation", "gravity"])));
+        }
+    }
     non_negative(at("damping"), m.damping)
 }
 

@@ -220,6 +220,7 @@ fn cylinder_energy_ratio(res: u32, model_kind: BendingModel, r: Scalar) -> Scala
     let el = Elements::build(&m, &mat);
     let stretch_springs = m.edges.len();
     let energy: Scalar = match model_kind {
+        BendingModel::ShapeOperator => el.shape_triangles.iter().map(|t| t.energy(&x)).sum(),
         BendingModel::Dihedral => el
             .hinges
             .iter()
@@ -260,6 +261,26 @@ fn bending_energy_on_a_cylinder_is_mesh_independent() {
         if res >= 32 {
             assert!((ratio - 1.0).abs() < 0.05, "res {res}: {ratio}");
         }
+    }
+}
+
+#[test]
+fn shape_operator_energy_on_a_cylinder_is_mesh_independent() {
+    // Each triangle's curvature tensor comes from the angles of its interior
+    // edges, so the triangles along the two free edges parallel to the axis miss
+    // the angle across their boundary edge: the same (1 - 1/rows) as the hinges.
+    let r = 0.5;
+    for res in [8u32, 16, 32, 64] {
+        let ratio = cylinder_energy_ratio(res, BendingModel::ShapeOperator, r);
+        let interior_share = 1.0 - 1.0 / res as Scalar;
+        println!(
+            "cylinder R={r}: res {res:2}: shape_operator E / (B A / 2R^2) = {ratio:.5} ({:+.3}%; interior-only expectation {interior_share:.5})",
+            100.0 * (ratio - 1.0)
+        );
+        assert!(
+            (ratio / interior_share - 1.0).abs() < 0.01,
+            "res {res}: {ratio} vs {interior_share}"
+        );
     }
 }
 

@@ -695,3 +695,35 @@ fn every_shipped_scene_file_is_valid() {
         dir.display()
     );
 }
+
+#[test]
+fn bending_length_is_an_alternative_to_bending() {
+    let with = |extra: &str| edit("stretch = 200.0\n", &format!("stretch = 200.0\n{extra}"));
+    // Converted with the density and |gravity| (the default 9.81 m/s^2).
+    let scene = load_scene_str(&with("bending_length = 0.02\n"), "test.toml", &[]).unwrap();
+    let b = scene.material.rigidity(scene.simulation.gravity);
+    println!("bending_length 0.02 m -> rigidity {b:.6e} N m");
+    assert!((b - 0.15 * 9.81 * 0.02f64.powi(3)).abs() < 1e-15, "{b}");
+    // Both given: located at bending_length, caused by bending.
+    let e = error_at(
+        &with("bending = 1e-5\nbending_length = 0.02\n"),
+        13,
+        "material.bending_length",
+        Kind::NotApplicable,
+    );
+    assert!(e.to_string().contains("material.bending"), "{e}");
+    error_at(
+        &with("bending_length = 0.0\n"),
+        12,
+        "material.bending_length",
+        Kind::OutOfRange,
+    );
+    // Without gravity it cannot be converted.
+    let text = with("bending_length = 0.02\n").replacen(
+        "duration = 1.0\n",
+        "duration = 1.0\ngravity = [0.0, 0.0, 0.0]\n",
+        1,
+    );
+    let e = error_at(&text, 13, "material.bending_length", Kind::NotApplicable);
+    assert!(e.to_string().contains("gravity"), "{e}");
+}

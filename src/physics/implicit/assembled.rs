@@ -106,6 +106,9 @@ pub(super) fn solve(
         hinge_gradients: &s.hinge_grad,
         hinge_coefficients: &s.hinge_coef,
         diagonal_mass: &s.diag_mass,
+        shape_triangles: &st.elements.shape_triangles,
+        shape_jacobians: &s.shape_grad,
+        h2: s.h2,
     };
     let a = &mut s.assembled;
     pattern.gather(&terms, &mut a.raw);
@@ -115,6 +118,9 @@ pub(super) fn solve(
         hinge_gradients: &s.hinge_grad,
         hinge_coefficients: &s.hinge_coef,
         diagonal_mass: &s.diag_mass,
+        shape_triangles: &st.elements.shape_triangles,
+        shape_jacobians: &s.shape_grad,
+        h2: s.h2,
     };
     pattern.compensation(
         &terms,

@@ -12,6 +12,7 @@ use super::{SolveFailure, without};
 use crate::math::{Scalar, Vector, deterministic_sum, deterministic_sum2};
 use crate::physics::Stepper;
 use crate::physics::forces::PAR_MIN;
+use crate::physics::shape::{SHAPE_SLOTS, rates, spread};
 
 /// Vectors of the iteration, kept between steps.
 #[derive(Debug, Default, Clone)]
@@ -149,8 +150,23 @@ fn apply_operator(st: &mut Stepper, which: Which, held: &[bool], filtered: bool)
                 slot[k] = g[k] * (coef * gp);
             }
         });
-    let (spring_slot, hinge_slot, diag_mass, filter) =
-        (&s.spring_slot, &s.hinge_slot, &s.diag_mass, &s.filter);
+    let h2 = s.h2;
+    s.shape_slot
+        .par_chunks_exact_mut(SHAPE_SLOTS)
+        .zip(s.shape_grad.par_iter())
+        .zip(el.shape_triangles.par_iter())
+        .with_min_len(PAR_MIN / SHAPE_SLOTS)
+        .for_each(|((slot, jac), t)| {
+            let c = t.times_m(rates(t, jac, input));
+            spread(jac, c.map(|c| c * h2), slot);
+        });
+    let (spring_slot, hinge_slot, shape_slot, diag_mass, filter) = (
+        &s.spring_slot,
+        &s.hinge_slot,
+        &s.shape_slot,
+        &s.diag_mass,
+        &s.filter,
+    );
     s.cg.ap
         .par_iter_mut()
         .enumerate()
@@ -170,6 +186,9 @@ fn apply_operator(st: &mut Stepper, which: Which, held: &[bool], filtered: bool)
             }
             for &k in el.hinge_slots.of(i) {
                 acc += hinge_slot[k as usize];
+            }
+            for &k in el.shape_slots.of(i) {
+                acc += shape_slot[k as usize];
             }
             *out = if filtered {
                 without(filter[i], acc)
