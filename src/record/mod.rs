@@ -48,9 +48,10 @@ pub mod obj;
 mod report;
 mod sink;
 
-use rerun::{AsComponents, EntityPath, RecordingStream, RecordingStreamBuilder};
 use std::collections::HashMap;
 use std::path::Path;
+
+use rerun::{AsComponents, EntityPath, RecordingStream, RecordingStreamBuilder};
 
 use crate::math::Vector;
 pub use edges::EdgeDisplay;
@@ -253,9 +254,9 @@ impl Recorder {
 
     /// Logs one frame: sets the `frame` and `sim_time` timelines, then logs the mesh at
     /// `cloth/mesh` (positions and normals; the topology, colours, class ids and
-    /// `triangle_level` data too when the triangles or levels changed), the edges at `cloth/edges` (unless [`EdgeDisplay::Off`]), the
-    /// pinned vertices at `cloth/pins`, the events at `events/points` and `events/log`, and each
-    /// scalar at `plots/<name>`.
+    /// `triangle_level` data too when the triangles or levels changed), the edges at
+    /// `cloth/edges` (unless [`EdgeDisplay::Off`]), the pinned vertices at `cloth/pins`, the
+    /// events at `events/points` and `events/log`, and each scalar at `plots/<name>`.
     ///
     /// The data is validated first ([`RecordError::InvalidFrame`] on a length mismatch, an
     /// index out of range or a non-finite `sim_time`); nothing is logged for an invalid frame
