@@ -7,7 +7,7 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use anyhow::{Context, Result};
-use clap::{Args, Parser, Subcommand};
+use clap::{Args, Parser, Subcommand, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use drape::record::inspect::inspect;
@@ -138,11 +138,16 @@ struct RunArgs {
     #[arg(long, value_name = "K", default_value_t = 1,
           value_parser = clap::value_parser!(u64).range(1..))]
     record_every: u64,
+    /// Which edges `cloth/edges` holds: `review` (default) the edges above the scene's
+    /// coarsen threshold (1.5 deg without adaptivity), `all` every edge.
+    #[arg(long, value_enum, value_name = "WHICH", default_value_t = EdgeChoice::Review)]
+    edges: EdgeChoice,
     /// Leave out `cloth/edges` (the per-edge dihedral angles).
-    #[arg(long, conflicts_with = "edge_threshold")]
+    #[arg(long, conflicts_with_all = ["edge_threshold", "edges"])]
     no_edges: bool,
-    /// Record only the edges whose dihedral angle is above DEG degrees (default: every edge).
-    #[arg(long, value_name = "DEG", value_parser = non_negative_degrees)]
+    /// Record only the edges whose dihedral angle is above DEG degrees (instead of --edges).
+    #[arg(long, value_name = "DEG", value_parser = non_negative_degrees,
+          conflicts_with = "edges")]
     edge_threshold: Option<f64>,
     /// Also start a Rerun viewer (`rerun` 0.36.3 on PATH) and stream the run to it live.
     #[arg(long, conflicts_with = "connect")]
@@ -197,6 +202,15 @@ fn load(args: &SceneArgs) -> Result<Scene> {
         Some(path) => load_scene_file(path, &args.overrides)?,
         None => default_scene(&args.overrides)?,
     })
+}
+
+/// The values of `--edges`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum EdgeChoice {
+    /// The edges above the scene's coarsen threshold.
+    Review,
+    /// Every edge.
+    All,
 }
 
 fn cmd_check(args: SceneArgs) -> Result<ExitCode> {
@@ -286,10 +300,11 @@ fn cmd_run(args: RunArgs) -> Result<ExitCode> {
             args.connect.clone().map(LiveViewer::Connect)
         },
         record_every: args.record_every,
-        edges: match (args.no_edges, args.edge_threshold) {
-            (true, _) => EdgeDisplay::Off,
-            (false, Some(deg)) => EdgeDisplay::Above(deg),
-            (false, None) => EdgeDisplay::All,
+        edges: match (args.no_edges, args.edge_threshold, args.edges) {
+            (true, _, _) => EdgeDisplay::Off,
+            (false, Some(deg), _) => EdgeDisplay::Above(deg),
+            (false, None, EdgeChoice::Review) => EdgeDisplay::Review,
+            (false, None, EdgeChoice::All) => EdgeDisplay::All,
         },
     };
     // Build the cloth and the obstacles once before any output is opened: a bad

@@ -87,7 +87,8 @@ pub struct RunOptions {
     /// Frame 0 and the last frame are always recorded, and so is the last good frame of a run
     /// stopped early; events of the frames left out go with the next recorded frame.
     pub record_every: u64,
-    /// Which edges `cloth/edges` shows.
+    /// Which edges `cloth/edges` shows; [`EdgeDisplay::Review`] (the default) is resolved
+    /// against the scene's coarsen threshold.
     pub edges: EdgeDisplay,
 }
 
@@ -220,7 +221,12 @@ fn run_in_pool(
                 file: file.clone(),
                 live: live.clone(),
             };
-            Some(Recorder::open(&target, &scene.name, opts.edges)?)
+            let coarsen = scene.adapt.as_ref().map(|a| a.coarsen_angle);
+            Some(Recorder::open(
+                &target,
+                &scene.name,
+                opts.edges.resolve(coarsen),
+            )?)
         }
     };
     let every = opts.record_every.max(1);

@@ -13,12 +13,34 @@ use crate::math::Vector;
 pub enum EdgeDisplay {
     /// No `cloth/edges` entity at all.
     Off,
-    /// Every edge of the mesh, boundary edges (angle 0) included.
+    /// The edges a reviewer needs to follow refinement decisions: those strictly above the
+    /// scene's coarsen threshold (every edge that can trigger or block a refinement or keep
+    /// a region from coarsening); see [`EdgeDisplay::resolve`]. Left out: the edges at or
+    /// below it (flat hinges and boundary edges), which only ever allow coarsening.
     #[default]
+    Review,
+    /// Every edge of the mesh, boundary edges (angle 0) included.
     All,
     /// Only the edges whose angle is strictly above this many degrees (the others are left
     /// out of the frame's data too).
     Above(f64),
+}
+
+/// The threshold [`EdgeDisplay::Review`] uses for a scene without adaptivity (or when it
+/// was not resolved): the default coarsen threshold of the scene files, paper B's
+/// beta_min = 1.5 deg.
+pub const REVIEW_DEFAULT_DEG: f64 = 1.5;
+
+impl EdgeDisplay {
+    /// [`EdgeDisplay::Review`] as the threshold it stands for: `Above(coarsen_angle)` for an
+    /// adaptive scene, `Above(`[`REVIEW_DEFAULT_DEG`]`)` without adaptivity (`None`); every
+    /// other choice is returned as it is.
+    pub fn resolve(self, coarsen_angle: Option<f64>) -> EdgeDisplay {
+        match self {
+            EdgeDisplay::Review => EdgeDisplay::Above(coarsen_angle.unwrap_or(REVIEW_DEFAULT_DEG)),
+            other => other,
+        }
+    }
 }
 
 /// Angle (degrees) at which the colour scale saturates; larger angles get the last colour.
@@ -72,6 +94,7 @@ fn kept(display: EdgeDisplay, angles: &[f64]) -> Vec<usize> {
     match display {
         EdgeDisplay::Off => Vec::new(),
         EdgeDisplay::All => (0..angles.len()).collect(),
+        EdgeDisplay::Review => kept(EdgeDisplay::Review.resolve(None), angles),
         EdgeDisplay::Above(t) => (0..angles.len()).filter(|&i| angles[i] > t).collect(),
     }
 }
@@ -134,5 +157,11 @@ mod tests {
         assert_eq!(kept(EdgeDisplay::Above(5.0), &angles), vec![2, 3]);
         assert_eq!(kept(EdgeDisplay::All, &angles).len(), 4);
         assert!(kept(EdgeDisplay::Off, &angles).is_empty());
+        assert_eq!(kept(EdgeDisplay::Review, &angles), vec![1, 2, 3]);
+        assert_eq!(
+            EdgeDisplay::Review.resolve(Some(5.0)),
+            EdgeDisplay::Above(5.0)
+        );
+        assert_eq!(EdgeDisplay::All.resolve(Some(5.0)), EdgeDisplay::All);
     }
 }

@@ -77,10 +77,13 @@ pub struct FrameInfo {
     pub sim_time: Option<f64>,
     /// Rows of `cloth/mesh` at this frame (1 in a drape recording).
     pub mesh_rows: usize,
-    /// Triangles of the mesh (its un-shared vertex positions / 3).
+    /// Triangles of the mesh (its `triangle_indices`, the latest at or before the frame).
     pub triangles: Option<usize>,
-    /// The `triangle_level` values of the mesh (one per triangle).
+    /// The `triangle_level` values of the mesh (one per triangle; the latest at or before the
+    /// frame).
     pub levels: Vec<u8>,
+    /// Whether this frame logged the mesh's topology (it changed since the previous one).
+    pub topology: bool,
     /// Segments at `cloth/edges`.
     pub edges: Option<usize>,
     /// Largest `dihedral_angle_deg` at `cloth/edges`, degrees.
@@ -182,6 +185,7 @@ pub fn inspect(path: &Path) -> Result<Inspection, InspectError> {
             gather(&mut out, &chunk);
         }
     }
+    carry_topology(&mut out);
     Ok(out)
 }
 
@@ -231,8 +235,9 @@ fn gather(out: &mut Inspection, chunk: &Chunk) {
         };
         if entity == ENTITY_MESH {
             info.mesh_rows += 1;
-            if let Some(p) = cell("vertex_positions") {
-                info.triangles = Some(p.len() / 3);
+            if let Some(t) = cell("triangle_indices") {
+                info.triangles = Some(t.len());
+                info.topology = true;
             }
             if let Some(l) = cell(LEVEL_COMPONENT)
                 && let Some(l) = l.as_primitive_opt::<UInt8Type>()
@@ -261,6 +266,22 @@ fn gather(out: &mut Inspection, chunk: &Chunk) {
             && let Some(&v) = v.values().first()
         {
             info.scalars.insert(name.to_owned(), v);
+        }
+    }
+}
+
+/// Rerun shows the latest value of each component: a frame that did not log the mesh's
+/// topology has the triangles and levels of the last frame before it that did.
+fn carry_topology(out: &mut Inspection) {
+    let mut last: Option<(usize, Vec<u8>)> = None;
+    for info in out.frames.values_mut() {
+        match (&info.triangles, &last) {
+            (Some(t), _) => last = Some((*t, info.levels.clone())),
+            (None, Some((t, levels))) if info.mesh_rows > 0 => {
+                info.triangles = Some(*t);
+                info.levels.clone_from(levels);
+            }
+            _ => {}
         }
     }
 }

@@ -10,14 +10,16 @@
 //!   (rerun's wall-clock `log_time` timeline is turned off);
 //! - static data: view coordinates at `/` (right-handed, z up) and an annotation context at
 //!   `cloth` that names and colours the refinement levels (`level 0`, `level 1`, ...);
-//! - `cloth/mesh` every frame: a `Mesh3D` whose vertices are un-shared (three per triangle, in
-//!   triangle order, no index buffer) so that each triangle carries its own colour from
-//!   [`LEVEL_PALETTE`], with per-vertex normals, the level as class id (legend), and the level
-//!   once per triangle as data (`triangle_level`, `u8`);
+//! - `cloth/mesh`: a `Mesh3D` with shared vertices, copied only where triangles of different
+//!   levels meet so that each triangle shows its level's colour from [`LEVEL_PALETTE`]; the
+//!   positions and normals every frame, the triangle indices, vertex colours, class ids
+//!   (legend) and the data `triangle_level` (`u8` per triangle) and `duplicate_of` only on
+//!   frames where the topology changed (`mesh.rs`; [`decode::cloth_mesh_at`] reads a frame
+//!   back);
 //! - `cloth/edges` every frame unless turned off: the edges as line segments coloured by their
 //!   dihedral angle ([`edges::angle_rgb`]), with the angle (`dihedral_angle_deg`) and the vertex
-//!   pair (`edge_vertices`) of each segment as data; all edges or only those above a threshold
-//!   ([`EdgeDisplay`]);
+//!   pair (`edge_vertices`) of each segment as data; by default the edges above the scene's
+//!   coarsen threshold, or all, or those above a given angle ([`EdgeDisplay`]);
 //! - `cloth/pins` every frame: the pinned vertices as points;
 //! - `events/points` and `events/log`: the remeshing events since the previous recorded frame;
 //! - `legend` (static): a markdown text document naming the colours;
@@ -34,27 +36,28 @@
 //! path; do not set it.
 
 mod convert;
+pub mod decode;
 pub mod edges;
 mod error;
 mod events;
 mod frame;
 pub mod inspect;
 mod layout;
+pub mod mesh;
 pub mod obj;
 mod report;
 mod sink;
 
 use std::collections::HashMap;
 use std::path::Path;
-use std::sync::Arc;
 
-use rerun::external::arrow::array::UInt8Array;
 use rerun::{AsComponents, EntityPath, RecordingStream, RecordingStreamBuilder};
 
 use crate::math::Vector;
 pub use edges::EdgeDisplay;
 pub use error::{BoxError, RecordError};
 pub use frame::{EventMark, FrameView};
+pub use mesh::{DUPLICATE_COMPONENT, LEVEL_COMPONENT};
 pub use sink::{LiveViewer, RecordTarget};
 /// Colour of each refinement level, as sRGB `[r, g, b]`.
 ///
@@ -95,8 +98,6 @@ pub const TIMELINE_SIM_TIME: &str = "sim_time";
 pub const ENTITY_MESH: &str = "cloth/mesh";
 /// Entity of the edges coloured by dihedral angle.
 pub const ENTITY_EDGES: &str = "cloth/edges";
-/// Component name of the per-triangle level data on `cloth/mesh` (`u8`, one per triangle).
-pub const LEVEL_COMPONENT: &str = "triangle_level";
 /// Entity of the static legend (a markdown text document: level colours, angle scale, event
 /// colours).
 pub const ENTITY_LEGEND: &str = "legend";
@@ -157,6 +158,8 @@ pub struct Recorder {
     mesh_path: EntityPath,
     edges_path: EntityPath,
     pins_path: EntityPath,
+    /// The recorded topology of `cloth/mesh` (logged again only when it changes).
+    cloth_mesh: mesh::ClothMesh,
     /// `plots/<name>` per scalar name, parsed once.
     scalar_paths: HashMap<String, EntityPath>,
     blueprint_sent: bool,
@@ -222,6 +225,7 @@ impl Recorder {
             mesh_path: EntityPath::from(ENTITY_MESH),
             edges_path: EntityPath::from(ENTITY_EDGES),
             pins_path: EntityPath::from(ENTITY_PINS),
+            cloth_mesh: mesh::ClothMesh::default(),
             scalar_paths: HashMap::new(),
             blueprint_sent: false,
         };
@@ -249,15 +253,16 @@ impl Recorder {
     }
 
     /// Logs one frame: sets the `frame` and `sim_time` timelines, then logs the mesh at
-    /// `cloth/mesh` (un-shared vertices coloured by level, normals, level as class id and as
-    /// `triangle_level` data), the edges at `cloth/edges` (unless [`EdgeDisplay::Off`]), the
-    /// pinned vertices at `cloth/pins`, the events at `events/points` and `events/log`, and each
-    /// scalar at `plots/<name>`.
+    /// `cloth/mesh` (positions and normals; the topology, colours, class ids and
+    /// `triangle_level` data too when the triangles or levels changed), the edges at
+    /// `cloth/edges` (unless [`EdgeDisplay::Off`]), the pinned vertices at `cloth/pins`, the
+    /// events at `events/points` and `events/log`, and each scalar at `plots/<name>`.
     ///
     /// The data is validated first ([`RecordError::InvalidFrame`] on a length mismatch, an
     /// index out of range or a non-finite `sim_time`); nothing is logged for an invalid frame
     /// and the recorder stays usable. Vertices are converted straight from the slices into
-    /// rerun's arrow buffers: no per-frame buffers of our own are needed.
+    /// rerun's arrow buffers; the recorder keeps one copy of the last logged topology to tell
+    /// whether it changed.
     pub fn record_frame(&mut self, frame: &FrameView) -> Result<(), RecordError> {
         let frame_index = frame::validate(frame)?;
         if !self.blueprint_sent {
@@ -272,41 +277,20 @@ impl Recorder {
             .set_duration_secs(TIMELINE_SIM_TIME, frame.sim_time);
 
         let (positions, normals) = (frame.positions, frame.vertex_normals);
-        let corners = |tri: &[u32; 3]| tri.map(|i| i as usize);
-        let mesh = rerun::Mesh3D::new(
-            frame
-                .triangles
-                .iter()
-                .flat_map(|t| corners(t).map(|i| convert::position(positions[i]))),
-        )
-        .with_vertex_normals(
-            frame
-                .triangles
-                .iter()
-                .flat_map(|t| corners(t).map(|i| convert::vector(normals[i]))),
-        )
-        .with_vertex_colors(
-            frame
-                .triangle_levels
-                .iter()
-                .flat_map(|&l| [convert::level_color(l); 3]),
-        )
-        .with_class_ids(
-            frame
-                .triangle_levels
-                .iter()
-                .flat_map(|&l| [convert::level_class_id(l); 3]),
-        );
-        let levels = rerun::AnyValues::default().with_component_from_data(
-            LEVEL_COMPONENT,
-            Arc::new(UInt8Array::from(frame.triangle_levels.to_vec())),
-        );
-        self.stream
-            .log(
+        let changed =
+            self.cloth_mesh
+                .update(positions.len(), frame.triangles, frame.triangle_levels);
+        let geometry = self.cloth_mesh.geometry(positions, normals);
+        let logged = if changed {
+            let (topology, data) = self.cloth_mesh.topology();
+            self.stream.log(
                 self.mesh_path.clone(),
-                &[&mesh as &dyn AsComponents, &levels],
+                &[&geometry as &dyn AsComponents, &topology, &data],
             )
-            .map_err(|e| self.log_err(ENTITY_MESH, e))?;
+        } else {
+            self.stream.log(self.mesh_path.clone(), &geometry)
+        };
+        logged.map_err(|e| self.log_err(ENTITY_MESH, e))?;
 
         if let Some((strips, data)) =
             edges::edge_row(self.edges, positions, frame.edges, frame.edge_angles)

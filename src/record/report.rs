@@ -89,6 +89,12 @@ impl Inspection {
             range(frames.clone().filter_map(|f| f.triangles)),
             range(frames.clone().flat_map(|f| f.levels.iter().copied())),
         );
+        let _ = writeln!(
+            s,
+            "mesh topology logged on {} of {} frames",
+            frames.clone().filter(|f| f.topology).count(),
+            self.frames.len()
+        );
         if self.frames.values().any(|f| f.edges.is_some()) {
             let _ = writeln!(
                 s,
@@ -140,7 +146,15 @@ impl Inspection {
         let _ = writeln!(s, "frame {n}, sim_time {time}");
         let tris = f.triangles.map_or("-".to_owned(), |t| t.to_string());
         let verts = f.vertices().map_or("-".to_owned(), |v| format!("{v}"));
-        let _ = writeln!(s, "mesh: {tris} triangles, {verts} vertices");
+        let logged = if f.topology {
+            "logged at this frame"
+        } else {
+            "as last logged"
+        };
+        let _ = writeln!(
+            s,
+            "mesh: {tris} triangles, {verts} vertices (topology {logged})"
+        );
         let mut per_level: BTreeMap<u8, usize> = BTreeMap::new();
         for &l in &f.levels {
             *per_level.entry(l).or_insert(0) += 1;

@@ -89,6 +89,7 @@ fn inspect_prints_the_overview_and_a_frame() {
         format!("application drape, recording id {id}"),
         "frames: 3 recorded, 0 to 2; sim_time 0.0000 s to 1.0000 s".to_owned(),
         "vertices: 4 to 4; triangles: 2 to 2; levels: 0 to 1".to_owned(),
+        "mesh topology logged on 1 of 3 frames".to_owned(),
         "edges per frame: 5 to 5; largest angle 10.00 deg".to_owned(),
         "events: 3 (merge 1, rollback 1, split 1)".to_owned(),
         "frames with the most events: 1 (2), 2 (1)".to_owned(),
@@ -112,7 +113,7 @@ fn inspect_prints_the_overview_and_a_frame() {
     assert_eq!(out.status.code(), Some(0));
     for want in [
         "frame 1, sim_time 0.5000 s",
-        "mesh: 2 triangles, 4 vertices",
+        "mesh: 2 triangles, 4 vertices (topology as last logged)",
         "triangles per level (2 values): level 0: 1, level 1: 1",
         "edges: 5 recorded, largest angle 10.00 deg",
         "  energy/total = 1",

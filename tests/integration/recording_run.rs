@@ -9,8 +9,9 @@ use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
 
 use drape::record::EdgeDisplay;
+use drape::record::decode::cloth_mesh_at;
 use drape::record::inspect::{Inspection, inspect};
-use drape::run::{RunError, RunOptions, run};
+use drape::run::{RunError, RunOptions, run, run_observed};
 use drape::scene::{Scene, default_scene, load_scene_file};
 use drape::summary::Summary;
 
@@ -48,22 +49,41 @@ fn tablecloth_short() -> Scene {
     )
 }
 
+/// The scenes' coarsen threshold, which the default edge choice keeps edges above.
+const COARSEN_DEG: f64 = 1.5;
+
 /// Every frame has one mesh row, one `triangle_level` per triangle, the triangle count of the
-/// `mesh/triangles` plot, and (a disk-like sheet) `V + T - 1` edges with the largest angle
-/// equal to the `angle/max_deg` plot.
-fn check_frames(ins: &Inspection) {
+/// `mesh/triangles` plot, and the edges: with `all_edges` (a disk-like sheet) `V + T - 1` of
+/// them with the largest angle equal to the `angle/max_deg` plot; else (the default choice)
+/// at most that many, every one above the coarsen threshold, and the largest one whenever it
+/// is above it.
+fn check_frames(ins: &Inspection, all_edges: bool) {
+    let topology = ins.frames.values().filter(|f| f.topology).count();
+    println!(
+        "topology logged on {topology} of {} frames",
+        ins.frames.len()
+    );
+    assert!(ins.frames.values().next().is_some_and(|f| f.topology));
     for (n, f) in &ins.frames {
         assert_eq!(f.mesh_rows, 1, "frame {n}: one mesh row");
-        let tris = f.triangles.expect("mesh positions");
+        let tris = f.triangles.expect("mesh topology");
         assert_eq!(f.levels.len(), tris, "frame {n}: one level per triangle");
         assert_eq!(f.scalars.get("mesh/triangles"), Some(&(tris as f64)));
         let verts = f.vertices().expect("vertex plot") as usize;
-        assert_eq!(
-            f.edges,
-            Some(verts + tris - 1),
-            "frame {n}: Euler's formula"
-        );
+        let edges = f.edges.expect("edges row");
         let plotted = f.scalars["angle/max_deg"];
+        if all_edges {
+            assert_eq!(edges, verts + tris - 1, "frame {n}: Euler's formula");
+        } else {
+            assert!(edges < verts + tris, "frame {n}: at most V + T - 1");
+            if let Some(min) = f.min_edge_angle {
+                assert!(min > COARSEN_DEG, "frame {n}: kept an edge at {min} deg");
+            }
+            if plotted <= COARSEN_DEG {
+                assert_eq!(edges, 0, "frame {n}: nothing above the threshold");
+                continue;
+            }
+        }
         let max = f.max_edge_angle.expect("angles");
         assert!(
             (max - plotted).abs() <= 1e-12 * plotted.max(1.0),
@@ -139,8 +159,54 @@ fn adaptive_run_holds_the_whole_schema() {
     assert_eq!(rec.frames, summary.frames);
     assert_eq!(rec.bytes, ins.bytes);
     assert!(summary.splits > 0, "the short run refines");
-    check_frames(&ins);
+    check_frames(&ins, false);
     check_event_counts(&ins, &summary);
+    std::fs::remove_file(&out).ok();
+}
+
+/// The engine's positions (as `f32`) and triangles of one recorded frame.
+type SeenFrame = (Vec<[f32; 3]>, Vec<[u32; 3]>);
+
+/// Every recorded frame decodes back to the engine's mesh of that frame: the same triangles
+/// in the same order, one level per triangle, and the positions to `f32`; between topology
+/// changes the frame shows the topology logged last.
+#[test]
+fn every_frame_decodes_to_the_engine_mesh() {
+    let out = temp_path("decode.rrd");
+    let opts = RunOptions {
+        record: Some(out.clone()),
+        ..RunOptions::default()
+    };
+    let mut seen: Vec<SeenFrame> = Vec::new();
+    let summary = run_observed(
+        &tablecloth_short(),
+        &opts,
+        &AtomicBool::new(false),
+        &mut |_| {},
+        &mut |s| {
+            let f32s = s.positions.iter().map(|p| p.to_array().map(|c| c as f32));
+            seen.push((f32s.collect(), s.triangles.to_vec()));
+        },
+    )
+    .expect("run");
+    assert_eq!(seen.len() as u64, summary.frames);
+    let ins = inspect(&out).expect("decodes");
+    let (mut copies, mut recorded) = (0, 0);
+    for (n, (positions, triangles)) in seen.iter().enumerate() {
+        let f = cloth_mesh_at(&out, n as i64).expect("frame decodes");
+        assert_eq!(&f.positions, positions, "frame {n}: positions");
+        assert_eq!(&f.triangles, triangles, "frame {n}: triangles");
+        assert_eq!(f.levels, ins.frames[&(n as i64)].levels, "frame {n}");
+        assert_eq!(f.levels.len(), triangles.len());
+        assert_eq!(f.normals.len(), positions.len());
+        copies += f.recorded_vertices - positions.len();
+        recorded += f.recorded_vertices;
+    }
+    println!(
+        "{} frames decoded; copies per level: {copies} of {recorded} recorded vertices ({:.1} %)",
+        seen.len(),
+        100.0 * copies as f64 / recorded as f64
+    );
     std::fs::remove_file(&out).ok();
 }
 
@@ -171,7 +237,7 @@ fn record_every_thins_frames_and_keeps_every_event() {
         summary.recording.as_ref().map(|r| r.frames),
         Some(got.len() as u64)
     );
-    check_frames(&ins);
+    check_frames(&ins, false);
     check_event_counts(&ins, &summary);
     std::fs::remove_file(&out).ok();
 }
@@ -182,16 +248,18 @@ fn edge_options_filter_or_drop_cloth_edges() {
         "hanging_sheet.toml",
         &["cloth.resolution=8", "simulation.duration=0.3"],
     );
-    let (all, above, none) = (
+    let (all, above, none, review) = (
         temp_path("all.rrd"),
         temp_path("above.rrd"),
         temp_path("none.rrd"),
+        temp_path("review.rrd"),
     );
     let threshold = 2.0;
     for (path, edges) in [
         (&all, EdgeDisplay::All),
         (&above, EdgeDisplay::Above(threshold)),
         (&none, EdgeDisplay::Off),
+        (&review, EdgeDisplay::Review),
     ] {
         let opts = RunOptions {
             edges,
@@ -199,12 +267,24 @@ fn edge_options_filter_or_drop_cloth_edges() {
         };
         record(&scene, path, opts).expect("run");
     }
-    let (all_i, above_i, none_i) = (
+    let (all_i, above_i, none_i, review_i) = (
         inspect(&all).expect("all"),
         inspect(&above).expect("above"),
         inspect(&none).expect("none"),
+        inspect(&review).expect("review"),
     );
     assert!(!none_i.entities.contains_key("/cloth/edges"));
+    check_frames(&all_i, true);
+    check_frames(&review_i, false);
+    let kept = |i: &Inspection| i.frames.values().filter_map(|f| f.edges).sum::<usize>();
+    assert!(
+        kept(&review_i) < kept(&all_i),
+        "the default leaves flat edges out"
+    );
+    assert!(
+        kept(&review_i) >= kept(&above_i),
+        "1.5 deg keeps more than 2 deg"
+    );
     let mut kept_some = false;
     for (n, f) in &all_i.frames {
         let g = &above_i.frames[n];
@@ -223,10 +303,16 @@ fn edge_options_filter_or_drop_cloth_edges() {
     }
     assert!(kept_some, "the run bends past {threshold} deg somewhere");
     println!(
-        "bytes: all edges {}, above {threshold} deg {}, no edges {}",
-        all_i.bytes, above_i.bytes, none_i.bytes
+        "bytes: all edges {} ({} edges), above {threshold} deg {}, default (above \
+         {COARSEN_DEG} deg) {} ({} edges), no edges {}",
+        all_i.bytes,
+        kept(&all_i),
+        above_i.bytes,
+        review_i.bytes,
+        kept(&review_i),
+        none_i.bytes
     );
-    for p in [all, above, none] {
+    for p in [all, above, none, review] {
         std::fs::remove_file(p).ok();
     }
 }

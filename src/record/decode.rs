@@ -1,0 +1,177 @@
+//! The cloth mesh of one frame, decoded back from a recording: what the viewer shows at that
+//! frame (the latest value of each `cloth/mesh` component at or before it), mapped back onto
+//! the simulated mesh (vertices, triangles and their levels).
+
+use std::path::Path;
+
+use rerun::external::arrow::array::{
+    Array, ArrayRef, AsArray, FixedSizeListArray,
+    types::{Float32Type, UInt8Type, UInt32Type},
+};
+use rerun::external::re_log_encoding::DecoderApp;
+use rerun::log::{Chunk, LogMsg};
+
+use super::inspect::InspectError;
+use super::mesh::{DUPLICATE_COMPONENT, LEVEL_COMPONENT, simulated_triangles};
+use super::{ENTITY_MESH, TIMELINE_FRAME};
+
+/// The simulated cloth mesh at one frame, as the recording holds it.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ClothFrame {
+    /// The frame these values are for.
+    pub frame: i64,
+    /// Positions of the simulated vertices (`f32`, m), in the engine's vertex order.
+    pub positions: Vec<[f32; 3]>,
+    /// Unit normals of the simulated vertices.
+    pub normals: Vec<[f32; 3]>,
+    /// Triangles as indices into `positions`, in the engine's triangle order.
+    pub triangles: Vec<[u32; 3]>,
+    /// Refinement level per triangle.
+    pub levels: Vec<u8>,
+    /// Vertices of the recorded `Mesh3D` (the simulated ones and their copies per level).
+    pub recorded_vertices: usize,
+    /// The frame whose row last logged the topology (at or before `frame`).
+    pub topology_frame: i64,
+}
+
+/// The latest value of one component: the frame it was logged at, and the cell.
+type Latest = Option<(i64, ArrayRef)>;
+
+/// Decodes the recording at `path` and rebuilds the cloth mesh at `frame`.
+///
+/// Fails like [`super::inspect::inspect`] on a file that does not decode, with
+/// [`InspectError::NoFrame`] when the recording holds no `cloth/mesh` row at `frame`, and with
+/// [`InspectError::Decode`] when the mesh's components do not fit together (a copy or an
+/// index past the recorded vertices, a level count other than the triangle count).
+pub fn cloth_mesh_at(path: &Path, frame: i64) -> Result<ClothFrame, InspectError> {
+    let bytes = std::fs::read(path).map_err(|source| InspectError::Read {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let decoder = DecoderApp::decode_eager(bytes.as_slice()).map_err(|e| InspectError::NotRrd {
+        path: path.to_path_buf(),
+        reason: e.to_string(),
+    })?;
+    let names = [
+        "vertex_positions",
+        "vertex_normals",
+        "triangle_indices",
+        LEVEL_COMPONENT,
+        DUPLICATE_COMPONENT,
+    ];
+    let mut latest: [Latest; 5] = Default::default();
+    let (mut first, mut last) = (None::<i64>, None::<i64>);
+    let mut at_frame = false;
+    for (index, msg) in decoder.enumerate() {
+        let decode_err = |reason: String| InspectError::Decode {
+            path: path.to_path_buf(),
+            index,
+            reason,
+        };
+        let msg = msg.map_err(|e| decode_err(e.to_string()))?;
+        let LogMsg::ArrowMsg(store, arrow) = &msg else {
+            continue;
+        };
+        if store.kind() != rerun::StoreKind::Recording {
+            continue;
+        }
+        let chunk = Chunk::from_arrow_msg(arrow).map_err(|e| decode_err(e.to_string()))?;
+        if chunk.is_static()
+            || chunk.entity_path().to_string().trim_start_matches('/') != ENTITY_MESH
+        {
+            continue;
+        }
+        let Some(times) = chunk
+            .timelines()
+            .iter()
+            .find(|(n, _)| n.as_str() == TIMELINE_FRAME)
+            .map(|(_, col)| col.times_raw().to_vec())
+        else {
+            continue;
+        };
+        for (slot, name) in latest.iter_mut().zip(names) {
+            let Some(array) = chunk.component_descriptors().find_map(|d| {
+                let c = d.component.as_str();
+                (c == name || c.ends_with(&format!(":{name}")))
+                    .then(|| chunk.components().get_array(d.component))
+                    .flatten()
+            }) else {
+                continue;
+            };
+            for (row, &t) in times.iter().enumerate() {
+                first = Some(first.map_or(t, |f| f.min(t)));
+                last = Some(last.map_or(t, |l| l.max(t)));
+                at_frame |= t == frame;
+                if t <= frame && array.is_valid(row) && slot.as_ref().is_none_or(|(s, _)| *s <= t) {
+                    *slot = Some((t, array.value(row)));
+                }
+            }
+        }
+    }
+    let no_frame = || InspectError::NoFrame {
+        frame,
+        first: first.unwrap_or(0),
+        last: last.unwrap_or(0),
+    };
+    let bad = |reason: &str| InspectError::Decode {
+        path: path.to_path_buf(),
+        index: 0,
+        reason: format!("cloth/mesh at frame {frame}: {reason}"),
+    };
+    if !at_frame {
+        return Err(no_frame());
+    }
+    let [positions, normals, indices, levels, copies] = latest;
+    let (Some((_, positions)), Some((topology_frame, indices))) = (positions, indices) else {
+        return Err(no_frame());
+    };
+    let positions = triples::<Float32Type, f32>(&positions).ok_or_else(|| bad("positions"))?;
+    let normals = match normals {
+        Some((_, n)) => triples::<Float32Type, f32>(&n).ok_or_else(|| bad("normals"))?,
+        None => Vec::new(),
+    };
+    let indices = triples::<UInt32Type, u32>(&indices).ok_or_else(|| bad("indices"))?;
+    let levels = levels
+        .as_ref()
+        .and_then(|(_, l)| l.as_primitive_opt::<UInt8Type>())
+        .map(|l| l.values().to_vec())
+        .ok_or_else(|| bad("no triangle_level"))?;
+    let copies = copies
+        .as_ref()
+        .and_then(|(_, c)| c.as_primitive_opt::<UInt32Type>())
+        .map(|c| c.values().to_vec())
+        .unwrap_or_default();
+    let recorded_vertices = positions.len();
+    let vertices = recorded_vertices
+        .checked_sub(copies.len())
+        .ok_or_else(|| bad("more copies than vertices"))?;
+    let triangles = simulated_triangles(vertices, &indices, &copies)
+        .filter(|t| t.iter().flatten().all(|&i| (i as usize) < vertices))
+        .ok_or_else(|| bad("an index past the vertices"))?;
+    if levels.len() != triangles.len() {
+        return Err(bad("not one level per triangle"));
+    }
+    Ok(ClothFrame {
+        frame,
+        positions: positions[..vertices].to_vec(),
+        normals: normals.into_iter().take(vertices).collect(),
+        triangles,
+        levels,
+        recorded_vertices,
+        topology_frame,
+    })
+}
+
+/// A list cell of fixed-size-3 lists as triples, or `None` when it is not one.
+fn triples<T, V>(cell: &ArrayRef) -> Option<Vec<[V; 3]>>
+where
+    T: rerun::external::arrow::datatypes::ArrowPrimitiveType<Native = V>,
+    V: rerun::external::arrow::datatypes::ArrowNativeType,
+{
+    let list: &FixedSizeListArray = cell.as_fixed_size_list_opt()?;
+    if list.value_length() != 3 {
+        return None;
+    }
+    let values: &[V] = list.values().as_primitive_opt::<T>()?.values();
+    Some(values.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect())
+}

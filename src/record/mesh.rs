@@ -1,0 +1,185 @@
+//! The cloth mesh at `cloth/mesh`: shared vertices, duplicated only where triangles of
+//! different levels meet, and the topology logged only when it changed.
+//!
+//! `Mesh3D` has no per-face colour, so a vertex where triangles of several levels meet is
+//! drawn once per level: the first `V` vertices of the recorded mesh are the simulated mesh's
+//! vertices in their order (each in the colour of its highest level), and after them come the
+//! copies, one per vertex and further level it is used at, listed by `duplicate_of` (the
+//! simulated vertex each copy repeats). Every frame logs the positions and normals of all of
+//! them; a frame whose triangles, levels or vertex count differ from the last logged topology
+//! also logs the triangle indices (into the recorded vertices), the vertex colours and class
+//! ids (the level: legend and hover label), `triangle_level` (one `u8` per triangle, in the
+//! simulated mesh's triangle order) and `duplicate_of`. Rerun keeps the latest value of each
+//! component, so every frame shows (and decodes to) the topology last logged at or before it.
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use rerun::external::arrow::array::{UInt8Array, UInt32Array};
+
+use super::convert;
+use crate::math::Vector;
+
+/// Component name of the per-triangle level data on `cloth/mesh` (`u8`, one per triangle).
+pub const LEVEL_COMPONENT: &str = "triangle_level";
+/// Component name of the copied vertices on `cloth/mesh` (`u32`, one per recorded vertex past
+/// the simulated mesh's: recorded vertex `V + i` is a copy of simulated vertex
+/// `duplicate_of[i]`).
+pub const DUPLICATE_COMPONENT: &str = "duplicate_of";
+
+/// The recorded topology of the cloth mesh, and the inputs it was built from.
+#[derive(Debug, Default)]
+pub(super) struct ClothMesh {
+    /// Simulated vertices of the topology last built.
+    vertices: usize,
+    /// Triangles of the topology last built (simulated vertex indices).
+    triangles: Vec<[u32; 3]>,
+    /// Levels of the topology last built.
+    levels: Vec<u8>,
+    /// Level (colour) of each recorded vertex.
+    vertex_levels: Vec<u8>,
+    /// Simulated vertex of each recorded vertex past the first `vertices`.
+    duplicate_of: Vec<u32>,
+    /// Triangles as indices into the recorded vertices.
+    indices: Vec<[u32; 3]>,
+    /// Whether a topology has been built (and must be logged) yet.
+    built: bool,
+}
+
+impl ClothMesh {
+    /// Rebuilds the recorded topology when `triangles`, `levels` or the vertex count differ
+    /// from the last one; returns whether they did (the topology must then be logged). The
+    /// slices must have been validated (indices in range, one level per triangle).
+    pub(super) fn update(
+        &mut self,
+        vertices: usize,
+        triangles: &[[u32; 3]],
+        levels: &[u8],
+    ) -> bool {
+        if self.built
+            && self.vertices == vertices
+            && self.triangles == triangles
+            && self.levels == levels
+        {
+            return false;
+        }
+        self.built = true;
+        self.vertices = vertices;
+        self.triangles.clear();
+        self.triangles.extend_from_slice(triangles);
+        self.levels.clear();
+        self.levels.extend_from_slice(levels);
+
+        // Each vertex keeps its highest level; other levels get a copy.
+        self.vertex_levels.clear();
+        self.vertex_levels.resize(vertices, 0);
+        for (t, &l) in triangles.iter().zip(levels) {
+            for &i in t {
+                let v = &mut self.vertex_levels[i as usize];
+                *v = (*v).max(l);
+            }
+        }
+        self.duplicate_of.clear();
+        self.indices.clear();
+        let mut copies: HashMap<(u32, u8), u32> = HashMap::new();
+        for (t, &l) in triangles.iter().zip(levels) {
+            let mut corner = |i: u32, this: &mut Self| -> u32 {
+                if this.vertex_levels[i as usize] == l {
+                    return i;
+                }
+                *copies.entry((i, l)).or_insert_with(|| {
+                    this.duplicate_of.push(i);
+                    this.vertex_levels.push(l);
+                    (this.vertex_levels.len() - 1) as u32
+                })
+            };
+            let tri = [corner(t[0], self), corner(t[1], self), corner(t[2], self)];
+            self.indices.push(tri);
+        }
+        true
+    }
+
+    /// The simulated vertex of each recorded vertex, in recorded order.
+    fn sources(&self) -> impl Iterator<Item = usize> + '_ {
+        (0..self.vertices).chain(self.duplicate_of.iter().map(|&i| i as usize))
+    }
+
+    /// The per-frame part of the row: positions and normals of every recorded vertex.
+    pub(super) fn geometry(&self, positions: &[Vector], normals: &[Vector]) -> rerun::Mesh3D {
+        rerun::Mesh3D::update_fields()
+            .with_vertex_positions(self.sources().map(|i| convert::position(positions[i])))
+            .with_vertex_normals(self.sources().map(|i| convert::vector(normals[i])))
+    }
+
+    /// The topology part of the row: triangle indices, vertex colours and class ids (the
+    /// level), and the data components `triangle_level` and `duplicate_of`.
+    pub(super) fn topology(&self) -> (rerun::Mesh3D, rerun::AnyValues) {
+        let mesh = rerun::Mesh3D::update_fields()
+            .with_triangle_indices(self.indices.iter().copied())
+            .with_vertex_colors(self.vertex_levels.iter().map(|&l| convert::level_color(l)))
+            .with_class_ids(
+                self.vertex_levels
+                    .iter()
+                    .map(|&l| convert::level_class_id(l)),
+            );
+        let data = rerun::AnyValues::default()
+            .with_component_from_data(
+                LEVEL_COMPONENT,
+                Arc::new(UInt8Array::from(self.levels.clone())),
+            )
+            .with_component_from_data(
+                DUPLICATE_COMPONENT,
+                Arc::new(UInt32Array::from(self.duplicate_of.clone())),
+            );
+        (mesh, data)
+    }
+}
+
+/// The simulated mesh's triangles rebuilt from a decoded `cloth/mesh` topology: recorded
+/// triangle `indices` mapped back through `duplicate_of` onto the first `vertices` (the
+/// simulated vertices). `None` when an index points past the recorded vertices.
+pub fn simulated_triangles(
+    vertices: usize,
+    indices: &[[u32; 3]],
+    duplicate_of: &[u32],
+) -> Option<Vec<[u32; 3]>> {
+    let source = |i: u32| -> Option<u32> {
+        let i = i as usize;
+        if i < vertices {
+            u32::try_from(i).ok()
+        } else {
+            duplicate_of.get(i - vertices).copied()
+        }
+    };
+    indices
+        .iter()
+        .map(|t| Some([source(t[0])?, source(t[1])?, source(t[2])?]))
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn copies_only_where_levels_meet_and_rebuild_only_on_change() {
+        // Two triangles sharing the edge 0-2, at levels 0 and 1: vertex 2 and 0 are shared.
+        let tris = [[0, 1, 2], [0, 2, 3]];
+        let mut m = ClothMesh::default();
+        assert!(m.update(4, &tris, &[0, 1]));
+        // 0 and 2 are at level 1 (their highest), so triangle 0 needs copies of both.
+        assert_eq!(m.duplicate_of, vec![0, 2]);
+        assert_eq!(m.indices, vec![[4, 1, 5], [0, 2, 3]]);
+        assert_eq!(m.vertex_levels, vec![1, 0, 1, 1, 0, 0]);
+        assert_eq!(
+            simulated_triangles(4, &m.indices, &m.duplicate_of),
+            Some(tris.to_vec())
+        );
+        assert!(!m.update(4, &tris, &[0, 1]), "same topology");
+        assert!(m.update(4, &tris, &[1, 1]), "levels changed");
+        assert!(m.duplicate_of.is_empty());
+        assert_eq!(m.vertex_levels.len(), 4);
+        assert!(m.update(5, &tris, &[1, 1]), "vertex count changed");
+        assert_eq!(simulated_triangles(4, &[[0, 1, 9]], &[]), None);
+    }
+}
