@@ -18,10 +18,10 @@
 //! from where it is. So the cost per step adapts to how fast the matrix changes:
 //! falling, folding cloth refactors often, cloth at rest almost never.
 //!
-//! Measured on `drape_sphere` (resolution 64, 4,225 vertices, dt 1/120 s) while
-//! choosing `refactor_iterations` (docs/performance.md has the table): refactoring at
-//! every step costs a factorization per step; with the reuse, most steps need 1 to 4
-//! preconditioned iterations.
+//! Measured (docs/performance.md): on a falling, draping sheet (`drape_sphere`) the
+//! matrix changes enough in one step that the solver refactors at 567 of 607 steps,
+//! with about 7 iterations a step; in free fall one factorization served every step
+//! with 1 iteration each; on a cantilever strip 71 factorizations served 1,530 steps.
 
 use std::sync::Arc;
 use std::time::Instant;
