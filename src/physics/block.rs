@@ -31,10 +31,6 @@
 //! every block (`factor_tips`) as soon as a fresh factor needs more than 10
 //! iterations (see `TIPS_AFTER` in the implicit module's direct solver).
 //!
-//! Tried first: triplets summed by faer's `try_new_from_triplets` at every step. It
-//! sorts about 1.6 million triplets at 4k vertices, which alone took longer than a
-//! numerical factorization, so the pattern is kept instead.
-
 use rayon::prelude::*;
 
 use super::elements::Elements;
@@ -388,24 +384,27 @@ impl BlockPattern {
     }
 
     /// Sums the element terms into `blocks` (module docs): `M + h D + h^2 K`.
-    pub fn gather(&self, terms: &ElementBlocks<'_>, blocks: &mut Vec<Matrix3>) {
+    /// `lower`: scratch that receives the lower blocks first.
+    pub fn gather(
+        &self,
+        terms: &ElementBlocks<'_>,
+        lower: &mut Vec<Matrix3>,
+        blocks: &mut Vec<Matrix3>,
+    ) {
+        lower.resize(self.blocks(), Matrix3::ZERO);
         blocks.resize(self.blocks(), Matrix3::ZERO);
-        // Each block from its own sources (an upper block from its lower mirror's,
-        // transposed), so every row is written by one task and nothing is shared.
-        blocks
+        // Each lower block (and the diagonal) from its own sources, in element order.
+        lower
             .par_iter_mut()
             .enumerate()
             .with_min_len(PAR_MIN)
             .for_each(|(slot, out)| {
                 let (i, j) = (self.rows[slot] as usize, self.columns[slot] as usize);
-                let lower = if j <= i {
-                    slot
-                } else {
-                    self.mirror[slot] as usize
-                };
+                if j > i {
+                    return;
+                }
                 let mut m = Matrix3::ZERO;
-                let range =
-                    self.source_start[lower] as usize..self.source_start[lower + 1] as usize;
+                let range = self.source_start[slot] as usize..self.source_start[slot + 1] as usize;
                 for src in &self.sources[range] {
                     m += match *src {
                         Source::SpringDiagonal(e) => terms.springs[e as usize],
@@ -420,12 +419,23 @@ impl BlockPattern {
                         }
                     };
                 }
-                *out = if j == i {
-                    m + Matrix3::from_diagonal(Vector::splat(terms.diagonal_mass[i]))
-                } else if j < i {
-                    m
+                if j == i {
+                    m += Matrix3::from_diagonal(Vector::splat(terms.diagonal_mass[i]));
+                }
+                *out = m;
+            });
+        // Then every block: a lower one as computed, an upper one as its mirror's
+        // transpose (summed once, not twice).
+        let lower = &*lower;
+        blocks
+            .par_iter_mut()
+            .enumerate()
+            .with_min_len(PAR_MIN)
+            .for_each(|(slot, out)| {
+                *out = if self.columns[slot] <= self.rows[slot] {
+                    lower[slot]
                 } else {
-                    m.transpose()
+                    lower[self.mirror[slot] as usize].transpose()
                 };
             });
     }
@@ -468,20 +478,6 @@ impl BlockPattern {
                 }
                 *out = m;
             });
-    }
-
-    /// A diagonally dominant test matrix on this pattern (probes and tests).
-    pub fn fill_test_matrix(&self, blocks: &mut [Matrix3]) {
-        for (slot, b) in blocks.iter_mut().enumerate() {
-            let (i, j) = (self.rows[slot], self.columns[slot]);
-            *b = if i == j {
-                Matrix3::from_diagonal(Vector::splat(40.0))
-            } else {
-                Matrix3::from_diagonal(Vector::splat(-1.0))
-                    + outer(Vector::X, Vector::Y) * 0.1
-                    + outer(Vector::Y, Vector::X) * 0.1
-            };
-        }
     }
 
     /// `y = A x` with the blocks `a` of this pattern, by rows (deterministic).

@@ -4,14 +4,15 @@
 //! depends only on the sparsity pattern, so it is computed once per mesh topology;
 //! a numerical factorization reuses it. Everything runs sequentially (`Par::Seq`):
 //! faer's parallel supernodal factorization changes the order of floating-point
-//! sums with the thread count, and on 2 cores it was also slower (a 65 x 65 grid,
-//! 12,675 unknowns: 14.5 ms on 1 thread, 26 ms on 2).
+//! sums with the thread count, and on 2 cores it was also slower in the probe that
+//! issue 11 reports (a 65 x 65 grid, 12,675 unknowns: 14.5 ms on 1 thread, 26 ms on
+//! 2; not re-measured here).
 //!
 //! Why faer: it is pure Rust (no system BLAS or SuiteSparse to install), maintained,
 //! has a supernodal LL^T and LDL^T with AMD, and exposes the symbolic and numeric
 //! phases separately. The alternatives on crates.io either wrap C libraries
 //! (suitesparse, cholmod) or offer only simplicial (column-by-column) factorizations
-//! (sprs-ldl, nalgebra-sparse), several times slower at these sizes.
+//! (sprs-ldl, nalgebra-sparse); none of them was benchmarked against faer here.
 
 use std::sync::Arc;
 
@@ -94,16 +95,6 @@ impl Factorization {
     pub fn reset(&mut self) {
         self.symbolic = None;
         self.valid = false;
-    }
-
-    /// Forgets the factor, keeping the symbolic analysis.
-    pub fn invalidate(&mut self) {
-        self.valid = false;
-    }
-
-    /// Stored values of the factor `L` (0 before the analysis).
-    pub fn factor_len(&self) -> usize {
-        self.symbolic.as_ref().map_or(0, |s| s.len_val())
     }
 
     /// True when a factor is ready for [`Factorization::solve`].

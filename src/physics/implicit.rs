@@ -211,27 +211,23 @@ fn newton(st: &mut Stepper, w: &mut World, h: Scalar, held: &[bool]) -> Result<(
         linear_solve(st, held, reference, false)?;
         st.stats.newton_iterations += 1;
         let s = &mut st.implicit;
-        let v0 = std::mem::take(&mut s.v0);
         // Accumulate into v (update_state expects dv relative to v0).
         s.dv.par_iter_mut()
-            .zip(w.v.par_iter().zip(v0.par_iter()))
+            .zip(w.v.par_iter().zip(s.v0.par_iter()))
             .with_min_len(PAR_MIN)
             .for_each(|(d, (v, v0))| *d += *v - *v0);
-        s.v0 = v0;
         update_state(&st.implicit, w, h);
     }
-    // The normal impulse each contact needed: minus the normal residual.
+    // The normal impulse each contact needed: the normal part of minus the
+    // residual `b` of the equations (no linear residual: `A dv` is zero).
     let s = &st.implicit;
-    let mass = &st.elements.mass;
-    st.contact_push.clear();
-    st.contact_push.extend((0..s.filter.len()).map(|i| {
-        let f = s.filter[i];
-        if f == Vector::ZERO {
-            0.0
-        } else {
-            (-f.dot(s.b[i]) / mass[i]).max(0.0)
-        }
-    }));
+    contact_push_from(
+        &s.filter,
+        None,
+        &s.b,
+        &st.elements.mass,
+        &mut st.contact_push,
+    );
     if residual > settings.newton_tolerance {
         return Err(SolveFailure::NewtonNotConverged {
             iterations: settings.newton_iterations,
@@ -240,6 +236,34 @@ fn newton(st: &mut Stepper, w: &mut World, h: Scalar, held: &[bool]) -> Result<(
         });
     }
     Ok(())
+}
+
+/// Per vertex, the normal velocity change its contact filter imposed,
+/// `n . (A dv - b) / m` (positive: the obstacle pushed; zero without a filter), into
+/// `push`, from `ap = A dv` (`None`: zero, for a residual `b` of the nonlinear
+/// equations). The collision pass turns it into friction's normal impulse.
+fn contact_push_from(
+    filter: &[Vector],
+    ap: Option<&[Vector]>,
+    b: &[Vector],
+    mass: &[Scalar],
+    push: &mut Vec<Scalar>,
+) {
+    push.clear();
+    push.resize(filter.len(), 0.0);
+    if filter.iter().all(|f| *f == Vector::ZERO) {
+        return;
+    }
+    push.par_iter_mut()
+        .enumerate()
+        .with_min_len(PAR_MIN)
+        .for_each(|(i, push)| {
+            let f = filter[i];
+            if f != Vector::ZERO {
+                let residual = ap.map_or(-b[i], |ap| ap[i] - b[i]);
+                *push = (f.dot(residual) / mass[i]).max(0.0);
+            }
+        });
 }
 
 /// `v = v0 + dv`, `x = x0 + h v`.
@@ -377,6 +401,8 @@ fn assemble(st: &mut Stepper, w: &World, h: Scalar, newton: bool) {
         &s.shape_slot,
     );
     let shape_grad = &s.shape_grad;
+    // The diagonal of `A` is the Jacobi preconditioner of `solver = "cg"` only.
+    let jacobi = st.model.solver.solver == Solver::Cg;
     s.b.par_iter_mut()
         .zip(s.diag_mass.par_iter_mut().zip(s.inv_diag.par_iter_mut()))
         .enumerate()
@@ -400,6 +426,9 @@ fn assemble(st: &mut Stepper, w: &World, h: Scalar, newton: bool) {
             for &k in el.shape_slots.of(i) {
                 rhs += shape_slot[k as usize];
                 let (t, slot) = (k as usize / SHAPE_SLOTS, k as usize % SHAPE_SLOTS);
+                if !jacobi {
+                    continue;
+                }
                 let (m, jac) = (&el.shape_triangles[t].m, &shape_grad[t]);
                 for a in 0..3 {
                     for b in 0..3 {

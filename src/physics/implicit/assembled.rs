@@ -37,9 +37,11 @@ use crate::physics::direct::{FactorError, Factorization};
 use crate::physics::forces::PAR_MIN;
 
 /// Iterations with a fresh factor of the reduced matrix (block module docs) after
-/// which the tip-tip blocks are factored too. A factor with them costs about three
-/// solves more than one without (65 x 65 grid: 0.80 against 1.99 million stored
-/// values), while a fresh reduced factor needs about 3 iterations on fabrics
+/// which the tip-tip blocks are factored too. A factor with them costs 2.5 to 4 times
+/// as much (65 x 65 grid: 1.99 against 0.80 million stored values, 45 against 11 to
+/// 16 ms per factorization and 3.4 against 1.0 to 1.7 ms per solve in one probe on
+/// the loaded 2-core machine), while a fresh reduced factor needs about 3 iterations
+/// on fabrics
 /// (`drape_sphere`) and 27 to 200 on a bending-dominated strip (resolutions 14 to
 /// 112): 10 separates the two with room on both sides.
 const TIPS_AFTER: u32 = 10;
@@ -55,6 +57,8 @@ pub(super) struct AssembledScratch {
     factor_tips: bool,
     /// `A` as assembled.
     raw: Vec<Matrix3>,
+    /// The lower blocks of `A` while it is assembled (upper ones are their mirrors).
+    lower: Vec<Matrix3>,
     /// `A_s`, the projected matrix.
     system: Vec<Matrix3>,
     /// Per vertex: the diagonal compensation added to the factored matrix.
@@ -90,28 +94,15 @@ pub(super) fn solve(
 ) -> Result<(), SolveFailure> {
     let started = Instant::now();
     let n = st.implicit.dv.len();
-    let a = &mut st.implicit.assembled;
+    let s = &mut st.implicit;
+    let a = &mut s.assembled;
     if a.pattern.is_none() {
-        a.pattern = Some(Arc::new(BlockPattern::build(
-            n,
-            &st.elements,
-            a.factor_tips,
-        )));
         a.factorization.reset();
     }
-    let s = &mut st.implicit;
-    let pattern = s.assembled.pattern.clone().unwrap_or_default();
-    let terms = ElementBlocks {
-        springs: &s.spring_block,
-        hinge_gradients: &s.hinge_grad,
-        hinge_coefficients: &s.hinge_coef,
-        diagonal_mass: &s.diag_mass,
-        shape_triangles: &st.elements.shape_triangles,
-        shape_jacobians: &s.shape_grad,
-        h2: s.h2,
-    };
-    let a = &mut s.assembled;
-    pattern.gather(&terms, &mut a.raw);
+    let pattern = a
+        .pattern
+        .get_or_insert_with(|| Arc::new(BlockPattern::build(n, &st.elements, a.factor_tips)))
+        .clone();
     split_prescribed(s, held);
     let terms = ElementBlocks {
         springs: &s.spring_block,
@@ -122,11 +113,9 @@ pub(super) fn solve(
         shape_jacobians: &s.shape_grad,
         h2: s.h2,
     };
-    pattern.compensation(
-        &terms,
-        &s.assembled.projection,
-        &mut s.assembled.compensation,
-    );
+    let a = &mut s.assembled;
+    pattern.gather(&terms, &mut a.lower, &mut a.raw);
+    pattern.compensation(&terms, &a.projection, &mut a.compensation);
     let a = &mut s.assembled;
     // b_s = S (b - A dv_c).
     a.ap.resize(n, Vector::ZERO);
@@ -322,27 +311,18 @@ fn refactor(
     result
 }
 
-/// The normal velocity change each filtered contact imposed in the solve,
-/// `n . (A dv - b) / m` with the unprojected `A`, into [`Stepper::contact_push`].
+/// The contacts' normal impulses from the linear residual `A dv - b`, with the
+/// unprojected `A` (see [`super::contact_push_from`]).
 fn contact_pressure(st: &mut Stepper, pattern: &BlockPattern) {
     let s = &mut st.implicit;
-    let n = s.filter.len();
-    st.contact_push.clear();
-    st.contact_push.resize(n, 0.0);
-    if s.filter.iter().all(|f| *f == Vector::ZERO) {
-        return;
+    if s.filter.iter().any(|f| *f != Vector::ZERO) {
+        pattern.multiply(&s.assembled.raw, &s.dv, &mut s.assembled.ap);
     }
-    let a = &mut s.assembled;
-    pattern.multiply(&a.raw, &s.dv, &mut a.ap);
-    let mass = &st.elements.mass;
-    st.contact_push
-        .par_iter_mut()
-        .enumerate()
-        .with_min_len(PAR_MIN)
-        .for_each(|(i, push)| {
-            let f = s.filter[i];
-            if f != Vector::ZERO {
-                *push = (f.dot(a.ap[i] - s.b[i]) / mass[i]).max(0.0);
-            }
-        });
+    super::contact_push_from(
+        &s.filter,
+        Some(&s.assembled.ap),
+        &s.b,
+        &st.elements.mass,
+        &mut st.contact_push,
+    );
 }

@@ -207,29 +207,20 @@ fn precondition(z: &mut [Vector], r: &[Vector], inv_diag: &[Vector], filter: &[V
         .for_each(|((z, (r, inv)), n)| *z = without(*n, *r * *inv));
 }
 
-/// The normal velocity change each filtered contact imposed in the solve,
-/// `n . (A dv - b) / m` (positive: the obstacle pushed), into
-/// [`Stepper::contact_push`]; the collision pass turns it into friction.
+/// The contacts' normal impulses from the linear residual `A dv - b` (see
+/// [`super::contact_push_from`]).
 fn contact_pressure(st: &mut Stepper, held: &[bool]) {
-    let n = st.implicit.filter.len();
-    st.contact_push.clear();
-    st.contact_push.resize(n, 0.0);
-    if st.implicit.filter.iter().all(|f| *f == Vector::ZERO) {
-        return;
+    if st.implicit.filter.iter().any(|f| *f != Vector::ZERO) {
+        apply_operator(st, Which::Solution, held, false);
     }
-    apply_operator(st, Which::Solution, held, false);
     let s = &st.implicit;
-    let mass = &st.elements.mass;
-    st.contact_push
-        .par_iter_mut()
-        .enumerate()
-        .with_min_len(PAR_MIN)
-        .for_each(|(i, push)| {
-            let f = s.filter[i];
-            if f != Vector::ZERO {
-                *push = (f.dot(s.cg.ap[i] - s.b[i]) / mass[i]).max(0.0);
-            }
-        });
+    super::contact_push_from(
+        &s.filter,
+        Some(&s.cg.ap),
+        &s.b,
+        &st.elements.mass,
+        &mut st.contact_push,
+    );
 }
 
 /// `r . z` and `r . r` in one pass, each bit-identical to its own [`dot`].
