@@ -1,9 +1,12 @@
 //! drape: adaptive mass-spring cloth simulation recorded to Rerun `.rrd` files.
 //!
 //! Data flows one way (SPEC section 2):
-//! scene file -> [`scene::Scene`] -> [`world::World`] -> per step: forces ->
-//! integrate -> record. Simulation state ([`world::World`]) is kept apart from the
-//! stepper's scratch memory ([`physics::Stepper`]), as in rapier's sets and pipeline.
+//! scene file -> [`scene::Scene`] -> [`sim::build`] -> a [`sim::SimState`] and the
+//! [`sim::Pipeline`] that advances it -> per frame ([`run::FrameLoop`]): the step's
+//! phases (forces + integrate, collide, account, health check, rollback, adapt; see
+//! [`sim`]) until the frame's time, then observe and record. The state is one
+//! cloneable value; the pipeline holds only scratch, as in rapier's sets and
+//! pipeline.
 
 pub mod adapt;
 pub mod bench;
@@ -16,6 +19,7 @@ pub mod physics;
 pub mod record;
 pub mod run;
 pub mod scene;
+pub mod sim;
 pub mod stability;
 pub mod summary;
 pub mod world;

@@ -12,7 +12,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 
 use drape::record::inspect::inspect;
 use drape::record::{EdgeDisplay, LiveViewer};
-use drape::run::{Progress, RunError, RunOptions, run};
+use drape::run::{Progress, RunError, RunOptions, run_built};
 use drape::scene::{Scene, default_scene, load_scene_file};
 
 /// Adaptive mass-spring cloth simulation, recorded to Rerun .rrd files.
@@ -310,8 +310,7 @@ fn cmd_run(args: RunArgs) -> Result<ExitCode> {
     // Build the cloth and the obstacles once before any output is opened: a bad
     // OBJ or a pin that selects nothing fails here and leaves no empty recording
     // behind (nor truncates an existing one).
-    drape::world::World::from_scene(&scene)?;
-    drape::collide::Collider::from_scene(&scene)?;
+    let sim = drape::sim::build(&scene)?;
     // Create the OBJ directory before the recording is opened, so that an unusable
     // one fails with its own message and leaves no recording behind.
     if let Some(dir) = &args.obj_dir {
@@ -354,7 +353,14 @@ fn cmd_run(args: RunArgs) -> Result<ExitCode> {
         bar.set_position(p.frame);
         bar.set_message(format!("t = {:.2} s", p.sim_time));
     };
-    let outcome = run(&scene, &opts, &interrupt, &mut on_progress);
+    let outcome = run_built(
+        &scene,
+        sim,
+        &opts,
+        &interrupt,
+        &mut on_progress,
+        &mut |_| {},
+    );
     bar.finish_and_clear();
     let (summary, failure) = match outcome {
         Ok(s) => (s, None),

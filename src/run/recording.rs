@@ -5,9 +5,9 @@ use crate::adapt::{AdaptEvent, Adapter, EventKind, edge_angles};
 use crate::math::Scalar;
 use crate::physics::Energy;
 use crate::record::{EventMark, FrameView, Recorder};
-use crate::world::World;
+use crate::sim::{Pipeline, SimState};
 
-use super::{Pipeline, RunError};
+use super::RunError;
 
 /// Wall time of the latest frame's stepping and of the latest recorded frame's recording, s.
 #[derive(Debug, Clone, Copy, Default)]
@@ -35,16 +35,17 @@ pub(super) struct Snapshot {
 /// recorded frame).
 pub(super) fn record_state(
     rec: &mut Recorder,
-    world: &World,
+    state: &mut SimState,
     pipe: &mut Pipeline,
     snap: &Snapshot,
     normals: &mut Vec<crate::math::Vector>,
 ) -> Result<(), RunError> {
-    let events = pipe
+    let events = state
         .adapter
         .as_mut()
         .map(Adapter::take_events)
         .unwrap_or_default();
+    let world = &state.world;
     let marks: Vec<EventMark> = events.iter().map(event_mark).collect();
     let angles = edge_angles(world);
     let edges: Vec<[u32; 2]> = world.mesh.edges.iter().map(|e| e.vertices).collect();
@@ -67,7 +68,7 @@ pub(super) fn record_state(
             angles.iter().copied().fold(0.0, Scalar::max),
         ),
     ];
-    if pipe.adapter.is_some() {
+    if state.adapter.is_some() {
         let count = |k: EventKind| events.iter().filter(|e| e.kind == k).count() as f64;
         scalars.push((
             "adapt/splits",
@@ -80,8 +81,8 @@ pub(super) fn record_state(
         scalars.push(("adapt/flips", count(EventKind::Flip)));
         scalars.push(("adapt/rollbacks", count(EventKind::Rollback)));
     }
-    if pipe.collider.is_some() {
-        let c = &pipe.collision;
+    if pipe.collider().is_some() {
+        let c = &state.ledger.collision;
         scalars.push(("collision/contacts", c.last_contacts as f64));
         scalars.push(("penetration/max_m", c.last_penetration));
     }
@@ -98,7 +99,7 @@ pub(super) fn record_state(
         scalars: &scalars,
         events: &marks,
     })?;
-    if let Some(c) = &pipe.collider {
+    if let Some(c) = pipe.collider() {
         for m in c.obstacle_meshes(world.time) {
             if m.moving || snap.frame == 0 {
                 rec.record_obstacle(&m.name, &m.positions, &m.triangles, !m.moving)?;

@@ -2,10 +2,9 @@
 
 use std::path::PathBuf;
 
-use crate::adapt::AdaptStats;
-use crate::collide::CollisionStats;
 use crate::math::Scalar;
 use crate::physics::{Energy, Stepper};
+use crate::sim::SimState;
 use crate::summary::{EnergySummary, Range, RecordingSummary, Summary};
 use crate::world::World;
 
@@ -24,23 +23,18 @@ pub(super) struct Tally {
 pub(super) struct TallyEnd<'a> {
     pub(super) scene: String,
     pub(super) frames: u64,
-    pub(super) steps: u64,
     pub(super) sim_time: Scalar,
     pub(super) wall_time_s: Scalar,
     pub(super) sim_wall_s: Scalar,
     pub(super) record_wall_s: Scalar,
     pub(super) dt: Scalar,
-    pub(super) nan_recoveries: u64,
     pub(super) interrupted: bool,
     pub(super) recording: Option<(PathBuf, u64, u64)>,
-    pub(super) stepper: &'a Stepper,
-    pub(super) adapt: Option<AdaptStats>,
-    pub(super) collision: CollisionStats,
+    /// The state at the end: its ledger, effort and adaptive counters.
+    pub(super) state: &'a SimState,
+    pub(super) mass_final: Scalar,
     pub(super) cusick: Option<crate::collide::cusick::CusickSummary>,
     pub(super) cantilever: Option<crate::cantilever::CantileverSummary>,
-    pub(super) external_work: Scalar,
-    pub(super) excess_max: Scalar,
-    pub(super) energy_retries: u64,
 }
 
 impl Tally {
@@ -67,12 +61,15 @@ impl Tally {
         self.energy_max = self.energy_max.max(e.total());
     }
 
-    pub(super) fn finish(self, end: TallyEnd) -> Summary {
-        let vertex_steps = end.steps as Scalar * self.vertices.mean;
+    pub(super) fn finish(&self, end: TallyEnd) -> Summary {
+        let (ledger, effort) = (&end.state.ledger, &end.state.effort);
+        let adapt = end.state.adapter.as_ref().map(|a| a.stats);
+        let collision = ledger.collision;
+        let vertex_steps = effort.solver.steps as Scalar * self.vertices.mean;
         Summary {
             scene: end.scene,
             frames: end.frames,
-            steps: end.steps,
+            steps: effort.solver.steps,
             sim_time: end.sim_time,
             wall_time_s: end.wall_time_s,
             simulation_wall_s: end.sim_wall_s,
@@ -86,29 +83,29 @@ impl Tally {
             vertices: self.vertices,
             triangles: self.triangles,
             mass_initial: self.mass_initial,
-            mass_final: end.stepper.elements.total_mass(),
+            mass_final: end.mass_final,
             energy: EnergySummary {
                 initial: self.energy_initial,
                 r#final: self.energy_final,
                 max: self.energy_max,
-                external_work: end.external_work,
-                excess_max: end.excess_max,
+                external_work: ledger.work(),
+                excess_max: ledger.excess_max,
             },
-            nan_recoveries: end.nan_recoveries,
-            energy_retries: end.energy_retries,
-            solver: end.stepper.stats,
+            nan_recoveries: effort.step_halvings,
+            energy_retries: effort.energy_retries,
+            solver: effort.solver,
             interrupted: end.interrupted,
-            splits: end.adapt.map_or(0, |a| a.splits),
-            merges: end.adapt.map_or(0, |a| a.merges),
-            rollbacks: end.adapt.map_or(0, |a| a.rollbacks),
+            splits: adapt.map_or(0, |a| a.splits),
+            merges: adapt.map_or(0, |a| a.merges),
+            rollbacks: adapt.map_or(0, |a| a.rollbacks),
             max_level: self.max_level,
-            adapt: end.adapt,
-            max_penetration: end.collision.max_penetration,
-            contacts: end.collision.mean_contacts(),
-            self_pairs_tested: end.collision.mean_self_pairs_tested(),
-            self_culled_fraction: end.collision.self_culled_fraction(),
-            collision_wall_s: end.collision.collision_wall_s,
-            self_collision_wall_s: end.collision.self_collision_wall_s,
+            adapt,
+            max_penetration: collision.max_penetration,
+            contacts: collision.mean_contacts(),
+            self_pairs_tested: collision.mean_self_pairs_tested(),
+            self_culled_fraction: collision.self_culled_fraction(),
+            collision_wall_s: collision.collision_wall_s,
+            self_collision_wall_s: collision.self_collision_wall_s,
             cusick: end.cusick,
             cantilever: end.cantilever,
             recording: end.recording.map(|(path, bytes, frames)| RecordingSummary {

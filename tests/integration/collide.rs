@@ -2,11 +2,9 @@
 //! tunneling at 20 m/s through a 5 mm box for each integrator, Coulomb friction on an
 //! incline, self-collision after crumpling, Volino culling, determinism.
 
-use drape::collide::{Collider, CollisionStats, StepCloth};
 use drape::math::{Scalar, Vector};
-use drape::physics::{Model, Stepper};
 use drape::scene::{Scene, load_scene_str};
-use drape::world::World;
+use drape::sim::{EnergyBound, Pipeline, SimState, build};
 
 /// A scene: a `size` m square sheet at `resolution`, with extra TOML appended.
 fn scene(size: Scalar, resolution: u32, z: Scalar, extra: &str) -> Scene {
@@ -36,58 +34,40 @@ damping = 0.001
     }
 }
 
-/// World, stepper and collider of a scene.
+/// A scene's simulation, stepped by the public pipeline (the run's own step:
+/// forces + integrate, collide, account, health check).
 struct Sim {
-    world: World,
-    stepper: Stepper,
-    collider: Collider,
-    stats: CollisionStats,
+    state: SimState,
+    pipe: Pipeline,
 }
 
 impl Sim {
     fn new(scene: &Scene) -> Sim {
-        let world = World::from_scene(scene).expect("world");
-        let stepper = Stepper::new(Model::from_scene(scene), &world);
-        let collider = Collider::from_scene(scene)
-            .expect("collider")
-            .expect("some");
-        Sim {
-            world,
-            stepper,
-            collider,
-            stats: CollisionStats::default(),
-        }
+        let (state, pipe) = build(scene).expect("simulation");
+        assert!(pipe.collider().is_some(), "the scene collides");
+        Sim { state, pipe }
     }
 
     fn step(&mut self, h: Scalar) {
-        self.collider.begin_step(&self.world);
-        self.stepper.contacts.clear();
-        self.stepper
-            .contacts
-            .extend_from_slice(self.collider.contacts());
-        self.stepper
-            .step(&mut self.world, h)
-            .expect("the step is solved");
-        let cloth = StepCloth {
-            pushed: &self.stepper.contact_push,
-            mass: &self.stepper.elements.mass,
-        };
-        self.collider
-            .end_step(&mut self.world, h, cloth, &mut self.stats);
+        let accepted = self.pipe.step(&mut self.state, h).expect("remesh");
+        assert!(accepted, "step rejected: {}", self.pipe.failure());
     }
 
     fn kinetic(&self) -> Scalar {
-        self.stepper.energy(&self.world).kinetic
+        self.pipe.stepper().energy(&self.state.world).kinetic
     }
 
     fn com(&self) -> Vector {
-        self.world.center_of_mass(&self.stepper.elements.mass)
+        self.state
+            .world
+            .center_of_mass(&self.pipe.stepper().elements.mass)
     }
 
     fn com_velocity(&self) -> Vector {
-        let m = &self.stepper.elements.mass;
+        let m = &self.pipe.stepper().elements.mass;
         let total: Scalar = m.iter().sum();
-        self.world
+        self.state
+            .world
             .v
             .iter()
             .zip(m)
@@ -126,6 +106,7 @@ fn sheet_rests_on_a_plane_and_on_a_sphere_without_sinking() {
         for _ in 0..2000 {
             sim.step(h);
             let d = sim
+                .state
                 .world
                 .x
                 .iter()
@@ -137,14 +118,14 @@ fn sheet_rests_on_a_plane_and_on_a_sphere_without_sinking() {
         println!(
             "rest on {}: closest vertex {worst:.6} m from the surface (thickness {THICK}), kinetic energy after 2 s {ke:.3e} J, {:.0} contacts/step",
             obstacle.lines().next().unwrap_or(""),
-            sim.stats.mean_contacts()
+            sim.state.ledger.collision.mean_contacts()
         );
         assert!(
             worst >= THICK * (1.0 - 1e-6),
             "a vertex came {worst} m from the surface"
         );
         assert!(ke < 1e-5, "kinetic energy {ke} J: not at rest");
-        assert_eq!(sim.stats.max_penetration, 0.0);
+        assert_eq!(sim.state.ledger.collision.max_penetration, 0.0);
     }
 }
 
@@ -168,14 +149,17 @@ fn a_20_m_per_s_sheet_does_not_tunnel_through_a_5_mm_box() {
             _ => drape::scene::Integrator::SymplecticEuler,
         };
         let mut sim = Sim::new(&s);
-        for v in &mut sim.world.v {
+        for v in &mut sim.state.world.v {
             *v = Vector::new(0.0, 0.0, -20.0);
         }
+        // The run's energy bound includes the kinetic energy given here.
+        sim.state.ledger.bound = EnergyBound::new(&sim.state.world, sim.pipe.stepper());
         let mut lowest: Scalar = Scalar::INFINITY;
         let steps = (0.1 / dt) as usize;
         for _ in 0..steps {
             sim.step(dt);
             let z = sim
+                .state
                 .world
                 .x
                 .iter()
@@ -327,12 +311,12 @@ fn crumpled_sheet_does_not_intersect_itself() {
     for _ in 0..600 {
         sim.step(h);
     }
-    let bad = intersecting_pairs(&sim.world.mesh.triangles, &sim.world.x);
-    let st = &sim.stats;
+    let bad = intersecting_pairs(&sim.state.world.mesh.triangles, &sim.state.world.x);
+    let st = &sim.state.ledger.collision;
     println!(
         "crumple (24, 1.2 s): {} intersecting non-adjacent triangle pairs of {} triangles; {:.0} pairs tested/step, culled fraction {:.3}, kinetic energy {:.3e} J",
         bad.len(),
-        sim.world.mesh.triangles.len(),
+        sim.state.world.mesh.triangles.len(),
         st.mean_self_pairs_tested(),
         st.self_culled_fraction(),
         sim.kinetic()
@@ -353,7 +337,7 @@ fn volino_culling_removes_most_pair_tests_on_a_gently_curved_sheet() {
     for _ in 0..200 {
         sim.step(1e-3);
     }
-    let st = sim.stats;
+    let st = sim.state.ledger.collision;
     let mut off = s.clone();
     if let Some(sc) = off.self_collision.as_mut() {
         sc.culling = false;
@@ -366,10 +350,12 @@ fn volino_culling_removes_most_pair_tests_on_a_gently_curved_sheet() {
         "Volino culling on a gently curved sheet: culled fraction {:.3}; {:.0} triangle pairs tested/step with culling, {:.0} without",
         st.self_culled_fraction(),
         st.mean_self_pairs_tested(),
-        plain.stats.mean_self_pairs_tested()
+        plain.state.ledger.collision.mean_self_pairs_tested()
     );
     assert!(st.self_culled_fraction() > 0.5);
-    assert!(st.mean_self_pairs_tested() < 0.5 * plain.stats.mean_self_pairs_tested());
+    assert!(
+        st.mean_self_pairs_tested() < 0.5 * plain.state.ledger.collision.mean_self_pairs_tested()
+    );
 }
 
 #[test]
@@ -385,7 +371,11 @@ fn collisions_are_identical_at_any_thread_count() {
             for _ in 0..300 {
                 sim.step(0.002);
             }
-            (sim.world.x, sim.stats.contacts, sim.stats.self_resolved)
+            (
+                sim.state.world.x,
+                sim.state.ledger.collision.contacts,
+                sim.state.ledger.collision.self_resolved,
+            )
         })
     };
     let (a, b) = (run(1), run(3));
@@ -407,7 +397,7 @@ fn a_broken_obstacle_obj_is_a_clear_error() {
         1.0,
         &format!("[[obstacle]]\nshape = \"mesh\"\npath = \"{garbage}\""),
     );
-    let e = Collider::from_scene(&s).expect_err("garbage OBJ");
+    let e = drape::collide::Collider::from_scene(&s).expect_err("garbage OBJ");
     println!("{e}");
     assert!(e.to_string().contains("garbage.obj"), "{e}");
     let missing = load_scene_str(
@@ -443,16 +433,18 @@ friction_kinetic = 0.4
 "#,
     );
     let mut sim = Sim::new(&s);
-    let e0 = sim.stepper.energy(&sim.world).total();
+    let e0 = sim.pipe.stepper().energy(&sim.state.world).total();
     let mut e_max: Scalar = e0;
     for _ in 0..200 {
         sim.step(0.004);
-        e_max = e_max.max(sim.stepper.energy(&sim.world).total());
+        e_max = e_max.max(sim.pipe.stepper().energy(&sim.state.world).total());
     }
-    let mesh = &sim.world.mesh;
+    let mesh = &sim.state.world.mesh;
     let max_strain = (0..mesh.edges.len())
         .map(|e| {
-            let [a, b] = mesh.edges[e].vertices.map(|v| sim.world.x[v as usize]);
+            let [a, b] = mesh.edges[e]
+                .vertices
+                .map(|v| sim.state.world.x[v as usize]);
             a.distance(b) / mesh.rest_length(e) - 1.0
         })
         .fold(0.0, Scalar::max);
@@ -484,5 +476,5 @@ fn self_collision_with_one_triangle_patches_does_not_panic() {
     for _ in 0..5 {
         sim.step(1e-3);
     }
-    assert!(sim.world.x.iter().all(|p| p.is_finite()));
+    assert!(sim.state.world.x.iter().all(|p| p.is_finite()));
 }

@@ -21,6 +21,7 @@ mod physics;
 mod recording;
 mod recording_run;
 mod scene_errors;
+mod sim;
 mod solver;
 mod stability;
 mod statics;

@@ -243,11 +243,26 @@ fn size_and_time_per_frame() {
     let big = grid(100);
     let (b1, _) = record_mesh(&one, &big, 1, std::time::Duration::ZERO).expect("recording");
     let (b11, t) = record_mesh(&many, &big, 11, std::time::Duration::ZERO).expect("recording");
+    let per_triangle = (b11 - b1) as f64 / 10.0 / big.triangles.len() as f64;
     println!(
-        "{} triangles: {:.0} kB/frame, record_frame {:.2} ms/frame",
+        "{} triangles: {:.0} kB/frame ({per_triangle:.2} B per triangle per frame), record_frame {:.2} ms/frame",
         big.triangles.len(),
         (b11 - b1) as f64 / 10.0 / 1000.0,
         t.as_secs_f64() * 1e3
+    );
+    // Every frame adds bytes (positions change), and batching frames into one chunk
+    // costs less per frame than a chunk per frame.
+    assert!(s101 > s1 && s4 > s1, "frames add bytes: {s1} {s101} {s4}");
+    assert!(
+        (s101 - s1) as f64 / 100.0 < (s4 - s1) as f64 / 3.0,
+        "batched frames cost less per frame"
+    );
+    // Topology constant, no edges: positions only after the first frame (shared
+    // vertices, triangles logged once). Budget of issue 15: 16 B per triangle per
+    // frame for a uniform scene without edges.
+    assert!(
+        per_triangle <= 16.0,
+        "{per_triangle:.2} B per triangle per frame on a constant topology"
     );
     std::fs::remove_file(&one).ok();
     std::fs::remove_file(&many).ok();

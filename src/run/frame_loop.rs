@@ -1,0 +1,306 @@
+//! [`FrameLoop`]: a run frame by frame — advance the simulation, observe and record
+//! the frame, and summarise at the end.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use super::recording::{self, FrameTiming, Snapshot};
+use super::tally::{Tally, TallyEnd};
+use super::{FrameState, Progress, RunError, RunOptions};
+use crate::adapt::Adapter;
+use crate::math::{Scalar, Vector};
+use crate::record::{RecordError, RecordTarget, Recorder, obj::write_frame_obj};
+use crate::scene::Scene;
+use crate::sim::{FrameFailed, MAX_STEP_HALVINGS, Pipeline, SimState, StepFailure};
+use crate::summary::Summary;
+
+/// A run in progress: the simulation, its outputs and its running statistics.
+/// [`FrameLoop::new`] opens the outputs; then, per frame, [`FrameLoop::record`]
+/// and [`FrameLoop::advance`]; [`FrameLoop::finish`] closes the recording and makes
+/// the summary.
+pub struct FrameLoop<'a> {
+    scene: &'a Scene,
+    state: SimState,
+    pipeline: Pipeline,
+    recorder: Option<Recorder>,
+    record_path: Option<PathBuf>,
+    obj_dir: Option<PathBuf>,
+    record_every: u64,
+    /// Frames after the initial one.
+    frames: u64,
+    frame_interval: Scalar,
+    /// The frame the state is at.
+    frame: u64,
+    tally: Tally,
+    started: Instant,
+    sim_seconds: Scalar,
+    record_seconds: Scalar,
+    /// Wall time of the last frame's stepping and of the last recorded frame's recording.
+    timing: FrameTiming,
+    recorded_frames: u64,
+    last_recorded: Option<u64>,
+    normals: Vec<Vector>,
+    interrupted: bool,
+    /// The frame whose steps all failed, and how.
+    failure: Option<(u64, FrameFailure)>,
+}
+
+/// How a frame's steps failed (from [`FrameFailed::Steps`]).
+#[derive(Debug, Clone, Copy)]
+struct FrameFailure {
+    last_dt: Scalar,
+    what: StepFailure,
+    step: u64,
+}
+
+impl<'a> FrameLoop<'a> {
+    /// A run of `scene` from the built simulation `(state, pipeline)`
+    /// ([`crate::sim::build`]); opens the recording and the OBJ directory.
+    pub fn new(
+        scene: &'a Scene,
+        (state, pipeline): (SimState, Pipeline),
+        opts: &RunOptions,
+    ) -> Result<FrameLoop<'a>, RunError> {
+        let recorder = match (&opts.record, &opts.live) {
+            (None, None) => None,
+            (file, live) => {
+                let target = RecordTarget {
+                    file: file.clone(),
+                    live: live.clone(),
+                };
+                let coarsen = scene.adapt.as_ref().map(|a| a.coarsen_angle);
+                Some(Recorder::open(
+                    &target,
+                    &scene.name,
+                    opts.edges.resolve(coarsen),
+                )?)
+            }
+        };
+        if let Some(dir) = &opts.obj_dir {
+            std::fs::create_dir_all(dir).map_err(|source| RecordError::Obj {
+                path: dir.clone(),
+                source,
+            })?;
+        }
+        let frames = (scene.simulation.duration * scene.simulation.frame_rate)
+            .round()
+            .max(1.0) as u64;
+        let tally = Tally::new(&state.world, pipeline.stepper());
+        Ok(FrameLoop {
+            scene,
+            state,
+            pipeline,
+            recorder,
+            record_path: opts.record.clone(),
+            obj_dir: opts.obj_dir.clone(),
+            record_every: opts.record_every.max(1),
+            frames,
+            frame_interval: 1.0 / scene.simulation.frame_rate,
+            frame: 0,
+            tally,
+            started: Instant::now(),
+            sim_seconds: 0.0,
+            record_seconds: 0.0,
+            timing: FrameTiming::default(),
+            recorded_frames: 0,
+            last_recorded: None,
+            normals: Vec::new(),
+            interrupted: false,
+            failure: None,
+        })
+    }
+
+    /// True when the state is at the last frame.
+    pub fn at_end(&self) -> bool {
+        self.frame >= self.frames
+    }
+
+    /// Progress after the frame the state is at.
+    pub fn progress(&self) -> Progress {
+        Progress {
+            frame: self.frame + 1,
+            frames: self.frames + 1,
+            sim_time: self.state.world.time,
+        }
+    }
+
+    /// Notes that the run was interrupted (Ctrl-C) before the next frame.
+    pub fn interrupt(&mut self) {
+        self.interrupted = true;
+    }
+
+    /// Advances the simulation by one frame. False when every step size tried
+    /// failed: the state is back at the frame's start, and [`FrameLoop::finish`]
+    /// reports the failure.
+    pub fn advance(&mut self) -> Result<bool, RunError> {
+        let t0 = Instant::now();
+        match self
+            .pipeline
+            .advance_frame(&mut self.state, self.frame_interval)
+        {
+            Ok(_) => {}
+            Err(FrameFailed::Steps {
+                last_dt,
+                failure,
+                step,
+            }) => {
+                let what = failure;
+                self.failure = Some((
+                    self.frame + 1,
+                    FrameFailure {
+                        last_dt,
+                        what,
+                        step,
+                    },
+                ));
+                return Ok(false);
+            }
+            Err(FrameFailed::Remesh(e)) => return Err(RunError::Remesh(e)),
+        }
+        self.frame += 1;
+        self.timing.sim_s = t0.elapsed().as_secs_f64();
+        self.sim_seconds += self.timing.sim_s;
+        Ok(true)
+    }
+
+    /// Observes the frame the state is at (statistics, `observe`) and records it
+    /// when it is due (every `record_every`-th frame and the last).
+    pub fn record(
+        &mut self,
+        observe: &mut (dyn FnMut(&FrameState) + Send),
+    ) -> Result<(), RunError> {
+        let world = &self.state.world;
+        let energy = self.pipeline.stepper().energy(world);
+        self.tally.observe(world, energy);
+        observe(&FrameState {
+            frame: self.frame,
+            sim_time: world.time,
+            positions: &world.x,
+            material: &world.mesh.material,
+            triangles: &world.mesh.triangles,
+        });
+        if self.frame.is_multiple_of(self.record_every) || self.frame == self.frames {
+            self.record_now()?;
+        }
+        if self.recorder.is_none() {
+            // Nobody takes the events: drop them rather than let them pile up.
+            self.state.adapter.as_mut().map(Adapter::take_events);
+        }
+        Ok(())
+    }
+
+    /// Records the current frame and exports its OBJ.
+    fn record_now(&mut self) -> Result<(), RunError> {
+        let t1 = Instant::now();
+        if let Some(rec) = self.recorder.as_mut() {
+            let snap = Snapshot {
+                frame: self.frame,
+                energy: self.pipeline.stepper().energy(&self.state.world),
+                timing: self.timing,
+            };
+            let (state, pipeline) = (&mut self.state, &mut self.pipeline);
+            recording::record_state(rec, state, pipeline, &snap, &mut self.normals)?;
+            self.recorded_frames += 1;
+            self.last_recorded = Some(self.frame);
+        }
+        if let Some(dir) = &self.obj_dir {
+            let w = &self.state.world;
+            write_frame_obj(dir, self.frame, &w.x, &w.mesh.material, &w.mesh.triangles)?;
+        }
+        self.timing.record_s = t1.elapsed().as_secs_f64();
+        self.record_seconds += self.timing.record_s;
+        Ok(())
+    }
+
+    /// Ends the run: records the last good frame if `record_every` left it out
+    /// (a run stopped early), closes the recording and returns the summary, or
+    /// [`RunError::Numerical`] (with the summary) when a frame failed.
+    pub fn finish(mut self) -> Result<Summary, RunError> {
+        if self.recorder.is_some() && self.last_recorded != Some(self.frame) {
+            let t1 = Instant::now();
+            let snap = Snapshot {
+                frame: self.frame,
+                energy: self.pipeline.stepper().energy(&self.state.world),
+                timing: self.timing,
+            };
+            if let Some(rec) = self.recorder.as_mut() {
+                let (state, pipeline) = (&mut self.state, &mut self.pipeline);
+                recording::record_state(rec, state, pipeline, &snap, &mut self.normals)?;
+            }
+            self.recorded_frames += 1;
+            self.record_seconds += t1.elapsed().as_secs_f64();
+        }
+        let recording = match self.recorder.take() {
+            Some(rec) => {
+                let bytes = rec.finish()?;
+                let frames = self.recorded_frames;
+                self.record_path.take().map(|path| (path, bytes, frames))
+            }
+            None => None,
+        };
+        let summary = self.summary(recording);
+        match self.failure {
+            None => Ok(summary),
+            Some((frame, f)) => Err(RunError::Numerical {
+                step: f.step,
+                failure: f.what,
+                frame,
+                time: self.state.world.time,
+                halvings: MAX_STEP_HALVINGS,
+                dt: f.last_dt,
+                cause: format!(
+                    "step {:.3e} s with the {:?} integrator; try a smaller `simulation.dt`, `dt = \"auto\"`, or `integrator = \"implicit\"`{}",
+                    self.pipeline.step_size(&self.state.world),
+                    self.pipeline.stepper().model.integrator,
+                    solver_hint(&f.what)
+                ),
+                summary: Box::new(summary),
+            }),
+        }
+    }
+
+    fn summary(&mut self, recording: Option<(PathBuf, u64, u64)>) -> Summary {
+        let (state, pipe) = (&self.state, &mut self.pipeline);
+        let dt = if state.effort.min_dt.is_finite() {
+            state.effort.min_dt
+        } else {
+            pipe.step_size(&state.world)
+        };
+        let stepper = pipe.stepper();
+        self.tally.finish(TallyEnd {
+            scene: self.scene.name.clone(),
+            frames: self.frame + 1,
+            sim_time: state.world.time,
+            wall_time_s: self.started.elapsed().as_secs_f64(),
+            sim_wall_s: self.sim_seconds,
+            record_wall_s: self.record_seconds,
+            dt,
+            interrupted: self.interrupted,
+            recording,
+            state,
+            mass_final: stepper.elements.total_mass(),
+            cusick: pipe
+                .collider()
+                .and_then(|c| c.cusick(self.scene, &state.world)),
+            cantilever: crate::cantilever::for_run(
+                self.scene,
+                &state.world,
+                &stepper.model.material,
+            ),
+        })
+    }
+}
+
+/// What else to try when the implicit solver failed.
+fn solver_hint(failure: &StepFailure) -> &'static str {
+    use crate::physics::SolveFailure;
+    match failure {
+        StepFailure::Solver(SolveFailure::NotConverged { .. }) => {
+            "; or let the linear solve converge: `simulation.solver = \"direct\"`, a larger `simulation.cg_max_iterations` or `simulation.cg_tolerance`"
+        }
+        StepFailure::Solver(SolveFailure::NewtonNotConverged { .. }) => {
+            "; or allow more `simulation.newton_iterations` or a larger `simulation.newton_tolerance`"
+        }
+        _ => "",
+    }
+}

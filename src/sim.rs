@@ -1,0 +1,65 @@
+//! One simulation as two values, in the manner of rapier's sets and pipeline:
+//!
+//! - [`SimState`]: everything a run's result depends on that changes as it runs
+//!   (mesh, positions, velocities, time, pins, the adaptive hierarchy, the resting
+//!   contacts, the work ledger and the counters). It is one cloneable value, so a
+//!   frame retry or a rollback is one `clone_from` and one restore.
+//! - [`Pipeline`]: the machinery that advances a state by a step
+//!   ([`Pipeline::step`]) or a frame ([`Pipeline::advance_frame`]): the force model
+//!   and its element tables, the collision passes, the solver's factorization and
+//!   scratch memory. It holds no simulation state: it can be dropped and rebuilt
+//!   from the model and the state at any step ([`Pipeline::new`]). Only the implicit
+//!   solver's warm start and stored factorization are lost then; the next solve
+//!   starts cold and the result differs within the solve's tolerance
+//!   (`simulation.cg_tolerance`), not beyond it.
+//!
+//! A step is a short list of named phases, in [`Pipeline::step`]:
+//! **forces + integrate** (the stepper), **collide** (obstacles, then self-collision),
+//! **account** (the work of wind, pins and moving obstacles), **health check**
+//! (finite, energy below its bound), **rollback** (paper A: redo the step on a
+//! refined mesh), **adapt** (the remeshing pass).
+
+mod bound;
+mod pipeline;
+mod state;
+
+pub use bound::{EXPLOSION_FACTOR, EnergyBound, StepFailure};
+pub use pipeline::{
+    ENERGY_GAIN_TOLERANCE, FrameFailed, MAX_ENERGY_HALVINGS, MAX_STEP_HALVINGS, Pipeline,
+};
+pub use state::{Effort, Ledger, SimState};
+
+use crate::adapt::{AdaptConfig, Adapter};
+use crate::collide::{CollideError, Collider};
+use crate::physics::Model;
+use crate::scene::{Scene, TimeStep};
+use crate::world::{BuildError, World};
+
+/// Why a scene could not become a simulation.
+#[derive(Debug, thiserror::Error)]
+pub enum SimBuildError {
+    /// The cloth, its pins or its mesh could not be built.
+    #[error("{0}")]
+    Build(#[from] BuildError),
+    /// The scene's obstacles could not be built.
+    #[error("{0}")]
+    Collide(#[from] CollideError),
+}
+
+/// Builds the initial state and the pipeline of a validated scene. This is where a
+/// bad OBJ file or a pin that selects nothing is found, before any output is opened.
+pub fn build(scene: &Scene) -> Result<(SimState, Pipeline), SimBuildError> {
+    let world = World::from_scene(scene)?;
+    let model = Model::from_scene(scene);
+    let adapter = AdaptConfig::from_scene(scene.adapt.as_ref())
+        .map(|c| Adapter::new(c, &world, scene.material.density));
+    let collider = Collider::from_scene(scene)?;
+    let fixed_dt = match scene.simulation.dt {
+        TimeStep::Fixed(dt) => Some(dt),
+        TimeStep::Auto => None,
+    };
+    let multirate = scene.adapt.as_ref().is_some_and(|a| a.multirate);
+    let mut pipeline = Pipeline::new(model, &world, collider, fixed_dt, multirate);
+    let state = SimState::new(world, adapter, &mut pipeline);
+    Ok((state, pipeline))
+}

@@ -1,0 +1,389 @@
+//! [`Pipeline`]: advances a [`SimState`] by a step or a frame; holds only scratch.
+
+use super::bound::is_finite;
+use super::{SimState, StepFailure};
+use crate::adapt::edge_angles;
+use crate::collide::{Collider, StepCloth};
+use crate::math::{Scalar, Vector};
+use crate::mesh::MeshError;
+use crate::physics::{Model, StepStats, Stepper};
+use crate::world::World;
+
+/// How often a failing frame is retried with half the step before giving up.
+pub const MAX_STEP_HALVINGS: u32 = 4;
+
+/// A frame whose energy minus external work rose by more than this share of the
+/// run's energy scale ([`super::EnergyBound`]) is retried with halved steps: large
+/// steps through an impact (one vertex stopped, its neighbours still moving)
+/// stretch the springs and create energy that smaller steps do not (a tablecloth at
+/// 4 ms steps gained 1.48 J, at 1 ms none).
+pub const ENERGY_GAIN_TOLERANCE: Scalar = 0.01;
+
+/// The most halvings spent on an energy gain (the frame is then accepted).
+pub const MAX_ENERGY_HALVINGS: u32 = 3;
+
+/// Why a frame could not be advanced.
+#[derive(Debug, thiserror::Error)]
+pub enum FrameFailed {
+    /// Remeshing produced an invalid mesh (a bug: please report it).
+    #[error("adaptive remeshing: {0}")]
+    Remesh(#[from] MeshError),
+    /// Every step size tried failed; the state is back at the frame's start.
+    #[error("all step sizes failed, down to {last_dt:.3e} s: {failure}")]
+    Steps {
+        /// The last step tried, s.
+        last_dt: Scalar,
+        /// What went wrong with it.
+        failure: StepFailure,
+        /// The step (counted from the start of the run) that failed.
+        step: u64,
+    },
+}
+
+/// The machinery that advances a [`SimState`]: the stepper (force model, element
+/// tables, integrators and solver scratch), the collision passes, and buffers for
+/// restoring a rejected step or frame. See the [module docs](super) for what it may
+/// and may not hold.
+pub struct Pipeline {
+    stepper: Stepper,
+    /// Obstacle and self-collision passes (`None`: the scene has neither).
+    collider: Option<Collider>,
+    /// The user's fixed step, or `None` for `dt = "auto"`.
+    fixed_dt: Option<Scalar>,
+    /// Cache: the automatic step for the current mesh (refinement lowers the
+    /// explicit stability limit, so a remesh forgets it).
+    auto_dt: Option<Scalar>,
+    /// Cache: the air's power at the end of the last step, W (the start of the next).
+    air_power: Option<Scalar>,
+    /// Why the last rejected step failed.
+    failure: StepFailure,
+    /// The frame's start, kept for a retry (buffers reused frame to frame).
+    frame_start: Option<SimState>,
+    /// The step's start, kept for paper A's rollback.
+    step_start: StepStart,
+}
+
+/// What a rollback restores: the step's start positions, velocities, time and
+/// ledger (so the rejected attempt's work and collision counts leave no trace).
+#[derive(Default)]
+struct StepStart {
+    x: Vec<Vector>,
+    v: Vec<Vector>,
+    time: Scalar,
+    ledger: Option<super::Ledger>,
+}
+
+impl Pipeline {
+    /// The pipeline of a run with `model` on `world`'s mesh. `fixed_dt`: the
+    /// scene's step (`None`: automatic); `multirate`: paper A's multirate stepping.
+    pub fn new(
+        model: Model,
+        world: &World,
+        collider: Option<Collider>,
+        fixed_dt: Option<Scalar>,
+        multirate: bool,
+    ) -> Pipeline {
+        let mut stepper = Stepper::new(model, world);
+        stepper.multirate = multirate;
+        Pipeline {
+            stepper,
+            collider,
+            fixed_dt,
+            auto_dt: None,
+            air_power: None,
+            failure: StepFailure::NonFinite,
+            frame_start: None,
+            step_start: StepStart::default(),
+        }
+    }
+
+    /// The stepper: force model, element tables (masses), energies.
+    pub fn stepper(&self) -> &Stepper {
+        &self.stepper
+    }
+
+    /// The collision passes (`None`: the scene has neither obstacles nor self-collision).
+    pub fn collider(&self) -> Option<&Collider> {
+        self.collider.as_ref()
+    }
+
+    /// Why the last rejected step failed.
+    pub fn failure(&self) -> StepFailure {
+        self.failure
+    }
+
+    /// Advances one frame; on a rejected step (non-finite state, energy explosion,
+    /// solver failure) restores the frame's start (mesh included) and retries with
+    /// the step halved (up to [`MAX_STEP_HALVINGS`] times). A frame whose energy rose
+    /// above its bound by more than [`ENERGY_GAIN_TOLERANCE`] energy scales is
+    /// retried the same way, up to [`MAX_ENERGY_HALVINGS`] times and only while
+    /// halving helps (the gain at least halves), then accepted. Returns the number
+    /// of halvings spent.
+    pub fn advance_frame(
+        &mut self,
+        state: &mut SimState,
+        frame_interval: Scalar,
+    ) -> Result<u64, FrameFailed> {
+        let start = match self.frame_start.take() {
+            Some(mut saved) => {
+                saved.clone_from(state);
+                saved
+            }
+            None => state.clone(),
+        };
+        let result = self.retry_frame(state, &start, frame_interval);
+        self.frame_start = Some(start);
+        result
+    }
+
+    fn retry_frame(
+        &mut self,
+        state: &mut SimState,
+        start: &SimState,
+        frame_interval: Scalar,
+    ) -> Result<u64, FrameFailed> {
+        let t0 = state.world.time;
+        // E - W at the frame start: without numerical error it can only fall.
+        let balance_start = self.stepper.energy(&state.world).total() - state.ledger.work();
+        let mut last_gain = Scalar::INFINITY;
+        for halving in 0..=MAX_STEP_HALVINGS {
+            let healthy = self.steps_through(state, frame_interval, halving)?;
+            state.world.time = t0 + frame_interval;
+            if healthy {
+                let balance = self.stepper.energy(&state.world).total() - state.ledger.work();
+                let gain = balance - balance_start;
+                let retry = gain > ENERGY_GAIN_TOLERANCE * state.ledger.bound.scale
+                    && halving < MAX_ENERGY_HALVINGS
+                    && gain < 0.75 * last_gain;
+                if !retry {
+                    let excess = balance - state.ledger.bound.initial;
+                    state.ledger.excess_max = state.ledger.excess_max.max(excess);
+                    state.effort.step_halvings += halving as u64;
+                    return Ok(halving as u64);
+                }
+                last_gain = gain;
+                state.effort.energy_retries += 1;
+            }
+            state.restore(start);
+            self.mesh_changed(state);
+        }
+        let last_dt = self.step_size(&state.world) / (1u64 << MAX_STEP_HALVINGS) as Scalar;
+        Err(FrameFailed::Steps {
+            last_dt,
+            failure: self.failure,
+            step: state.ledger.steps_done + 1,
+        })
+    }
+
+    /// Steps through `frame_interval` with the current mesh's step divided by
+    /// `2^halving`, the last steps evened out so the frame ends exactly on its time.
+    /// False when a step was rejected.
+    fn steps_through(
+        &mut self,
+        state: &mut SimState,
+        frame_interval: Scalar,
+        halving: u32,
+    ) -> Result<bool, MeshError> {
+        let shrink = (1u64 << halving) as Scalar;
+        let mut done = 0.0;
+        while done < frame_interval * (1.0 - 1e-12) {
+            let remaining = frame_interval - done;
+            let target = self.step_size(&state.world) / shrink;
+            let h = remaining / (remaining / target * (1.0 - 1e-12)).ceil().max(1.0);
+            if !self.step(state, h)? {
+                return Ok(false);
+            }
+            state.effort.min_dt = state.effort.min_dt.min(h);
+            done += h;
+        }
+        Ok(true)
+    }
+
+    /// The step for the current mesh: the fixed one, or the automatic estimate.
+    pub fn step_size(&mut self, world: &World) -> Scalar {
+        if let Some(dt) = self.fixed_dt {
+            return dt;
+        }
+        *self
+            .auto_dt
+            .get_or_insert_with(|| self.stepper.auto_dt(world))
+    }
+
+    /// One step of `h` seconds, in phases: forces + integrate, collide, account,
+    /// health check (together [`Pipeline::attempt`]), rollback (paper A: redo the
+    /// step on a refined mesh when it bent past the upper threshold), adapt.
+    /// Returns false when the step was rejected ([`Pipeline::failure`] says why);
+    /// the state is then not restored (the frame retry does that).
+    pub fn step(&mut self, state: &mut SimState, h: Scalar) -> Result<bool, MeshError> {
+        let rollback = state.adapter.as_ref().is_some_and(|a| a.config.rollback);
+        let mut tries = 0;
+        loop {
+            if rollback {
+                self.remember_step_start(state);
+            }
+            if let Err(why) = self.attempt(state, h) {
+                self.failure = why;
+                return Ok(false);
+            }
+            if rollback && self.rollback(state, &mut tries)? {
+                continue;
+            }
+            break;
+        }
+        state.ledger.steps_done += 1;
+        self.adapt(state)?;
+        Ok(true)
+    }
+
+    /// The phases of one attempt at a step: forces + integrate, collide, account,
+    /// health check. The contacts the last step ended in go to the implicit solve
+    /// (filtered there, see [`crate::physics::implicit`]).
+    fn attempt(&mut self, state: &mut SimState, h: Scalar) -> Result<(), StepFailure> {
+        let air0 = match self.air_power.take() {
+            Some(p) => p,
+            None => self.stepper.air_power(&state.world),
+        };
+        let pinned = self.stepper.pinned_start(&state.world);
+        self.integrate(state, h)?;
+        self.collide(state, h)?;
+        // Account: the work of the air (trapezoid over the step) and of moving pins.
+        let air1 = self.stepper.air_power(&state.world);
+        self.air_power = Some(air1);
+        state.ledger.external_work +=
+            0.5 * h * (air0 + air1) + self.stepper.pin_work(&pinned, &state.world, h);
+        // Health check.
+        state
+            .ledger
+            .bound
+            .check(&state.world, &self.stepper, state.ledger.work())
+    }
+
+    /// Forces + integrate: the stepper's step from the state's positions, velocities
+    /// and resting contacts; its counters go to the state's [`super::Effort`].
+    fn integrate(&mut self, state: &mut SimState, h: Scalar) -> Result<(), StepFailure> {
+        if let Some(c) = self.collider.as_mut() {
+            c.begin_step(&state.world);
+            // Resting contacts from the last step: the vertices are on the surface now.
+            self.stepper.contacts.clear();
+            self.stepper.contacts.extend_from_slice(&state.contacts);
+        }
+        let solved = self.stepper.step(&mut state.world, h);
+        absorb(&mut state.effort.solver, &mut self.stepper.stats);
+        solved.map_err(StepFailure::Solver)?;
+        if !is_finite(&state.world.x) {
+            return Err(StepFailure::NonFinite);
+        }
+        Ok(())
+    }
+
+    /// Collide: obstacles, then self-collision; the contacts found become the
+    /// state's resting contacts.
+    fn collide(&mut self, state: &mut SimState, h: Scalar) -> Result<(), StepFailure> {
+        let Some(c) = self.collider.as_mut() else {
+            return Ok(());
+        };
+        // An exploding state (finite but huge) must not reach the geometry code.
+        let work = state.ledger.work();
+        state
+            .ledger
+            .bound
+            .check(&state.world, &self.stepper, work)?;
+        let cloth = StepCloth {
+            pushed: &self.stepper.contact_push,
+            mass: &self.stepper.elements.mass,
+        };
+        c.end_step(&mut state.world, h, cloth, &mut state.ledger.collision);
+        state.contacts.clear();
+        state.contacts.extend_from_slice(c.contacts());
+        Ok(())
+    }
+
+    /// Saves what a rollback restores.
+    fn remember_step_start(&mut self, state: &SimState) {
+        let s = &mut self.step_start;
+        s.x.clone_from(&state.world.x);
+        s.v.clone_from(&state.world.v);
+        s.time = state.world.time;
+        s.ledger = Some(state.ledger);
+    }
+
+    /// Rollback (paper A): when the step bent an edge past the upper threshold and
+    /// rollbacks are left, restores the step's start (positions, velocities, time,
+    /// ledger), refines the marked edges and returns true (redo the step).
+    fn rollback(&mut self, state: &mut SimState, tries: &mut u32) -> Result<bool, MeshError> {
+        let Some(ad) = state.adapter.as_mut() else {
+            return Ok(false);
+        };
+        if *tries >= ad.config.max_rollbacks {
+            return Ok(false);
+        }
+        let marks = ad.refinement_marks(&state.world, &edge_angles(&state.world));
+        if marks.is_empty() {
+            return Ok(false);
+        }
+        let s = &mut self.step_start;
+        std::mem::swap(&mut state.world.x, &mut s.x);
+        std::mem::swap(&mut state.world.v, &mut s.v);
+        state.world.time = s.time;
+        if let Some(ledger) = s.ledger {
+            state.ledger = ledger;
+        }
+        ad.note_rollback(&state.world, state.ledger.steps_done);
+        ad.refine(&mut state.world, &marks, state.ledger.steps_done)?;
+        self.mesh_changed(state);
+        *tries += 1;
+        Ok(true)
+    }
+
+    /// Adapt: the remeshing pass, every `adapt.every` accepted steps.
+    fn adapt(&mut self, state: &mut SimState) -> Result<(), MeshError> {
+        if let Some(ad) = state.adapter.as_mut()
+            && state.ledger.steps_done.is_multiple_of(ad.config.every)
+            && ad.pass(&mut state.world, state.ledger.steps_done)?
+        {
+            self.mesh_changed(state);
+        }
+        Ok(())
+    }
+
+    /// After the state's mesh changed (remeshing, or a restored start): rebuilds the
+    /// force elements and forgets the step size, the air power and the (now stale)
+    /// contacts.
+    pub fn mesh_changed(&mut self, state: &mut SimState) {
+        self.stepper.rebuild(&state.world);
+        self.auto_dt = None;
+        self.air_power = None;
+        if let Some(c) = self.collider.as_mut() {
+            c.forget_contacts();
+        }
+        state.contacts.clear();
+    }
+}
+
+/// Adds a step's solver counters to the run's and clears them.
+fn absorb(total: &mut StepStats, step: &mut StepStats) {
+    let StepStats {
+        steps,
+        cg_iterations,
+        cg_capped,
+        failed_solves,
+        newton_iterations,
+        symbolic_analyses,
+        factorizations,
+        factor_solves,
+        assembly_s,
+        factorization_s,
+        solve_s,
+    } = std::mem::take(step);
+    total.steps += steps;
+    total.cg_iterations += cg_iterations;
+    total.cg_capped += cg_capped;
+    total.failed_solves += failed_solves;
+    total.newton_iterations += newton_iterations;
+    total.symbolic_analyses += symbolic_analyses;
+    total.factorizations += factorizations;
+    total.factor_solves += factor_solves;
+    total.assembly_s += assembly_s;
+    total.factorization_s += factorization_s;
+    total.solve_s += solve_s;
+}

@@ -1,0 +1,149 @@
+//! [`SimState`]: everything a run's result depends on that changes as it runs.
+
+use crate::adapt::Adapter;
+use crate::collide::CollisionStats;
+use crate::math::Scalar;
+use crate::physics::{Contact, StepStats};
+use crate::world::World;
+
+use super::{EnergyBound, Pipeline};
+
+/// The simulation state: one cloneable value (see the [module docs](super)).
+///
+/// Restoring a saved state ([`SimState::restore`]) brings back everything but the
+/// [`Effort`] counters, which measure the computer's work rather than the cloth's:
+/// a retried frame's cost stays counted.
+#[derive(Debug)]
+pub struct SimState {
+    /// Mesh, positions, velocities, time and pins.
+    pub world: World,
+    /// The adaptive hierarchy, its counters and its pending events (`None`: the
+    /// scene does not adapt).
+    pub adapter: Option<Adapter>,
+    /// The obstacle contacts the last step ended in, one per vertex (empty before
+    /// the first step, after a remesh, or without obstacles); the next implicit
+    /// step filters them (see [`crate::physics::implicit`]).
+    pub contacts: Vec<Contact>,
+    /// The energy accounting and the accepted steps.
+    pub ledger: Ledger,
+    /// What the computer did, retried work included.
+    pub effort: Effort,
+}
+
+/// The energy accounting of a run: the work done on the cloth from outside, the
+/// collision passes' counters and the bound the explosion check holds it to.
+/// Restored with the state, so a rejected attempt leaves no trace in it.
+#[derive(Debug, Clone, Copy)]
+pub struct Ledger {
+    /// Steps accepted so far.
+    pub steps_done: u64,
+    /// Work done on the cloth by wind, moving air and moving pins so far, J
+    /// (moving obstacles' is in `collision`).
+    pub external_work: Scalar,
+    /// What the collision passes did (moving obstacles' work included).
+    pub collision: CollisionStats,
+    /// The energy bound of the run, fixed at its start.
+    pub bound: EnergyBound,
+    /// Largest `E(t) - E(0) - W(t)` at the end of an accepted frame so far, J.
+    pub excess_max: Scalar,
+}
+
+impl Ledger {
+    /// Work done on the cloth from outside so far (wind, pins, moving obstacles), J.
+    pub fn work(&self) -> Scalar {
+        self.external_work + self.collision.obstacle_work
+    }
+}
+
+/// Counters of the computer's work: kept across restores.
+#[derive(Debug, Clone, Copy)]
+pub struct Effort {
+    /// The stepper's counters (steps taken, retried ones included; solves; timings).
+    pub solver: StepStats,
+    /// Smallest step taken so far, s (infinite before the first).
+    pub min_dt: Scalar,
+    /// Frames retried because their energy rose.
+    pub energy_retries: u64,
+    /// Halvings spent on frames that failed or gained energy.
+    pub step_halvings: u64,
+}
+
+impl Default for Effort {
+    fn default() -> Effort {
+        Effort {
+            solver: StepStats::default(),
+            min_dt: Scalar::INFINITY,
+            energy_retries: 0,
+            step_halvings: 0,
+        }
+    }
+}
+
+impl SimState {
+    /// The state at the start of a run (no steps taken) on `world`.
+    pub fn new(world: World, adapter: Option<Adapter>, pipeline: &mut Pipeline) -> SimState {
+        let bound = EnergyBound::new(&world, pipeline.stepper());
+        SimState {
+            world,
+            adapter,
+            contacts: Vec::new(),
+            ledger: Ledger {
+                steps_done: 0,
+                external_work: 0.0,
+                collision: CollisionStats::default(),
+                bound,
+                excess_max: 0.0,
+            },
+            effort: Effort::default(),
+        }
+    }
+
+    /// Makes `self` a copy of `saved`, keeping its own [`Effort`] and reusing its
+    /// buffers.
+    pub fn restore(&mut self, saved: &SimState) {
+        let effort = self.effort;
+        self.clone_from(saved);
+        self.effort = effort;
+    }
+}
+
+impl Clone for SimState {
+    fn clone(&self) -> SimState {
+        SimState {
+            world: self.world.clone(),
+            adapter: self.adapter.clone(),
+            contacts: self.contacts.clone(),
+            ledger: self.ledger,
+            effort: self.effort,
+        }
+    }
+
+    /// Reuses the position, velocity and contact buffers: the frame retry saves a
+    /// state every frame.
+    fn clone_from(&mut self, source: &SimState) {
+        // Destructured so that a new field cannot be forgotten here.
+        let SimState {
+            world,
+            adapter,
+            contacts,
+            ledger,
+            effort,
+        } = source;
+        let World {
+            mesh,
+            x,
+            v,
+            time,
+            pins,
+        } = world;
+        self.world.mesh.clone_from(mesh);
+        self.world.x.clone_from(x);
+        self.world.v.clone_from(v);
+        self.world.time = *time;
+        self.world.pins.clone_from(pins);
+        self.adapter.clone_from(adapter);
+        self.contacts.clone_from(contacts);
+        self.ledger = *ledger;
+        self.effort = *effort;
+    }
+}
