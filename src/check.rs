@@ -21,7 +21,7 @@ pub fn describe(scene: &Scene) -> Result<String, BuildError> {
     );
     let mut s = String::new();
     let sim = &scene.simulation;
-    let frames = (sim.duration * sim.frame_rate).round().max(1.0) as u64;
+    let frames = sim.frame_count();
     // Writing to a String cannot fail.
     let _ = writeln!(s, "scene `{}`", scene.name);
     let _ = writeln!(
@@ -165,7 +165,7 @@ pub fn describe(scene: &Scene) -> Result<String, BuildError> {
             );
         }
     }
-    let interval = 1.0 / sim.frame_rate;
+    let interval = sim.frame_interval();
     let (target, how) = match sim.dt {
         TimeStep::Fixed(dt) => (dt, "fixed".to_string()),
         TimeStep::Auto => {

@@ -82,9 +82,7 @@ impl<'a> FrameLoop<'a> {
                 source,
             })?;
         }
-        let frames = (scene.simulation.duration * scene.simulation.frame_rate)
-            .round()
-            .max(1.0) as u64;
+        let frames = scene.simulation.frame_count();
         let tally = Tally::new(&state.world, pipeline.stepper());
         Ok(FrameLoop {
             scene,
@@ -95,7 +93,7 @@ impl<'a> FrameLoop<'a> {
             obj_dir: opts.obj_dir.clone(),
             record_every: opts.record_every.max(1),
             frames,
-            frame_interval: 1.0 / scene.simulation.frame_rate,
+            frame_interval: scene.simulation.frame_interval(),
             frame: 0,
             tally,
             started: Instant::now(),

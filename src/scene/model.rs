@@ -76,6 +76,18 @@ pub struct Simulation {
     pub newton_tolerance: f64,
 }
 
+impl Simulation {
+    /// Frames after the initial one: `duration * frame_rate`, rounded, at least 1.
+    pub fn frame_count(&self) -> u64 {
+        (self.duration * self.frame_rate).round().max(1.0) as u64
+    }
+
+    /// Simulated time between two frames, s.
+    pub fn frame_interval(&self) -> f64 {
+        1.0 / self.frame_rate
+    }
+}
+
 /// The linear solver of the implicit integrator.
 #[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq, Default)]
 #[serde(rename_all = "snake_case")]

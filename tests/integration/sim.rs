@@ -203,7 +203,7 @@ thickness = 0.003
         let (one, s1) = run(1);
         let last = &one.last().expect("frames").1;
         println!(
-            "{method}: {} frames, {} vertices at the end (max {}), {} splits, {:.0} contacts/step, {} self-collision pairs/step",
+            "{method}: {} frames, {} vertices at the end (max {}), {} splits, {:.0} contacts/step, {:.0} self-collision pairs/step",
             one.len(),
             last.len(),
             s1.vertices.max,
