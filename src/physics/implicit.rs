@@ -59,14 +59,16 @@
 //! positive definite on all of space and whose solution has the prescribed parts
 //! unchanged.
 
+mod assemble;
 mod assembled;
 mod cg;
 
+use assemble::assemble;
+
 use rayon::prelude::*;
 
-use super::bending::dihedral_angle_and_gradient;
-use super::forces::{PAR_MIN, spring_force, wind_share};
-use super::shape::{SHAPE_SLOTS, ShapeJacobian, rates, spread};
+use super::forces::PAR_MIN;
+use super::shape::ShapeJacobian;
 use super::{Contact, Stepper};
 use crate::math::{Matrix3, Scalar, Vector, deterministic_sum};
 use crate::scene::Solver;
@@ -304,161 +306,6 @@ fn filtered_norm(s: &ImplicitScratch, held: &[bool]) -> Scalar {
     .sqrt()
 }
 
-/// Builds the per-element blocks, the right-hand side `b` and the diagonal. With
-/// `newton`, `b` is the residual `h f(x, v) - M (v - v0)` at the current iterate
-/// instead of Baraff and Witkin's `h f(x0, v0) - h^2 K v0`.
-fn assemble(st: &mut Stepper, w: &World, h: Scalar, newton: bool) {
-    let started = std::time::Instant::now();
-    let (el, ext) = (&st.elements, &st.model.external);
-    let (x, v) = (&w.x, &w.v);
-    let s = &mut st.implicit;
-    let n = x.len();
-    let k_term = if newton { 0.0 } else { 1.0 };
-    s.spring_block.resize(el.springs.len(), Matrix3::ZERO);
-    s.spring_slot.resize(el.springs.len(), Vector::ZERO);
-    s.spring_block
-        .par_iter_mut()
-        .zip(s.spring_slot.par_iter_mut())
-        .zip(el.springs.par_iter())
-        .with_min_len(PAR_MIN)
-        .for_each(|((block, slot), sp)| {
-            let [a, b] = [sp.v[0] as usize, sp.v[1] as usize];
-            let f = spring_force(x[a], x[b], v[a], v[b], sp.rest, sp.k, sp.c);
-            let d = x[b] - x[a];
-            let len = d.length();
-            let dir = if len > 0.0 { d / len } else { Vector::ZERO };
-            let nn = outer(dir, dir);
-            let transverse = if len > 0.0 {
-                (1.0 - sp.rest / len).max(0.0)
-            } else {
-                0.0
-            };
-            let stiff = (nn + (Matrix3::IDENTITY - nn) * transverse) * sp.k;
-            *block = stiff * (h * h) + nn * (h * sp.c);
-            *slot = f * h - stiff * (v[a] - v[b]) * (h * h * k_term);
-        });
-    let hinges = el.hinges.len();
-    s.hinge_grad.resize(4 * hinges, Vector::ZERO);
-    s.hinge_coef.resize(hinges, 0.0);
-    s.hinge_slot.resize(4 * hinges, Vector::ZERO);
-    s.hinge_grad
-        .par_chunks_exact_mut(4)
-        .zip(s.hinge_slot.par_chunks_exact_mut(4))
-        .zip(s.hinge_coef.par_iter_mut())
-        .zip(el.hinges.par_iter())
-        .with_min_len(PAR_MIN / 4)
-        .for_each(|(((grad, slot), coef), hg)| {
-            let (theta, g) = dihedral_angle_and_gradient(hg.v.map(|i| x[i as usize]));
-            let gv: Scalar = (0..4).map(|k| g[k].dot(v[hg.v[k] as usize])).sum();
-            *coef = h * h * hg.k;
-            for k in 0..4 {
-                grad[k] = g[k];
-                slot[k] = g[k] * (-h * hg.k * theta - *coef * gv * k_term);
-            }
-        });
-    // Shape triangles: slot = J^T (-h M theta - h^2 M J v).
-    s.h2 = h * h;
-    let shapes = el.shape_triangles.len();
-    s.shape_slot.resize(SHAPE_SLOTS * shapes, Vector::ZERO);
-    s.shape_grad
-        .resize(shapes, [[Vector::ZERO; SHAPE_SLOTS]; 3]);
-    s.shape_slot
-        .par_chunks_exact_mut(SHAPE_SLOTS)
-        .zip(s.shape_grad.par_iter_mut())
-        .zip(el.shape_triangles.par_iter())
-        .with_min_len(PAR_MIN / SHAPE_SLOTS)
-        .for_each(|((slot, grad), t)| {
-            let (theta, jac) = t.angles(x);
-            let jv = rates(t, &jac, v);
-            let c = t.times_m([0, 1, 2].map(|a| -h * theta[a] - h * h * jv[a] * k_term));
-            spread(&jac, c, slot);
-            *grad = jac;
-        });
-    // Wind is explicit: its force at the start of the step serves every Newton
-    // iteration (re-evaluated at each iterate, without its derivative in `A`, the
-    // iterations diverged on a flag at 10 ms steps).
-    if let Some(wind) = ext.wind.as_ref().filter(|_| !newton) {
-        s.tri_slot.resize(w.mesh.triangles.len(), Vector::ZERO);
-        s.tri_slot
-            .par_iter_mut()
-            .zip(w.mesh.triangles.par_iter())
-            .with_min_len(PAR_MIN)
-            .for_each(|(f, t)| {
-                *f = wind_share(t.map(|i| x[i as usize]), t.map(|i| v[i as usize]), wind) * h
-            });
-    }
-    s.b.resize(n, Vector::ZERO);
-    s.diag_mass.resize(n, 0.0);
-    s.inv_diag.resize(n, Vector::ZERO);
-    let (spring_slot, block, hinge_slot, hinge_grad, hinge_coef, tri_slot, v0, shape_slot) = (
-        &s.spring_slot,
-        &s.spring_block,
-        &s.hinge_slot,
-        &s.hinge_grad,
-        &s.hinge_coef,
-        &s.tri_slot,
-        &s.v0,
-        &s.shape_slot,
-    );
-    let shape_grad = &s.shape_grad;
-    // The diagonal of `A` is the Jacobi preconditioner of `solver = "cg"` only.
-    let jacobi = st.model.solver.solver == Solver::Cg;
-    s.b.par_iter_mut()
-        .zip(s.diag_mass.par_iter_mut().zip(s.inv_diag.par_iter_mut()))
-        .enumerate()
-        .with_min_len(PAR_MIN)
-        .for_each(|(i, (b, (dm, inv)))| {
-            let mut rhs = Vector::ZERO;
-            let mut diag = Vector::ZERO;
-            for &e in el.spring_first.of(i) {
-                rhs += spring_slot[e as usize];
-                diag += matrix_diagonal(&block[e as usize]);
-            }
-            for &e in el.spring_second.of(i) {
-                rhs -= spring_slot[e as usize];
-                diag += matrix_diagonal(&block[e as usize]);
-            }
-            for &k in el.hinge_slots.of(i) {
-                rhs += hinge_slot[k as usize];
-                let g = hinge_grad[k as usize];
-                diag += g * g * hinge_coef[k as usize / 4];
-            }
-            for &k in el.shape_slots.of(i) {
-                rhs += shape_slot[k as usize];
-                let (t, slot) = (k as usize / SHAPE_SLOTS, k as usize % SHAPE_SLOTS);
-                if !jacobi {
-                    continue;
-                }
-                let (m, jac) = (&el.shape_triangles[t].m, &shape_grad[t]);
-                for a in 0..3 {
-                    for b in 0..3 {
-                        diag += jac[a][slot] * jac[b][slot] * (h * h * m[a][b]);
-                    }
-                }
-            }
-            if ext.wind.is_some() {
-                for &t in el.vertex_triangles.of(i) {
-                    rhs += tri_slot[t as usize];
-                }
-            }
-            if let Some(g) = ext.gravity {
-                rhs += g * (el.mass[i] * h);
-            }
-            let mut m = el.mass[i];
-            if let Some(drag) = ext.drag {
-                rhs -= (v[i] - ext.air_velocity) * (drag * el.vertex_area[i] * h);
-                m += h * drag * el.vertex_area[i];
-            }
-            if newton {
-                rhs -= (v[i] - v0[i]) * el.mass[i];
-            }
-            *b = rhs;
-            *dm = m;
-            *inv = Vector::ONE / (diag + Vector::splat(m));
-        });
-    st.stats.assembly_s += started.elapsed().as_secs_f64();
-}
-
 /// `v` without its component along the unit vector `n` (`v` itself when `n` is zero).
 #[inline(always)]
 fn without(n: Vector, v: Vector) -> Vector {
@@ -484,12 +331,4 @@ fn contact_filters(s: &mut ImplicitScratch, contacts: &[Contact], held: &[bool],
         // (v0 + dv) . n = u_n, the tangential part of the warm start kept.
         s.dv[i] = without(c.normal, s.dv[i]) + c.normal * (c.normal_speed - v[i].dot(c.normal));
     }
-}
-
-fn outer(a: Vector, b: Vector) -> Matrix3 {
-    Matrix3::from_cols(a * b.x, a * b.y, a * b.z)
-}
-
-fn matrix_diagonal(m: &Matrix3) -> Vector {
-    Vector::new(m.x_axis.x, m.y_axis.y, m.z_axis.z)
 }
