@@ -2,6 +2,7 @@
 //! heavy dependencies (rerun) are linked once.
 
 mod adapt;
+mod adapt_cost;
 mod bad_cli;
 mod bad_input;
 mod bad_obj;
