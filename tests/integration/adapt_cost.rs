@@ -17,7 +17,7 @@ use drape::world::World;
 
 /// The draped shape at step `k`: flat over the table, hanging down beyond its
 /// edge, with a fold radius between 2 and 22 cm.
-fn drape(m: Vector2, k: usize) -> Vector {
+pub(crate) fn drape(m: Vector2, k: usize) -> Vector {
     let r = 0.02 + 0.1 * (1.0 + (k as Scalar / 6.0).cos());
     let out = (m.x.abs().max(m.y.abs()) - 0.5).max(0.0);
     // Bend through 90 degrees over an arc of length r * pi / 2, then hang.

@@ -21,6 +21,7 @@ mod metric;
 mod physics;
 mod recording;
 mod recording_run;
+mod remesh_ops;
 mod scene_errors;
 mod solver;
 mod stability;
