@@ -174,4 +174,3 @@ impl Adapter {
         Ok(map)
     }
 }
-

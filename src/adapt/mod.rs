@@ -195,7 +195,9 @@ impl Adapter {
     /// every remesh in debug builds; tests call it in release builds too.
     pub fn check(&self, world: &World) -> Result<(), ConsistencyError> {
         check_consistency(world, self.density, self.area, self.boundary)?;
-        self.hierarchy.check_tables().map_err(ConsistencyError::Tables)
+        self.hierarchy
+            .check_tables()
+            .map_err(ConsistencyError::Tables)
     }
 
     /// [`Adapter::check`] as a debug assertion (no cost in release builds).
@@ -409,4 +411,3 @@ fn red_green_event(world: &World, a: &Applied, angle: Option<Scalar>, step: u64)
         step,
     }
 }
-

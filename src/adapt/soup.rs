@@ -103,7 +103,12 @@ impl SoupOp {
             removed: self.added.clone(),
             added: self.removed.clone(),
             slots: (self.slots.1, self.slots.0),
-            touched: self.touched.iter().rev().map(|&(v, b, a)| (v, a, b)).collect(),
+            touched: self
+                .touched
+                .iter()
+                .rev()
+                .map(|&(v, b, a)| (v, a, b))
+                .collect(),
         }
     }
 }

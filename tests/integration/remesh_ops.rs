@@ -49,14 +49,13 @@ fn refused_edge_split_leaves_no_partial_work() {
         after.0.len(),
         ops.len()
     );
-    assert!(!done, "the leg's triangles would reach level 2 > max_level 1");
+    assert!(
+        !done,
+        "the leg's triangles would reach level 2 > max_level 1"
+    );
     assert_eq!(ops, Vec::new(), "a refused split reports nothing");
     assert_eq!(after, before, "a refused split changes nothing");
-    assert_eq!(
-        soup.material.len(),
-        m.material.len(),
-        "and adds no vertex"
-    );
+    assert_eq!(soup.material.len(), m.material.len(), "and adds no vertex");
 }
 
 /// A grid's forest after random splits and merges (each closed), with the
@@ -239,6 +238,9 @@ fn incremental_tables_equal_a_rebuild_over_draping_passes() {
             "{method:?}: {changed} of 30 passes changed the mesh; {} splits, {} merges",
             s.splits, s.merges
         );
-        assert!(s.splits > 0 && s.merges > 0, "{method:?} should refine and coarsen");
+        assert!(
+            s.splits > 0 && s.merges > 0,
+            "{method:?} should refine and coarsen"
+        );
     }
 }

@@ -61,7 +61,11 @@ impl RedGreen {
 
     fn unmerge(&mut self, n: u32, done: &Applied) {
         let kept = self.free.len() - done.children.len();
-        debug_assert_eq!(self.free[kept..], done.children, "children on the free list");
+        debug_assert_eq!(
+            self.free[kept..],
+            done.children,
+            "children on the free list"
+        );
         self.free.truncate(kept);
         self.remove_leaf_edges(n);
         for &(edge, m) in &done.midpoints {
