@@ -15,8 +15,20 @@
 //!   remove a pinned vertex or a boundary corner, keep boundary vertices on the
 //!   boundary, refuse to invert or pinch the mesh (link condition).
 //!
-//! The pass works on a triangle soup with incidence lists; the adapter then
-//! compacts it and transfers the state (`transfer.rs`).
+//! The pass works on a triangle soup with incidence lists (`soup.rs`); every
+//! split, flip and collapse is first planned as a [`SoupOp`] value from the
+//! guards' reading of the soup and only then committed, so a refused
+//! operation never touches the soup. A split whose longest-edge chain ends in
+//! a refusal undoes the chain's committed splits through their inverses.
+//! The adapter then compacts the soup and transfers the state
+//! (`transfer.rs`).
+//!
+//! Issue 13, measured: before, a refused split left its chain's splits in
+//! the mesh and counted them. Making splits atomic changes the flag scene
+//! (the one scene on this method): 1 s of it made 2187 splits and 102
+//! collapses before and 2270 and 50 now. The same build with the undo
+//! switched off reproduced the old summary exactly, so atomicity is the whole
+//! difference.
 
 use crate::math::{Scalar, Vector2};
 

@@ -12,6 +12,10 @@
 //! were sorted then too and every forward result is unchanged), so removing the
 //! added triangles and putting back the removed ones gives the same lists; the
 //! slot count is recorded and restored, so new slots get the same ids again.
+//! An undo that put the removed triangles back in fresh slots (as `kill` and
+//! `add` did before) was the first idea and does not work: the live order, and
+//! so the world's triangle order after compaction, would change with each
+//! refused split.
 
 use crate::math::Vector2;
 use crate::mesh::PairMap;
