@@ -10,9 +10,10 @@
 //! each binary, medians of the 60-pass totals; issue 13 items 4 and 5):
 //! * red_green: 745 ms before, 488 ms after (-35%), the same 4936 splits and
 //!   3308 merges. The gain is the in-place `remap` (no table rebuild when a
-//!   pass only refined), the pair hasher, and no per-edge `Vec` in the tables.
+//!   pass only refined) and the pair hasher; not measured apart.
 //! * edge: 971 ms before, 796 ms after, but not the same work: atomic splits
-//!   make 4350 splits and 2418 collapses instead of 4816 and 2839.
+//!   make 4350 splits and 2418 collapses instead of 4816 and 2839 (the soup
+//!   also lost its per-edge `Vec` and SipHash).
 //!
 //! The whole tablecloth scene (0.5 s simulated, 3 runs each) gives identical
 //! summaries; its wall times (base 131, 171, 133 s; after 167, 111, 149 s)
