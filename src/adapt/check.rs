@@ -46,6 +46,9 @@ pub enum ConsistencyError {
         /// Density times area.
         want: Scalar,
     },
+    /// An incrementally kept lookup table differs from a rebuild.
+    #[error("adapted mesh: {0}")]
+    Tables(String),
     /// Position and velocity arrays do not match the mesh.
     #[error("world has {arrays} positions/velocities for {vertices} vertices")]
     Arrays {

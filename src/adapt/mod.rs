@@ -8,21 +8,22 @@
 
 mod check;
 pub mod edge;
+mod edge_pass;
 pub mod red_green;
+pub mod soup;
 pub mod transfer;
+mod tri_list;
 
-pub use check::{ConsistencyError, check_consistency};
-
-use std::collections::HashMap;
+pub use check::{ConsistencyError, boundary_length, check_consistency};
 
 use rayon::prelude::*;
 
-use crate::math::{Scalar, Vector, Vector2};
+use crate::math::{Scalar, Vector};
 use crate::mesh::MeshError;
 use crate::scene::{Adapt, AdaptMethod};
 use crate::world::World;
 use red_green::{Applied, RedGreen, RedGreenOp};
-use transfer::{Origin, Remeshed, transfer};
+use transfer::{compact, transfer};
 
 /// What happened, for the recording and the counters.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -133,6 +134,9 @@ pub struct Adapter {
     density: Scalar,
     /// Limits of the edge method (`None` for red_green).
     edge: Option<edge::Limits>,
+    /// Rest area and boundary length of the cloth, for [`Adapter::check`].
+    area: Scalar,
+    boundary: Scalar,
 }
 
 /// Angle in degrees between the normals of the two triangles at each edge
@@ -180,6 +184,28 @@ impl Adapter {
             owner,
             density,
             edge,
+            area: m.total_rest_area(),
+            boundary: boundary_length(m),
+        }
+    }
+
+    /// Checks the adapted world (manifold, conforming, positive rest areas,
+    /// exact mass: [`check_consistency`] against the cloth this adapter
+    /// started from) and the red-green tables against a rebuild. Runs after
+    /// every remesh in debug builds; tests call it in release builds too.
+    pub fn check(&self, world: &World) -> Result<(), ConsistencyError> {
+        check_consistency(world, self.density, self.area, self.boundary)?;
+        self.hierarchy
+            .check_tables()
+            .map_err(ConsistencyError::Tables)
+    }
+
+    /// [`Adapter::check`] as a debug assertion (no cost in release builds).
+    fn debug_check(&self, world: &World) {
+        if cfg!(debug_assertions)
+            && let Err(e) = self.check(world)
+        {
+            panic!("after remeshing: {e}");
         }
     }
 
@@ -300,7 +326,10 @@ impl Adapter {
     }
 
     /// Applies operations (each with the angle that asked for it), closes the
-    /// mesh and moves the world onto it.
+    /// mesh and moves the world onto it. Atomic: if the world cannot take the
+    /// new mesh, the hierarchy's operations are undone (newest first, see
+    /// [`RedGreen::undo`]) and the world, the counters and the events stay as
+    /// they were.
     pub fn apply(
         &mut self,
         world: &mut World,
@@ -319,45 +348,35 @@ impl Adapter {
         if applied.is_empty() {
             return Ok(false);
         }
-        for (a, angle) in applied.iter().zip(asked) {
-            let centre = a
-                .vertices
-                .iter()
-                .map(|&v| world.x[v as usize])
-                .sum::<Vector>()
-                / 3.0;
-            let kind = match a.op {
-                RedGreenOp::Merge(_) => {
-                    self.stats.merges += 1;
-                    EventKind::Merge
-                }
-                RedGreenOp::Split(_) if a.forced => {
-                    self.stats.splits += 1;
-                    self.stats.closure_splits += 1;
-                    EventKind::ClosureSplit
-                }
+        let events: Vec<AdaptEvent> = applied
+            .iter()
+            .zip(asked)
+            .map(|(a, angle)| red_green_event(world, a, angle, step))
+            .collect();
+        if let Err(e) = self.rebuild_world(world) {
+            for a in applied.iter().rev() {
+                self.hierarchy.undo(a);
+            }
+            return Err(e);
+        }
+        for a in &applied {
+            match a.op {
+                RedGreenOp::Merge(_) => self.stats.merges += 1,
                 RedGreenOp::Split(_) => {
                     self.stats.splits += 1;
-                    EventKind::Split
+                    self.stats.closure_splits += a.forced as u64;
                 }
-            };
-            let angle = if a.forced { None } else { angle };
-            self.events.push(AdaptEvent {
-                kind,
-                position: centre,
-                level: a.level,
-                angle,
-                step,
-            });
+            }
         }
+        self.events.extend(events);
         self.stats.changed_passes += 1;
         self.stats.max_ops_per_pass = self.stats.max_ops_per_pass.max(applied.len() as u64);
-        self.rebuild_world(world)?;
+        self.debug_check(world);
         Ok(true)
     }
 
     /// Builds the conforming mesh from the hierarchy, compacts the vertices and
-    /// transfers the world's state onto it.
+    /// transfers the world's state onto it (the world is unchanged on error).
     fn rebuild_world(&mut self, world: &mut World) -> Result<(), MeshError> {
         let (tris, levels, owner) = self.hierarchy.build();
         let (first_new, created) = self.hierarchy.created();
@@ -370,179 +389,25 @@ impl Adapter {
     }
 }
 
-impl Adapter {
-    /// The stated minimum angle of the edge method, degrees (`None` for red_green).
-    pub fn min_angle(&self) -> Option<Scalar> {
-        self.edge.map(|l| l.min_angle)
-    }
-
-    /// One pass of paper B's method: split edges above the upper threshold
-    /// (longest-edge bisection), flip around the new vertices for quality, then
-    /// collapse short edges at vertices whose every edge is flat.
-    fn edge_pass(
-        &mut self,
-        world: &mut World,
-        step: u64,
-        limits: edge::Limits,
-    ) -> Result<bool, MeshError> {
-        let angles = edge_angles(world);
-        self.stats.passes += 1;
-        let m = &world.mesh;
-        let mut soup = edge::Soup::new(&m.material, &m.triangles, &m.levels);
-        let mut ops = Vec::new();
-        let mut marks: Vec<(usize, Scalar)> = angles
-            .iter()
-            .enumerate()
-            .filter(|(_, a)| **a > self.config.refine_angle)
-            .map(|(e, a)| (e, *a))
-            .collect();
-        marks.sort_by(|x, y| y.1.total_cmp(&x.1).then(x.0.cmp(&y.0)));
-        let mut asked: HashMap<(u32, u32), Scalar> = HashMap::new();
-        for &(e, a) in &marks {
-            let [p, q] = m.edges[e].vertices;
-            asked.insert((p.min(q), p.max(q)), a);
-            soup.split(p, q, &limits, &mut ops, 0);
-        }
-        let seeds: Vec<u32> = (soup.first_new..soup.material.len() as u32).collect();
-        soup.flip_around(&seeds, &limits, &mut ops);
-        // Flat vertices: every edge at them below both thresholds' limit.
-        let flat_limit = self
-            .config
-            .coarsen_angle
-            .min(0.5 * self.config.refine_angle);
-        let mut vertex_max = vec![0.0 as Scalar; m.vertex_count()];
-        for (e, edge) in m.edges.iter().enumerate() {
-            for &v in &edge.vertices {
-                vertex_max[v as usize] = vertex_max[v as usize].max(angles[e]);
-            }
-        }
-        let mut pinned = vec![false; m.vertex_count()];
-        for a in &world.pins.anchors {
-            pinned[a.vertex as usize] = true;
-        }
-        let mut by_length: Vec<(Scalar, u32, u32)> = m
-            .edges
-            .iter()
-            .filter(|e| {
-                e.vertices
-                    .iter()
-                    .all(|&v| vertex_max[v as usize] < flat_limit)
-            })
-            .map(|e| {
-                let [a, b] = e.vertices;
-                (
-                    m.material[a as usize].distance(m.material[b as usize]),
-                    a,
-                    b,
-                )
-            })
-            .filter(|&(len, _, _)| len < limits.collapse_below)
-            .collect();
-        by_length.sort_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))));
-        for (_, a, b) in by_length {
-            // Remove the vertex made later (refinement vertices carry larger ids).
-            let (v, u) = if a > b { (a, b) } else { (b, a) };
-            if !soup.collapse(v, u, &pinned, &limits, &mut ops) {
-                soup.collapse(u, v, &pinned, &limits, &mut ops);
-            }
-        }
-        if ops.is_empty() {
-            return Ok(false);
-        }
-        let map = self.rebuild_from_soup(world, &soup)?;
-        for op in &ops {
-            let at = |v: u32| {
-                world
-                    .x
-                    .get(map[v as usize] as usize)
-                    .copied()
-                    .unwrap_or(Vector::ZERO)
-            };
-            let (kind, position, angle) = match *op {
-                edge::EdgeOp::Split(a, b) => {
-                    self.stats.splits += 1;
-                    (
-                        EventKind::Split,
-                        (at(a) + at(b)) * 0.5,
-                        asked.get(&(a.min(b), a.max(b))).copied(),
-                    )
-                }
-                edge::EdgeOp::Flip(a, b) => {
-                    self.stats.flips += 1;
-                    (EventKind::Flip, (at(a) + at(b)) * 0.5, None)
-                }
-                edge::EdgeOp::Collapse(_, u) => {
-                    self.stats.merges += 1;
-                    (EventKind::Collapse, at(u), None)
-                }
-            };
-            let level = world.mesh.levels.iter().copied().max().unwrap_or(0);
-            self.events.push(AdaptEvent {
-                kind,
-                position,
-                level,
-                angle,
-                step,
-            });
-        }
-        self.stats.changed_passes += 1;
-        self.stats.max_ops_per_pass = self.stats.max_ops_per_pass.max(ops.len() as u64);
-        Ok(true)
-    }
-
-    /// Compacts the soup's live vertices and moves the world onto it; returns the
-    /// map from soup vertex ids to new indices (`u32::MAX` for removed ones).
-    fn rebuild_from_soup(
-        &mut self,
-        world: &mut World,
-        soup: &edge::Soup,
-    ) -> Result<Vec<u32>, MeshError> {
-        let (tris, levels) = soup.live();
-        let (map, remeshed) = compact(&soup.material, soup.first_new, &soup.created, &tris, levels);
-        transfer(world, self.density, remeshed)?;
-        Ok(map)
-    }
-}
-
-/// Keeps the vertices the triangles use, in their order: returns the map from
-/// old ids to new indices (`u32::MAX` for dropped ones) and the new topology.
-/// Ids below `first_new` are old world vertices; `created[k]` is the parent edge
-/// of vertex `first_new + k`.
-fn compact(
-    material: &[Vector2],
-    first_new: u32,
-    created: &[(u32, u32)],
-    tris: &[[u32; 3]],
-    levels: Vec<u8>,
-) -> (Vec<u32>, Remeshed) {
-    let mut used = vec![false; material.len()];
-    for t in tris {
-        for &v in t {
-            used[v as usize] = true;
-        }
-    }
-    let mut map = vec![u32::MAX; material.len()];
-    let mut kept = Vec::new();
-    for (v, _) in used.iter().enumerate().filter(|(_, u)| **u) {
-        map[v] = kept.len() as u32;
-        kept.push(v);
-    }
-    let origin = kept
+/// The event of one red-green operation, at the world's positions before the
+/// remesh (the node's corners are vertices of the old mesh).
+fn red_green_event(world: &World, a: &Applied, angle: Option<Scalar>, step: u64) -> AdaptEvent {
+    let centre = a
+        .vertices
         .iter()
-        .map(|&v| {
-            if (v as u32) < first_new {
-                Origin::Old(v as u32)
-            } else {
-                let (a, b) = created[v - first_new as usize];
-                Origin::Midpoint(map[a as usize], map[b as usize])
-            }
-        })
-        .collect();
-    let remeshed = Remeshed {
-        material: kept.iter().map(|&v| material[v]).collect(),
-        triangles: tris.iter().map(|t| t.map(|v| map[v as usize])).collect(),
-        levels,
-        origin,
+        .map(|&v| world.x[v as usize])
+        .sum::<Vector>()
+        / 3.0;
+    let kind = match a.op {
+        RedGreenOp::Merge(_) => EventKind::Merge,
+        RedGreenOp::Split(_) if a.forced => EventKind::ClosureSplit,
+        RedGreenOp::Split(_) => EventKind::Split,
     };
-    (map, remeshed)
+    AdaptEvent {
+        kind,
+        position: centre,
+        level: a.level,
+        angle: if a.forced { None } else { angle },
+        step,
+    }
 }

@@ -12,11 +12,19 @@
 //! * Levels (paper A, 2.1): a red split adds 2, a green split adds 1.
 //!
 //! Vertex ids here are the world's vertex indices; vertices created during a pass
-//! are appended, and [`RedGreen::remap`] follows the world's compaction.
+//! are appended, and [`RedGreen::remap`] follows the world's compaction
+//! (`red_green/mesh.rs`, which also builds the conforming mesh).
+//!
+//! Operations are values (issue 13): every split or merge done is reported as
+//! an [`Applied`] that records what it added and removed, and [`RedGreen::undo`]
+//! applies its exact inverse (`red_green/undo.rs`). The adapter uses it to keep
+//! a pass atomic when the world refuses the new mesh.
 
-use std::collections::HashMap;
+mod mesh;
+mod undo;
 
 use crate::math::Vector2;
+use crate::mesh::PairMap;
 
 /// Marks "no node" (a root's parent).
 const NONE: u32 = u32::MAX;
@@ -54,8 +62,10 @@ impl RedGreenOp {
     }
 }
 
-/// What a split or merge did, for events and counters.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// What a split or merge did, as a value: for events and counters, and with
+/// what it added and removed so that [`RedGreen::undo`] applies its inverse
+/// exactly (see `red_green/undo.rs`).
+#[derive(Debug, Clone, PartialEq)]
 pub struct Applied {
     /// The operation.
     pub op: RedGreenOp,
@@ -66,6 +76,15 @@ pub struct Applied {
     pub level: u8,
     /// True for a split forced by closure or 1-irregularity rather than asked for.
     pub forced: bool,
+    /// The four children the split made or the merge freed.
+    pub children: [u32; 4],
+    /// Midpoint entries (sorted edge, vertex) the split created (each with a
+    /// new vertex) or the merge dropped.
+    pub midpoints: Vec<((u32, u32), u32)>,
+    /// Split: the node count before, and the earlier contents of the free
+    /// slots its children took (restored by the undo).
+    nodes_before: u32,
+    reused: Vec<Node>,
 }
 
 /// The red forest with its lookup tables.
@@ -75,11 +94,11 @@ pub struct RedGreen {
     roots: Vec<u32>,
     free: Vec<u32>,
     /// Sorted edge -> its midpoint vertex, for every edge split by some red split.
-    mid: HashMap<(u32, u32), u32>,
+    mid: PairMap<(u32, u32), u32>,
     /// Directed half edge of a split node -> the directed edge it halves.
-    half_of: HashMap<(u32, u32), (u32, u32)>,
+    half_of: PairMap<(u32, u32), (u32, u32)>,
     /// Directed edge of a leaf (counter-clockwise) -> that leaf.
-    leaf_by_edge: HashMap<(u32, u32), u32>,
+    leaf_by_edge: PairMap<(u32, u32), u32>,
     /// Material coordinates of every vertex, including those made in this pass.
     material: Vec<Vector2>,
     /// For each vertex made in this pass (id `first_new + k`), its parent edge.
@@ -102,9 +121,9 @@ impl RedGreen {
             nodes: Vec::with_capacity(triangles.len()),
             roots: Vec::with_capacity(triangles.len()),
             free: Vec::new(),
-            mid: HashMap::new(),
-            half_of: HashMap::new(),
-            leaf_by_edge: HashMap::new(),
+            mid: PairMap::default(),
+            half_of: PairMap::default(),
+            leaf_by_edge: PairMap::default(),
             material: material.to_vec(),
             created: Vec::new(),
             first_new: material.len() as u32,
@@ -227,16 +246,28 @@ impl RedGreen {
             }
         }
         let [a, b, c] = self.vertices(t);
+        let made = self.created.len();
         let (mab, mbc, mca) = (
             self.midpoint(a, b),
             self.midpoint(b, c),
             self.midpoint(c, a),
         );
+        let midpoints = (made..self.created.len())
+            .map(|k| {
+                let (p, q) = self.created[k];
+                (sorted(p, q), self.first_new + k as u32)
+            })
+            .collect();
         let level = self.level(t) + 2;
         self.remove_leaf_edges(t);
         let corners = [[a, mab, mca], [mab, b, mbc], [mca, mbc, c], [mab, mbc, mca]];
         let mut ids = [0u32; 4];
+        let nodes_before = self.nodes.len() as u32;
+        let mut reused = Vec::new();
         for (k, v) in corners.into_iter().enumerate() {
+            if let Some(&slot) = self.free.last() {
+                reused.push(self.nodes[slot as usize].clone());
+            }
             ids[k] = self.alloc(Node {
                 v,
                 level,
@@ -255,6 +286,10 @@ impl RedGreen {
             vertices: [a, b, c],
             level,
             forced,
+            children: ids,
+            midpoints,
+            nodes_before,
+            reused,
         });
     }
 
@@ -352,12 +387,14 @@ impl RedGreen {
         for &c in &children {
             self.remove_leaf_edges(c);
         }
+        let mut midpoints = Vec::new();
         for (p, q) in edges_of(self.vertices(n)) {
             let m = self.mid[&sorted(p, q)];
             self.half_of.remove(&(p, m));
             self.half_of.remove(&(m, q));
             if self.outside_user(p, q, m).is_none() {
                 self.mid.remove(&sorted(p, q));
+                midpoints.push((sorted(p, q), m));
             }
         }
         self.nodes[n as usize].children = None;
@@ -369,6 +406,10 @@ impl RedGreen {
             vertices: self.vertices(n),
             level,
             forced: false,
+            children,
+            midpoints,
+            nodes_before: self.nodes.len() as u32,
+            reused: Vec::new(),
         });
     }
 
@@ -423,77 +464,5 @@ impl RedGreen {
             }
         }
         seen
-    }
-
-    /// The conforming simulation mesh: each leaf, or its two green halves when it
-    /// has one hanging node. Returns triangles, their levels and their leaf.
-    pub fn build(&self) -> (Vec<[u32; 3]>, Vec<u8>, Vec<u32>) {
-        let leaves = self.leaves();
-        let mut tris = Vec::with_capacity(leaves.len() + leaves.len() / 4);
-        let mut levels = Vec::with_capacity(tris.capacity());
-        let mut owner = Vec::with_capacity(tris.capacity());
-        for t in leaves {
-            let v = self.vertices(t);
-            let level = self.level(t);
-            let hanging = (0..3).find_map(|k| {
-                let (p, q) = (v[k], v[(k + 1) % 3]);
-                self.mid.get(&sorted(p, q)).map(|&m| (k, m))
-            });
-            match hanging {
-                None => {
-                    tris.push(v);
-                    levels.push(level);
-                    owner.push(t);
-                }
-                Some((k, m)) => {
-                    let (p, q, o) = (v[k], v[(k + 1) % 3], v[(k + 2) % 3]);
-                    tris.extend([[p, m, o], [m, q, o]]);
-                    levels.extend([level + 1, level + 1]);
-                    owner.extend([t, t]);
-                }
-            }
-        }
-        (tris, levels, owner)
-    }
-
-    /// Follows the world's vertex compaction: `map[old]` is the new index of
-    /// every surviving vertex (`u32::MAX` for removed ones).
-    pub fn remap(&mut self, map: &[u32], material: &[Vector2]) {
-        let m = |v: u32| map[v as usize];
-        let live = self.live_nodes();
-        for n in live {
-            let node = &mut self.nodes[n as usize];
-            node.v = node.v.map(m);
-        }
-        self.mid = self
-            .mid
-            .iter()
-            .map(|(&(a, b), &v)| (sorted(m(a), m(b)), m(v)))
-            .collect();
-        self.half_of = self
-            .half_of
-            .iter()
-            .map(|(&(a, b), &(p, q))| ((m(a), m(b)), (m(p), m(q))))
-            .collect();
-        self.leaf_by_edge = self
-            .leaf_by_edge
-            .iter()
-            .map(|(&(a, b), &n)| ((m(a), m(b)), n))
-            .collect();
-        self.material = material.to_vec();
-        self.created.clear();
-        self.first_new = material.len() as u32;
-    }
-
-    fn live_nodes(&self) -> Vec<u32> {
-        let mut out = Vec::new();
-        let mut stack = self.roots.clone();
-        while let Some(n) = stack.pop() {
-            out.push(n);
-            if let Some(ch) = self.nodes[n as usize].children {
-                stack.extend(ch);
-            }
-        }
-        out
     }
 }

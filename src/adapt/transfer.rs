@@ -115,9 +115,55 @@ pub fn transfer(world: &mut World, density: Scalar, new: Remeshed) -> Result<(),
             });
         }
     }
+    // The only fallible step comes before the world changes, so a refused
+    // mesh leaves the world as it was.
+    let mesh = Mesh::from_parts(new.material, new.triangles, new.levels)?;
     world.pins.anchors = anchor_of.into_iter().flatten().collect();
-    world.mesh = Mesh::from_parts(new.material, new.triangles, new.levels)?;
+    world.mesh = mesh;
     world.x = x;
     world.v = v;
     Ok(())
+}
+
+/// Keeps the vertices the triangles use, in their order: returns the map from
+/// old ids to new indices (`u32::MAX` for dropped ones) and the new topology.
+/// Ids below `first_new` are old world vertices; `created[k]` is the parent edge
+/// of vertex `first_new + k`.
+pub(super) fn compact(
+    material: &[Vector2],
+    first_new: u32,
+    created: &[(u32, u32)],
+    tris: &[[u32; 3]],
+    levels: Vec<u8>,
+) -> (Vec<u32>, Remeshed) {
+    let mut used = vec![false; material.len()];
+    for t in tris {
+        for &v in t {
+            used[v as usize] = true;
+        }
+    }
+    let mut map = vec![u32::MAX; material.len()];
+    let mut kept = Vec::new();
+    for (v, _) in used.iter().enumerate().filter(|(_, u)| **u) {
+        map[v] = kept.len() as u32;
+        kept.push(v);
+    }
+    let origin = kept
+        .iter()
+        .map(|&v| {
+            if (v as u32) < first_new {
+                Origin::Old(v as u32)
+            } else {
+                let (a, b) = created[v - first_new as usize];
+                Origin::Midpoint(map[a as usize], map[b as usize])
+            }
+        })
+        .collect();
+    let remeshed = Remeshed {
+        material: kept.iter().map(|&v| material[v]).collect(),
+        triangles: tris.iter().map(|t| t.map(|v| map[v as usize])).collect(),
+        levels,
+        origin,
+    };
+    (map, remeshed)
 }

@@ -7,10 +7,12 @@
 
 mod generate;
 mod obj;
+mod pairmap;
 mod topology;
 
 pub use generate::{disk, rectangle};
 pub use obj::{ObjCloth, ObjError, load_obj};
+pub use pairmap::{PairHasher, PairMap, PairSet};
 pub use topology::{Edge, NO_TRIANGLE};
 
 use crate::math::{Scalar, Vector2};

@@ -2,6 +2,7 @@
 //! heavy dependencies (rerun) are linked once.
 
 mod adapt;
+mod adapt_cost;
 mod bad_cli;
 mod bad_input;
 mod bad_obj;
@@ -20,6 +21,7 @@ mod metric;
 mod physics;
 mod recording;
 mod recording_run;
+mod remesh_ops;
 mod scene_errors;
 mod sim;
 mod solver;
