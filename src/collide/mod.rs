@@ -153,6 +153,11 @@ pub struct Collider {
     /// Per vertex: the obstacle contact the last step ended in (for the implicit solve).
     contacts: Vec<Contact>,
     t0: Scalar,
+    /// Per-step scratch, kept so that a step allocates nothing: each body's pose at the
+    /// start and the end of the step.
+    poses: Vec<(Pose, Pose)>,
+    /// Per-step scratch: per vertex, whether it touched an obstacle and the work done on it.
+    hits: Vec<(u64, Scalar)>,
 }
 
 impl Collider {
@@ -175,6 +180,8 @@ impl Collider {
             held: Vec::new(),
             contacts: Vec::new(),
             t0: 0.0,
+            poses: Vec::new(),
+            hits: Vec::new(),
         }))
     }
 
@@ -262,11 +269,10 @@ impl Collider {
         let StepCloth { pushed, mass } = cloth;
         let (t0, t1) = (self.t0, world.time);
         let started = Instant::now();
-        let poses: Vec<(Pose, Pose)> = self
-            .bodies
-            .iter()
-            .map(|b| (b.pose(t0), b.pose(t1)))
-            .collect();
+        self.poses.clear();
+        self.poses
+            .extend(self.bodies.iter().map(|b| (b.pose(t0), b.pose(t1))));
+        let poses = &self.poses;
         let contacts = if self.bodies.is_empty() {
             0
         } else {
@@ -274,7 +280,7 @@ impl Collider {
             self.contacts.clear();
             self.contacts.resize(world.x.len(), Contact::default());
             let moving = self.bodies.iter().any(Body::is_moving);
-            let (contacts, work) = world
+            world
                 .x
                 .par_iter_mut()
                 .zip(world.v.par_iter_mut())
@@ -288,7 +294,7 @@ impl Collider {
                     let mut hit = false;
                     let push = pushed.get(i).copied().unwrap_or(0.0);
                     let mut work = 0.0;
-                    for (b, pose) in bodies.iter().zip(&poses) {
+                    for (b, pose) in bodies.iter().zip(poses) {
                         let before = *v;
                         if let Some(c) = respond(b, pose, t1, h, push, x0[i], x, v) {
                             // A moving surface works on the cloth: impulse . surface velocity
@@ -304,9 +310,12 @@ impl Collider {
                     }
                     (u64::from(hit), work)
                 })
-                .collect::<Vec<_>>()
-                .into_iter()
-                .fold((0u64, 0.0), |(n, w), (a, b)| (n + a, w + b));
+                .collect_into_vec(&mut self.hits);
+            // Summed in vertex order, so the work is the same at any thread count.
+            let (contacts, work) = self
+                .hits
+                .iter()
+                .fold((0u64, 0.0), |(n, w), &(a, b)| (n + a, w + b));
             stats.obstacle_work += work;
             contacts
         };
@@ -337,7 +346,7 @@ impl Collider {
                 .with_min_len(256)
                 .map(|(i, (x, v))| {
                     let mut deepest: Scalar = 0.0;
-                    for (b, pose) in bodies.iter().zip(&poses) {
+                    for (b, pose) in bodies.iter().zip(poses) {
                         if after_self && !held[i] {
                             push_out(b, &pose.1, t1, x, v);
                         }

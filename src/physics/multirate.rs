@@ -188,6 +188,7 @@ pub fn symplectic_multirate(st: &mut Stepper, w: &mut World, big: Scalar) {
     let Some(levels) = st.levels.take() else {
         return;
     };
+    let mut rk = std::mem::take(&mut st.rk4_multirate);
     let scratch = &mut st.forces;
     let n_springs = st.elements.springs.len();
     scratch.spring.resize(n_springs, Vector::ZERO);
@@ -221,10 +222,10 @@ pub fn symplectic_multirate(st: &mut Stepper, w: &mut World, big: Scalar) {
                 &w.v,
                 g,
                 scratch,
+                &mut rk.level,
             );
             let (el, ext, held, forces) = (&st.elements, &st.model.external, &st.held, &*scratch);
-            let kicked: Vec<Vector> = g
-                .vertices
+            g.vertices
                 .par_iter()
                 .with_min_len(256)
                 .map(|&i| {
@@ -235,8 +236,8 @@ pub fn symplectic_multirate(st: &mut Stepper, w: &mut World, big: Scalar) {
                         w.v[i] + gather(el, ext, forces, i, w.v[i]) * (h / el.mass[i])
                     }
                 })
-                .collect();
-            for (&i, v) in g.vertices.iter().zip(kicked) {
+                .collect_into_vec(&mut rk.kicked);
+            for (&i, &v) in g.vertices.iter().zip(&rk.kicked) {
                 w.v[i as usize] = v;
             }
         }
@@ -252,6 +253,7 @@ pub fn symplectic_multirate(st: &mut Stepper, w: &mut World, big: Scalar) {
                 }
             });
     }
+    st.rk4_multirate = rk;
     st.levels = Some(levels);
     w.pins.apply(t + big, &mut w.x, &mut w.v);
 }
@@ -265,9 +267,9 @@ fn level_forces(
     v: &[Vector],
     g: &Group,
     scratch: &mut ForceScratch,
+    level: &mut LevelScratch,
 ) {
-    let springs: Vec<Vector> = g
-        .springs
+    g.springs
         .par_iter()
         .with_min_len(512)
         .map(|&s| {
@@ -275,12 +277,11 @@ fn level_forces(
             let [a, b] = [sp.v[0] as usize, sp.v[1] as usize];
             spring_force(x[a], x[b], v[a], v[b], sp.rest, sp.k, sp.c)
         })
-        .collect();
-    for (&s, f) in g.springs.iter().zip(springs) {
+        .collect_into_vec(&mut level.springs);
+    for (&s, &f) in g.springs.iter().zip(&level.springs) {
         scratch.spring[s as usize] = f;
     }
-    let hinges: Vec<[Vector; 4]> = g
-        .hinges
+    g.hinges
         .par_iter()
         .with_min_len(256)
         .map(|&h| {
@@ -288,12 +289,11 @@ fn level_forces(
             let (theta, grad) = dihedral_angle_and_gradient(hg.v.map(|i| x[i as usize]));
             grad.map(|gk| gk * (-hg.k * theta))
         })
-        .collect();
-    for (&h, f) in g.hinges.iter().zip(hinges) {
-        scratch.hinge[4 * h as usize..4 * h as usize + 4].copy_from_slice(&f);
+        .collect_into_vec(&mut level.hinges);
+    for (&h, f) in g.hinges.iter().zip(&level.hinges) {
+        scratch.hinge[4 * h as usize..4 * h as usize + 4].copy_from_slice(f);
     }
-    let shape: Vec<[Vector; SHAPE_SLOTS]> = g
-        .shape
+    g.shape
         .par_iter()
         .with_min_len(128)
         .map(|&p| {
@@ -301,9 +301,9 @@ fn level_forces(
             el.shape_triangles[p as usize].forces(x, &mut f);
             f
         })
-        .collect();
-    for (&p, f) in g.shape.iter().zip(shape) {
-        scratch.shape[SHAPE_SLOTS * p as usize..SHAPE_SLOTS * (p as usize + 1)].copy_from_slice(&f);
+        .collect_into_vec(&mut level.shape);
+    for (&p, f) in g.shape.iter().zip(&level.shape) {
+        scratch.shape[SHAPE_SLOTS * p as usize..SHAPE_SLOTS * (p as usize + 1)].copy_from_slice(f);
     }
     if let Some(wind) = &ext.wind {
         for &t in &g.triangles {
@@ -314,13 +314,33 @@ fn level_forces(
     }
 }
 
-/// Scratch of the RK4 multirate step.
+/// Scratch of the multirate steps (both integrators; the name is kept from when only
+/// RK4 had one), kept between steps so that a kick or substep allocates nothing once
+/// the buffers have grown to the mesh's size (issue 13).
 #[derive(Debug, Clone, Default)]
 pub struct Rk4MultirateScratch {
     xs: Vec<Vector>,
     vs: Vec<Vector>,
     x_new: Vec<Vector>,
     v_new: Vec<Vector>,
+    /// Symplectic Euler: the kicked velocities of a group's vertices.
+    kicked: Vec<Vector>,
+    /// RK4: a group's state at the start of the substep, the weighted sum of the
+    /// stages' derivatives, the current stage's state and its derivatives.
+    y0: Vec<(Vector, Vector)>,
+    acc: Vec<(Vector, Vector)>,
+    stage: Vec<(Vector, Vector)>,
+    derivs: Vec<(Vector, Vector)>,
+    level: LevelScratch,
+}
+
+/// The element forces of one group, computed in parallel before they are written into
+/// their slots.
+#[derive(Debug, Clone, Default)]
+struct LevelScratch {
+    springs: Vec<Vector>,
+    hinges: Vec<[Vector; 4]>,
+    shape: Vec<[Vector; SHAPE_SLOTS]>,
 }
 
 /// One RK4 macro step of `big` seconds. Each level integrates its own vertices
@@ -372,13 +392,16 @@ pub fn rk4_multirate(st: &mut Stepper, w: &mut World, big: Scalar) {
         for sub in 0..g.substeps {
             let t_sub = sub as Scalar * h;
             // State of the group's vertices at the start of the substep.
-            let y0: Vec<(Vector, Vector)> = g
-                .vertices
-                .iter()
-                .map(|&i| (rk.x_new[i as usize], rk.v_new[i as usize]))
-                .collect();
-            let mut acc: Vec<(Vector, Vector)> = vec![(Vector::ZERO, Vector::ZERO); y0.len()];
-            let mut stage: Vec<(Vector, Vector)> = y0.clone();
+            rk.y0.clear();
+            rk.y0.extend(
+                g.vertices
+                    .iter()
+                    .map(|&i| (rk.x_new[i as usize], rk.v_new[i as usize])),
+            );
+            rk.acc.clear();
+            rk.acc.resize(rk.y0.len(), (Vector::ZERO, Vector::ZERO));
+            rk.stage.clear();
+            rk.stage.extend_from_slice(&rk.y0);
             for s in 0..4 {
                 // Other levels' vertices move at their macro-start velocity.
                 let tau = t_sub + AT[s] * h;
@@ -387,7 +410,7 @@ pub fn rk4_multirate(st: &mut Stepper, w: &mut World, big: Scalar) {
                     rk.xs[o] = w.x[o] + w.v[o] * tau;
                     rk.vs[o] = w.v[o];
                 }
-                for (&i, &(x, v)) in g.vertices.iter().zip(&stage) {
+                for (&i, &(x, v)) in g.vertices.iter().zip(&rk.stage) {
                     rk.xs[i as usize] = x;
                     rk.vs[i as usize] = v;
                 }
@@ -399,13 +422,13 @@ pub fn rk4_multirate(st: &mut Stepper, w: &mut World, big: Scalar) {
                     &rk.vs,
                     g,
                     scratch,
+                    &mut rk.level,
                 );
                 let (el, ext, held, forces) =
                     (&st.elements, &st.model.external, &st.held, &*scratch);
-                let derivs: Vec<(Vector, Vector)> = g
-                    .vertices
+                g.vertices
                     .par_iter()
-                    .zip(stage.par_iter())
+                    .zip(rk.stage.par_iter())
                     .with_min_len(256)
                     .map(|(&i, &(_, v))| {
                         let i = i as usize;
@@ -416,21 +439,21 @@ pub fn rk4_multirate(st: &mut Stepper, w: &mut World, big: Scalar) {
                         };
                         (v, a)
                     })
-                    .collect();
-                for (k, &(dx, dv)) in derivs.iter().enumerate() {
-                    acc[k].0 += dx * WEIGHT[s];
-                    acc[k].1 += dv * WEIGHT[s];
+                    .collect_into_vec(&mut rk.derivs);
+                for (k, &(dx, dv)) in rk.derivs.iter().enumerate() {
+                    rk.acc[k].0 += dx * WEIGHT[s];
+                    rk.acc[k].1 += dv * WEIGHT[s];
                     if s < 3 {
                         let c = AT[s + 1] * h;
-                        stage[k] = (y0[k].0 + dx * c, y0[k].1 + dv * c);
+                        rk.stage[k] = (rk.y0[k].0 + dx * c, rk.y0[k].1 + dv * c);
                     }
                 }
             }
             for (k, &i) in g.vertices.iter().enumerate() {
                 let i = i as usize;
                 if !st.held[i] {
-                    rk.x_new[i] = y0[k].0 + acc[k].0 * (h / 6.0);
-                    rk.v_new[i] = y0[k].1 + acc[k].1 * (h / 6.0);
+                    rk.x_new[i] = rk.y0[k].0 + rk.acc[k].0 * (h / 6.0);
+                    rk.v_new[i] = rk.y0[k].1 + rk.acc[k].1 * (h / 6.0);
                 }
             }
         }
