@@ -258,7 +258,9 @@ pub fn symplectic_multirate(st: &mut Stepper, w: &mut World, big: Scalar) {
     w.pins.apply(t + big, &mut w.x, &mut w.v);
 }
 
-/// Forces of the elements touching group `g`, written into their slots.
+/// Forces of the elements touching group `g`, written into their slots (`level` holds
+/// them between the parallel pass and the write).
+#[allow(clippy::too_many_arguments)]
 fn level_forces(
     el: &Elements,
     ext: &super::ExternalForces,
