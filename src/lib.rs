@@ -16,6 +16,7 @@ pub mod physics;
 pub mod record;
 pub mod run;
 pub mod scene;
+pub mod spec;
 pub mod stability;
 pub mod summary;
 pub mod world;

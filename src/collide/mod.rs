@@ -41,7 +41,7 @@ use serde::Serialize;
 
 use crate::math::{Scalar, Vector};
 use crate::physics::Contact;
-use crate::scene::{ClothShape, ObstacleShape, Scene};
+use crate::spec::{ClothMesh, ClothSpec, Obstacle, ObstacleShape, SelfCollision};
 use crate::world::World;
 use obstacle::Body;
 use parry3d_f64::math::Pose;
@@ -161,21 +161,24 @@ pub struct Collider {
 }
 
 impl Collider {
-    /// The collision passes `scene` declares; `None` when it has neither obstacles nor
-    /// self-collision (nothing runs, nothing costs).
-    pub fn from_scene(scene: &Scene) -> Result<Option<Collider>, CollideError> {
-        if scene.obstacle.is_empty() && scene.self_collision.is_none() {
+    /// The collision passes of a scene's obstacles and self-collision; `None` when it
+    /// has neither (nothing runs, nothing costs). `crate::scene` builds it from a scene
+    /// (`Collider::from_scene`).
+    pub fn new(
+        obstacles: &[Obstacle],
+        self_collision: Option<&SelfCollision>,
+    ) -> Result<Option<Collider>, CollideError> {
+        if obstacles.is_empty() && self_collision.is_none() {
             return Ok(None);
         }
-        let bodies = scene
-            .obstacle
+        let bodies = obstacles
             .iter()
             .enumerate()
-            .map(|(i, o)| Body::from_scene(i, o))
+            .map(|(i, o)| Body::from_spec(i, o))
             .collect::<Result<Vec<_>, _>>()?;
         Ok(Some(Collider {
             bodies,
-            self_collider: scene.self_collision.as_ref().map(SelfCollider::new),
+            self_collider: self_collision.map(SelfCollider::new),
             x0: Vec::new(),
             held: Vec::new(),
             contacts: Vec::new(),
@@ -375,14 +378,16 @@ impl Collider {
         self.contacts.clear();
     }
 
-    /// The Cusick drape measurements, when the scene is a disk specimen lying on a
+    /// The Cusick drape measurements, when the cloth is a disk specimen lying on a
     /// vertical cylinder (the support disk) centred under it.
-    pub fn cusick(&self, scene: &Scene, world: &World) -> Option<cusick::CusickSummary> {
-        if scene.cloth.shape != ClothShape::Disk {
+    pub fn cusick_of(&self, cloth: &ClothSpec, world: &World) -> Option<cusick::CusickSummary> {
+        let ClothMesh::Disk {
+            radius: specimen, ..
+        } = cloth.mesh
+        else {
             return None;
-        }
-        let specimen = scene.cloth.radius?;
-        let centre = Vector::from_array(scene.cloth.position);
+        };
+        let centre = Vector::from_array(cloth.position);
         let (top, disk) = self
             .bodies
             .iter()

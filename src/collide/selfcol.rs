@@ -20,7 +20,7 @@ use super::geometry::{closest_on_segments, closest_on_triangle};
 use super::volino::{Patches, ProjectedEdge};
 use crate::math::{Scalar, Vector};
 use crate::mesh::Mesh;
-use crate::scene::SelfCollision;
+use crate::spec::SelfCollision;
 
 /// Primitive pair: `(kind, a, b, c, d)`; kind 0: vertex `a` against triangle `b`;
 /// kind 1: edge `(a, b)` against edge `(c, d)`.

@@ -69,7 +69,7 @@ use super::forces::{PAR_MIN, spring_force, wind_share};
 use super::shape::{SHAPE_SLOTS, ShapeJacobian, rates, spread};
 use super::{Contact, Stepper};
 use crate::math::{Matrix3, Scalar, Vector, deterministic_sum};
-use crate::scene::Solver;
+use crate::spec::Solver;
 use crate::world::World;
 
 /// Why an implicit step could not be solved.

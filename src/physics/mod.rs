@@ -17,14 +17,14 @@ pub mod shape;
 pub mod timestep;
 pub mod work;
 
-pub use crate::scene::Solver;
+pub use crate::spec::Solver;
 pub use elements::{Elements, Hinge, MaterialParams, Spring};
 pub use forces::{Energy, ExternalForces, WindForce};
 pub use implicit::SolveFailure;
 pub use shape::{SHAPE_SLOTS, ShapeTriangle};
 
 use crate::math::{Scalar, Vector};
-use crate::scene::Integrator;
+use crate::spec::Integrator;
 use crate::world::World;
 
 /// The resolved physics of a scene.
