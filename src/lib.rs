@@ -13,6 +13,7 @@ pub mod collide;
 pub mod math;
 pub mod mesh;
 pub mod physics;
+pub mod pins;
 pub mod record;
 pub mod run;
 pub mod scene;

@@ -8,7 +8,7 @@ use std::path::Path;
 
 use crate::math::{Scalar, Vector, rotation_from_euler_deg};
 use crate::mesh::{self, Mesh, MeshError, ObjError};
-use crate::physics::pins::{PinError, Pins};
+use crate::pins::{PinError, Pins};
 use crate::spec::{ClothMesh, ClothSpec, Pin};
 
 /// Why a world could not be built from a scene.

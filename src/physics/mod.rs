@@ -12,7 +12,9 @@ pub mod explicit;
 pub mod forces;
 pub mod implicit;
 pub mod multirate;
-pub mod pins;
+/// Pinned vertices (a top-level module, [`crate::pins`], so that `world` needs nothing
+/// from `physics`); kept reachable here.
+pub use crate::pins;
 pub mod shape;
 pub mod timestep;
 pub mod work;
