@@ -5,12 +5,13 @@ use std::fmt::Write;
 use crate::collide::Collider;
 use crate::physics::timestep::fit_to_frame;
 use crate::physics::{Model, Stepper};
+use crate::run::RunError;
 use crate::scene::{BendingModel, Integrator, PinMotion, Scene, StiffnessRule, TimeStep};
-use crate::world::{BuildError, World};
+use crate::world::World;
 
 /// Describes what a run of `scene` will compute: mesh, forces (and what is not
 /// modelled), integrator and time step, pins.
-pub fn describe(scene: &Scene) -> Result<String, BuildError> {
+pub fn describe(scene: &Scene) -> Result<String, RunError> {
     let world = World::from_scene(scene)?;
     let model = Model::from_scene(scene);
     let stepper = Stepper::new(model, &world);

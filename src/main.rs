@@ -310,7 +310,7 @@ fn cmd_run(args: RunArgs) -> Result<ExitCode> {
     // Build the cloth and the obstacles once before any output is opened: a bad
     // OBJ or a pin that selects nothing fails here and leaves no empty recording
     // behind (nor truncates an existing one).
-    let sim = drape::sim::build(&scene)?;
+    let sim = drape::sim::build(&scene.resolve()?)?;
     // Create the OBJ directory before the recording is opened, so that an unusable
     // one fails with its own message and leaves no recording behind.
     if let Some(dir) = &args.obj_dir {

@@ -146,7 +146,7 @@ pub fn run_observed(
     progress: &mut (dyn FnMut(Progress) + Send),
     observe: &mut (dyn FnMut(&FrameState) + Send),
 ) -> Result<Summary, RunError> {
-    let sim = crate::sim::build(scene)?;
+    let sim = crate::sim::build(&scene.resolve()?)?;
     run_built(scene, sim, opts, interrupt, progress, observe)
 }
 

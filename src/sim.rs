@@ -31,35 +31,62 @@ pub use state::{Effort, Ledger, SimState};
 
 use crate::adapt::{AdaptConfig, Adapter};
 use crate::collide::{CollideError, Collider};
+use crate::math::Scalar;
 use crate::physics::Model;
-use crate::scene::{Scene, TimeStep};
+use crate::spec::{ClothSpec, Obstacle, Pin, SelfCollision};
 use crate::world::{BuildError, World};
 
-/// Why a scene could not become a simulation.
+/// Everything a simulation is built from: a scene resolved into the engine's
+/// specifications ([`crate::scene::Scene::resolve`]).
+#[derive(Debug, Clone)]
+pub struct SimSpec {
+    /// The cloth's rest mesh and placement.
+    pub cloth: ClothSpec,
+    /// The pinned regions.
+    pub pins: Vec<Pin>,
+    /// Material, external forces, integrator and solver settings.
+    pub model: Model,
+    /// The rigid obstacles.
+    pub obstacles: Vec<Obstacle>,
+    /// Self-collision, when the scene turns it on.
+    pub self_collision: Option<SelfCollision>,
+    /// Adaptivity, when the scene adapts.
+    pub adapt: Option<AdaptConfig>,
+    /// Paper A's multirate stepping (explicit integrators, adaptive meshes).
+    pub multirate: bool,
+    /// Area density, kg/m^2 (the remesher's mass transfer).
+    pub density: Scalar,
+    /// The fixed step, s (`None`: automatic).
+    pub fixed_dt: Option<Scalar>,
+}
+
+/// Why a specification could not become a simulation.
 #[derive(Debug, thiserror::Error)]
 pub enum SimBuildError {
     /// The cloth, its pins or its mesh could not be built.
     #[error("{0}")]
     Build(#[from] BuildError),
-    /// The scene's obstacles could not be built.
+    /// The obstacles could not be built.
     #[error("{0}")]
     Collide(#[from] CollideError),
 }
 
-/// Builds the initial state and the pipeline of a validated scene. This is where a
+/// Builds the initial state and the pipeline of a specification. This is where a
 /// bad OBJ file or a pin that selects nothing is found, before any output is opened.
-pub fn build(scene: &Scene) -> Result<(SimState, Pipeline), SimBuildError> {
-    let world = World::from_scene(scene)?;
-    let model = Model::from_scene(scene);
-    let adapter = AdaptConfig::from_scene(scene.adapt.as_ref())
-        .map(|c| Adapter::new(c, &world, scene.material.density));
-    let collider = Collider::from_scene(scene)?;
-    let fixed_dt = match scene.simulation.dt {
-        TimeStep::Fixed(dt) => Some(dt),
-        TimeStep::Auto => None,
-    };
-    let multirate = scene.adapt.as_ref().is_some_and(|a| a.multirate);
-    let mut pipeline = Pipeline::new(model, &world, collider, fixed_dt, multirate);
+pub fn build(spec: &SimSpec) -> Result<(SimState, Pipeline), SimBuildError> {
+    let world = World::from_spec(&spec.cloth, &spec.pins)?;
+    let adapter = spec
+        .adapt
+        .clone()
+        .map(|c| Adapter::new(c, &world, spec.density));
+    let collider = Collider::new(&spec.obstacles, spec.self_collision.as_ref())?;
+    let mut pipeline = Pipeline::new(
+        spec.model.clone(),
+        &world,
+        collider,
+        spec.fixed_dt,
+        spec.multirate,
+    );
     let state = SimState::new(world, adapter, &mut pipeline);
     Ok((state, pipeline))
 }

@@ -1,15 +1,15 @@
 //! The simulation state: mesh, positions, velocities, time and pins.
 //!
-//! Built from a validated [`Scene`]; the stepper's scratch memory lives elsewhere
+//! Built from a resolved cloth ([`ClothSpec`], made from a validated scene by
+//! `crate::scene`); the stepper's scratch memory lives elsewhere
 //! ([`crate::physics::Stepper`]).
 
 use std::path::Path;
 
 use crate::math::{Scalar, Vector, rotation_from_euler_deg};
 use crate::mesh::{self, Mesh, MeshError, ObjError};
-use crate::physics::pins::{PinError, Pins};
-use crate::physics::{ExternalForces, MaterialParams, Model, SolverSettings, WindForce};
-use crate::scene::{ClothShape, DEFAULT_AIR_DENSITY, Scene};
+use crate::pins::{PinError, Pins};
+use crate::spec::{ClothMesh, ClothSpec, Pin};
 
 /// Why a world could not be built from a scene.
 #[derive(Debug, thiserror::Error)]
@@ -23,9 +23,6 @@ pub enum BuildError {
     /// A pin region could not be resolved.
     #[error("{0}")]
     Pin(#[from] PinError),
-    /// An obstacle could not be built (e.g. a broken OBJ mesh).
-    #[error("{0}")]
-    Collide(#[from] crate::collide::CollideError),
     /// A key the shape needs is missing (validation normally catches this first).
     #[error("cloth: `{0}` is required for this shape")]
     Missing(&'static str),
@@ -59,38 +56,33 @@ impl World {
         }
     }
 
-    /// Builds the cloth of `scene` and resolves its pins.
-    pub fn from_scene(scene: &Scene) -> Result<World, BuildError> {
-        let c = &scene.cloth;
-        let need = |v: Option<Scalar>, name| v.ok_or(BuildError::Missing(name));
-        let (mesh, local): (Mesh, Vec<Vector>) = match c.shape {
-            ClothShape::Rectangle => {
-                let res = c.resolution.ok_or(BuildError::Missing("resolution"))?;
-                let m = mesh::rectangle(
-                    need(c.width, "width")?,
-                    need(c.height, "height")?,
-                    res,
-                    c.diagonals,
-                )?;
+    /// Builds the cloth and resolves its pins.
+    pub fn from_spec(cloth: &ClothSpec, pins: &[Pin]) -> Result<World, BuildError> {
+        let (mesh, local): (Mesh, Vec<Vector>) = match &cloth.mesh {
+            &ClothMesh::Rectangle {
+                width,
+                height,
+                resolution,
+                diagonals,
+            } => {
+                let m = mesh::rectangle(width, height, resolution, diagonals)?;
                 let local = m.material.iter().map(|p| p.extend(0.0)).collect();
                 (m, local)
             }
-            ClothShape::Disk => {
-                let res = c.resolution.ok_or(BuildError::Missing("resolution"))?;
-                let m = mesh::disk(need(c.radius, "radius")?, res)?;
+            &ClothMesh::Disk { radius, resolution } => {
+                let m = mesh::disk(radius, resolution)?;
                 let local = m.material.iter().map(|p| p.extend(0.0)).collect();
                 (m, local)
             }
-            ClothShape::Obj => {
-                let path = c.path.as_deref().ok_or(BuildError::Missing("path"))?;
-                let obj = mesh::load_obj(Path::new(path), c.uv_scale)?;
+            ClothMesh::Obj { path, uv_scale } => {
+                let obj = mesh::load_obj(Path::new(path), *uv_scale)?;
                 (obj.mesh, obj.positions)
             }
         };
-        let rot = rotation_from_euler_deg(c.rotation);
-        let origin = Vector::from_array(c.position);
+        let rot = rotation_from_euler_deg(cloth.rotation);
+        let origin = Vector::from_array(cloth.position);
         let x: Vec<Vector> = local.iter().map(|p| origin + rot * *p).collect();
-        let pins = Pins::select(&scene.pin, &mesh, &x)?;
+        let pins = Pins::select(pins, &mesh, &x)?;
         let mut world = World::new(mesh, x);
         world.pins = pins;
         Ok(world)
@@ -120,48 +112,6 @@ impl World {
         }
         for n in out.iter_mut() {
             *n = n.normalize_or_zero();
-        }
-    }
-}
-
-impl Model {
-    /// The physics a scene declares (undeclared forces are `None`).
-    pub fn from_scene(scene: &Scene) -> Model {
-        let m = &scene.material;
-        let g = Vector::from_array(scene.simulation.gravity);
-        let wind = scene.wind.as_ref().map(|w| WindForce {
-            velocity: Vector::from_array(w.velocity),
-            coefficient: w.coefficient,
-            air_density: scene
-                .air
-                .as_ref()
-                .map_or(DEFAULT_AIR_DENSITY, |a| a.density),
-        });
-        let external = ExternalForces {
-            gravity: (g != Vector::ZERO).then_some(g),
-            drag: scene.air.as_ref().map(|a| a.drag).filter(|&d| d > 0.0),
-            air_velocity: wind.map_or(Vector::ZERO, |w| w.velocity),
-            wind: wind.filter(|w| w.coefficient > 0.0),
-        };
-        Model {
-            material: MaterialParams {
-                density: m.density,
-                stretch: m.stretch,
-                bending: m.rigidity(scene.simulation.gravity),
-                damping: m.damping,
-                bending_model: m.bending_model,
-                stiffness_rule: m.stiffness_rule,
-            },
-            external,
-            integrator: scene.simulation.integrator,
-            cg_tolerance: scene.simulation.cg_tolerance,
-            cg_max_iterations: scene.simulation.cg_max_iterations,
-            solver: SolverSettings {
-                solver: scene.simulation.solver,
-                refactor_iterations: scene.simulation.refactor_iterations,
-                newton_iterations: scene.simulation.newton_iterations,
-                newton_tolerance: scene.simulation.newton_tolerance,
-            },
         }
     }
 }

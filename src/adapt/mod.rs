@@ -20,7 +20,7 @@ use rayon::prelude::*;
 
 use crate::math::{Scalar, Vector};
 use crate::mesh::MeshError;
-use crate::scene::{Adapt, AdaptMethod};
+use crate::spec::{Adapt, AdaptMethod};
 use crate::world::World;
 use red_green::{Applied, RedGreen, RedGreenOp};
 use transfer::{compact, transfer};

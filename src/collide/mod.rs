@@ -31,6 +31,7 @@
 pub mod cusick;
 pub mod geometry;
 pub mod obstacle;
+mod response;
 pub mod selfcol;
 pub mod volino;
 
@@ -41,10 +42,11 @@ use serde::Serialize;
 
 use crate::math::{Scalar, Vector};
 use crate::physics::Contact;
-use crate::scene::{ClothShape, ObstacleShape, Scene};
+use crate::spec::{ClothMesh, ClothSpec, Obstacle, ObstacleShape, SelfCollision};
 use crate::world::World;
 use obstacle::Body;
 use parry3d_f64::math::Pose;
+use response::{depth_below, push_out, respond};
 use selfcol::SelfCollider;
 
 /// Why the collision setup of a scene failed.
@@ -153,28 +155,38 @@ pub struct Collider {
     /// Per vertex: the obstacle contact the last step ended in (for the implicit solve).
     contacts: Vec<Contact>,
     t0: Scalar,
+    /// Per-step scratch, kept so that a step allocates nothing: each body's pose at the
+    /// start and the end of the step.
+    poses: Vec<(Pose, Pose)>,
+    /// Per-step scratch: per vertex, whether it touched an obstacle and the work done on it.
+    hits: Vec<(u64, Scalar)>,
 }
 
 impl Collider {
-    /// The collision passes `scene` declares; `None` when it has neither obstacles nor
-    /// self-collision (nothing runs, nothing costs).
-    pub fn from_scene(scene: &Scene) -> Result<Option<Collider>, CollideError> {
-        if scene.obstacle.is_empty() && scene.self_collision.is_none() {
+    /// The collision passes of a scene's obstacles and self-collision; `None` when it
+    /// has neither (nothing runs, nothing costs). `crate::scene` builds it from a scene
+    /// (`Collider::from_scene`).
+    pub fn new(
+        obstacles: &[Obstacle],
+        self_collision: Option<&SelfCollision>,
+    ) -> Result<Option<Collider>, CollideError> {
+        if obstacles.is_empty() && self_collision.is_none() {
             return Ok(None);
         }
-        let bodies = scene
-            .obstacle
+        let bodies = obstacles
             .iter()
             .enumerate()
-            .map(|(i, o)| Body::from_scene(i, o))
+            .map(|(i, o)| Body::from_spec(i, o))
             .collect::<Result<Vec<_>, _>>()?;
         Ok(Some(Collider {
             bodies,
-            self_collider: scene.self_collision.as_ref().map(SelfCollider::new),
+            self_collider: self_collision.map(SelfCollider::new),
             x0: Vec::new(),
             held: Vec::new(),
             contacts: Vec::new(),
             t0: 0.0,
+            poses: Vec::new(),
+            hits: Vec::new(),
         }))
     }
 
@@ -262,11 +274,10 @@ impl Collider {
         let StepCloth { pushed, mass } = cloth;
         let (t0, t1) = (self.t0, world.time);
         let started = Instant::now();
-        let poses: Vec<(Pose, Pose)> = self
-            .bodies
-            .iter()
-            .map(|b| (b.pose(t0), b.pose(t1)))
-            .collect();
+        self.poses.clear();
+        self.poses
+            .extend(self.bodies.iter().map(|b| (b.pose(t0), b.pose(t1))));
+        let poses = &self.poses;
         let contacts = if self.bodies.is_empty() {
             0
         } else {
@@ -274,7 +285,7 @@ impl Collider {
             self.contacts.clear();
             self.contacts.resize(world.x.len(), Contact::default());
             let moving = self.bodies.iter().any(Body::is_moving);
-            let (contacts, work) = world
+            world
                 .x
                 .par_iter_mut()
                 .zip(world.v.par_iter_mut())
@@ -288,7 +299,7 @@ impl Collider {
                     let mut hit = false;
                     let push = pushed.get(i).copied().unwrap_or(0.0);
                     let mut work = 0.0;
-                    for (b, pose) in bodies.iter().zip(&poses) {
+                    for (b, pose) in bodies.iter().zip(poses) {
                         let before = *v;
                         if let Some(c) = respond(b, pose, t1, h, push, x0[i], x, v) {
                             // A moving surface works on the cloth: impulse . surface velocity
@@ -304,9 +315,12 @@ impl Collider {
                     }
                     (u64::from(hit), work)
                 })
-                .collect::<Vec<_>>()
-                .into_iter()
-                .fold((0u64, 0.0), |(n, w), (a, b)| (n + a, w + b));
+                .collect_into_vec(&mut self.hits);
+            // Summed in vertex order, so the work is the same at any thread count.
+            let (contacts, work) = self
+                .hits
+                .iter()
+                .fold((0u64, 0.0), |(n, w), &(a, b)| (n + a, w + b));
             stats.obstacle_work += work;
             contacts
         };
@@ -337,7 +351,7 @@ impl Collider {
                 .with_min_len(256)
                 .map(|(i, (x, v))| {
                     let mut deepest: Scalar = 0.0;
-                    for (b, pose) in bodies.iter().zip(&poses) {
+                    for (b, pose) in bodies.iter().zip(poses) {
                         if after_self && !held[i] {
                             push_out(b, &pose.1, t1, x, v);
                         }
@@ -366,14 +380,16 @@ impl Collider {
         self.contacts.clear();
     }
 
-    /// The Cusick drape measurements, when the scene is a disk specimen lying on a
+    /// The Cusick drape measurements, when the cloth is a disk specimen lying on a
     /// vertical cylinder (the support disk) centred under it.
-    pub fn cusick(&self, scene: &Scene, world: &World) -> Option<cusick::CusickSummary> {
-        if scene.cloth.shape != ClothShape::Disk {
+    pub fn cusick_of(&self, cloth: &ClothSpec, world: &World) -> Option<cusick::CusickSummary> {
+        let ClothMesh::Disk {
+            radius: specimen, ..
+        } = cloth.mesh
+        else {
             return None;
-        }
-        let specimen = scene.cloth.radius?;
-        let centre = Vector::from_array(scene.cloth.position);
+        };
+        let centre = Vector::from_array(cloth.position);
         let (top, disk) = self
             .bodies
             .iter()
@@ -383,105 +399,4 @@ impl Collider {
         (off < 0.25 * disk && disk < specimen)
             .then(|| cusick::measure(&world.mesh, &world.x, top, specimen, disk))
     }
-}
-
-/// A vertex this close to a surface, in thicknesses, is in contact: resting cloth sits
-/// exactly one thickness out, and rounding must not let it flicker in and out of
-/// contact (and of the implicit solve's contact filter).
-const CONTACT_MARGIN: Scalar = 1.0 + 1e-6;
-
-/// Contact response of one vertex against one obstacle (module docs, steps 1-3).
-/// `p0` is the start-of-step position, `x`/`v` the state after the integrator.
-/// Returns the contact when the vertex touched the obstacle.
-#[allow(clippy::too_many_arguments)]
-fn respond(
-    b: &Body,
-    (pose0, pose1): &(Pose, Pose),
-    t1: Scalar,
-    h: Scalar,
-    pushed: Scalar,
-    p0: Vector,
-    x: &mut Vector,
-    v: &mut Vector,
-) -> Option<Contact> {
-    let q0 = pose0.inverse_transform_point(p0);
-    let q1 = pose1.inverse_transform_point(*x);
-    if !b.may_touch(q0, q1) {
-        return None;
-    }
-    let thick = b.thickness;
-    // The contact plane: outward normal and its offset n . s at the surface point s.
-    let mut plane = None;
-    if b.probe(q0).signed >= 0.0
-        && let Some((toi, n)) = b.first_entry(q0, q1)
-    {
-        plane = Some((n, n.dot(q0 + (q1 - q0) * toi)));
-    }
-    if plane.is_none() {
-        let p = b.probe(q1);
-        if p.signed < thick * CONTACT_MARGIN {
-            plane = Some((p.normal, p.normal.dot(q1) - p.signed));
-        }
-    }
-    let (n, offset) = plane?;
-    let mut q = q1 + n * (offset + thick - n.dot(q1));
-    let rot = pose1.rotation;
-    let mut u = rot.inverse() * (*v - b.point_velocity(t1, pose1.transform_point(q)));
-    let un = u.dot(n);
-    // Normal impulse per mass of the step: the approach removed here, plus what the
-    // implicit solve's contact filter already removed.
-    let dun = (-un).max(0.0) + pushed;
-    if dun > 0.0 {
-        let ut = u - n * un;
-        let speed = ut.length();
-        let ut_new = if speed <= b.mu_static * dun {
-            Vector::ZERO
-        } else {
-            ut * (1.0 - b.mu_kinetic * dun / speed)
-        };
-        q += (ut_new - ut) * h;
-        u = ut_new + n * un.max(0.0);
-    }
-    // Curved surfaces and corners: make sure the final point is a thickness outside.
-    let f = b.probe(q);
-    if f.signed < thick {
-        q += f.normal * (thick - f.signed);
-    }
-    *x = pose1.transform_point(q);
-    let surface = b.point_velocity(t1, *x);
-    *v = rot * u + surface;
-    let normal = rot * n;
-    Some(Contact {
-        normal,
-        normal_speed: surface.dot(normal),
-    })
-}
-
-/// Pushes a vertex that came within the thickness back out along the normal and removes
-/// its approaching normal velocity (the pass after self-collision).
-fn push_out(b: &Body, pose: &Pose, t: Scalar, x: &mut Vector, v: &mut Vector) {
-    let q = pose.inverse_transform_point(*x);
-    if !b.may_touch(q, q) {
-        return;
-    }
-    let p = b.probe(q);
-    if p.signed >= b.thickness {
-        return;
-    }
-    *x = pose.transform_point(q + p.normal * (b.thickness - p.signed));
-    let n = pose.rotation * p.normal;
-    let rel = *v - b.point_velocity(t, *x);
-    let vn = rel.dot(n);
-    if vn < 0.0 {
-        *v -= n * vn;
-    }
-}
-
-/// Depth of `x` below the obstacle's surface, m (0 outside).
-fn depth_below(b: &Body, pose: &Pose, x: Vector) -> Scalar {
-    let q = pose.inverse_transform_point(x);
-    if !b.may_touch(q, q) {
-        return 0.0;
-    }
-    (-b.probe(q).signed).max(0.0)
 }

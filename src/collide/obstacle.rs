@@ -12,7 +12,7 @@ use parry3d_f64::shape::{
 
 use super::CollideError;
 use crate::math::{Scalar, Vector, rotation_from_euler_deg};
-use crate::scene::{Obstacle, ObstacleShape};
+use crate::spec::{Obstacle, ObstacleShape};
 
 /// Half the side of the square drawn for a plane in the recording, m.
 const PLANE_DISPLAY_HALF_SIZE: Scalar = 3.0;
@@ -58,7 +58,7 @@ pub struct Probe {
 
 impl Body {
     /// Builds obstacle `index` of a scene (OBJ paths are already resolved by the loader).
-    pub fn from_scene(index: usize, o: &Obstacle) -> Result<Body, CollideError> {
+    pub fn from_spec(index: usize, o: &Obstacle) -> Result<Body, CollideError> {
         let need =
             |v: Option<Scalar>, key: &'static str| v.ok_or(CollideError::Missing { index, key });
         // parry's cylinder is along local y; ours stand along local z.

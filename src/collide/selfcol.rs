@@ -2,8 +2,8 @@
 //! resolved by repulsion (position correction plus an inelastic normal impulse).
 //!
 //! Each step: the swept box (start and end positions, inflated by the thickness) of every
-//! triangle goes into one parry [`Bvh`] per Volino patch, rebuilt for the current
-//! triangles; patches that pass Volino's test ([`super::volino`]) skip their self-test;
+//! triangle goes into one parry [`Bvh`] per Volino patch, built when the patches are
+//! (for the current triangles) and refitted to the new boxes at every later step; patches that pass Volino's test ([`super::volino`]) skip their self-test;
 //! every other box-overlapping pair of triangles that share no vertex yields its 6
 //! vertex-triangle and 9 edge-edge primitive pairs (deduplicated). A primitive pair acts
 //! when, with its closest features at the end positions, the two sides are closer than the
@@ -17,10 +17,10 @@ use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
 use rayon::prelude::*;
 
 use super::geometry::{closest_on_segments, closest_on_triangle};
-use super::volino::Patches;
+use super::volino::{Patches, ProjectedEdge};
 use crate::math::{Scalar, Vector};
 use crate::mesh::Mesh;
-use crate::scene::SelfCollision;
+use crate::spec::SelfCollision;
 
 /// Primitive pair: `(kind, a, b, c, d)`; kind 0: vertex `a` against triangle `b`;
 /// kind 1: edge `(a, b)` against edge `(c, d)`.
@@ -51,6 +51,35 @@ pub struct SelfCollider {
     built_for: Vec<[u32; 3]>,
     patches: Patches,
     area: Vec<Scalar>,
+    /// False after the patches were rebuilt: the next step builds the patch trees.
+    trees_built: bool,
+    scratch: Scratch,
+}
+
+/// The per-step buffers of [`SelfCollider::resolve`], kept between steps: once they
+/// have grown to the mesh's size a step allocates nothing (issue 13). Their contents
+/// do not survive a step, except the patch trees, which keep their shape and are
+/// refitted to the new boxes.
+#[derive(Debug, Clone, Default)]
+struct Scratch {
+    inv_mass: Vec<Scalar>,
+    /// Swept box of every triangle.
+    boxes: Vec<Aabb>,
+    /// Per patch: Volino's test passed.
+    culled: Vec<bool>,
+    /// Per patch: its projected boundary (Volino's test).
+    boundary: Vec<Vec<ProjectedEdge>>,
+    /// One BVH per patch, leaves numbered within the patch.
+    trees: Vec<Bvh>,
+    /// Box of every patch tree.
+    patch_box: Vec<Aabb>,
+    /// Per patch: its box-overlapping triangle pairs and the pairs culling skipped.
+    pairs: Vec<(Vec<(u32, u32)>, u64)>,
+    prims: Vec<Prim>,
+    fixes: Vec<Option<Fix>>,
+    dx: Vec<Vector>,
+    dv: Vec<Vector>,
+    count: Vec<u32>,
 }
 
 impl SelfCollider {
@@ -64,6 +93,8 @@ impl SelfCollider {
             built_for: Vec::new(),
             patches: Patches::default(),
             area: Vec::new(),
+            trees_built: false,
+            scratch: Scratch::default(),
         }
     }
 
@@ -85,6 +116,7 @@ impl SelfCollider {
             }
         }
         self.built_for = mesh.triangles.clone();
+        self.trees_built = false;
     }
 
     /// Separates the cloth from itself: `x0` start-of-step positions, `x`/`v` the state
@@ -98,33 +130,38 @@ impl SelfCollider {
         held: &[bool],
     ) -> SelfStats {
         self.prepare(mesh);
-        let inv_mass: Vec<Scalar> = (0..x.len())
-            .map(|i| {
-                if held.get(i).copied().unwrap_or(false) || self.area[i] <= 0.0 {
-                    0.0
-                } else {
-                    1.0 / self.area[i]
-                }
-            })
-            .collect();
-        let (prims, mut stats) = self.candidates(mesh, x0, x);
+        // Taken out for the step so that `&self` methods can fill it (no allocation:
+        // the placeholder left behind is empty).
+        let mut s = std::mem::take(&mut self.scratch);
+        s.inv_mass.clear();
+        s.inv_mass.extend((0..x.len()).map(|i| {
+            if held.get(i).copied().unwrap_or(false) || self.area[i] <= 0.0 {
+                0.0
+            } else {
+                1.0 / self.area[i]
+            }
+        }));
+        let mut stats = self.candidates(mesh, x0, x, &mut s);
         for _ in 0..self.iterations {
-            let fixes: Vec<Option<Fix>> = prims
+            s.prims
                 .par_iter()
-                .map(|p| self.fix(mesh, p, x0, x, v, &inv_mass))
-                .collect();
-            let mut dx = vec![Vector::ZERO; x.len()];
-            let mut dv = vec![Vector::ZERO; x.len()];
-            let mut count = vec![0u32; x.len()];
+                .map(|p| self.fix(mesh, p, x0, x, v, &s.inv_mass))
+                .collect_into_vec(&mut s.fixes);
+            for buf in [&mut s.dx, &mut s.dv] {
+                buf.clear();
+                buf.resize(x.len(), Vector::ZERO);
+            }
+            s.count.clear();
+            s.count.resize(x.len(), 0);
             let mut acted = 0u64;
-            for f in fixes.iter().flatten() {
+            for f in s.fixes.iter().flatten() {
                 acted += 1;
                 for k in 0..4 {
                     let i = f.vertex[k] as usize;
                     if f.dx[k] != Vector::ZERO || f.dv[k] != Vector::ZERO {
-                        dx[i] += f.dx[k];
-                        dv[i] += f.dv[k];
-                        count[i] += 1;
+                        s.dx[i] += f.dx[k];
+                        s.dv[i] += f.dv[k];
+                        s.count[i] += 1;
                     }
                 }
             }
@@ -133,22 +170,29 @@ impl SelfCollider {
                 break;
             }
             for i in 0..x.len() {
-                if count[i] > 0 {
-                    let c = count[i] as Scalar;
-                    x[i] += dx[i] / c;
-                    v[i] += dv[i] / c;
+                if s.count[i] > 0 {
+                    let c = s.count[i] as Scalar;
+                    x[i] += s.dx[i] / c;
+                    v[i] += s.dv[i] / c;
                 }
             }
         }
+        self.scratch = s;
         stats
     }
 
-    /// Primitive pairs of the box-overlapping, non-adjacent triangle pairs.
-    fn candidates(&self, mesh: &Mesh, x0: &[Vector], x: &[Vector]) -> (Vec<Prim>, SelfStats) {
+    /// Primitive pairs of the box-overlapping, non-adjacent triangle pairs, into
+    /// `s.prims`.
+    fn candidates(
+        &mut self,
+        mesh: &Mesh,
+        x0: &[Vector],
+        x: &[Vector],
+        s: &mut Scratch,
+    ) -> SelfStats {
         let tris = &mesh.triangles;
         let pad = Vector::splat(self.thickness);
-        let boxes: Vec<Aabb> = tris
-            .par_iter()
+        tris.par_iter()
             .map(|t| {
                 let mut lo = Vector::splat(Scalar::INFINITY);
                 let mut hi = -lo;
@@ -160,42 +204,115 @@ impl SelfCollider {
                 }
                 Aabb::new(lo - pad, hi + pad)
             })
-            .collect();
+            .collect_into_vec(&mut s.boxes);
         let pt = &self.patches;
-        let culled: Vec<bool> = (0..pt.len())
-            .into_par_iter()
-            .map(|p| self.culling && pt.cannot_self_intersect(p, tris, x0, x))
-            .collect();
-        // Leaves are numbered within their patch (0, 1, ...) and mapped back to triangles
-        // on query: parry 0.31's `Bvh::from_iter` indexes its leaf table by position for
-        // one or two leaves, so a small patch with global triangle ids panicked.
-        let trees: Vec<Bvh> = pt
-            .triangles
-            .par_iter()
-            .map(|ts| {
-                Bvh::from_iter(
-                    BvhBuildStrategy::Binned,
-                    ts.iter().enumerate().map(|(k, &t)| (k, boxes[t as usize])),
-                )
-            })
-            .collect();
-        let patch_box: Vec<Aabb> = trees.iter().map(|b| b.root_aabb()).collect();
+        s.boundary.resize_with(pt.len(), Vec::new);
+        s.boundary
+            .par_iter_mut()
+            .enumerate()
+            .map(|(p, boundary)| self.culling && pt.cannot_self_intersect(p, tris, x0, x, boundary))
+            .collect_into_vec(&mut s.culled);
+        self.fit_trees(s);
+        self.collect_pairs(tris, s);
+        let mut stats = SelfStats::default();
+        s.prims.clear();
+        for (pairs, skipped) in &s.pairs {
+            stats.pairs_culled += skipped;
+            stats.pairs_tested += pairs.len() as u64;
+            for &(t, u) in pairs {
+                let (a, b) = (tris[t as usize], tris[u as usize]);
+                for k in 0..3 {
+                    s.prims.push((0, a[k], u, 0, 0));
+                    s.prims.push((0, b[k], t, 0, 0));
+                    let e = edge(a[k], a[(k + 1) % 3]);
+                    for j in 0..3 {
+                        let f = edge(b[j], b[(j + 1) % 3]);
+                        let (lo, hi) = if e <= f { (e, f) } else { (f, e) };
+                        s.prims.push((1, lo[0], lo[1], hi[0], hi[1]));
+                    }
+                }
+            }
+        }
+        // Sorted and deduplicated, the list does not depend on the order the trees
+        // report their pairs in (so neither on the trees' shapes).
+        s.prims.par_sort_unstable();
+        s.prims.dedup();
+        // Parts that are close in the rest state cannot be held a thickness apart.
+        let rest = |i: u32| mesh.material[i as usize].extend(0.0);
+        s.prims.retain(|p| {
+            let (ids, w) = weights(p, tris, &rest);
+            let r: Vector = (0..4).map(|k| rest(ids[k]) * w[k]).sum();
+            r.length() >= 1.5 * self.thickness
+        });
+        stats
+    }
+
+    /// Brings the patch trees to this step's boxes: built after the patches changed,
+    /// else refitted in place (same tree shape, boxes recomputed bottom-up, no
+    /// allocation). A refitted tree answers box queries exactly like a rebuilt one;
+    /// only its traversal cost may differ.
+    fn fit_trees(&mut self, s: &mut Scratch) {
+        let pt = &self.patches;
+        let boxes = &s.boxes;
+        if self.trees_built {
+            s.trees
+                .par_iter_mut()
+                .zip(pt.triangles.par_iter())
+                .for_each(|(tree, ts)| {
+                    for (k, &t) in ts.iter().enumerate() {
+                        tree.update_partially_if_present(boxes[t as usize], k as u32, 0.0);
+                    }
+                    tree.refit_without_opt();
+                });
+        } else {
+            // Leaves are numbered within their patch (0, 1, ...) and mapped back to
+            // triangles on query: parry 0.31's `Bvh::from_iter` indexes its leaf table
+            // by position for one or two leaves, so a small patch with global triangle
+            // ids panicked.
+            pt.triangles
+                .par_iter()
+                .map(|ts| {
+                    Bvh::from_iter(
+                        BvhBuildStrategy::Binned,
+                        ts.iter().enumerate().map(|(k, &t)| (k, boxes[t as usize])),
+                    )
+                })
+                .collect_into_vec(&mut s.trees);
+            self.trees_built = true;
+        }
+        s.patch_box.clear();
+        s.patch_box.extend(s.trees.iter().map(|b| b.root_aabb()));
+    }
+
+    /// Per patch, into `s.pairs`: its own box-overlapping pairs (or their count when
+    /// culled) and its pairs with later patches.
+    fn collect_pairs(&self, tris: &[[u32; 3]], s: &mut Scratch) {
+        let pt = &self.patches;
+        let Scratch {
+            boxes,
+            culled,
+            trees,
+            patch_box,
+            pairs,
+            ..
+        } = s;
         let disjoint = |a: u32, b: u32| {
             let (ta, tb) = (tris[a as usize], tris[b as usize]);
             !ta.iter().any(|v| tb.contains(v))
         };
-        // Per patch: its own pairs (or their count when culled) and its pairs with later patches.
-        let per_patch: Vec<(Vec<(u32, u32)>, u64)> = (0..pt.len())
-            .into_par_iter()
-            .map(|p| {
-                let mut pairs = Vec::new();
-                let mut skipped = 0u64;
+        pairs.resize_with(pt.len(), Default::default);
+        pairs
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(p, (pairs, skipped))| {
+                pairs.clear();
+                *skipped = 0;
                 for &t in &pt.triangles[p] {
                     for k in trees[p].intersect_aabb(&boxes[t as usize]) {
                         let u = pt.triangles[p][k as usize];
                         if u > t && disjoint(t, u) {
                             if culled[p] {
-                                skipped += 1;
+                                *skipped += 1;
                             } else {
                                 pairs.push((t, u));
                             }
@@ -218,38 +335,7 @@ impl SelfCollider {
                         }
                     }
                 }
-                (pairs, skipped)
-            })
-            .collect();
-        let mut stats = SelfStats::default();
-        let mut prims: Vec<Prim> = Vec::new();
-        for (pairs, skipped) in &per_patch {
-            stats.pairs_culled += skipped;
-            stats.pairs_tested += pairs.len() as u64;
-            for &(t, u) in pairs {
-                let (a, b) = (tris[t as usize], tris[u as usize]);
-                for k in 0..3 {
-                    prims.push((0, a[k], u, 0, 0));
-                    prims.push((0, b[k], t, 0, 0));
-                    let e = edge(a[k], a[(k + 1) % 3]);
-                    for j in 0..3 {
-                        let f = edge(b[j], b[(j + 1) % 3]);
-                        let (lo, hi) = if e <= f { (e, f) } else { (f, e) };
-                        prims.push((1, lo[0], lo[1], hi[0], hi[1]));
-                    }
-                }
-            }
-        }
-        prims.par_sort_unstable();
-        prims.dedup();
-        // Parts that are close in the rest state cannot be held a thickness apart.
-        let rest = |i: u32| mesh.material[i as usize].extend(0.0);
-        prims.retain(|p| {
-            let (ids, w) = weights(p, tris, &rest);
-            let r: Vector = (0..4).map(|k| rest(ids[k]) * w[k]).sum();
-            r.length() >= 1.5 * self.thickness
-        });
-        (prims, stats)
+            });
     }
 
     /// The correction of one primitive pair, if it acts.

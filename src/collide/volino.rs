@@ -32,6 +32,9 @@ pub const NORMAL_MARGIN: Scalar = 0.05;
 /// Triangles per patch side when `patch_size` is not given.
 pub const AUTO_PATCH_TRIANGLES: Scalar = 12.0;
 
+/// A boundary edge projected onto the test plane: its vertices and both projected ends.
+pub type ProjectedEdge = ([u32; 2], [Scalar; 2], [Scalar; 2]);
+
 /// A fixed partition of the mesh's triangles into patches.
 #[derive(Debug, Clone, Default)]
 pub struct Patches {
@@ -114,12 +117,14 @@ impl Patches {
     }
 
     /// Volino's test for patch `p` at both positions `x0` and `x1` (see the module docs).
+    /// `segs` is scratch for the projected boundary (kept by the caller between steps).
     pub fn cannot_self_intersect(
         &self,
         p: usize,
         tris: &[[u32; 3]],
         x0: &[Vector],
         x1: &[Vector],
+        segs: &mut Vec<ProjectedEdge>,
     ) -> bool {
         let normal = |x: &[Vector], t: u32| {
             let [a, b, c] = tris[t as usize].map(|i| x[i as usize]);
@@ -146,8 +151,8 @@ impl Patches {
                 let q = x[i as usize];
                 [q.dot(u), q.dot(w)]
             };
-            let segs: Vec<([u32; 2], [Scalar; 2], [Scalar; 2])> =
-                bnd.iter().map(|&e| (e, proj(e[0]), proj(e[1]))).collect();
+            segs.clear();
+            segs.extend(bnd.iter().map(|&e| (e, proj(e[0]), proj(e[1]))));
             for (i, a) in segs.iter().enumerate() {
                 for b in &segs[i + 1..] {
                     let shared = a.0.iter().any(|v| b.0.contains(v));

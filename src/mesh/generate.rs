@@ -2,7 +2,7 @@
 
 use super::{Mesh, MeshError};
 use crate::math::{Scalar, Vector2};
-use crate::scene::DiagonalPattern;
+use crate::spec::DiagonalPattern;
 
 /// A `width` x `height` grid with `resolution` segments along the longer side
 /// (at least one along the shorter), each square split into two right triangles.

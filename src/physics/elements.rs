@@ -35,7 +35,7 @@
 use super::shape::{SHAPE_SLOTS, ShapeTriangle, build_shape_triangles};
 use crate::math::{Scalar, Vector2};
 use crate::mesh::Mesh;
-use crate::scene::{BendingModel, StiffnessRule};
+use crate::spec::{BendingModel, StiffnessRule};
 
 /// Material parameters the elements are built from (per area, mesh independent).
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -71,7 +71,7 @@ use super::forces::PAR_MIN;
 use super::shape::ShapeJacobian;
 use super::{Contact, Stepper};
 use crate::math::{Matrix3, Scalar, Vector, deterministic_sum};
-use crate::scene::Solver;
+use crate::spec::Solver;
 use crate::world::World;
 
 /// Why an implicit step could not be solved.

@@ -12,19 +12,21 @@ pub mod explicit;
 pub mod forces;
 pub mod implicit;
 pub mod multirate;
-pub mod pins;
+/// Pinned vertices (a top-level module, [`crate::pins`], so that `world` needs nothing
+/// from `physics`); kept reachable here.
+pub use crate::pins;
 pub mod shape;
 pub mod timestep;
 pub mod work;
 
-pub use crate::scene::Solver;
+pub use crate::spec::Solver;
 pub use elements::{Elements, Hinge, MaterialParams, Spring};
 pub use forces::{Energy, ExternalForces, WindForce};
 pub use implicit::SolveFailure;
 pub use shape::{SHAPE_SLOTS, ShapeTriangle};
 
 use crate::math::{Scalar, Vector};
-use crate::scene::Integrator;
+use crate::spec::Integrator;
 use crate::world::World;
 
 /// The resolved physics of a scene.

@@ -26,6 +26,9 @@
 
 use rayon::prelude::*;
 
+mod rk4;
+pub use rk4::rk4_multirate;
+
 use super::Stepper;
 use super::bending::dihedral_angle_and_gradient;
 use super::elements::Elements;
@@ -188,6 +191,7 @@ pub fn symplectic_multirate(st: &mut Stepper, w: &mut World, big: Scalar) {
     let Some(levels) = st.levels.take() else {
         return;
     };
+    let mut rk = std::mem::take(&mut st.rk4_multirate);
     let scratch = &mut st.forces;
     let n_springs = st.elements.springs.len();
     scratch.spring.resize(n_springs, Vector::ZERO);
@@ -221,10 +225,10 @@ pub fn symplectic_multirate(st: &mut Stepper, w: &mut World, big: Scalar) {
                 &w.v,
                 g,
                 scratch,
+                &mut rk.level,
             );
             let (el, ext, held, forces) = (&st.elements, &st.model.external, &st.held, &*scratch);
-            let kicked: Vec<Vector> = g
-                .vertices
+            g.vertices
                 .par_iter()
                 .with_min_len(256)
                 .map(|&i| {
@@ -235,8 +239,8 @@ pub fn symplectic_multirate(st: &mut Stepper, w: &mut World, big: Scalar) {
                         w.v[i] + gather(el, ext, forces, i, w.v[i]) * (h / el.mass[i])
                     }
                 })
-                .collect();
-            for (&i, v) in g.vertices.iter().zip(kicked) {
+                .collect_into_vec(&mut rk.kicked);
+            for (&i, &v) in g.vertices.iter().zip(&rk.kicked) {
                 w.v[i as usize] = v;
             }
         }
@@ -252,11 +256,14 @@ pub fn symplectic_multirate(st: &mut Stepper, w: &mut World, big: Scalar) {
                 }
             });
     }
+    st.rk4_multirate = rk;
     st.levels = Some(levels);
     w.pins.apply(t + big, &mut w.x, &mut w.v);
 }
 
-/// Forces of the elements touching group `g`, written into their slots.
+/// Forces of the elements touching group `g`, written into their slots (`level` holds
+/// them between the parallel pass and the write).
+#[allow(clippy::too_many_arguments)]
 fn level_forces(
     el: &Elements,
     ext: &super::ExternalForces,
@@ -265,9 +272,9 @@ fn level_forces(
     v: &[Vector],
     g: &Group,
     scratch: &mut ForceScratch,
+    level: &mut LevelScratch,
 ) {
-    let springs: Vec<Vector> = g
-        .springs
+    g.springs
         .par_iter()
         .with_min_len(512)
         .map(|&s| {
@@ -275,12 +282,11 @@ fn level_forces(
             let [a, b] = [sp.v[0] as usize, sp.v[1] as usize];
             spring_force(x[a], x[b], v[a], v[b], sp.rest, sp.k, sp.c)
         })
-        .collect();
-    for (&s, f) in g.springs.iter().zip(springs) {
+        .collect_into_vec(&mut level.springs);
+    for (&s, &f) in g.springs.iter().zip(&level.springs) {
         scratch.spring[s as usize] = f;
     }
-    let hinges: Vec<[Vector; 4]> = g
-        .hinges
+    g.hinges
         .par_iter()
         .with_min_len(256)
         .map(|&h| {
@@ -288,12 +294,11 @@ fn level_forces(
             let (theta, grad) = dihedral_angle_and_gradient(hg.v.map(|i| x[i as usize]));
             grad.map(|gk| gk * (-hg.k * theta))
         })
-        .collect();
-    for (&h, f) in g.hinges.iter().zip(hinges) {
-        scratch.hinge[4 * h as usize..4 * h as usize + 4].copy_from_slice(&f);
+        .collect_into_vec(&mut level.hinges);
+    for (&h, f) in g.hinges.iter().zip(&level.hinges) {
+        scratch.hinge[4 * h as usize..4 * h as usize + 4].copy_from_slice(f);
     }
-    let shape: Vec<[Vector; SHAPE_SLOTS]> = g
-        .shape
+    g.shape
         .par_iter()
         .with_min_len(128)
         .map(|&p| {
@@ -301,9 +306,9 @@ fn level_forces(
             el.shape_triangles[p as usize].forces(x, &mut f);
             f
         })
-        .collect();
-    for (&p, f) in g.shape.iter().zip(shape) {
-        scratch.shape[SHAPE_SLOTS * p as usize..SHAPE_SLOTS * (p as usize + 1)].copy_from_slice(&f);
+        .collect_into_vec(&mut level.shape);
+    for (&p, f) in g.shape.iter().zip(&level.shape) {
+        scratch.shape[SHAPE_SLOTS * p as usize..SHAPE_SLOTS * (p as usize + 1)].copy_from_slice(f);
     }
     if let Some(wind) = &ext.wind {
         for &t in &g.triangles {
@@ -314,130 +319,31 @@ fn level_forces(
     }
 }
 
-/// Scratch of the RK4 multirate step.
+/// Scratch of the multirate steps (both integrators; the name is kept from when only
+/// RK4 had one), kept between steps so that a kick or substep allocates nothing once
+/// the buffers have grown to the mesh's size (issue 13).
 #[derive(Debug, Clone, Default)]
 pub struct Rk4MultirateScratch {
     xs: Vec<Vector>,
     vs: Vec<Vector>,
     x_new: Vec<Vector>,
     v_new: Vec<Vector>,
+    /// Symplectic Euler: the kicked velocities of a group's vertices.
+    kicked: Vec<Vector>,
+    /// RK4: a group's state at the start of the substep, the weighted sum of the
+    /// stages' derivatives, the current stage's state and its derivatives.
+    y0: Vec<(Vector, Vector)>,
+    acc: Vec<(Vector, Vector)>,
+    stage: Vec<(Vector, Vector)>,
+    derivs: Vec<(Vector, Vector)>,
+    level: LevelScratch,
 }
 
-/// One RK4 macro step of `big` seconds. Each level integrates its own vertices
-/// with RK4 at its own substep; the vertices of other levels that its elements
-/// touch move at their velocity from the start of the macro step (paper A:
-/// their motion is unchanged, zero acceleration). With one level this is RK4.
-pub fn rk4_multirate(st: &mut Stepper, w: &mut World, big: Scalar) {
-    let t = w.time;
-    w.pins.held_at(t, &mut st.held);
-    if st.levels.is_none() {
-        let drag = st.model.external.drag.unwrap_or(0.0);
-        st.levels = Some(Levels::build(&w.mesh, &st.elements, drag));
-    }
-    let Some(levels) = st.levels.take() else {
-        return;
-    };
-    let mut rk = std::mem::take(&mut st.rk4_multirate);
-    let n = w.x.len();
-    for (buf, src) in [
-        (&mut rk.xs, &w.x),
-        (&mut rk.vs, &w.v),
-        (&mut rk.x_new, &w.x),
-        (&mut rk.v_new, &w.v),
-    ] {
-        buf.clear();
-        buf.extend_from_slice(src);
-    }
-    debug_assert_eq!(rk.xs.len(), n);
-    let scratch = &mut st.forces;
-    scratch
-        .spring
-        .resize(st.elements.springs.len(), Vector::ZERO);
-    scratch
-        .hinge
-        .resize(4 * st.elements.hinges.len(), Vector::ZERO);
-    scratch.shape.resize(
-        SHAPE_SLOTS * st.elements.shape_triangles.len(),
-        Vector::ZERO,
-    );
-    if st.model.external.wind.is_some() {
-        scratch
-            .triangle
-            .resize(w.mesh.triangles.len(), Vector::ZERO);
-    }
-    const WEIGHT: [Scalar; 4] = [1.0, 2.0, 2.0, 1.0];
-    const AT: [Scalar; 4] = [0.0, 0.5, 0.5, 1.0];
-    for g in &levels.groups {
-        let h = big / g.substeps as Scalar;
-        for sub in 0..g.substeps {
-            let t_sub = sub as Scalar * h;
-            // State of the group's vertices at the start of the substep.
-            let y0: Vec<(Vector, Vector)> = g
-                .vertices
-                .iter()
-                .map(|&i| (rk.x_new[i as usize], rk.v_new[i as usize]))
-                .collect();
-            let mut acc: Vec<(Vector, Vector)> = vec![(Vector::ZERO, Vector::ZERO); y0.len()];
-            let mut stage: Vec<(Vector, Vector)> = y0.clone();
-            for s in 0..4 {
-                // Other levels' vertices move at their macro-start velocity.
-                let tau = t_sub + AT[s] * h;
-                for &o in &g.halo {
-                    let o = o as usize;
-                    rk.xs[o] = w.x[o] + w.v[o] * tau;
-                    rk.vs[o] = w.v[o];
-                }
-                for (&i, &(x, v)) in g.vertices.iter().zip(&stage) {
-                    rk.xs[i as usize] = x;
-                    rk.vs[i as usize] = v;
-                }
-                level_forces(
-                    &st.elements,
-                    &st.model.external,
-                    &w.mesh.triangles,
-                    &rk.xs,
-                    &rk.vs,
-                    g,
-                    scratch,
-                );
-                let (el, ext, held, forces) =
-                    (&st.elements, &st.model.external, &st.held, &*scratch);
-                let derivs: Vec<(Vector, Vector)> = g
-                    .vertices
-                    .par_iter()
-                    .zip(stage.par_iter())
-                    .with_min_len(256)
-                    .map(|(&i, &(_, v))| {
-                        let i = i as usize;
-                        let a = if held[i] {
-                            Vector::ZERO
-                        } else {
-                            gather(el, ext, forces, i, v) / el.mass[i]
-                        };
-                        (v, a)
-                    })
-                    .collect();
-                for (k, &(dx, dv)) in derivs.iter().enumerate() {
-                    acc[k].0 += dx * WEIGHT[s];
-                    acc[k].1 += dv * WEIGHT[s];
-                    if s < 3 {
-                        let c = AT[s + 1] * h;
-                        stage[k] = (y0[k].0 + dx * c, y0[k].1 + dv * c);
-                    }
-                }
-            }
-            for (k, &i) in g.vertices.iter().enumerate() {
-                let i = i as usize;
-                if !st.held[i] {
-                    rk.x_new[i] = y0[k].0 + acc[k].0 * (h / 6.0);
-                    rk.v_new[i] = y0[k].1 + acc[k].1 * (h / 6.0);
-                }
-            }
-        }
-    }
-    std::mem::swap(&mut w.x, &mut rk.x_new);
-    std::mem::swap(&mut w.v, &mut rk.v_new);
-    st.rk4_multirate = rk;
-    st.levels = Some(levels);
-    w.pins.apply(t + big, &mut w.x, &mut w.v);
+/// The element forces of one group, computed in parallel before they are written into
+/// their slots.
+#[derive(Debug, Clone, Default)]
+struct LevelScratch {
+    springs: Vec<Vector>,
+    hinges: Vec<[Vector; 4]>,
+    shape: Vec<[Vector; SHAPE_SLOTS]>,
 }

@@ -20,7 +20,7 @@ use super::bending::dihedral_angle_and_gradient;
 use super::elements::Elements;
 use crate::math::{Scalar, Vector};
 use crate::mesh::Mesh;
-use crate::scene::Integrator;
+use crate::spec::Integrator;
 
 /// Safety factor applied to the explicit stability limits.
 pub const SAFETY: Scalar = 0.4;

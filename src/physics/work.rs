@@ -18,7 +18,7 @@ use rayon::prelude::*;
 use super::Stepper;
 use super::forces::{PAR_MIN, element_pass, gather, wind_share};
 use crate::math::{Scalar, Vector, deterministic_sum};
-use crate::scene::PinMotion;
+use crate::spec::PinMotion;
 use crate::world::World;
 
 /// A held vertex of a moving pin at the start of a step.

@@ -11,6 +11,7 @@ mod limits;
 pub mod model;
 mod overrides;
 mod parse;
+pub mod resolve;
 mod schema;
 mod serde_errors;
 mod spans;
@@ -22,6 +23,7 @@ use std::path::Path;
 pub use error::{SceneError, SceneErrorKind};
 pub use limits::{MAX_COUNT, MAX_RESOLUTION};
 pub use model::*;
+pub use resolve::cloth_spec;
 
 /// The built-in scene used when no scene file is given (`src/scene/default.toml`).
 pub const DEFAULT_SCENE_TOML: &str = include_str!("default.toml");

@@ -43,7 +43,7 @@ struct Sim {
 
 impl Sim {
     fn new(scene: &Scene) -> Sim {
-        let (state, pipe) = build(scene).expect("simulation");
+        let (state, pipe) = build(&scene.resolve().expect("resolve")).expect("simulation");
         assert!(pipe.collider().is_some(), "the scene collides");
         Sim { state, pipe }
     }

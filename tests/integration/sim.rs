@@ -48,8 +48,8 @@ fn until_rollback(
 #[test]
 fn rollback_keeps_only_the_accepted_attempts_work() {
     let scene = thrash();
-    let (mut state, mut pipe) = build(&scene).expect("build");
-    let mut twin = build(&scene).expect("build twin");
+    let (mut state, mut pipe) = build(&scene.resolve().expect("resolve")).expect("build");
+    let mut twin = build(&scene.resolve().expect("resolve")).expect("build twin");
     let h = pipe.step_size(&state.world);
     let saved = until_rollback(&mut state, &mut pipe, &mut twin, h);
     let work0 = saved.ledger.external_work;
@@ -109,7 +109,7 @@ fn a_restored_state_replays_bit_for_bit_on_a_fresh_pipeline() {
         "simulation.dt=2e-4".to_string(),
     ];
     let scene = load_scene_file(Path::new("scenes/hard/thrash.toml"), &overrides).expect("scene");
-    let (mut state, mut pipe) = build(&scene).expect("build");
+    let (mut state, mut pipe) = build(&scene.resolve().expect("resolve")).expect("build");
     let h = pipe.step_size(&state.world);
     for _ in 0..50 {
         assert!(pipe.step(&mut state, h).expect("remesh"));
@@ -118,7 +118,7 @@ fn a_restored_state_replays_bit_for_bit_on_a_fresh_pipeline() {
     for _ in 0..50 {
         assert!(pipe.step(&mut state, h).expect("remesh"));
     }
-    let (_, mut fresh) = build(&scene).expect("build");
+    let (_, mut fresh) = build(&scene.resolve().expect("resolve")).expect("build");
     let mut replay = saved.clone();
     fresh.mesh_changed(&mut replay);
     for _ in 0..50 {

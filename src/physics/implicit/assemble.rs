@@ -12,7 +12,7 @@ use super::super::shape::{SHAPE_SLOTS, rates, spread};
 use super::super::{ExternalForces, Stepper};
 use super::ImplicitScratch;
 use crate::math::{Matrix3, Scalar, Vector};
-use crate::scene::Solver;
+use crate::spec::Solver;
 use crate::world::World;
 
 /// Builds the per-element blocks, the right-hand side `b` and the diagonal. With

@@ -3,7 +3,7 @@
 
 use crate::math::{Matrix3, Scalar, Vector, Vector2};
 use crate::mesh::Mesh;
-use crate::scene::{Pin, PinMotion};
+use crate::spec::{Pin, PinMotion};
 
 /// Why a pin could not be set up.
 #[derive(Debug, thiserror::Error, PartialEq)]

@@ -1,0 +1,110 @@
+//! The contact response of one vertex against one obstacle (the steps of the module
+//! docs of [`super`]): continuous detection, proximity, placement and friction; and the
+//! push-out and depth measurement of the pass after self-collision.
+
+use parry3d_f64::math::Pose;
+
+use super::obstacle::Body;
+use crate::math::{Scalar, Vector};
+use crate::physics::Contact;
+
+/// A vertex this close to a surface, in thicknesses, is in contact: resting cloth sits
+/// exactly one thickness out, and rounding must not let it flicker in and out of
+/// contact (and of the implicit solve's contact filter).
+const CONTACT_MARGIN: Scalar = 1.0 + 1e-6;
+
+/// Contact response of one vertex against one obstacle (module docs, steps 1-3).
+/// `p0` is the start-of-step position, `x`/`v` the state after the integrator.
+/// Returns the contact when the vertex touched the obstacle.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn respond(
+    b: &Body,
+    (pose0, pose1): &(Pose, Pose),
+    t1: Scalar,
+    h: Scalar,
+    pushed: Scalar,
+    p0: Vector,
+    x: &mut Vector,
+    v: &mut Vector,
+) -> Option<Contact> {
+    let q0 = pose0.inverse_transform_point(p0);
+    let q1 = pose1.inverse_transform_point(*x);
+    if !b.may_touch(q0, q1) {
+        return None;
+    }
+    let thick = b.thickness;
+    // The contact plane: outward normal and its offset n . s at the surface point s.
+    let mut plane = None;
+    if b.probe(q0).signed >= 0.0
+        && let Some((toi, n)) = b.first_entry(q0, q1)
+    {
+        plane = Some((n, n.dot(q0 + (q1 - q0) * toi)));
+    }
+    if plane.is_none() {
+        let p = b.probe(q1);
+        if p.signed < thick * CONTACT_MARGIN {
+            plane = Some((p.normal, p.normal.dot(q1) - p.signed));
+        }
+    }
+    let (n, offset) = plane?;
+    let mut q = q1 + n * (offset + thick - n.dot(q1));
+    let rot = pose1.rotation;
+    let mut u = rot.inverse() * (*v - b.point_velocity(t1, pose1.transform_point(q)));
+    let un = u.dot(n);
+    // Normal impulse per mass of the step: the approach removed here, plus what the
+    // implicit solve's contact filter already removed.
+    let dun = (-un).max(0.0) + pushed;
+    if dun > 0.0 {
+        let ut = u - n * un;
+        let speed = ut.length();
+        let ut_new = if speed <= b.mu_static * dun {
+            Vector::ZERO
+        } else {
+            ut * (1.0 - b.mu_kinetic * dun / speed)
+        };
+        q += (ut_new - ut) * h;
+        u = ut_new + n * un.max(0.0);
+    }
+    // Curved surfaces and corners: make sure the final point is a thickness outside.
+    let f = b.probe(q);
+    if f.signed < thick {
+        q += f.normal * (thick - f.signed);
+    }
+    *x = pose1.transform_point(q);
+    let surface = b.point_velocity(t1, *x);
+    *v = rot * u + surface;
+    let normal = rot * n;
+    Some(Contact {
+        normal,
+        normal_speed: surface.dot(normal),
+    })
+}
+
+/// Pushes a vertex that came within the thickness back out along the normal and removes
+/// its approaching normal velocity (the pass after self-collision).
+pub(super) fn push_out(b: &Body, pose: &Pose, t: Scalar, x: &mut Vector, v: &mut Vector) {
+    let q = pose.inverse_transform_point(*x);
+    if !b.may_touch(q, q) {
+        return;
+    }
+    let p = b.probe(q);
+    if p.signed >= b.thickness {
+        return;
+    }
+    *x = pose.transform_point(q + p.normal * (b.thickness - p.signed));
+    let n = pose.rotation * p.normal;
+    let rel = *v - b.point_velocity(t, *x);
+    let vn = rel.dot(n);
+    if vn < 0.0 {
+        *v -= n * vn;
+    }
+}
+
+/// Depth of `x` below the obstacle's surface, m (0 outside).
+pub(super) fn depth_below(b: &Body, pose: &Pose, x: Vector) -> Scalar {
+    let q = pose.inverse_transform_point(x);
+    if !b.may_touch(q, q) {
+        return 0.0;
+    }
+    (-b.probe(q).signed).max(0.0)
+}

@@ -1,0 +1,132 @@
+//! The scene resolved into the engine's specifications ([`crate::spec`]): the one place
+//! where scene data becomes engine input, so the engine never imports `crate::scene`.
+//!
+//! [`Scene::resolve`] makes all of them at once ([`SimSpec`]); the `from_scene`
+//! constructors below make one part each, for callers that need only that part.
+
+use crate::adapt::AdaptConfig;
+use crate::collide::{CollideError, Collider, cusick::CusickSummary};
+use crate::math::Vector;
+use crate::physics::{ExternalForces, MaterialParams, Model, SolverSettings, WindForce};
+use crate::spec::{ClothMesh, ClothSpec};
+use crate::world::{BuildError, World};
+
+use super::{Cloth, ClothShape, DEFAULT_AIR_DENSITY, Scene, TimeStep};
+use crate::sim::SimSpec;
+
+impl Scene {
+    /// The engine's specification of this (validated) scene: the one input of
+    /// [`crate::sim::build`].
+    pub fn resolve(&self) -> Result<SimSpec, BuildError> {
+        Ok(SimSpec {
+            cloth: cloth_spec(&self.cloth)?,
+            pins: self.pin.clone(),
+            model: Model::from_scene(self),
+            obstacles: self.obstacle.clone(),
+            self_collision: self.self_collision.clone(),
+            adapt: AdaptConfig::from_scene(self.adapt.as_ref()),
+            multirate: self.adapt.as_ref().is_some_and(|a| a.multirate),
+            density: self.material.density,
+            fixed_dt: match self.simulation.dt {
+                TimeStep::Fixed(dt) => Some(dt),
+                TimeStep::Auto => None,
+            },
+        })
+    }
+}
+
+/// `[cloth]` with the keys its shape needs checked present (validation normally
+/// reports a missing one first, with its line).
+pub fn cloth_spec(c: &Cloth) -> Result<ClothSpec, BuildError> {
+    let need = |v: Option<f64>, name| v.ok_or(BuildError::Missing(name));
+    let mesh = match c.shape {
+        ClothShape::Rectangle => {
+            let resolution = c.resolution.ok_or(BuildError::Missing("resolution"))?;
+            ClothMesh::Rectangle {
+                width: need(c.width, "width")?,
+                height: need(c.height, "height")?,
+                resolution,
+                diagonals: c.diagonals,
+            }
+        }
+        ClothShape::Disk => {
+            let resolution = c.resolution.ok_or(BuildError::Missing("resolution"))?;
+            ClothMesh::Disk {
+                radius: need(c.radius, "radius")?,
+                resolution,
+            }
+        }
+        ClothShape::Obj => ClothMesh::Obj {
+            path: c.path.clone().ok_or(BuildError::Missing("path"))?,
+            uv_scale: c.uv_scale,
+        },
+    };
+    Ok(ClothSpec {
+        mesh,
+        position: c.position,
+        rotation: c.rotation,
+    })
+}
+
+impl World {
+    /// Builds the cloth of `scene` and resolves its pins.
+    pub fn from_scene(scene: &Scene) -> Result<World, BuildError> {
+        World::from_spec(&cloth_spec(&scene.cloth)?, &scene.pin)
+    }
+}
+
+impl Collider {
+    /// The collision passes `scene` declares; `None` when it has neither obstacles nor
+    /// self-collision (nothing runs, nothing costs).
+    pub fn from_scene(scene: &Scene) -> Result<Option<Collider>, CollideError> {
+        Collider::new(&scene.obstacle, scene.self_collision.as_ref())
+    }
+
+    /// The Cusick drape measurements, when the scene is a disk specimen lying on a
+    /// vertical cylinder (the support disk) centred under it.
+    pub fn cusick(&self, scene: &Scene, world: &World) -> Option<CusickSummary> {
+        self.cusick_of(&cloth_spec(&scene.cloth).ok()?, world)
+    }
+}
+
+impl Model {
+    /// The physics a scene declares (undeclared forces are `None`).
+    pub fn from_scene(scene: &Scene) -> Model {
+        let m = &scene.material;
+        let g = Vector::from_array(scene.simulation.gravity);
+        let wind = scene.wind.as_ref().map(|w| WindForce {
+            velocity: Vector::from_array(w.velocity),
+            coefficient: w.coefficient,
+            air_density: scene
+                .air
+                .as_ref()
+                .map_or(DEFAULT_AIR_DENSITY, |a| a.density),
+        });
+        let external = ExternalForces {
+            gravity: (g != Vector::ZERO).then_some(g),
+            drag: scene.air.as_ref().map(|a| a.drag).filter(|&d| d > 0.0),
+            air_velocity: wind.map_or(Vector::ZERO, |w| w.velocity),
+            wind: wind.filter(|w| w.coefficient > 0.0),
+        };
+        Model {
+            material: MaterialParams {
+                density: m.density,
+                stretch: m.stretch,
+                bending: m.rigidity(scene.simulation.gravity),
+                damping: m.damping,
+                bending_model: m.bending_model,
+                stiffness_rule: m.stiffness_rule,
+            },
+            external,
+            integrator: scene.simulation.integrator,
+            cg_tolerance: scene.simulation.cg_tolerance,
+            cg_max_iterations: scene.simulation.cg_max_iterations,
+            solver: SolverSettings {
+                solver: scene.simulation.solver,
+                refactor_iterations: scene.simulation.refactor_iterations,
+                newton_iterations: scene.simulation.newton_iterations,
+                newton_tolerance: scene.simulation.newton_tolerance,
+            },
+        }
+    }
+}
