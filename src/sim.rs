@@ -75,10 +75,7 @@ pub enum SimBuildError {
 /// bad OBJ file or a pin that selects nothing is found, before any output is opened.
 pub fn build(spec: &SimSpec) -> Result<(SimState, Pipeline), SimBuildError> {
     let world = World::from_spec(&spec.cloth, &spec.pins)?;
-    let adapter = spec
-        .adapt
-        .clone()
-        .map(|c| Adapter::new(c, &world, spec.density));
+    let adapter = spec.adapt.map(|c| Adapter::new(c, &world, spec.density));
     let collider = Collider::new(&spec.obstacles, spec.self_collision.as_ref())?;
     let mut pipeline = Pipeline::new(
         spec.model.clone(),
