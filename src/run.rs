@@ -88,7 +88,7 @@ pub struct RunOptions {
     /// stopped early; events of the frames left out go with the next recorded frame.
     pub record_every: u64,
     /// Which edges `cloth/edges` shows; [`EdgeDisplay::Review`] (the default) is resolved
-    /// against the scene's coarsen threshold.
+    /// against the scene's refine threshold.
     pub edges: EdgeDisplay,
 }
 
@@ -221,11 +221,11 @@ fn run_in_pool(
                 file: file.clone(),
                 live: live.clone(),
             };
-            let coarsen = scene.adapt.as_ref().map(|a| a.coarsen_angle);
+            let refine = scene.adapt.as_ref().map(|a| a.refine_angle);
             Some(Recorder::open(
                 &target,
                 &scene.name,
-                opts.edges.resolve(coarsen),
+                opts.edges.resolve(refine),
             )?)
         }
     };
