@@ -157,8 +157,8 @@ pub(super) enum Message {
         application_id: String,
         /// The store's recording id.
         recording_id: String,
-        /// The data, for an arrow message.
-        chunk: Option<Chunk>,
+        /// The data, for an arrow message (boxed: a chunk is large beside the other variant).
+        chunk: Option<Box<Chunk>>,
     },
 }
 
@@ -217,9 +217,9 @@ impl RecordingFile {
                 continue;
             }
             let chunk = match &msg {
-                LogMsg::ArrowMsg(_, arrow) => {
-                    Some(Chunk::from_arrow_msg(arrow).map_err(|e| decode_err(e.to_string()))?)
-                }
+                LogMsg::ArrowMsg(_, arrow) => Some(Box::new(
+                    Chunk::from_arrow_msg(arrow).map_err(|e| decode_err(e.to_string()))?,
+                )),
                 _ => None,
             };
             visit(
