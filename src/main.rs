@@ -138,8 +138,9 @@ struct RunArgs {
     #[arg(long, value_name = "K", default_value_t = 1,
           value_parser = clap::value_parser!(u64).range(1..))]
     record_every: u64,
-    /// Which edges `cloth/edges` holds: `review` (default) the edges above the scene's
-    /// coarsen threshold (1.5 deg without adaptivity), `all` every edge.
+    /// Which edges `cloth/edges` holds: `review` (default) the edges near the scene's refine
+    /// threshold (within a factor 1.2 either way: 12.5 to 18 deg for 15 deg; 15 deg without
+    /// adaptivity), `all` every edge.
     #[arg(long, value_enum, value_name = "WHICH", default_value_t = EdgeChoice::Review)]
     edges: EdgeChoice,
     /// Leave out `cloth/edges` (the per-edge dihedral angles).
@@ -207,7 +208,7 @@ fn load(args: &SceneArgs) -> Result<Scene> {
 /// The values of `--edges`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 enum EdgeChoice {
-    /// The edges above the scene's coarsen threshold.
+    /// The edges near the scene's refine threshold.
     Review,
     /// Every edge.
     All,

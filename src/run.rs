@@ -39,7 +39,7 @@ pub struct RunOptions {
     /// stopped early; events of the frames left out go with the next recorded frame.
     pub record_every: u64,
     /// Which edges `cloth/edges` shows; [`EdgeDisplay::Review`] (the default) is resolved
-    /// against the scene's coarsen threshold.
+    /// against the scene's refine threshold.
     pub edges: EdgeDisplay,
 }
 

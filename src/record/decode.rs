@@ -4,16 +4,13 @@
 
 use std::path::Path;
 
+use super::inspect::{InspectError, Message, RecordingFile};
+use super::mesh::{DUPLICATE_COMPONENT, LEVEL_COMPONENT, simulated_triangles};
+use super::{ENTITY_MESH, TIMELINE_FRAME};
 use rerun::external::arrow::array::{
     Array, ArrayRef, AsArray, FixedSizeListArray,
     types::{Float32Type, UInt8Type, UInt32Type},
 };
-use rerun::external::re_log_encoding::DecoderApp;
-use rerun::log::{Chunk, LogMsg};
-
-use super::inspect::InspectError;
-use super::mesh::{DUPLICATE_COMPONENT, LEVEL_COMPONENT, simulated_triangles};
-use super::{ENTITY_MESH, TIMELINE_FRAME};
 
 /// The simulated cloth mesh at one frame, as the recording holds it.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -44,14 +41,7 @@ type Latest = Option<(i64, ArrayRef)>;
 /// [`InspectError::Decode`] when the mesh's components do not fit together (a copy or an
 /// index past the recorded vertices, a level count other than the triangle count).
 pub fn cloth_mesh_at(path: &Path, frame: i64) -> Result<ClothFrame, InspectError> {
-    let bytes = std::fs::read(path).map_err(|source| InspectError::Read {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    let decoder = DecoderApp::decode_eager(bytes.as_slice()).map_err(|e| InspectError::NotRrd {
-        path: path.to_path_buf(),
-        reason: e.to_string(),
-    })?;
+    let file = RecordingFile::read(path)?;
     let names = [
         "vertex_positions",
         "vertex_normals",
@@ -62,24 +52,17 @@ pub fn cloth_mesh_at(path: &Path, frame: i64) -> Result<ClothFrame, InspectError
     let mut latest: [Latest; 5] = Default::default();
     let (mut first, mut last) = (None::<i64>, None::<i64>);
     let mut at_frame = false;
-    for (index, msg) in decoder.enumerate() {
-        let decode_err = |reason: String| InspectError::Decode {
-            path: path.to_path_buf(),
-            index,
-            reason,
+    file.read_messages(|_, msg| {
+        let Message::Recording {
+            chunk: Some(chunk), ..
+        } = msg
+        else {
+            return Ok(());
         };
-        let msg = msg.map_err(|e| decode_err(e.to_string()))?;
-        let LogMsg::ArrowMsg(store, arrow) = &msg else {
-            continue;
-        };
-        if store.kind() != rerun::StoreKind::Recording {
-            continue;
-        }
-        let chunk = Chunk::from_arrow_msg(arrow).map_err(|e| decode_err(e.to_string()))?;
         if chunk.is_static()
             || chunk.entity_path().to_string().trim_start_matches('/') != ENTITY_MESH
         {
-            continue;
+            return Ok(());
         }
         let Some(times) = chunk
             .timelines()
@@ -87,8 +70,13 @@ pub fn cloth_mesh_at(path: &Path, frame: i64) -> Result<ClothFrame, InspectError
             .find(|(n, _)| n.as_str() == TIMELINE_FRAME)
             .map(|(_, col)| col.times_raw().to_vec())
         else {
-            continue;
+            return Ok(());
         };
+        for &t in &times {
+            first = Some(first.map_or(t, |f| f.min(t)));
+            last = Some(last.map_or(t, |l| l.max(t)));
+            at_frame |= t == frame;
+        }
         for (slot, name) in latest.iter_mut().zip(names) {
             let Some(array) = chunk.component_descriptors().find_map(|d| {
                 let c = d.component.as_str();
@@ -99,15 +87,13 @@ pub fn cloth_mesh_at(path: &Path, frame: i64) -> Result<ClothFrame, InspectError
                 continue;
             };
             for (row, &t) in times.iter().enumerate() {
-                first = Some(first.map_or(t, |f| f.min(t)));
-                last = Some(last.map_or(t, |l| l.max(t)));
-                at_frame |= t == frame;
                 if t <= frame && array.is_valid(row) && slot.as_ref().is_none_or(|(s, _)| *s <= t) {
                     *slot = Some((t, array.value(row)));
                 }
             }
         }
-    }
+        Ok(())
+    })?;
     let no_frame = || InspectError::NoFrame {
         frame,
         first: first.unwrap_or(0),

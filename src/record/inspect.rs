@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 
 use rerun::external::arrow::array::{
     Array, AsArray, ListArray, StringArray,
-    types::{Float64Type, UInt8Type},
+    types::{Float32Type, Float64Type, UInt8Type},
 };
 use rerun::external::re_log_encoding::DecoderApp;
 use rerun::log::{Chunk, LogMsg};
@@ -147,44 +147,121 @@ impl Inspection {
     }
 }
 
+/// One decoded message of a recording, as [`read_messages`] hands it over.
+pub(super) enum Message {
+    /// A message of the blueprint store.
+    Blueprint,
+    /// A message of the recording store, with its ids, and its chunk when it carries data.
+    Recording {
+        /// The store's application id.
+        application_id: String,
+        /// The store's recording id.
+        recording_id: String,
+        /// The data, for an arrow message (boxed: a chunk is large beside the other variant).
+        chunk: Option<Box<Chunk>>,
+    },
+}
+
+/// The raw bytes of a recording file and whether they end with rerun's stream footer.
+pub(super) struct RecordingFile {
+    /// The file.
+    pub path: PathBuf,
+    /// Its contents.
+    pub bytes: Vec<u8>,
+}
+
+impl RecordingFile {
+    /// Reads the file at `path` ([`InspectError::Read`] when it cannot be read).
+    pub fn read(path: &Path) -> Result<RecordingFile, InspectError> {
+        let bytes = std::fs::read(path).map_err(|source| InspectError::Read {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Ok(RecordingFile {
+            path: path.to_path_buf(),
+            bytes,
+        })
+    }
+
+    /// Whether the file ends with rerun's stream footer (written when a recording is closed).
+    pub fn footer(&self) -> bool {
+        let n = self.bytes.len();
+        n >= 12 && &self.bytes[n - 12..n - 4] == b"RRF2FOOT"
+    }
+
+    /// Decodes every message in file order and hands each to `visit` with its index; the
+    /// shared loop of [`inspect`] and [`super::decode::cloth_mesh_at`].
+    ///
+    /// Fails with [`InspectError::NotRrd`] when the file has no `.rrd` header, with
+    /// [`InspectError::Decode`] at the first message (or chunk) that does not decode, and
+    /// with whatever `visit` returns.
+    pub fn read_messages(
+        &self,
+        mut visit: impl FnMut(usize, Message) -> Result<(), InspectError>,
+    ) -> Result<(), InspectError> {
+        let decoder =
+            DecoderApp::decode_eager(self.bytes.as_slice()).map_err(|e| InspectError::NotRrd {
+                path: self.path.clone(),
+                reason: e.to_string(),
+            })?;
+        for (index, msg) in decoder.enumerate() {
+            let decode_err = |reason: String| InspectError::Decode {
+                path: self.path.clone(),
+                index,
+                reason,
+            };
+            let msg = msg.map_err(|e| decode_err(e.to_string()))?;
+            let store = msg.store_id();
+            if store.kind() != rerun::StoreKind::Recording {
+                visit(index, Message::Blueprint)?;
+                continue;
+            }
+            let chunk = match &msg {
+                LogMsg::ArrowMsg(_, arrow) => Some(Box::new(
+                    Chunk::from_arrow_msg(arrow).map_err(|e| decode_err(e.to_string()))?,
+                )),
+                _ => None,
+            };
+            visit(
+                index,
+                Message::Recording {
+                    application_id: store.application_id().to_string(),
+                    recording_id: store.recording_id().to_string(),
+                    chunk,
+                },
+            )?;
+        }
+        Ok(())
+    }
+}
+
 /// Decodes the recording at `path` completely and gathers its contents.
 pub fn inspect(path: &Path) -> Result<Inspection, InspectError> {
-    let read_err = |source| InspectError::Read {
-        path: path.to_path_buf(),
-        source,
-    };
-    let bytes = std::fs::read(path).map_err(read_err)?;
-    let decoder = DecoderApp::decode_eager(bytes.as_slice()).map_err(|e| InspectError::NotRrd {
-        path: path.to_path_buf(),
-        reason: e.to_string(),
-    })?;
+    let file = RecordingFile::read(path)?;
     let mut out = Inspection {
         path: path.to_path_buf(),
-        bytes: bytes.len() as u64,
-        footer: bytes.len() >= 12 && &bytes[bytes.len() - 12..bytes.len() - 4] == b"RRF2FOOT",
+        bytes: file.bytes.len() as u64,
+        footer: file.footer(),
         ..Inspection::default()
     };
-    for (index, msg) in decoder.enumerate() {
-        let decode_err = |reason: String| InspectError::Decode {
-            path: path.to_path_buf(),
-            index,
-            reason,
-        };
-        let msg = msg.map_err(|e| decode_err(e.to_string()))?;
+    file.read_messages(|_, msg| {
         out.messages += 1;
-        let store = msg.store_id();
-        if store.kind() != rerun::StoreKind::Recording {
-            out.blueprint_messages += 1;
-            continue;
+        match msg {
+            Message::Blueprint => out.blueprint_messages += 1,
+            Message::Recording {
+                application_id,
+                recording_id,
+                chunk,
+            } => {
+                out.application_ids.insert(application_id);
+                out.recording_ids.insert(recording_id);
+                if let Some(chunk) = chunk {
+                    gather(&mut out, &chunk);
+                }
+            }
         }
-        out.application_ids
-            .insert(store.application_id().to_string());
-        out.recording_ids.insert(store.recording_id().to_string());
-        if let LogMsg::ArrowMsg(_, arrow) = &msg {
-            let chunk = Chunk::from_arrow_msg(arrow).map_err(|e| decode_err(e.to_string()))?;
-            gather(&mut out, &chunk);
-        }
-    }
+        Ok(())
+    })?;
     carry_topology(&mut out);
     Ok(out)
 }
@@ -245,12 +322,19 @@ fn gather(out: &mut Inspection, chunk: &Chunk) {
                 info.levels = l.values().to_vec();
             }
         } else if entity == ENTITY_EDGES {
-            if let Some(a) = cell(ANGLE_COMPONENT)
-                && let Some(a) = a.as_primitive_opt::<Float64Type>()
-            {
+            // `f32` since issue 15, `f64` in older recordings.
+            let angles: Option<Vec<f64>> = cell(ANGLE_COMPONENT).and_then(|a| {
+                a.as_primitive_opt::<Float32Type>()
+                    .map(|a| a.values().iter().map(|&v| f64::from(v)).collect())
+                    .or_else(|| {
+                        a.as_primitive_opt::<Float64Type>()
+                            .map(|a| a.values().to_vec())
+                    })
+            });
+            if let Some(a) = angles {
                 info.edges = Some(a.len());
-                info.max_edge_angle = a.values().iter().copied().reduce(f64::max);
-                info.min_edge_angle = a.values().iter().copied().reduce(f64::min);
+                info.max_edge_angle = a.iter().copied().reduce(f64::max);
+                info.min_edge_angle = a.iter().copied().reduce(f64::min);
             }
         } else if entity == ENTITY_EVENT_LOG {
             if let Some(t) = cell("text")

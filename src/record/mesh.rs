@@ -3,7 +3,8 @@
 //!
 //! `Mesh3D` has no per-face colour, so a vertex where triangles of several levels meet is
 //! drawn once per level: the first `V` vertices of the recorded mesh are the simulated mesh's
-//! vertices in their order (each in the colour of its highest level), and after them come the
+//! vertices in their order (each in the colour of the level of most of its triangles, the
+//! highest on a tie), and after them come the
 //! copies, one per vertex and further level it is used at, listed by `duplicate_of` (the
 //! simulated vertex each copy repeats). Every frame logs the positions and normals of all of
 //! them; a frame whose triangles, levels or vertex count differ from the last logged topology
@@ -70,13 +71,24 @@ impl ClothMesh {
         self.levels.clear();
         self.levels.extend_from_slice(levels);
 
-        // Each vertex keeps its highest level; other levels get a copy.
+        // Each vertex keeps the level of most of its triangles (the highest on a tie), so
+        // that as few corners as possible need a copy; other levels get one.
+        let mut corners: Vec<(u32, u8)> = triangles
+            .iter()
+            .zip(levels)
+            .flat_map(|(t, &l)| t.map(|i| (i, l)))
+            .collect();
+        corners.sort_unstable();
         self.vertex_levels.clear();
         self.vertex_levels.resize(vertices, 0);
-        for (t, &l) in triangles.iter().zip(levels) {
-            for &i in t {
-                let v = &mut self.vertex_levels[i as usize];
-                *v = (*v).max(l);
+        let mut best = vec![0usize; vertices];
+        for run in corners.chunk_by(|a, b| a == b) {
+            let (i, l) = run[0];
+            let i = i as usize;
+            // Runs come in ascending level per vertex: `>=` keeps the highest on a tie.
+            if run.len() >= best[i] {
+                best[i] = run.len();
+                self.vertex_levels[i] = l;
             }
         }
         self.duplicate_of.clear();
@@ -112,10 +124,13 @@ impl ClothMesh {
     }
 
     /// The topology part of the row: triangle indices, vertex colours and class ids (the
-    /// level), and the data components `triangle_level` and `duplicate_of`.
+    /// level: colour, legend and hover label), and the data components `triangle_level` and
+    /// `duplicate_of`. The colours cannot be left to the class ids: the 0.36 viewer draws a
+    /// `Mesh3D` without vertex colours in its default grey, annotation context or not.
     pub(super) fn topology(&self) -> (rerun::Mesh3D, rerun::AnyValues) {
         let mesh = rerun::Mesh3D::update_fields()
             .with_triangle_indices(self.indices.iter().copied())
+            // Needed: the 0.36 viewer does not colour a mesh from its class ids.
             .with_vertex_colors(self.vertex_levels.iter().map(|&l| convert::level_color(l)))
             .with_class_ids(
                 self.vertex_levels
@@ -167,7 +182,8 @@ mod tests {
         let tris = [[0, 1, 2], [0, 2, 3]];
         let mut m = ClothMesh::default();
         assert!(m.update(4, &tris, &[0, 1]));
-        // 0 and 2 are at level 1 (their highest), so triangle 0 needs copies of both.
+        // 0 and 2 have one triangle at each level: the tie goes to level 1, so triangle 0
+        // needs copies of both.
         assert_eq!(m.duplicate_of, vec![0, 2]);
         assert_eq!(m.indices, vec![[4, 1, 5], [0, 2, 3]]);
         assert_eq!(m.vertex_levels, vec![1, 0, 1, 1, 0, 0]);
@@ -180,6 +196,16 @@ mod tests {
         assert!(m.duplicate_of.is_empty());
         assert_eq!(m.vertex_levels.len(), 4);
         assert!(m.update(5, &tris, &[1, 1]), "vertex count changed");
+        // Vertex 0 has two triangles at level 0 and one at level 1: it keeps level 0.
+        let fan = [[0, 1, 2], [0, 2, 3], [0, 3, 4]];
+        assert!(m.update(5, &fan, &[0, 0, 1]));
+        assert_eq!(m.vertex_levels[..5], [0, 0, 0, 1, 1]);
+        assert_eq!(m.duplicate_of, vec![3, 0]);
+        assert_eq!(m.indices, vec![[0, 1, 2], [0, 2, 5], [6, 3, 4]]);
+        assert_eq!(
+            simulated_triangles(5, &m.indices, &m.duplicate_of),
+            Some(fan.to_vec())
+        );
         assert_eq!(simulated_triangles(4, &[[0, 1, 9]], &[]), None);
     }
 }

@@ -17,9 +17,10 @@
 //!   frames where the topology changed (`mesh.rs`; [`decode::cloth_mesh_at`] reads a frame
 //!   back);
 //! - `cloth/edges` every frame unless turned off: the edges as line segments coloured by their
-//!   dihedral angle ([`edges::angle_rgb`]), with the angle (`dihedral_angle_deg`) and the vertex
-//!   pair (`edge_vertices`) of each segment as data; by default the edges above the scene's
-//!   coarsen threshold, or all, or those above a given angle ([`EdgeDisplay`]);
+//!   dihedral angle (a class id per whole degree, [`edges::angle_class`], coloured and named by
+//!   a static annotation context at `cloth/edges`), with the angle (`dihedral_angle_deg`, `f32`)
+//!   and the vertex pair (`edge_vertices`) of each segment as data; by default the edges near
+//!   the scene's refine threshold, or all, or those above a given angle ([`EdgeDisplay`]);
 //! - `cloth/pins` every frame: the pinned vertices as points;
 //! - `events/points` and `events/log`: the remeshing events since the previous recorded frame;
 //! - `legend` (static): a markdown text document naming the colours;
@@ -190,7 +191,13 @@ impl Recorder {
     ///
     /// The recording id derives from `scene_name` ([`recording_id`]), which is also the
     /// recording's name. Logs once: view coordinates (right-handed, z up) and the annotation
-    /// context of the level colours. The default blueprint follows with the first frame.
+    /// context of the level colours (and one of the angle classes at `cloth/edges` unless
+    /// edges are off). The default blueprint follows with the first frame.
+    ///
+    /// Without a live viewer the rows of an entity are batched into chunks of up to 2 MiB
+    /// whatever the time between frames ([`sink::file_only_batching`]): a slow run otherwise
+    /// gets one chunk, with its own schema, per entity and frame. With a viewer rerun's
+    /// default (a chunk at least every 200 ms) keeps the viewer up to date.
     pub fn open(
         target: &RecordTarget,
         scene_name: &str,
@@ -202,7 +209,11 @@ impl Recorder {
             source,
         };
         let sinks = sink::open_sinks(target)?;
-        let stream = RecordingStreamBuilder::new(APPLICATION_ID)
+        let mut builder = RecordingStreamBuilder::new(APPLICATION_ID);
+        if target.live.is_none() {
+            builder = builder.batcher_config(sink::file_only_batching());
+        }
+        let stream = builder
             .recording_id(recording_id(scene_name))
             // `recording_id` turns the properties chunk off; keep the name in the file.
             .send_properties(true)
@@ -237,6 +248,12 @@ impl Recorder {
             .stream
             .log_static("cloth", &convert::level_annotations())
             .map_err(|e| recorder.log_err("cloth", e))?;
+        if edges != EdgeDisplay::Off {
+            recorder
+                .stream
+                .log_static(ENTITY_EDGES, &edges::angle_annotations())
+                .map_err(|e| recorder.log_err(ENTITY_EDGES, e))?;
+        }
         recorder
             .stream
             .log_static(

@@ -88,6 +88,17 @@ pub(super) fn open_sinks(target: &RecordTarget) -> Result<Vec<Box<dyn LogSink>>,
     Ok(sinks)
 }
 
+/// The batching of a recording without a live viewer: rerun's default thresholds (a chunk
+/// per entity once its rows reach 2 MiB) without the 200 ms wall-clock tick, so that the rows
+/// of many frames share a chunk (and its schema) however long a frame takes to simulate.
+/// Everything still pending is written when the recording is flushed or closed.
+pub(super) fn file_only_batching() -> rerun::log::ChunkBatcherConfig {
+    rerun::log::ChunkBatcherConfig {
+        flush_tick: std::time::Duration::MAX,
+        ..rerun::log::ChunkBatcherConfig::DEFAULT
+    }
+}
+
 /// A gRPC sink for a proxy URL; anything else (a catalog URL, garbage) is an error.
 fn grpc_sink(url: &str) -> Result<GrpcSink, BoxError> {
     use rerun::external::re_uri::RedapUri;

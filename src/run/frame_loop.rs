@@ -68,11 +68,11 @@ impl<'a> FrameLoop<'a> {
                     file: file.clone(),
                     live: live.clone(),
                 };
-                let coarsen = scene.adapt.as_ref().map(|a| a.coarsen_angle);
+                let refine = scene.adapt.as_ref().map(|a| a.refine_angle);
                 Some(Recorder::open(
                     &target,
                     &scene.name,
-                    opts.edges.resolve(coarsen),
+                    opts.edges.resolve(refine),
                 )?)
             }
         };

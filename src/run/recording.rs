@@ -60,7 +60,7 @@ pub(super) fn record_state(
         ("energy/gravitational", e.gravitational),
         ("energy/elastic", e.elastic),
         ("energy/total", e.total()),
-        ("time/dt", dt_now),
+        ("time/dt_ms", 1e3 * dt_now),
         ("timing/sim_ms", 1e3 * snap.timing.sim_s),
         ("timing/record_ms", 1e3 * snap.timing.record_s),
         (

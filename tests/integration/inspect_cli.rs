@@ -102,7 +102,8 @@ fn inspect_prints_the_overview_and_a_frame() {
             .map(|l| l.split_whitespace().skip(1).collect::<Vec<_>>())
     };
     assert_eq!(rows("/cloth/mesh"), Some(vec!["3", "0"]));
-    assert_eq!(rows("/cloth/edges"), Some(vec!["3", "0"]));
+    // One static row: the annotation context of the angle classes.
+    assert_eq!(rows("/cloth/edges"), Some(vec!["3", "1"]));
     assert_eq!(rows("/events/log"), Some(vec!["3", "0"]));
     assert_eq!(rows("/plots/energy/total"), Some(vec!["3", "0"]));
     assert_eq!(rows("/cloth"), Some(vec!["0", "1"]));

@@ -124,6 +124,8 @@ fn grid(n: u32) -> Square {
 pub(crate) struct Decoded {
     /// Rows per entity path in the recording store.
     pub(crate) rows: std::collections::BTreeMap<String, usize>,
+    /// Chunks (arrow messages) of the recording store.
+    pub(crate) chunks: usize,
     /// Timeline names seen on `cloth/mesh`.
     mesh_timelines: std::collections::BTreeSet<String>,
     recording_ids: std::collections::BTreeSet<String>,
@@ -145,6 +147,7 @@ pub(crate) fn decode(path: &std::path::Path) -> Decoded {
         out.recording_ids.insert(store.recording_id().to_string());
         if let LogMsg::ArrowMsg(_, arrow) = &msg {
             let chunk = Chunk::from_arrow_msg(arrow).expect("chunk");
+            out.chunks += 1;
             let entity = chunk.entity_path().to_string();
             *out.rows.entry(entity.clone()).or_default() += chunk.num_rows();
             if entity == "/cloth/mesh" {
@@ -233,12 +236,19 @@ fn size_and_time_per_frame() {
          {:.0} B/frame",
         (s101 - s1) as f64 / 100.0
     );
-    // Pauses longer than the file sink's 200 ms batching tick: one chunk per entity per frame.
+    // Pauses longer than rerun's default 200 ms batching tick, which a recording without a
+    // live viewer does without: the frames still share their chunks (one per entity, not one
+    // per entity and frame).
     let pause = std::time::Duration::from_millis(250);
     let (s4, _) = record_mesh(&many, &square(), 4, pause).expect("recording");
     println!(
-        "2-triangle mesh, one chunk per frame: 4 frames {s4} B, {:.0} B/frame",
+        "2-triangle mesh, 250 ms between frames: 4 frames {s4} B, {:.0} B/frame",
         (s4 - s1) as f64 / 3.0
+    );
+    let chunks = decode(&many).chunks;
+    assert!(
+        chunks <= 16,
+        "{chunks} chunks: frames 250 ms apart should share their entities' chunks"
     );
     let big = grid(100);
     let (b1, _) = record_mesh(&one, &big, 1, std::time::Duration::ZERO).expect("recording");

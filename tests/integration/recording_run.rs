@@ -10,6 +10,7 @@ use std::time::{Duration, Instant};
 
 use drape::record::EdgeDisplay;
 use drape::record::decode::cloth_mesh_at;
+use drape::record::edges::REVIEW_BAND;
 use drape::record::inspect::{Inspection, inspect};
 use drape::run::{RunError, RunOptions, run, run_observed};
 use drape::scene::{Scene, default_scene, load_scene_file};
@@ -49,14 +50,16 @@ fn tablecloth_short() -> Scene {
     )
 }
 
-/// The scenes' coarsen threshold, which the default edge choice keeps edges above.
-const COARSEN_DEG: f64 = 1.5;
+/// The band of angles the default edge choice keeps: within a factor `REVIEW_BAND` of the
+/// scenes' refine threshold (15 deg).
+const REVIEW_DEG: (f64, f64) = (15.0 / REVIEW_BAND, 15.0 * REVIEW_BAND);
 
 /// Every frame has one mesh row, one `triangle_level` per triangle, the triangle count of the
 /// `mesh/triangles` plot, and the edges: with `all_edges` (a disk-like sheet) `V + T - 1` of
 /// them with the largest angle equal to the `angle/max_deg` plot; else (the default choice)
-/// at most that many, every one above the coarsen threshold, and the largest one whenever it
-/// is above it.
+/// at most that many, every one in the band near the refine threshold, none when the largest
+/// angle is below the band, and the largest one whenever it is in the band (the angles are
+/// recorded as `f32`).
 fn check_frames(ins: &Inspection, all_edges: bool) {
     let topology = ins.frames.values().filter(|f| f.topology).count();
     println!(
@@ -72,21 +75,30 @@ fn check_frames(ins: &Inspection, all_edges: bool) {
         let verts = f.vertices().expect("vertex plot") as usize;
         let edges = f.edges.expect("edges row");
         let plotted = f.scalars["angle/max_deg"];
+        let (low, high) = REVIEW_DEG;
+        // The f32 angle of an edge at exactly a bound may round to either side of it.
+        let slack = 1e-6;
         if all_edges {
             assert_eq!(edges, verts + tris - 1, "frame {n}: Euler's formula");
         } else {
             assert!(edges < verts + tris, "frame {n}: at most V + T - 1");
-            if let Some(min) = f.min_edge_angle {
-                assert!(min > COARSEN_DEG, "frame {n}: kept an edge at {min} deg");
+            if let (Some(min), Some(max)) = (f.min_edge_angle, f.max_edge_angle) {
+                assert!(
+                    min >= low - slack && max <= high + slack,
+                    "frame {n}: kept edges from {min} to {max} deg"
+                );
             }
-            if plotted <= COARSEN_DEG {
-                assert_eq!(edges, 0, "frame {n}: nothing above the threshold");
+            if plotted < low {
+                assert_eq!(edges, 0, "frame {n}: nothing near the threshold");
+                continue;
+            }
+            if plotted > high {
                 continue;
             }
         }
         let max = f.max_edge_angle.expect("angles");
         assert!(
-            (max - plotted).abs() <= 1e-12 * plotted.max(1.0),
+            (max - plotted).abs() <= 1e-6 * plotted.max(1.0),
             "{max} vs {plotted}"
         );
     }
@@ -131,7 +143,7 @@ fn adaptive_run_holds_the_whole_schema() {
         "energy/gravitational",
         "energy/elastic",
         "energy/total",
-        "time/dt",
+        "time/dt_ms",
         "timing/sim_ms",
         "timing/record_ms",
         "angle/max_deg",
@@ -282,8 +294,8 @@ fn edge_options_filter_or_drop_cloth_edges() {
         "the default leaves flat edges out"
     );
     assert!(
-        kept(&review_i) >= kept(&above_i),
-        "1.5 deg keeps more than 2 deg"
+        kept(&review_i) <= kept(&above_i),
+        "the band (12.5 to 18 deg) is within the edges above 2 deg"
     );
     let mut kept_some = false;
     for (n, f) in &all_i.frames {
@@ -303,11 +315,13 @@ fn edge_options_filter_or_drop_cloth_edges() {
     }
     assert!(kept_some, "the run bends past {threshold} deg somewhere");
     println!(
-        "bytes: all edges {} ({} edges), above {threshold} deg {}, default (above \
-         {COARSEN_DEG} deg) {} ({} edges), no edges {}",
+        "bytes: all edges {} ({} edges), above {threshold} deg {}, default ({:.1} to {:.1} \
+         deg) {} ({} edges), no edges {}",
         all_i.bytes,
         kept(&all_i),
         above_i.bytes,
+        REVIEW_DEG.0,
+        REVIEW_DEG.1,
         review_i.bytes,
         kept(&review_i),
         none_i.bytes
@@ -407,15 +421,15 @@ fn sigint_leaves_a_complete_recording() {
         .stderr(Stdio::piped())
         .spawn()
         .expect("spawn drape");
-    // Let it record a few frames (the file grows as rerun flushes), then interrupt.
+    // Let it start recording, then interrupt. Without a live viewer rerun writes an entity's
+    // rows only once they reach 2 MiB, so the file's size says little about the frames done:
+    // wait for the file, then a little (the first, flat frames are quick).
     let started = Instant::now();
     let rrd = dir.join("x.rrd");
-    while std::fs::metadata(&rrd).map_or(0, |m| m.len()) < 100_000
-        && started.elapsed() < Duration::from_secs(60)
-    {
+    while !rrd.exists() && started.elapsed() < Duration::from_secs(60) {
         std::thread::sleep(Duration::from_millis(100));
     }
-    std::thread::sleep(Duration::from_millis(500));
+    std::thread::sleep(Duration::from_secs(2));
     let status = Command::new("kill")
         .args(["-INT", &child.id().to_string()])
         .status()
