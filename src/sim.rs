@@ -77,13 +77,13 @@ pub fn build(spec: &SimSpec) -> Result<(SimState, Pipeline), SimBuildError> {
     let world = World::from_spec(&spec.cloth, &spec.pins)?;
     let adapter = spec.adapt.map(|c| Adapter::new(c, &world, spec.density));
     let collider = Collider::new(&spec.obstacles, spec.self_collision.as_ref())?;
-    let mut pipeline = Pipeline::new(
+    let pipeline = Pipeline::new(
         spec.model.clone(),
         &world,
         collider,
         spec.fixed_dt,
         spec.multirate,
     );
-    let state = SimState::new(world, adapter, &mut pipeline);
+    let state = SimState::new(world, adapter, &pipeline);
     Ok((state, pipeline))
 }

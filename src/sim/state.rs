@@ -81,7 +81,7 @@ impl Default for Effort {
 
 impl SimState {
     /// The state at the start of a run (no steps taken) on `world`.
-    pub fn new(world: World, adapter: Option<Adapter>, pipeline: &mut Pipeline) -> SimState {
+    pub fn new(world: World, adapter: Option<Adapter>, pipeline: &Pipeline) -> SimState {
         let bound = EnergyBound::new(&world, pipeline.stepper());
         SimState {
             world,
