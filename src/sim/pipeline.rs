@@ -348,7 +348,9 @@ impl Pipeline {
 
     /// After the state's mesh changed (remeshing, or a restored start): rebuilds the
     /// force elements and forgets the step size, the air power and the (now stale)
-    /// contacts.
+    /// contacts. The pipeline calls it after its own remeshing and restores; call it
+    /// before stepping a state whose mesh was changed or restored outside the
+    /// pipeline, or a state the pipeline was not built for.
     pub fn mesh_changed(&mut self, state: &mut SimState) {
         self.stepper.rebuild(&state.world);
         self.auto_dt = None;
