@@ -215,6 +215,11 @@ impl Pipeline {
     /// Returns false when the step was rejected ([`Pipeline::failure`] says why);
     /// the state is then not restored (the frame retry does that).
     pub fn step(&mut self, state: &mut SimState, h: Scalar) -> Result<bool, MeshError> {
+        debug_assert_eq!(
+            self.stepper.elements.mass.len(),
+            state.world.x.len(),
+            "the pipeline's elements are not those of the state's mesh: call mesh_changed"
+        );
         let rollback = state.adapter.as_ref().is_some_and(|a| a.config.rollback);
         let mut tries = 0;
         loop {
