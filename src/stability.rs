@@ -11,6 +11,10 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
+mod cases;
+
+pub use cases::{CASES, Case};
+
 use crate::math::Scalar;
 use crate::run::{FrameState, RunError, RunOptions, run_observed};
 use crate::scene::{Integrator, Scene, SceneError, TimeStep, load_scene_file};
@@ -22,107 +26,6 @@ pub const ENERGY_TOLERANCE: Scalar = 0.05;
 
 /// Largest allowed relative change of the total mass.
 pub const MASS_TOLERANCE: Scalar = 1e-9;
-
-const ALL: &[Integrator] = &[
-    Integrator::SymplecticEuler,
-    Integrator::Rk4,
-    Integrator::Implicit,
-];
-
-/// One hard case: a scene of `scenes/hard/` and how the suite runs it.
-#[derive(Debug, Clone, Copy)]
-pub struct Case {
-    /// Short name (`--case NAME`); the scene file is `NAME.toml`.
-    pub name: &'static str,
-    /// What the case stresses, one line.
-    pub stresses: &'static str,
-    /// The integrators the case is run with.
-    pub integrators: &'static [Integrator],
-    /// The integrators of a `--quick` run (a subset of `integrators`).
-    pub quick_integrators: &'static [Integrator],
-    /// Whether the case is also run with adaptivity off (the scenes all adapt).
-    pub adapt_off: bool,
-    /// `--quick`: simulated duration, s.
-    pub quick_duration: Scalar,
-    /// `--quick`: cloth resolution (`None`: the scene's, e.g. an OBJ mesh).
-    pub quick_resolution: Option<u32>,
-}
-
-/// The hard-case suite.
-pub const CASES: &[Case] = &[
-    Case {
-        name: "stiff",
-        stresses: "stretch 1e4 N/m, 0.1 kg/m^2; implicit at one step per frame",
-        integrators: ALL,
-        quick_integrators: ALL,
-        adapt_off: true,
-        quick_duration: 1.0,
-        quick_resolution: Some(8),
-    },
-    Case {
-        name: "impact",
-        stresses: "20 m/s impact on a 5 mm box",
-        integrators: ALL,
-        quick_integrators: ALL,
-        adapt_off: true,
-        quick_duration: 2.3,
-        quick_resolution: Some(8),
-    },
-    Case {
-        name: "wind",
-        stresses: "30 m/s wind on a flag for 10 s",
-        integrators: ALL,
-        quick_integrators: ALL,
-        adapt_off: true,
-        quick_duration: 1.0,
-        quick_resolution: Some(8),
-    },
-    Case {
-        name: "yank",
-        stresses: "pinned corner yanked at 50 m/s^2",
-        integrators: ALL,
-        quick_integrators: ALL,
-        adapt_off: true,
-        quick_duration: 0.5,
-        quick_resolution: Some(8),
-    },
-    Case {
-        name: "sliver",
-        stresses: "input mesh with sliver triangles (aspect 1e-3)",
-        integrators: &[Integrator::Implicit],
-        quick_integrators: &[Integrator::Implicit],
-        adapt_off: true,
-        quick_duration: 0.5,
-        quick_resolution: None,
-    },
-    Case {
-        name: "long",
-        stresses: "20 s run",
-        integrators: ALL,
-        quick_integrators: ALL,
-        adapt_off: true,
-        quick_duration: 4.0,
-        quick_resolution: Some(8),
-    },
-    Case {
-        name: "thrash",
-        stresses: "refine 10 deg / coarsen 9.9 deg, every step, rollback",
-        integrators: ALL,
-        quick_integrators: ALL,
-        adapt_off: false,
-        quick_duration: 0.5,
-        quick_resolution: Some(8),
-    },
-    Case {
-        name: "crumple",
-        stresses: "crumpling on the floor with self-contact",
-        integrators: ALL,
-        quick_integrators: &[Integrator::Implicit],
-        adapt_off: true,
-        quick_duration: 0.6,
-        quick_resolution: Some(10),
-    },
-];
 
 /// Why the suite could not run (a failing case is not an error: it is a row).
 #[derive(Debug, thiserror::Error)]
