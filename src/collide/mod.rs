@@ -152,8 +152,6 @@ pub struct Collider {
     self_collider: Option<SelfCollider>,
     x0: Vec<Vector>,
     held: Vec<bool>,
-    /// Per vertex: the obstacle contact the last step ended in (for the implicit solve).
-    contacts: Vec<Contact>,
     t0: Scalar,
     /// Per-step scratch, kept so that a step allocates nothing: each body's pose at the
     /// start and the end of the step.
@@ -183,7 +181,6 @@ impl Collider {
             self_collider: self_collision.map(SelfCollider::new),
             x0: Vec::new(),
             held: Vec::new(),
-            contacts: Vec::new(),
             t0: 0.0,
             poses: Vec::new(),
             hits: Vec::new(),
@@ -264,11 +261,14 @@ impl Collider {
     }
 
     /// Resolves collisions after an integrator step of `h` seconds (see the module docs).
+    /// With obstacles, `contacts` becomes the contacts the step ended in, one per
+    /// vertex (the simulation state's resting contacts, for the next implicit step).
     pub fn end_step(
         &mut self,
         world: &mut World,
         h: Scalar,
         cloth: StepCloth,
+        contacts: &mut Vec<Contact>,
         stats: &mut CollisionStats,
     ) {
         let StepCloth { pushed, mass } = cloth;
@@ -278,18 +278,18 @@ impl Collider {
         self.poses
             .extend(self.bodies.iter().map(|b| (b.pose(t0), b.pose(t1))));
         let poses = &self.poses;
-        let contacts = if self.bodies.is_empty() {
+        let touching = if self.bodies.is_empty() {
             0
         } else {
             let (bodies, x0, held) = (&self.bodies, &self.x0, &self.held);
-            self.contacts.clear();
-            self.contacts.resize(world.x.len(), Contact::default());
+            contacts.clear();
+            contacts.resize(world.x.len(), Contact::default());
             let moving = self.bodies.iter().any(Body::is_moving);
             world
                 .x
                 .par_iter_mut()
                 .zip(world.v.par_iter_mut())
-                .zip(self.contacts.par_iter_mut())
+                .zip(contacts.par_iter_mut())
                 .enumerate()
                 .with_min_len(256)
                 .map(|(i, ((x, v), contact))| {
@@ -317,12 +317,12 @@ impl Collider {
                 })
                 .collect_into_vec(&mut self.hits);
             // Summed in vertex order, so the work is the same at any thread count.
-            let (contacts, work) = self
+            let (touching, work) = self
                 .hits
                 .iter()
                 .fold((0u64, 0.0), |(n, w), &(a, b)| (n + a, w + b));
             stats.obstacle_work += work;
-            contacts
+            touching
         };
         stats.collision_wall_s += started.elapsed().as_secs_f64();
         if let Some(sc) = self.self_collider.as_mut() {
@@ -364,20 +364,9 @@ impl Collider {
             stats.last_penetration = depth;
         }
         stats.steps += 1;
-        stats.contacts += contacts;
-        stats.last_contacts = contacts;
+        stats.contacts += touching;
+        stats.last_contacts = touching;
         stats.collision_wall_s += started.elapsed().as_secs_f64();
-    }
-
-    /// The obstacle contacts the last step ended in, one per vertex (empty before the
-    /// first step); hand them to [`crate::physics::Stepper::contacts`].
-    pub fn contacts(&self) -> &[Contact] {
-        &self.contacts
-    }
-
-    /// Forgets the contacts (after the mesh changed, their vertex indices are stale).
-    pub fn forget_contacts(&mut self) {
-        self.contacts.clear();
     }
 
     /// The Cusick drape measurements, when the cloth is a disk specimen lying on a

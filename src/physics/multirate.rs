@@ -180,17 +180,23 @@ fn touch(
     }
 }
 
+/// The stepper's levels, built for the current mesh if it has none (they are
+/// dropped when the mesh changes); the caller puts them back after the step.
+pub(super) fn take_levels(st: &mut Stepper, w: &World) -> Levels {
+    match st.levels.take() {
+        Some(levels) => levels,
+        None => {
+            let drag = st.model.external.drag.unwrap_or(0.0);
+            Levels::build(&w.mesh, &st.elements, drag)
+        }
+    }
+}
+
 /// One macro step of `big` seconds: each level in turn, finest first.
 pub fn symplectic_multirate(st: &mut Stepper, w: &mut World, big: Scalar) {
     let t = w.time;
     w.pins.held_at(t, &mut st.held);
-    if st.levels.is_none() {
-        let drag = st.model.external.drag.unwrap_or(0.0);
-        st.levels = Some(Levels::build(&w.mesh, &st.elements, drag));
-    }
-    let Some(levels) = st.levels.take() else {
-        return;
-    };
+    let levels = take_levels(st, w);
     let mut rk = std::mem::take(&mut st.rk4_multirate);
     let scratch = &mut st.forces;
     let n_springs = st.elements.springs.len();

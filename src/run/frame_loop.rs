@@ -190,17 +190,7 @@ impl<'a> FrameLoop<'a> {
     /// Records the current frame and exports its OBJ.
     fn record_now(&mut self) -> Result<(), RunError> {
         let t1 = Instant::now();
-        if let Some(rec) = self.recorder.as_mut() {
-            let snap = Snapshot {
-                frame: self.frame,
-                energy: self.pipeline.stepper().energy(&self.state.world),
-                timing: self.timing,
-            };
-            let (state, pipeline) = (&mut self.state, &mut self.pipeline);
-            recording::record_state(rec, state, pipeline, &snap, &mut self.normals)?;
-            self.recorded_frames += 1;
-            self.last_recorded = Some(self.frame);
-        }
+        self.log_frame()?;
         if let Some(dir) = &self.obj_dir {
             let w = &self.state.world;
             write_frame_obj(dir, self.frame, &w.x, &w.mesh.material, &w.mesh.triangles)?;
@@ -210,22 +200,30 @@ impl<'a> FrameLoop<'a> {
         Ok(())
     }
 
+    /// Logs the current frame to the recording (when there is one).
+    fn log_frame(&mut self) -> Result<(), RunError> {
+        let Some(rec) = self.recorder.as_mut() else {
+            return Ok(());
+        };
+        let snap = Snapshot {
+            frame: self.frame,
+            energy: self.pipeline.stepper().energy(&self.state.world),
+            timing: self.timing,
+        };
+        let (state, pipeline) = (&mut self.state, &mut self.pipeline);
+        recording::record_state(rec, state, pipeline, &snap, &mut self.normals)?;
+        self.recorded_frames += 1;
+        self.last_recorded = Some(self.frame);
+        Ok(())
+    }
+
     /// Ends the run: records the last good frame if `record_every` left it out
     /// (a run stopped early), closes the recording and returns the summary, or
     /// [`RunError::Numerical`] (with the summary) when a frame failed.
     pub fn finish(mut self) -> Result<Summary, RunError> {
         if self.recorder.is_some() && self.last_recorded != Some(self.frame) {
             let t1 = Instant::now();
-            let snap = Snapshot {
-                frame: self.frame,
-                energy: self.pipeline.stepper().energy(&self.state.world),
-                timing: self.timing,
-            };
-            if let Some(rec) = self.recorder.as_mut() {
-                let (state, pipeline) = (&mut self.state, &mut self.pipeline);
-                recording::record_state(rec, state, pipeline, &snap, &mut self.normals)?;
-            }
-            self.recorded_frames += 1;
+            self.log_frame()?;
             self.record_seconds += t1.elapsed().as_secs_f64();
         }
         let recording = match self.recorder.take() {

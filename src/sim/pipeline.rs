@@ -297,9 +297,8 @@ impl Pipeline {
             pushed: &self.stepper.contact_push,
             mass: &self.stepper.elements.mass,
         };
-        c.end_step(&mut state.world, h, cloth, &mut state.ledger.collision);
-        state.contacts.clear();
-        state.contacts.extend_from_slice(c.contacts());
+        let (world, contacts) = (&mut state.world, &mut state.contacts);
+        c.end_step(world, h, cloth, contacts, &mut state.ledger.collision);
         Ok(())
     }
 
@@ -330,6 +329,7 @@ impl Pipeline {
         std::mem::swap(&mut state.world.x, &mut s.x);
         std::mem::swap(&mut state.world.v, &mut s.v);
         state.world.time = s.time;
+        debug_assert!(s.ledger.is_some(), "rollback without a saved step start");
         if let Some(ledger) = s.ledger {
             state.ledger = ledger;
         }
@@ -360,9 +360,6 @@ impl Pipeline {
         self.stepper.rebuild(&state.world);
         self.auto_dt = None;
         self.air_power = None;
-        if let Some(c) = self.collider.as_mut() {
-            c.forget_contacts();
-        }
         state.contacts.clear();
     }
 }

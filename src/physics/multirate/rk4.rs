@@ -2,7 +2,7 @@
 
 use rayon::prelude::*;
 
-use super::{Levels, level_forces};
+use super::{level_forces, take_levels};
 use crate::math::{Scalar, Vector};
 use crate::physics::Stepper;
 use crate::physics::forces::gather;
@@ -16,13 +16,7 @@ use crate::world::World;
 pub fn rk4_multirate(st: &mut Stepper, w: &mut World, big: Scalar) {
     let t = w.time;
     w.pins.held_at(t, &mut st.held);
-    if st.levels.is_none() {
-        let drag = st.model.external.drag.unwrap_or(0.0);
-        st.levels = Some(Levels::build(&w.mesh, &st.elements, drag));
-    }
-    let Some(levels) = st.levels.take() else {
-        return;
-    };
+    let levels = take_levels(st, w);
     let mut rk = std::mem::take(&mut st.rk4_multirate);
     let n = w.x.len();
     for (buf, src) in [
