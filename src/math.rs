@@ -28,17 +28,8 @@ pub fn deterministic_sum<F>(len: usize, term: F) -> Scalar
 where
     F: Fn(usize) -> Scalar + Sync,
 {
-    use rayon::prelude::*;
-    const CHUNK: usize = 2048;
-    let chunks = len.div_ceil(CHUNK);
-    let partial: Vec<Scalar> = (0..chunks)
-        .into_par_iter()
-        .map(|c| {
-            let end = ((c + 1) * CHUNK).min(len);
-            (c * CHUNK..end).map(&term).sum()
-        })
-        .collect();
-    partial.iter().sum()
+    let (a, _) = deterministic_sum2(len, |i| (term(i), 0.0));
+    a
 }
 
 /// Two sums at once, each in exactly the association order of
@@ -49,19 +40,37 @@ where
     F: Fn(usize) -> (Scalar, Scalar) + Sync,
 {
     use rayon::prelude::*;
-    const CHUNK: usize = 2048;
-    let chunks = len.div_ceil(CHUNK);
-    let partial: Vec<(Scalar, Scalar)> = (0..chunks)
-        .into_par_iter()
-        .map(|c| {
-            let end = ((c + 1) * CHUNK).min(len);
-            // `Iterator::sum` for floats folds from -0.0; do the same.
-            (c * CHUNK..end)
-                .map(&term)
-                .fold((-0.0, -0.0), |(a, b), (x, y)| (a + x, b + y))
-        })
-        .collect();
-    let a = partial.iter().map(|p| p.0).sum();
-    let b = partial.iter().map(|p| p.1).sum();
-    (a, b)
+    let chunks = len.div_ceil(SUM_CHUNK);
+    let chunk_sum = |c: usize| {
+        let end = ((c + 1) * SUM_CHUNK).min(len);
+        // `Iterator::sum` for floats folds from -0.0; do the same.
+        (c * SUM_CHUNK..end)
+            .map(&term)
+            .fold((-0.0, -0.0), |(a, b), (x, y)| (a + x, b + y))
+    };
+    let total = |partial: &[(Scalar, Scalar)]| {
+        let a = partial.iter().map(|p| p.0).sum();
+        let b = partial.iter().map(|p| p.1).sum();
+        (a, b)
+    };
+    if chunks <= STACK_CHUNKS {
+        // The chunk sums on the stack: no allocation per call (issue 13: these
+        // sums run several times a step). Same chunks, same order as below.
+        let mut partial = [(0.0, 0.0); STACK_CHUNKS];
+        partial[..chunks]
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(c, p)| *p = chunk_sum(c));
+        return total(&partial[..chunks]);
+    }
+    let partial: Vec<(Scalar, Scalar)> = (0..chunks).into_par_iter().map(chunk_sum).collect();
+    total(&partial)
 }
+
+/// Terms per chunk of [`deterministic_sum`] and [`deterministic_sum2`]: the
+/// chunking (and so the rounding) depends on this alone.
+const SUM_CHUNK: usize = 2048;
+
+/// Chunk sums kept on the stack (meshes up to `STACK_CHUNKS * SUM_CHUNK`, about
+/// 520k vertices, sum without allocating); larger ones collect into a vector.
+const STACK_CHUNKS: usize = 256;
