@@ -31,6 +31,7 @@
 //! every block (`factor_tips`) as soon as a fresh factor needs more than 10
 //! iterations (see `TIPS_AFTER` in the implicit module's direct solver).
 //!
+mod buckets;
 mod csc;
 
 use rayon::prelude::*;
@@ -39,6 +40,7 @@ use super::elements::Elements;
 use super::forces::PAR_MIN;
 use super::shape::{ShapeJacobian, ShapeTriangle};
 use crate::math::{Matrix3, Scalar, Vector};
+use buckets::{group_by_key, sorted_unique_rows};
 
 /// One element term summed into a lower block.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -152,24 +154,28 @@ impl BlockPattern {
                 }
             }
         }
-        pairs.sort_unstable();
-        pairs.dedup();
-        let mut row_start = vec![0u32; n + 1];
-        for &(i, _) in &pairs {
-            row_start[i as usize + 1] += 1;
-        }
-        for i in 0..n {
-            row_start[i + 1] += row_start[i];
-        }
+        let (row_start, columns) = sorted_unique_rows(n, &pairs);
+        let rows = (0..n as u32)
+            .flat_map(|i| {
+                std::iter::repeat_n(
+                    i,
+                    (row_start[i as usize + 1] - row_start[i as usize]) as usize,
+                )
+            })
+            .collect();
         let mut p = BlockPattern {
             row_start,
-            rows: pairs.iter().map(|&(i, _)| i).collect(),
-            columns: pairs.iter().map(|&(_, j)| j).collect(),
+            rows,
+            columns,
             ..Default::default()
         };
         p.diagonal = (0..n as u32).map(|i| p.slot(i, i)).collect();
-        p.mirror = pairs.iter().map(|&(i, j)| p.slot(j, i)).collect();
-        p.factored = pairs.iter().map(|&(i, j)| i == j || factor_tips).collect();
+        p.mirror = (0..p.blocks())
+            .map(|b| p.slot(p.columns[b], p.rows[b]))
+            .collect();
+        p.factored = (0..p.blocks())
+            .map(|b| p.rows[b] == p.columns[b] || factor_tips)
+            .collect();
         for sp in &elements.springs {
             let [a, b] = sp.v;
             for (i, j) in [(a, b), (b, a)] {
@@ -185,15 +191,7 @@ impl BlockPattern {
                 tips.push((tip_q, 4 * h as u32 + 3));
             }
         }
-        tips.sort_by_key(|&(v, _)| v);
-        p.compensation_start = vec![0; n + 1];
-        for &(v, _) in &tips {
-            p.compensation_start[v as usize + 1] += 1;
-        }
-        for i in 0..n {
-            p.compensation_start[i + 1] += p.compensation_start[i];
-        }
-        p.compensation = tips.into_iter().map(|(_, k)| k).collect();
+        (p.compensation_start, p.compensation) = group_by_key(n, &tips);
         let mut dropped: Vec<(u32, (u32, u8, u8))> = Vec::new();
         for (ti, t) in elements.shape_triangles.iter().enumerate() {
             for (k, i) in t.slots() {
@@ -204,15 +202,7 @@ impl BlockPattern {
                 }
             }
         }
-        dropped.sort_by_key(|&(v, _)| v);
-        p.shape_dropped_start = vec![0; n + 1];
-        for &(v, _) in &dropped {
-            p.shape_dropped_start[v as usize + 1] += 1;
-        }
-        for i in 0..n {
-            p.shape_dropped_start[i + 1] += p.shape_dropped_start[i];
-        }
-        p.shape_dropped = dropped.into_iter().map(|(_, e)| e).collect();
+        (p.shape_dropped_start, p.shape_dropped) = group_by_key(n, &dropped);
         p.build_sources(elements);
         p.build_csc();
         p
@@ -271,16 +261,8 @@ impl BlockPattern {
                 }
             }
         }
-        // Stable: the sources of a block stay in element order.
-        tagged.sort_by_key(|&(slot, _)| slot);
-        self.source_start = vec![0; self.blocks() + 1];
-        for &(slot, _) in &tagged {
-            self.source_start[slot as usize + 1] += 1;
-        }
-        for b in 0..self.blocks() {
-            self.source_start[b + 1] += self.source_start[b];
-        }
-        self.sources = tagged.into_iter().map(|(_, s)| s).collect();
+        // Grouped stably: the sources of a block stay in element order.
+        (self.source_start, self.sources) = group_by_key(self.blocks(), &tagged);
     }
 
     /// Per vertex: the diagonal compensation of the dropped tip-tip blocks (module
