@@ -54,6 +54,17 @@ pub fn cmd_run(args: RunArgs) -> Result<ExitCode> {
         &mut |_| {},
     );
     bar.finish_and_clear();
+    report_outcome(outcome, args.summary.as_deref(), summary_file)
+}
+
+/// Prints the run's summary and writes it to `summary_file` (opened before the run, at
+/// `summary_path`), also after a numerical failure, which the exit code 2 reports. Any
+/// other error leaves no summary: the file opened for it is removed.
+fn report_outcome(
+    outcome: Result<Summary, RunError>,
+    summary_path: Option<&Path>,
+    summary_file: Option<std::fs::File>,
+) -> Result<ExitCode> {
     let (summary, failure) = match outcome {
         Ok(s) => (s, None),
         Err(e) => match &e {
@@ -61,7 +72,7 @@ pub fn cmd_run(args: RunArgs) -> Result<ExitCode> {
             RunError::Numerical { summary, .. } => (summary.as_ref().clone(), Some(e.to_string())),
             _ => {
                 // No summary to write: remove the file opened for it.
-                if let Some(path) = &args.summary {
+                if let Some(path) = summary_path {
                     let _ = std::fs::remove_file(path);
                 }
                 return Err(e.into());
