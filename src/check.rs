@@ -2,12 +2,18 @@
 
 use std::fmt::Write;
 
+use crate::adapt::AdaptConfig;
 use crate::collide::Collider;
 use crate::physics::timestep::fit_to_frame;
-use crate::physics::{Model, Stepper};
+use crate::physics::{Elements, ExternalForces, MaterialParams, Model, Stepper};
 use crate::run::RunError;
-use crate::scene::{BendingModel, Integrator, PinMotion, Scene, StiffnessRule, TimeStep};
+use crate::scene::{
+    AdaptMethod, BendingModel, Integrator, PinMotion, Scene, Simulation, Solver, StiffnessRule,
+    TimeStep,
+};
 use crate::world::World;
+
+// Writing to a String cannot fail: every `writeln!` below ignores its `Ok(())`.
 
 /// Describes what a run of `scene` will compute: mesh, forces (and what is not
 /// modelled), integrator and time step, pins.
@@ -15,16 +21,31 @@ pub fn describe(scene: &Scene) -> Result<String, RunError> {
     let world = World::from_scene(scene)?;
     let model = Model::from_scene(scene);
     let stepper = Stepper::new(model, &world);
-    let (el, ext, mat) = (
-        &stepper.elements,
-        &stepper.model.external,
-        &stepper.model.material,
-    );
     let mut s = String::new();
-    let sim = &scene.simulation;
-    let frames = sim.frame_count();
-    // Writing to a String cannot fail.
     let _ = writeln!(s, "scene `{}`", scene.name);
+    describe_cloth(&mut s, scene, &world, &stepper.elements);
+    let (ext, mat) = (&stepper.model.external, &stepper.model.material);
+    describe_forces(&mut s, &world, &stepper.elements, mat, ext);
+    let adapt = AdaptConfig::from_scene(scene.adapt.as_ref());
+    let collider = Collider::from_scene(scene)?;
+    let absent = not_modelled(mat, ext, adapt.as_ref(), collider.as_ref());
+    let _ = writeln!(s, "not modelled: {}", absent.join(", "));
+    if let Some(c) = &collider {
+        let _ = writeln!(s, "collisions:");
+        for line in c.describe() {
+            let _ = writeln!(s, "  {line}");
+        }
+    }
+    if let Some(a) = &adapt {
+        describe_adapt(&mut s, scene, a);
+    }
+    describe_time_step(&mut s, &scene.simulation, &stepper, &world, adapt.is_some());
+    describe_pins(&mut s, scene, &world);
+    Ok(s)
+}
+
+/// The `cloth:` line: shape, mesh size, rest area and mass.
+fn describe_cloth(s: &mut String, scene: &Scene, world: &World, el: &Elements) {
     let _ = writeln!(
         s,
         "cloth: {:?}, {} vertices, {} triangles, {} edges ({} interior); rest area {:.6} m^2, mass {:.6} kg",
@@ -36,6 +57,16 @@ pub fn describe(scene: &Scene) -> Result<String, RunError> {
         world.mesh.total_rest_area(),
         el.total_mass()
     );
+}
+
+/// The `forces computed:` block: stretch always, then each force the scene declares.
+fn describe_forces(
+    s: &mut String,
+    world: &World,
+    el: &Elements,
+    mat: &MaterialParams,
+    ext: &ExternalForces,
+) {
     let _ = writeln!(s, "forces computed:");
     let rule = match mat.stiffness_rule {
         StiffnessRule::Consistent => "consistent (Van Gelder: k = stretch * sum(A) / L^2)",
@@ -48,32 +79,7 @@ pub fn describe(scene: &Scene) -> Result<String, RunError> {
         stretch_springs, mat.stretch, rule
     );
     if mat.bending > 0.0 {
-        match mat.bending_model {
-            BendingModel::ShapeOperator => {
-                let _ = writeln!(
-                    s,
-                    "  bending: shape operator (curvature tensor per triangle from its edge angles), {} triangles, rigidity {} N m",
-                    el.shape_triangles.len(),
-                    mat.bending
-                );
-            }
-            BendingModel::Dihedral => {
-                let _ = writeln!(
-                    s,
-                    "  bending: dihedral angle, {} hinges, rigidity {} N m",
-                    el.hinges.len(),
-                    mat.bending
-                );
-            }
-            BendingModel::HingeSpring => {
-                let _ = writeln!(
-                    s,
-                    "  bending: hinge springs (paper A), {} springs, rigidity {} N m",
-                    el.springs.len() - stretch_springs,
-                    mat.bending
-                );
-            }
-        }
+        describe_bending(s, el, mat, stretch_springs);
     }
     if mat.damping > 0.0 {
         let _ = writeln!(
@@ -101,6 +107,46 @@ pub fn describe(scene: &Scene) -> Result<String, RunError> {
             w.air_density
         );
     }
+}
+
+/// The `bending:` line of the bending model in use. The hinge springs of paper A are
+/// the springs beyond the `stretch_springs` (one per edge).
+fn describe_bending(s: &mut String, el: &Elements, mat: &MaterialParams, stretch_springs: usize) {
+    match mat.bending_model {
+        BendingModel::ShapeOperator => {
+            let _ = writeln!(
+                s,
+                "  bending: shape operator (curvature tensor per triangle from its edge angles), {} triangles, rigidity {} N m",
+                el.shape_triangles.len(),
+                mat.bending
+            );
+        }
+        BendingModel::Dihedral => {
+            let _ = writeln!(
+                s,
+                "  bending: dihedral angle, {} hinges, rigidity {} N m",
+                el.hinges.len(),
+                mat.bending
+            );
+        }
+        BendingModel::HingeSpring => {
+            let _ = writeln!(
+                s,
+                "  bending: hinge springs (paper A), {} springs, rigidity {} N m",
+                el.springs.len() - stretch_springs,
+                mat.bending
+            );
+        }
+    }
+}
+
+/// What the scene leaves out, in the order `drape check` names it.
+fn not_modelled(
+    mat: &MaterialParams,
+    ext: &ExternalForces,
+    adapt: Option<&AdaptConfig>,
+    collider: Option<&Collider>,
+) -> Vec<&'static str> {
     let mut absent = Vec::new();
     if mat.bending <= 0.0 {
         absent.push("bending");
@@ -117,98 +163,82 @@ pub fn describe(scene: &Scene) -> Result<String, RunError> {
     if ext.wind.is_none() {
         absent.push("wind");
     }
-    let adapt = crate::adapt::AdaptConfig::from_scene(scene.adapt.as_ref());
     if adapt.is_none() {
         absent.push("adaptive meshing");
     }
-    let collider = Collider::from_scene(scene)?;
-    if !collider.as_ref().is_some_and(Collider::has_obstacles) {
+    if !collider.is_some_and(Collider::has_obstacles) {
         absent.push("obstacles and collisions");
     }
-    if !collider.as_ref().is_some_and(Collider::has_self_collision) {
+    if !collider.is_some_and(Collider::has_self_collision) {
         absent.push("self-collision");
     }
-    let _ = writeln!(s, "not modelled: {}", absent.join(", "));
-    if let Some(c) = &collider {
-        let _ = writeln!(s, "collisions:");
-        for line in c.describe() {
-            let _ = writeln!(s, "  {line}");
+    absent
+}
+
+/// The `adaptive meshing:` line (and the multirate note when it is on).
+fn describe_adapt(s: &mut String, scene: &Scene, a: &AdaptConfig) {
+    let _ = writeln!(
+        s,
+        "adaptive meshing: {}, refine above {} deg, coarsen below {} deg (and below half the upper threshold), levels 0..{}, every {} steps{}{}",
+        match a.method {
+            AdaptMethod::Edge =>
+                "edge (paper B: longest-edge splits, Delaunay flips, guarded collapses)",
+            _ => "red_green (paper A)",
+        },
+        a.refine_angle,
+        a.coarsen_angle,
+        a.max_level,
+        a.every,
+        if a.min_edge_length > 0.0 {
+            format!(", edges >= {} m", a.min_edge_length)
+        } else {
+            String::new()
+        },
+        if a.rollback {
+            format!(", rollback (up to {} per step)", a.max_rollbacks)
+        } else {
+            String::new()
         }
-    }
-    if let Some(a) = &adapt {
+    );
+    if scene.adapt.as_ref().is_some_and(|x| x.multirate) {
         let _ = writeln!(
             s,
-            "adaptive meshing: {}, refine above {} deg, coarsen below {} deg (and below half the upper threshold), levels 0..{}, every {} steps{}{}",
-            match a.method {
-                crate::scene::AdaptMethod::Edge =>
-                    "edge (paper B: longest-edge splits, Delaunay flips, guarded collapses)",
-                _ => "red_green (paper A)",
-            },
-            a.refine_angle,
-            a.coarsen_angle,
-            a.max_level,
-            a.every,
-            if a.min_edge_length > 0.0 {
-                format!(", edges >= {} m", a.min_edge_length)
-            } else {
-                String::new()
-            },
-            if a.rollback {
-                format!(", rollback (up to {} per step)", a.max_rollbacks)
-            } else {
-                String::new()
-            }
+            "  multirate (paper A): level L takes 2^ceil(L/2) substeps per macro step; the time step below is the macro step"
         );
-        if scene.adapt.as_ref().is_some_and(|x| x.multirate) {
-            let _ = writeln!(
-                s,
-                "  multirate (paper A): level L takes 2^ceil(L/2) substeps per macro step; the time step below is the macro step"
-            );
-        }
     }
+}
+
+/// The integrator (with the implicit solver's settings), the time step fitted to the
+/// frame interval, and the run's length in frames and steps.
+fn describe_time_step(
+    s: &mut String,
+    sim: &Simulation,
+    stepper: &Stepper,
+    world: &World,
+    adaptive: bool,
+) {
     let interval = sim.frame_interval();
     let (target, how) = match sim.dt {
         TimeStep::Fixed(dt) => (dt, "fixed".to_string()),
         TimeStep::Auto => {
             let how = match sim.integrator {
                 Integrator::Implicit => "auto: implicit accuracy cap".to_string(),
-                _ if adapt.is_some() => format!(
+                _ if adaptive => format!(
                     "auto: stability estimate {:.3e} s on the initial mesh, recomputed whenever the mesh changes",
-                    stepper.auto_dt(&world)
+                    stepper.auto_dt(world)
                 ),
-                _ => format!("auto: stability estimate {:.3e} s", stepper.auto_dt(&world)),
+                _ => format!("auto: stability estimate {:.3e} s", stepper.auto_dt(world)),
             };
-            (stepper.auto_dt(&world), how)
+            (stepper.auto_dt(world), how)
         }
     };
     let (steps, dt) = fit_to_frame(target, interval);
     let _ = writeln!(s, "integrator: {:?}", sim.integrator);
     if sim.integrator == Integrator::Implicit {
-        let solver = match sim.solver {
-            crate::scene::Solver::Direct => format!(
-                "direct (sparse Cholesky, reused as the preconditioner of conjugate gradients, refactored after {} iterations)",
-                sim.refactor_iterations
-            ),
-            crate::scene::Solver::Cg => "cg (matrix-free, Jacobi preconditioner)".to_string(),
-        };
-        let _ = writeln!(s, "  linear solver: {solver}");
-        let _ = writeln!(
-            s,
-            "  linear solves: relative residual {:e}, at most {} iterations (else the step fails and is retried)",
-            sim.cg_tolerance, sim.cg_max_iterations
-        );
-        let _ = writeln!(
-            s,
-            "  Newton iterations: at most {}{}",
-            sim.newton_iterations,
-            if sim.newton_iterations > 1 {
-                format!(", relative residual {:e}", sim.newton_tolerance)
-            } else {
-                " (the linearised step)".to_string()
-            }
-        );
+        describe_implicit_solver(s, sim);
     }
     let _ = writeln!(s, "time step: {dt:.4e} s ({how}); {steps} steps per frame");
+    let frames = sim.frame_count();
     let _ = writeln!(
         s,
         "run: {} s, {} fps: {} frames after the initial one, {} steps",
@@ -217,6 +247,37 @@ pub fn describe(scene: &Scene) -> Result<String, RunError> {
         frames,
         frames * steps
     );
+}
+
+/// The implicit integrator's linear solver, its tolerances and the Newton iterations.
+fn describe_implicit_solver(s: &mut String, sim: &Simulation) {
+    let solver = match sim.solver {
+        Solver::Direct => format!(
+            "direct (sparse Cholesky, reused as the preconditioner of conjugate gradients, refactored after {} iterations)",
+            sim.refactor_iterations
+        ),
+        Solver::Cg => "cg (matrix-free, Jacobi preconditioner)".to_string(),
+    };
+    let _ = writeln!(s, "  linear solver: {solver}");
+    let _ = writeln!(
+        s,
+        "  linear solves: relative residual {:e}, at most {} iterations (else the step fails and is retried)",
+        sim.cg_tolerance, sim.cg_max_iterations
+    );
+    let _ = writeln!(
+        s,
+        "  Newton iterations: at most {}{}",
+        sim.newton_iterations,
+        if sim.newton_iterations > 1 {
+            format!(", relative residual {:e}", sim.newton_tolerance)
+        } else {
+            " (the linearised step)".to_string()
+        }
+    );
+}
+
+/// One line per pin: region, vertex count, motion and release time (or `pins: none`).
+fn describe_pins(s: &mut String, scene: &Scene, world: &World) {
     if scene.pin.is_empty() {
         let _ = writeln!(s, "pins: none");
     }
@@ -250,5 +311,4 @@ pub fn describe(scene: &Scene) -> Result<String, RunError> {
             pin.region
         );
     }
-    Ok(s)
 }

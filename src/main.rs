@@ -8,12 +8,15 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use indicatif::{ProgressBar, ProgressStyle};
 
+use cli::run::cmd_run;
 use drape::record::inspect::inspect;
-use drape::record::{EdgeDisplay, LiveViewer};
-use drape::run::{Progress, RunError, RunOptions, run_built};
 use drape::scene::{Scene, default_scene, load_scene_file};
+
+/// The subcommands that have a file of their own.
+mod cli {
+    pub mod run;
+}
 
 /// Adaptive mass-spring cloth simulation, recorded to Rerun .rrd files.
 #[derive(Parser)]
@@ -284,114 +287,6 @@ fn cmd_inspect(args: InspectArgs) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-fn cmd_run(args: RunArgs) -> Result<ExitCode> {
-    let scene = load(&args.scene)?;
-    let record = (!args.no_record).then(|| {
-        args.out
-            .clone()
-            .unwrap_or_else(|| PathBuf::from(format!("{}.rrd", scene.name)))
-    });
-    let opts = RunOptions {
-        record,
-        obj_dir: args.obj_dir.clone(),
-        threads: args.threads.map(|n| n as usize),
-        live: if args.spawn {
-            Some(LiveViewer::Spawn)
-        } else {
-            args.connect.clone().map(LiveViewer::Connect)
-        },
-        record_every: args.record_every,
-        edges: match (args.no_edges, args.edge_threshold, args.edges) {
-            (true, _, _) => EdgeDisplay::Off,
-            (false, Some(deg), _) => EdgeDisplay::Above(deg),
-            (false, None, EdgeChoice::Review) => EdgeDisplay::Review,
-            (false, None, EdgeChoice::All) => EdgeDisplay::All,
-        },
-    };
-    // Build the cloth and the obstacles once before any output is opened: a bad
-    // OBJ or a pin that selects nothing fails here and leaves no empty recording
-    // behind (nor truncates an existing one).
-    let sim = drape::sim::build(&scene.resolve()?)?;
-    // Create the OBJ directory before the recording is opened, so that an unusable
-    // one fails with its own message and leaves no recording behind.
-    if let Some(dir) = &args.obj_dir {
-        if dir.exists() && !dir.is_dir() {
-            anyhow::bail!(
-                "cannot create the OBJ directory {}: a file of that name exists",
-                dir.display()
-            );
-        }
-        std::fs::create_dir_all(dir)
-            .with_context(|| format!("cannot create the OBJ directory {}", dir.display()))?;
-    }
-    // Open the summary now so that an unwritable path fails before a long run.
-    let summary_file = match &args.summary {
-        Some(path) => Some(
-            std::fs::File::create(path)
-                .with_context(|| format!("cannot write summary {}", path.display()))?,
-        ),
-        None => None,
-    };
-    let interrupt = Arc::new(AtomicBool::new(false));
-    {
-        let flag = interrupt.clone();
-        ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed))
-            .context("installing the Ctrl-C handler")?;
-    }
-    let bar = if args.quiet {
-        ProgressBar::hidden()
-    } else {
-        ProgressBar::new(0)
-    };
-    bar.set_style(
-        ProgressStyle::with_template(
-            "{spinner} [{elapsed_precise}] {bar:40} frame {pos}/{len} {msg} (eta {eta})",
-        )
-        .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
-    let mut on_progress = |p: Progress| {
-        bar.set_length(p.frames);
-        bar.set_position(p.frame);
-        bar.set_message(format!("t = {:.2} s", p.sim_time));
-    };
-    let outcome = run_built(
-        &scene,
-        sim,
-        &opts,
-        &interrupt,
-        &mut on_progress,
-        &mut |_| {},
-    );
-    bar.finish_and_clear();
-    let (summary, failure) = match outcome {
-        Ok(s) => (s, None),
-        Err(e) => match &e {
-            // The run stopped on a numerical failure: still report what it did.
-            RunError::Numerical { summary, .. } => (summary.as_ref().clone(), Some(e.to_string())),
-            _ => {
-                // No summary to write: remove the file opened for it.
-                if let Some(path) = &args.summary {
-                    let _ = std::fs::remove_file(path);
-                }
-                return Err(e.into());
-            }
-        },
-    };
-    println!("{}", summary.paragraph());
-    if let Some(file) = summary_file {
-        write_json(file, &summary)?;
-    }
-    if let Some(message) = failure {
-        eprintln!("error: {message}");
-        return Ok(ExitCode::from(2));
-    }
-    Ok(if summary.interrupted {
-        ExitCode::from(130)
-    } else {
-        ExitCode::SUCCESS
-    })
-}
-
 fn cmd_bench(args: BenchArgs) -> Result<ExitCode> {
     use drape::bench::{BenchOptions, Ladder, bench, ladder::default_ladder};
     let ladder = match &args.ladder {
@@ -445,10 +340,4 @@ fn cmd_bench(args: BenchArgs) -> Result<ExitCode> {
         println!("wrote {}", f.display());
     }
     Ok(ExitCode::SUCCESS)
-}
-
-fn write_json(mut f: std::fs::File, summary: &drape::summary::Summary) -> Result<()> {
-    serde_json::to_writer_pretty(&mut f, summary)?;
-    writeln!(f)?;
-    Ok(())
 }

@@ -271,58 +271,15 @@ impl Collider {
         contacts: &mut Vec<Contact>,
         stats: &mut CollisionStats,
     ) {
-        let StepCloth { pushed, mass } = cloth;
         let (t0, t1) = (self.t0, world.time);
         let started = Instant::now();
         self.poses.clear();
         self.poses
             .extend(self.bodies.iter().map(|b| (b.pose(t0), b.pose(t1))));
-        let poses = &self.poses;
         let touching = if self.bodies.is_empty() {
             0
         } else {
-            let (bodies, x0, held) = (&self.bodies, &self.x0, &self.held);
-            contacts.clear();
-            contacts.resize(world.x.len(), Contact::default());
-            let moving = self.bodies.iter().any(Body::is_moving);
-            world
-                .x
-                .par_iter_mut()
-                .zip(world.v.par_iter_mut())
-                .zip(contacts.par_iter_mut())
-                .enumerate()
-                .with_min_len(256)
-                .map(|(i, ((x, v), contact))| {
-                    if held[i] {
-                        return (0u64, 0.0);
-                    }
-                    let mut hit = false;
-                    let push = pushed.get(i).copied().unwrap_or(0.0);
-                    let mut work = 0.0;
-                    for (b, pose) in bodies.iter().zip(poses) {
-                        let before = *v;
-                        if let Some(c) = respond(b, pose, t1, h, push, x0[i], x, v) {
-                            // A moving surface works on the cloth: impulse . surface velocity
-                            // (the filter's impulse included).
-                            if moving {
-                                let surface = b.point_velocity(t1, *x);
-                                let m = mass.get(i).copied().unwrap_or(0.0);
-                                work += m * ((*v - before).dot(surface) + push * c.normal_speed);
-                            }
-                            *contact = c;
-                            hit = true;
-                        }
-                    }
-                    (u64::from(hit), work)
-                })
-                .collect_into_vec(&mut self.hits);
-            // Summed in vertex order, so the work is the same at any thread count.
-            let (touching, work) = self
-                .hits
-                .iter()
-                .fold((0u64, 0.0), |(n, w), &(a, b)| (n + a, w + b));
-            stats.obstacle_work += work;
-            touching
+            self.obstacle_pass(world, h, cloth, contacts, stats)
         };
         stats.collision_wall_s += started.elapsed().as_secs_f64();
         if let Some(sc) = self.self_collider.as_mut() {
@@ -341,25 +298,7 @@ impl Collider {
         }
         let started = Instant::now();
         if !self.bodies.is_empty() {
-            let (bodies, held) = (&self.bodies, &self.held);
-            let after_self = self.self_collider.is_some();
-            let depth = world
-                .x
-                .par_iter_mut()
-                .zip(world.v.par_iter_mut())
-                .enumerate()
-                .with_min_len(256)
-                .map(|(i, (x, v))| {
-                    let mut deepest: Scalar = 0.0;
-                    for (b, pose) in bodies.iter().zip(poses) {
-                        if after_self && !held[i] {
-                            push_out(b, &pose.1, t1, x, v);
-                        }
-                        deepest = deepest.max(depth_below(b, &pose.1, *x));
-                    }
-                    deepest
-                })
-                .reduce(|| 0.0, Scalar::max);
+            let depth = self.final_obstacle_pass(world);
             stats.max_penetration = stats.max_penetration.max(depth);
             stats.last_penetration = depth;
         }
@@ -367,6 +306,90 @@ impl Collider {
         stats.contacts += touching;
         stats.last_contacts = touching;
         stats.collision_wall_s += started.elapsed().as_secs_f64();
+    }
+
+    /// Steps 1 to 3 of the module docs for every unpinned vertex against every obstacle:
+    /// continuous detection or proximity, then the response with friction. Fills
+    /// `contacts` (one per vertex), adds the work moving obstacles did to
+    /// `stats.obstacle_work`, and returns how many vertices touch an obstacle.
+    fn obstacle_pass(
+        &mut self,
+        world: &mut World,
+        h: Scalar,
+        cloth: StepCloth,
+        contacts: &mut Vec<Contact>,
+        stats: &mut CollisionStats,
+    ) -> u64 {
+        let StepCloth { pushed, mass } = cloth;
+        let t1 = world.time;
+        let (bodies, x0, held, poses) = (&self.bodies, &self.x0, &self.held, &self.poses);
+        contacts.clear();
+        contacts.resize(world.x.len(), Contact::default());
+        let moving = self.bodies.iter().any(Body::is_moving);
+        world
+            .x
+            .par_iter_mut()
+            .zip(world.v.par_iter_mut())
+            .zip(contacts.par_iter_mut())
+            .enumerate()
+            .with_min_len(256)
+            .map(|(i, ((x, v), contact))| {
+                if held[i] {
+                    return (0u64, 0.0);
+                }
+                let mut hit = false;
+                let push = pushed.get(i).copied().unwrap_or(0.0);
+                let mut work = 0.0;
+                for (b, pose) in bodies.iter().zip(poses) {
+                    let before = *v;
+                    if let Some(c) = respond(b, pose, t1, h, push, x0[i], x, v) {
+                        // A moving surface works on the cloth: impulse . surface velocity
+                        // (the filter's impulse included).
+                        if moving {
+                            let surface = b.point_velocity(t1, *x);
+                            let m = mass.get(i).copied().unwrap_or(0.0);
+                            work += m * ((*v - before).dot(surface) + push * c.normal_speed);
+                        }
+                        *contact = c;
+                        hit = true;
+                    }
+                }
+                (u64::from(hit), work)
+            })
+            .collect_into_vec(&mut self.hits);
+        // Summed in vertex order, so the work is the same at any thread count.
+        let (touching, work) = self
+            .hits
+            .iter()
+            .fold((0u64, 0.0), |(n, w), &(a, b)| (n + a, w + b));
+        stats.obstacle_work += work;
+        touching
+    }
+
+    /// The last proximity pass: when self-collision ran (it may have moved vertices
+    /// into an obstacle), pushes unpinned vertices back out of every obstacle at its
+    /// end-of-step pose. Returns the largest depth of a vertex below an obstacle surface.
+    fn final_obstacle_pass(&self, world: &mut World) -> Scalar {
+        let t1 = world.time;
+        let (bodies, held, poses) = (&self.bodies, &self.held, &self.poses);
+        let after_self = self.self_collider.is_some();
+        world
+            .x
+            .par_iter_mut()
+            .zip(world.v.par_iter_mut())
+            .enumerate()
+            .with_min_len(256)
+            .map(|(i, (x, v))| {
+                let mut deepest: Scalar = 0.0;
+                for (b, pose) in bodies.iter().zip(poses) {
+                    if after_self && !held[i] {
+                        push_out(b, &pose.1, t1, x, v);
+                    }
+                    deepest = deepest.max(depth_below(b, &pose.1, *x));
+                }
+                deepest
+            })
+            .reduce(|| 0.0, Scalar::max)
     }
 
     /// The Cusick drape measurements, when the cloth is a disk specimen lying on a

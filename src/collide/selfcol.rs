@@ -191,6 +191,34 @@ impl SelfCollider {
         s: &mut Scratch,
     ) -> SelfStats {
         let tris = &mesh.triangles;
+        self.swept_boxes(tris, x0, x, s);
+        let pt = &self.patches;
+        s.boundary.resize_with(pt.len(), Vec::new);
+        s.boundary
+            .par_iter_mut()
+            .enumerate()
+            .map(|(p, boundary)| self.culling && pt.cannot_self_intersect(p, tris, x0, x, boundary))
+            .collect_into_vec(&mut s.culled);
+        self.fit_trees(s);
+        self.collect_pairs(tris, s);
+        let stats = primitive_pairs(tris, s);
+        // Sorted and deduplicated, the list does not depend on the order the trees
+        // report their pairs in (so neither on the trees' shapes).
+        s.prims.par_sort_unstable();
+        s.prims.dedup();
+        // Parts that are close in the rest state cannot be held a thickness apart.
+        let rest = |i: u32| mesh.material[i as usize].extend(0.0);
+        s.prims.retain(|p| {
+            let (ids, w) = weights(p, tris, &rest);
+            let r: Vector = (0..4).map(|k| rest(ids[k]) * w[k]).sum();
+            r.length() >= 1.5 * self.thickness
+        });
+        stats
+    }
+
+    /// The swept box of every triangle, into `s.boxes`: its corners at the start and at
+    /// the end of the step, inflated by the thickness.
+    fn swept_boxes(&self, tris: &[[u32; 3]], x0: &[Vector], x: &[Vector], s: &mut Scratch) {
         let pad = Vector::splat(self.thickness);
         tris.par_iter()
             .map(|t| {
@@ -205,46 +233,6 @@ impl SelfCollider {
                 Aabb::new(lo - pad, hi + pad)
             })
             .collect_into_vec(&mut s.boxes);
-        let pt = &self.patches;
-        s.boundary.resize_with(pt.len(), Vec::new);
-        s.boundary
-            .par_iter_mut()
-            .enumerate()
-            .map(|(p, boundary)| self.culling && pt.cannot_self_intersect(p, tris, x0, x, boundary))
-            .collect_into_vec(&mut s.culled);
-        self.fit_trees(s);
-        self.collect_pairs(tris, s);
-        let mut stats = SelfStats::default();
-        s.prims.clear();
-        for (pairs, skipped) in &s.pairs {
-            stats.pairs_culled += skipped;
-            stats.pairs_tested += pairs.len() as u64;
-            for &(t, u) in pairs {
-                let (a, b) = (tris[t as usize], tris[u as usize]);
-                for k in 0..3 {
-                    s.prims.push((0, a[k], u, 0, 0));
-                    s.prims.push((0, b[k], t, 0, 0));
-                    let e = edge(a[k], a[(k + 1) % 3]);
-                    for j in 0..3 {
-                        let f = edge(b[j], b[(j + 1) % 3]);
-                        let (lo, hi) = if e <= f { (e, f) } else { (f, e) };
-                        s.prims.push((1, lo[0], lo[1], hi[0], hi[1]));
-                    }
-                }
-            }
-        }
-        // Sorted and deduplicated, the list does not depend on the order the trees
-        // report their pairs in (so neither on the trees' shapes).
-        s.prims.par_sort_unstable();
-        s.prims.dedup();
-        // Parts that are close in the rest state cannot be held a thickness apart.
-        let rest = |i: u32| mesh.material[i as usize].extend(0.0);
-        s.prims.retain(|p| {
-            let (ids, w) = weights(p, tris, &rest);
-            let r: Vector = (0..4).map(|k| rest(ids[k]) * w[k]).sum();
-            r.length() >= 1.5 * self.thickness
-        });
-        stats
     }
 
     /// Brings the patch trees to this step's boxes: built after the patches changed,
@@ -402,6 +390,32 @@ struct Fix {
     dv: [Vector; 4],
 }
 
+/// Every triangle pair of `s.pairs` as its 6 vertex-triangle and 9 edge-edge primitive
+/// pairs, into `s.prims` (unsorted, with repeats); counts the pairs tested and culled.
+fn primitive_pairs(tris: &[[u32; 3]], s: &mut Scratch) -> SelfStats {
+    let mut stats = SelfStats::default();
+    s.prims.clear();
+    for (pairs, skipped) in &s.pairs {
+        stats.pairs_culled += skipped;
+        stats.pairs_tested += pairs.len() as u64;
+        for &(t, u) in pairs {
+            let (a, b) = (tris[t as usize], tris[u as usize]);
+            for k in 0..3 {
+                s.prims.push((0, a[k], u, 0, 0));
+                s.prims.push((0, b[k], t, 0, 0));
+                let e = edge(a[k], a[(k + 1) % 3]);
+                for j in 0..3 {
+                    let f = edge(b[j], b[(j + 1) % 3]);
+                    let (lo, hi) = if e <= f { (e, f) } else { (f, e) };
+                    s.prims.push((1, lo[0], lo[1], hi[0], hi[1]));
+                }
+            }
+        }
+    }
+    stats
+}
+
+/// The edge `(a, b)` with its smaller vertex first.
 fn edge(a: u32, b: u32) -> [u32; 2] {
     [a.min(b), a.max(b)]
 }

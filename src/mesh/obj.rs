@@ -90,13 +90,58 @@ pub fn load_obj(path: &Path, uv_scale: Scalar) -> Result<ObjCloth, ObjError> {
         path: name.clone(),
         reason: e.to_string(),
     })?;
-    // Merge all objects into one vertex set, keyed by exact position.
+    let MergedObj {
+        positions,
+        uvs,
+        triangles,
+        with_uv,
+        without_uv,
+    } = merge_models(&models, uv_scale, &name)?;
+    if with_uv > 0 && without_uv > 0 {
+        return Err(ObjError::PartialTexcoords { path: name });
+    }
+    let material = if with_uv > 0 {
+        uvs.into_iter()
+            .map(|uv| uv.unwrap_or(Vector2::ZERO))
+            .collect()
+    } else {
+        planar_rest_shape(&positions, &triangles).map_err(|distance| ObjError::NotPlanar {
+            path: name.clone(),
+            distance,
+        })?
+    };
+    let mesh =
+        Mesh::new(material, triangles).map_err(|source| ObjError::Mesh { path: name, source })?;
+    Ok(ObjCloth { mesh, positions })
+}
+
+/// The triangles of every object of an OBJ file over one vertex set.
+struct MergedObj {
+    /// Vertex positions, one per distinct position in the file.
+    positions: Vec<Vector>,
+    /// Per vertex: its texture coordinate times `uv_scale`, when a triangle gave one.
+    uvs: Vec<Option<Vector2>>,
+    /// Triangles as indices into `positions`.
+    triangles: Vec<[u32; 3]>,
+    /// Triangles of objects with texture coordinates.
+    with_uv: usize,
+    /// Triangles of objects without them.
+    without_uv: usize,
+}
+
+/// Merges all objects into one vertex set, keyed by exact position. A vertex given two
+/// different texture coordinates (a UV seam) is an error.
+fn merge_models(
+    models: &[tobj::Model],
+    uv_scale: Scalar,
+    name: &str,
+) -> Result<MergedObj, ObjError> {
     let mut index_of: HashMap<[u64; 3], u32> = HashMap::new();
     let mut positions: Vec<Vector> = Vec::new();
     let mut uvs: Vec<Option<Vector2>> = Vec::new();
     let mut triangles: Vec<[u32; 3]> = Vec::new();
     let (mut with_uv, mut without_uv) = (0usize, 0usize);
-    for model in &models {
+    for model in models {
         let m = &model.mesh;
         let has_uv = !m.texcoord_indices.is_empty();
         for (f, corners) in m.indices.chunks_exact(3).enumerate() {
@@ -121,7 +166,7 @@ pub fn load_obj(path: &Path, uv_scale: Scalar) -> Result<ObjCloth, ObjError> {
                     match uvs[v as usize] {
                         Some(old) if old != uv => {
                             return Err(ObjError::Seam {
-                                path: name,
+                                path: name.to_owned(),
                                 vertex: v as usize,
                             });
                         }
@@ -138,22 +183,13 @@ pub fn load_obj(path: &Path, uv_scale: Scalar) -> Result<ObjCloth, ObjError> {
             triangles.push(tri);
         }
     }
-    if with_uv > 0 && without_uv > 0 {
-        return Err(ObjError::PartialTexcoords { path: name });
-    }
-    let material = if with_uv > 0 {
-        uvs.into_iter()
-            .map(|uv| uv.unwrap_or(Vector2::ZERO))
-            .collect()
-    } else {
-        planar_rest_shape(&positions, &triangles).map_err(|distance| ObjError::NotPlanar {
-            path: name.clone(),
-            distance,
-        })?
-    };
-    let mesh =
-        Mesh::new(material, triangles).map_err(|source| ObjError::Mesh { path: name, source })?;
-    Ok(ObjCloth { mesh, positions })
+    Ok(MergedObj {
+        positions,
+        uvs,
+        triangles,
+        with_uv,
+        without_uv,
+    })
 }
 
 /// Checks what tobj lets through, from the file's text: coordinates that are NaN or

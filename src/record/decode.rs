@@ -11,6 +11,7 @@ use rerun::external::arrow::array::{
     Array, ArrayRef, AsArray, FixedSizeListArray,
     types::{Float32Type, UInt8Type, UInt32Type},
 };
+use rerun::log::Chunk;
 
 /// The simulated cloth mesh at one frame, as the recording holds it.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -34,6 +35,28 @@ pub struct ClothFrame {
 /// The latest value of one component: the frame it was logged at, and the cell.
 type Latest = Option<(i64, ArrayRef)>;
 
+/// The `cloth/mesh` components [`cloth_mesh_at`] reads, in the order of [`MeshRows::latest`].
+const MESH_COMPONENTS: [&str; 5] = [
+    "vertex_positions",
+    "vertex_normals",
+    "triangle_indices",
+    LEVEL_COMPONENT,
+    DUPLICATE_COMPONENT,
+];
+
+/// What one pass over a recording's `cloth/mesh` rows finds for one frame.
+#[derive(Default)]
+struct MeshRows {
+    /// Per entry of [`MESH_COMPONENTS`]: its latest value at or before the frame.
+    latest: [Latest; 5],
+    /// First frame with a `cloth/mesh` row.
+    first: Option<i64>,
+    /// Last frame with a `cloth/mesh` row.
+    last: Option<i64>,
+    /// Whether a `cloth/mesh` row is logged at the frame itself.
+    at_frame: bool,
+}
+
 /// Decodes the recording at `path` and rebuilds the cloth mesh at `frame`.
 ///
 /// Fails like [`super::inspect::inspect`] on a file that does not decode, with
@@ -42,27 +65,27 @@ type Latest = Option<(i64, ArrayRef)>;
 /// index past the recorded vertices, a level count other than the triangle count).
 pub fn cloth_mesh_at(path: &Path, frame: i64) -> Result<ClothFrame, InspectError> {
     let file = RecordingFile::read(path)?;
-    let names = [
-        "vertex_positions",
-        "vertex_normals",
-        "triangle_indices",
-        LEVEL_COMPONENT,
-        DUPLICATE_COMPONENT,
-    ];
-    let mut latest: [Latest; 5] = Default::default();
-    let (mut first, mut last) = (None::<i64>, None::<i64>);
-    let mut at_frame = false;
+    let mut rows = MeshRows::default();
     file.read_messages(|_, msg| {
-        let Message::Recording {
+        if let Message::Recording {
             chunk: Some(chunk), ..
         } = msg
-        else {
-            return Ok(());
-        };
+        {
+            rows.add_chunk(&chunk, frame);
+        }
+        Ok(())
+    })?;
+    rows.rebuild(path, frame)
+}
+
+impl MeshRows {
+    /// Takes in one chunk: only the temporal `cloth/mesh` chunks on the `frame` timeline
+    /// count; a later row at or before `frame` replaces an earlier value.
+    fn add_chunk(&mut self, chunk: &Chunk, frame: i64) {
         if chunk.is_static()
             || chunk.entity_path().to_string().trim_start_matches('/') != ENTITY_MESH
         {
-            return Ok(());
+            return;
         }
         let Some(times) = chunk
             .timelines()
@@ -70,14 +93,14 @@ pub fn cloth_mesh_at(path: &Path, frame: i64) -> Result<ClothFrame, InspectError
             .find(|(n, _)| n.as_str() == TIMELINE_FRAME)
             .map(|(_, col)| col.times_raw().to_vec())
         else {
-            return Ok(());
+            return;
         };
         for &t in &times {
-            first = Some(first.map_or(t, |f| f.min(t)));
-            last = Some(last.map_or(t, |l| l.max(t)));
-            at_frame |= t == frame;
+            self.first = Some(self.first.map_or(t, |f| f.min(t)));
+            self.last = Some(self.last.map_or(t, |l| l.max(t)));
+            self.at_frame |= t == frame;
         }
-        for (slot, name) in latest.iter_mut().zip(names) {
+        for (slot, name) in self.latest.iter_mut().zip(MESH_COMPONENTS) {
             let Some(array) = chunk.component_descriptors().find_map(|d| {
                 let c = d.component.as_str();
                 (c == name || c.ends_with(&format!(":{name}")))
@@ -92,60 +115,64 @@ pub fn cloth_mesh_at(path: &Path, frame: i64) -> Result<ClothFrame, InspectError
                 }
             }
         }
-        Ok(())
-    })?;
-    let no_frame = || InspectError::NoFrame {
-        frame,
-        first: first.unwrap_or(0),
-        last: last.unwrap_or(0),
-    };
-    let bad = |reason: &str| InspectError::Decode {
-        path: path.to_path_buf(),
-        index: 0,
-        reason: format!("cloth/mesh at frame {frame}: {reason}"),
-    };
-    if !at_frame {
-        return Err(no_frame());
     }
-    let [positions, normals, indices, levels, copies] = latest;
-    let (Some((_, positions)), Some((topology_frame, indices))) = (positions, indices) else {
-        return Err(no_frame());
-    };
-    let positions = triples::<Float32Type, f32>(&positions).ok_or_else(|| bad("positions"))?;
-    let normals = match normals {
-        Some((_, n)) => triples::<Float32Type, f32>(&n).ok_or_else(|| bad("normals"))?,
-        None => Vec::new(),
-    };
-    let indices = triples::<UInt32Type, u32>(&indices).ok_or_else(|| bad("indices"))?;
-    let levels = levels
-        .as_ref()
-        .and_then(|(_, l)| l.as_primitive_opt::<UInt8Type>())
-        .map(|l| l.values().to_vec())
-        .ok_or_else(|| bad("no triangle_level"))?;
-    let copies = copies
-        .as_ref()
-        .and_then(|(_, c)| c.as_primitive_opt::<UInt32Type>())
-        .map(|c| c.values().to_vec())
-        .unwrap_or_default();
-    let recorded_vertices = positions.len();
-    let vertices = recorded_vertices
-        .checked_sub(copies.len())
-        .ok_or_else(|| bad("more copies than vertices"))?;
-    let triangles = simulated_triangles(vertices, &indices, &copies)
-        .filter(|t| t.iter().flatten().all(|&i| (i as usize) < vertices))
-        .ok_or_else(|| bad("an index past the vertices"))?;
-    if levels.len() != triangles.len() {
-        return Err(bad("not one level per triangle"));
+
+    /// The simulated mesh at `frame` from the latest values: the recorded vertices less
+    /// their per-level copies, and the triangles mapped back onto the simulated vertices.
+    fn rebuild(self, path: &Path, frame: i64) -> Result<ClothFrame, InspectError> {
+        let no_frame = || InspectError::NoFrame {
+            frame,
+            first: self.first.unwrap_or(0),
+            last: self.last.unwrap_or(0),
+        };
+        let bad = |reason: &str| InspectError::Decode {
+            path: path.to_path_buf(),
+            index: 0,
+            reason: format!("cloth/mesh at frame {frame}: {reason}"),
+        };
+        if !self.at_frame {
+            return Err(no_frame());
+        }
+        let [positions, normals, indices, levels, copies] = &self.latest;
+        let (Some((_, positions)), Some((topology_frame, indices))) = (positions, indices) else {
+            return Err(no_frame());
+        };
+        let positions = triples::<Float32Type, f32>(positions).ok_or_else(|| bad("positions"))?;
+        let normals = match normals {
+            Some((_, n)) => triples::<Float32Type, f32>(n).ok_or_else(|| bad("normals"))?,
+            None => Vec::new(),
+        };
+        let indices = triples::<UInt32Type, u32>(indices).ok_or_else(|| bad("indices"))?;
+        let levels = levels
+            .as_ref()
+            .and_then(|(_, l)| l.as_primitive_opt::<UInt8Type>())
+            .map(|l| l.values().to_vec())
+            .ok_or_else(|| bad("no triangle_level"))?;
+        let copies = copies
+            .as_ref()
+            .and_then(|(_, c)| c.as_primitive_opt::<UInt32Type>())
+            .map(|c| c.values().to_vec())
+            .unwrap_or_default();
+        let recorded_vertices = positions.len();
+        let vertices = recorded_vertices
+            .checked_sub(copies.len())
+            .ok_or_else(|| bad("more copies than vertices"))?;
+        let triangles = simulated_triangles(vertices, &indices, &copies)
+            .filter(|t| t.iter().flatten().all(|&i| (i as usize) < vertices))
+            .ok_or_else(|| bad("an index past the vertices"))?;
+        if levels.len() != triangles.len() {
+            return Err(bad("not one level per triangle"));
+        }
+        Ok(ClothFrame {
+            frame,
+            positions: positions[..vertices].to_vec(),
+            normals: normals.into_iter().take(vertices).collect(),
+            triangles,
+            levels,
+            recorded_vertices,
+            topology_frame: *topology_frame,
+        })
     }
-    Ok(ClothFrame {
-        frame,
-        positions: positions[..vertices].to_vec(),
-        normals: normals.into_iter().take(vertices).collect(),
-        triangles,
-        levels,
-        recorded_vertices,
-        topology_frame,
-    })
 }
 
 /// A list cell of fixed-size-3 lists as triples, or `None` when it is not one.

@@ -10,7 +10,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 use rerun::external::arrow::array::{
-    Array, AsArray, ListArray, StringArray,
+    Array, ArrayRef, AsArray, ListArray, StringArray,
     types::{Float32Type, Float64Type, UInt8Type},
 };
 use rerun::external::re_log_encoding::DecoderApp;
@@ -310,48 +310,56 @@ fn gather(out: &mut Inspection, chunk: &Chunk) {
                 .filter(|a| a.is_valid(row))
                 .map(|a| a.value(row))
         };
-        if entity == ENTITY_MESH {
-            info.mesh_rows += 1;
-            if let Some(t) = cell("triangle_indices") {
-                info.triangles = Some(t.len());
-                info.topology = true;
-            }
-            if let Some(l) = cell(LEVEL_COMPONENT)
-                && let Some(l) = l.as_primitive_opt::<UInt8Type>()
-            {
-                info.levels = l.values().to_vec();
-            }
-        } else if entity == ENTITY_EDGES {
-            // `f32` since issue 15, `f64` in older recordings.
-            let angles: Option<Vec<f64>> = cell(ANGLE_COMPONENT).and_then(|a| {
-                a.as_primitive_opt::<Float32Type>()
-                    .map(|a| a.values().iter().map(|&v| f64::from(v)).collect())
-                    .or_else(|| {
-                        a.as_primitive_opt::<Float64Type>()
-                            .map(|a| a.values().to_vec())
-                    })
-            });
-            if let Some(a) = angles {
-                info.edges = Some(a.len());
-                info.max_edge_angle = a.iter().copied().reduce(f64::max);
-                info.min_edge_angle = a.iter().copied().reduce(f64::min);
-            }
-        } else if entity == ENTITY_EVENT_LOG {
-            if let Some(t) = cell("text")
-                && let Some(t) = t.as_any().downcast_ref::<StringArray>()
-            {
-                info.events.extend(t.iter().flatten().map(str::to_owned));
-            }
-        } else if let Some(name) = entity
-            .strip_prefix(ENTITY_PLOTS)
-            .and_then(|n| n.strip_prefix('/'))
-            && let Some(v) = cell("scalars")
-            && let Some(v) = v.as_primitive_opt::<Float64Type>()
-            && let Some(&v) = v.values().first()
-        {
-            info.scalars.insert(name.to_owned(), v);
-        }
+        gather_row(info, entity, cell);
     }
+}
+
+/// Adds one row of `entity` to its frame's `info`; `cell` gives the row's value of a
+/// component, named by its name or its descriptor's suffix.
+fn gather_row(info: &mut FrameInfo, entity: &str, cell: impl Fn(&str) -> Option<ArrayRef>) {
+    if entity == ENTITY_MESH {
+        info.mesh_rows += 1;
+        if let Some(t) = cell("triangle_indices") {
+            info.triangles = Some(t.len());
+            info.topology = true;
+        }
+        if let Some(l) = cell(LEVEL_COMPONENT)
+            && let Some(l) = l.as_primitive_opt::<UInt8Type>()
+        {
+            info.levels = l.values().to_vec();
+        }
+    } else if entity == ENTITY_EDGES {
+        if let Some(a) = cell(ANGLE_COMPONENT).and_then(|a| edge_angles(&a)) {
+            info.edges = Some(a.len());
+            info.max_edge_angle = a.iter().copied().reduce(f64::max);
+            info.min_edge_angle = a.iter().copied().reduce(f64::min);
+        }
+    } else if entity == ENTITY_EVENT_LOG {
+        if let Some(t) = cell("text")
+            && let Some(t) = t.as_any().downcast_ref::<StringArray>()
+        {
+            info.events.extend(t.iter().flatten().map(str::to_owned));
+        }
+    } else if let Some(name) = entity
+        .strip_prefix(ENTITY_PLOTS)
+        .and_then(|n| n.strip_prefix('/'))
+        && let Some(v) = cell("scalars")
+        && let Some(v) = v.as_primitive_opt::<Float64Type>()
+        && let Some(&v) = v.values().first()
+    {
+        info.scalars.insert(name.to_owned(), v);
+    }
+}
+
+/// The dihedral angles of one `cloth/edges` row, in degrees: `f32` since issue 15, `f64`
+/// in older recordings.
+fn edge_angles(cell: &ArrayRef) -> Option<Vec<f64>> {
+    cell.as_primitive_opt::<Float32Type>()
+        .map(|a| a.values().iter().map(|&v| f64::from(v)).collect())
+        .or_else(|| {
+            cell.as_primitive_opt::<Float64Type>()
+                .map(|a| a.values().to_vec())
+        })
 }
 
 /// Rerun shows the latest value of each component: a frame that did not log the mesh's

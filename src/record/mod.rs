@@ -2,7 +2,8 @@
 //! inspect` decoder, and OBJ frame export.
 //!
 //! This is the only module that imports `rerun`. The engine hands each frame over as plain
-//! slices ([`FrameView`]); every conversion to rerun types lives in this module's files.
+//! slices ([`FrameView`]) to a [`Recorder`] (`recorder.rs`); every conversion to rerun types
+//! lives in this module's files.
 //! `docs/recording.md` documents the schema (every entity, type and unit) for users.
 //!
 //! What a recording holds:
@@ -46,19 +47,15 @@ pub mod inspect;
 mod layout;
 pub mod mesh;
 pub mod obj;
+mod recorder;
 mod report;
 mod sink;
 
-use std::collections::HashMap;
-use std::path::Path;
-
-use rerun::{AsComponents, EntityPath, RecordingStream, RecordingStreamBuilder};
-
-use crate::math::Vector;
 pub use edges::EdgeDisplay;
 pub use error::{BoxError, RecordError};
 pub use frame::{EventMark, FrameView};
 pub use mesh::{DUPLICATE_COMPONENT, LEVEL_COMPONENT};
+pub use recorder::Recorder;
 pub use sink::{LiveViewer, RecordTarget};
 /// Colour of each refinement level, as sRGB `[r, g, b]`.
 ///
@@ -108,14 +105,6 @@ pub const ENTITY_PINS: &str = "cloth/pins";
 pub const ENTITY_PLOTS: &str = "plots";
 /// Parent entity of the obstacles: each is a mesh at `obstacles/<name>`.
 pub const ENTITY_OBSTACLES: &str = "obstacles";
-/// Colour of the obstacles (light grey).
-const OBSTACLE_COLOR: [u8; 3] = [0xB0, 0xB0, 0xB0];
-
-/// Colour of the pin markers (white, visible on every level colour).
-const PIN_COLOR: [u8; 3] = [0xFF, 0xFF, 0xFF];
-/// Radius of the pin markers on screen, in UI points.
-const PIN_RADIUS_UI: f32 = 4.0;
-
 /// Entity of the event points (one point per event of the frame, labelled).
 pub const ENTITY_EVENT_POINTS: &str = "events/points";
 /// Entity of the event log (one text line per event).
@@ -143,308 +132,4 @@ pub fn recording_id(scene_name: &str) -> String {
         (h >> 48) & 0xffff,
         h & 0xffff_ffff_ffff
     )
-}
-
-/// Writes one run to a `.rrd` file and/or a live viewer, frame by frame.
-///
-/// Dropping a `Recorder` without [`Recorder::finish`] (early return, `?`, panic unwinding)
-/// still flushes and closes the file, footer included, so it stays a valid `.rrd`.
-pub struct Recorder {
-    /// The sole handle on the stream: dropping it joins rerun's threads and writes the footer.
-    stream: RecordingStream,
-    target: RecordTarget,
-    /// `target.describe()`, for error messages.
-    described: String,
-    edges: EdgeDisplay,
-    mesh_path: EntityPath,
-    edges_path: EntityPath,
-    pins_path: EntityPath,
-    /// The recorded topology of `cloth/mesh` (logged again only when it changes).
-    cloth_mesh: mesh::ClothMesh,
-    /// `plots/<name>` per scalar name, parsed once.
-    scalar_paths: HashMap<String, EntityPath>,
-    blueprint_sent: bool,
-}
-
-impl std::fmt::Debug for Recorder {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Recorder")
-            .field("target", &self.target)
-            .field("edges", &self.edges)
-            .finish_non_exhaustive()
-    }
-}
-
-impl Recorder {
-    /// Opens `path` for writing, with every edge drawn; see [`Recorder::open`].
-    pub fn create(path: &Path, scene_name: &str) -> Result<Recorder, RecordError> {
-        Recorder::open(&RecordTarget::file(path), scene_name, EdgeDisplay::All)
-    }
-
-    /// Opens the recording's destinations and logs the static data.
-    ///
-    /// The file, if any, is created (truncated) immediately, so an unwritable path (missing
-    /// directory, no permission) fails here with [`RecordError::Create`], before a viewer is
-    /// started and before any simulation. A viewer that cannot be spawned (no `rerun` on
-    /// `PATH`) or a URL that is not a viewer's proxy URL fails here too; a viewer that does not
-    /// answer does not (rerun keeps retrying in the background).
-    ///
-    /// The recording id derives from `scene_name` ([`recording_id`]), which is also the
-    /// recording's name. Logs once: view coordinates (right-handed, z up) and the annotation
-    /// context of the level colours (and one of the angle classes at `cloth/edges` unless
-    /// edges are off). The default blueprint follows with the first frame.
-    ///
-    /// Without a live viewer the rows of an entity are batched into chunks of up to 2 MiB
-    /// whatever the time between frames ([`sink::file_only_batching`]): a slow run otherwise
-    /// gets one chunk, with its own schema, per entity and frame. With a viewer rerun's
-    /// default (a chunk at least every 200 ms) keeps the viewer up to date.
-    pub fn open(
-        target: &RecordTarget,
-        scene_name: &str,
-        edges: EdgeDisplay,
-    ) -> Result<Recorder, RecordError> {
-        let described = target.describe();
-        let create_err = |source: BoxError| RecordError::Create {
-            target: described.clone(),
-            source,
-        };
-        let sinks = sink::open_sinks(target)?;
-        let mut builder = RecordingStreamBuilder::new(APPLICATION_ID);
-        if target.live.is_none() {
-            builder = builder.batcher_config(sink::file_only_batching());
-        }
-        let stream = builder
-            .recording_id(recording_id(scene_name))
-            // `recording_id` turns the properties chunk off; keep the name in the file.
-            .send_properties(true)
-            .recording_name(scene_name)
-            // Ignore `RERUN=off`: a requested recording is always written.
-            .enabled(true)
-            .set_sinks(sinks)
-            .map_err(|e| create_err(Box::new(e)))?;
-        if !stream.is_enabled() {
-            return Err(create_err("rerun disabled the recording stream".into()));
-        }
-        // Only `frame` and `sim_time`: no wall-clock `log_time` column (wall time per frame is
-        // a plot instead), which also keeps the data part of the file reproducible.
-        stream.set_log_time_enabled(false);
-        let recorder = Recorder {
-            stream,
-            target: target.clone(),
-            described,
-            edges,
-            mesh_path: EntityPath::from(ENTITY_MESH),
-            edges_path: EntityPath::from(ENTITY_EDGES),
-            pins_path: EntityPath::from(ENTITY_PINS),
-            cloth_mesh: mesh::ClothMesh::default(),
-            scalar_paths: HashMap::new(),
-            blueprint_sent: false,
-        };
-        recorder
-            .stream
-            .log_static("/", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP())
-            .map_err(|e| recorder.log_err("/", e))?;
-        recorder
-            .stream
-            .log_static("cloth", &convert::level_annotations())
-            .map_err(|e| recorder.log_err("cloth", e))?;
-        if edges != EdgeDisplay::Off {
-            recorder
-                .stream
-                .log_static(ENTITY_EDGES, &edges::angle_annotations())
-                .map_err(|e| recorder.log_err(ENTITY_EDGES, e))?;
-        }
-        recorder
-            .stream
-            .log_static(
-                ENTITY_LEGEND,
-                &rerun::TextDocument::from_markdown(layout::legend_markdown()),
-            )
-            .map_err(|e| recorder.log_err(ENTITY_LEGEND, e))?;
-        Ok(recorder)
-    }
-
-    /// Where the recording goes.
-    pub fn target(&self) -> &RecordTarget {
-        &self.target
-    }
-
-    /// Logs one frame: sets the `frame` and `sim_time` timelines, then logs the mesh at
-    /// `cloth/mesh` (positions and normals; the topology, colours, class ids and
-    /// `triangle_level` data too when the triangles or levels changed), the edges at
-    /// `cloth/edges` (unless [`EdgeDisplay::Off`]), the pinned vertices at `cloth/pins`, the
-    /// events at `events/points` and `events/log`, and each scalar at `plots/<name>`.
-    ///
-    /// The data is validated first ([`RecordError::InvalidFrame`] on a length mismatch, an
-    /// index out of range or a non-finite `sim_time`); nothing is logged for an invalid frame
-    /// and the recorder stays usable. Vertices are converted straight from the slices into
-    /// rerun's arrow buffers; the recorder keeps one copy of the last logged topology to tell
-    /// whether it changed.
-    pub fn record_frame(&mut self, frame: &FrameView) -> Result<(), RecordError> {
-        let frame_index = frame::validate(frame)?;
-        if !self.blueprint_sent {
-            let names: Vec<&str> = frame.scalars.iter().map(|(n, _)| *n).collect();
-            layout::send_blueprint(&self.stream, &names)
-                .map_err(|e| self.log_err("blueprint", e))?;
-            self.blueprint_sent = true;
-        }
-
-        self.stream.set_time_sequence(TIMELINE_FRAME, frame_index);
-        self.stream
-            .set_duration_secs(TIMELINE_SIM_TIME, frame.sim_time);
-
-        let (positions, normals) = (frame.positions, frame.vertex_normals);
-        let changed =
-            self.cloth_mesh
-                .update(positions.len(), frame.triangles, frame.triangle_levels);
-        let geometry = self.cloth_mesh.geometry(positions, normals);
-        let logged = if changed {
-            let (topology, data) = self.cloth_mesh.topology();
-            self.stream.log(
-                self.mesh_path.clone(),
-                &[&geometry as &dyn AsComponents, &topology, &data],
-            )
-        } else {
-            self.stream.log(self.mesh_path.clone(), &geometry)
-        };
-        logged.map_err(|e| self.log_err(ENTITY_MESH, e))?;
-
-        if let Some((strips, data)) =
-            edges::edge_row(self.edges, positions, frame.edges, frame.edge_angles)
-        {
-            self.stream
-                .log(
-                    self.edges_path.clone(),
-                    &[&strips as &dyn AsComponents, &data],
-                )
-                .map_err(|e| self.log_err(ENTITY_EDGES, e))?;
-        }
-
-        let [r, g, b] = PIN_COLOR;
-        let pins = rerun::Points3D::new(
-            frame
-                .pinned
-                .iter()
-                .map(|&i| convert::position(positions[i as usize])),
-        )
-        .with_radii([rerun::Radius::new_ui_points(PIN_RADIUS_UI)])
-        .with_colors([rerun::Rgba32::from_rgb(r, g, b)]);
-        self.stream
-            .log(self.pins_path.clone(), &pins)
-            .map_err(|e| self.log_err(ENTITY_PINS, e))?;
-
-        self.stream
-            .log(ENTITY_EVENT_POINTS, &events::event_points(frame.events))
-            .map_err(|e| self.log_err(ENTITY_EVENT_POINTS, e))?;
-        for e in frame.events {
-            self.stream
-                .log(ENTITY_EVENT_LOG, &events::event_line(e))
-                .map_err(|err| self.log_err(ENTITY_EVENT_LOG, err))?;
-        }
-
-        for &(name, value) in frame.scalars {
-            let path = match self.scalar_paths.get(name) {
-                Some(path) => path.clone(),
-                None => {
-                    let path = EntityPath::from(format!("{ENTITY_PLOTS}/{name}"));
-                    self.scalar_paths.insert(name.to_owned(), path.clone());
-                    path
-                }
-            };
-            self.stream
-                .log(path, &rerun::Scalars::single(value))
-                .map_err(|e| self.log_err(&format!("{ENTITY_PLOTS}/{name}"), e))?;
-        }
-        Ok(())
-    }
-
-    /// Logs an obstacle's triangulation at `obstacles/<name>` (non-alphanumeric characters of
-    /// `name` become `_`) in a neutral grey: as static data when `fixed` (log it once), else
-    /// at the current frame (call it after [`Recorder::record_frame`] every frame).
-    pub fn record_obstacle(
-        &mut self,
-        name: &str,
-        positions: &[Vector],
-        triangles: &[[u32; 3]],
-        fixed: bool,
-    ) -> Result<(), RecordError> {
-        let n = positions.len();
-        if let Some(t) = triangles
-            .iter()
-            .find(|t| t.iter().any(|&i| i as usize >= n))
-        {
-            return Err(RecordError::InvalidFrame {
-                frame: 0,
-                reason: format!("obstacle {name}: triangle {t:?} indexes past {n} vertices"),
-            });
-        }
-        let clean: String = name
-            .chars()
-            .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
-            .collect();
-        let entity = format!("{ENTITY_OBSTACLES}/{clean}");
-        let [r, g, b] = OBSTACLE_COLOR;
-        let mesh = rerun::Mesh3D::new(positions.iter().map(|&p| convert::position(p)))
-            .with_triangle_indices(triangles.iter().copied())
-            .with_albedo_factor(rerun::Rgba32::from_rgb(r, g, b));
-        let logged = if fixed {
-            self.stream.log_static(entity.as_str(), &mesh)
-        } else {
-            self.stream.log(entity.as_str(), &mesh)
-        };
-        logged.map_err(|e| self.log_err(&entity, e))
-    }
-
-    /// Flushes and closes the stream (the file's footer included) and returns the size of the
-    /// `.rrd` file in bytes (0 when only streaming to a viewer).
-    ///
-    /// The stream is closed even when flushing fails; the error then says the file may be
-    /// incomplete.
-    pub fn finish(mut self) -> Result<u64, RecordError> {
-        let stream = std::mem::replace(&mut self.stream, RecordingStream::disabled());
-        let flushed = stream.flush_blocking();
-        // Last handle: this joins rerun's batcher and writer threads, which write the footer.
-        drop(stream);
-        let finish_err = |message: String| RecordError::Finish {
-            target: self.described.clone(),
-            message,
-        };
-        flushed.map_err(|e| finish_err(e.to_string()))?;
-        match &self.target.file {
-            Some(path) => Ok(std::fs::metadata(path)
-                .map_err(|e| finish_err(format!("cannot read the file size: {e}")))?
-                .len()),
-            None => Ok(0),
-        }
-    }
-
-    fn log_err(
-        &self,
-        entity: &str,
-        source: impl std::error::Error + Send + Sync + 'static,
-    ) -> RecordError {
-        RecordError::Log {
-            target: self.described.clone(),
-            entity: entity.to_owned(),
-            source: Box::new(source),
-        }
-    }
-}
-
-impl Drop for Recorder {
-    /// Flushes and closes the stream if [`Recorder::finish`] was not called, so that an early
-    /// return or a panic still leaves a complete `.rrd` (errors go to stderr: none can be
-    /// returned from here).
-    fn drop(&mut self) {
-        let stream = std::mem::replace(&mut self.stream, RecordingStream::disabled());
-        if stream.is_enabled()
-            && let Err(e) = stream.flush_blocking()
-        {
-            eprintln!(
-                "drape: warning: recording {} may be incomplete: {e}",
-                self.described
-            );
-        }
-        drop(stream);
-    }
 }

@@ -40,6 +40,23 @@ impl Inspection {
     /// the frames with the most events, and every entity path with its row counts.
     pub fn report(&self) -> String {
         let mut s = String::new();
+        self.write_file_lines(&mut s);
+        self.write_frame_lines(&mut s);
+        self.write_event_lines(&mut s);
+        let _ = writeln!(s, "entities (rows on the timelines, static rows):");
+        let width = self.entities.keys().map(String::len).max().unwrap_or(0);
+        for (path, rows) in &self.entities {
+            let _ = writeln!(
+                s,
+                "  {path:<width$}  {:>7}  {:>3}",
+                rows.temporal, rows.static_rows
+            );
+        }
+        s
+    }
+
+    /// The overview's file line (size, messages, footer) and ids line.
+    fn write_file_lines(&self, s: &mut String) {
         let footer = if self.footer {
             "complete (stream footer present)"
         } else {
@@ -62,6 +79,10 @@ impl Inspection {
             ids(&self.recording_ids),
             self.blueprint_messages
         );
+    }
+
+    /// The overview's frame span, mesh size ranges, topology rows and edge angles.
+    fn write_frame_lines(&self, s: &mut String) {
         let first = self.frames.keys().next();
         let last = self.frames.keys().next_back();
         let times: Vec<f64> = self.frames.values().filter_map(|f| f.sim_time).collect();
@@ -107,6 +128,10 @@ impl Inspection {
                     .map_or("-".to_owned(), |a| format!("{a:.2}")),
             );
         }
+    }
+
+    /// The overview's event counts by kind and the busiest frames.
+    fn write_event_lines(&self, s: &mut String) {
         let counts = self.event_counts();
         let total: usize = counts.values().sum();
         let _ = writeln!(s, "events: {total} ({})", counts_line(&counts));
@@ -125,16 +150,6 @@ impl Inspection {
                 .collect();
             let _ = writeln!(s, "frames with the most events: {}", top.join(", "));
         }
-        let _ = writeln!(s, "entities (rows on the timelines, static rows):");
-        let width = self.entities.keys().map(String::len).max().unwrap_or(0);
-        for (path, rows) in &self.entities {
-            let _ = writeln!(
-                s,
-                "  {path:<width$}  {:>7}  {:>3}",
-                rows.temporal, rows.static_rows
-            );
-        }
-        s
     }
 
     /// One frame in detail: its time, mesh statistics (triangles, vertices, triangles per
