@@ -161,92 +161,146 @@ impl Elements {
             }
         }
         let mass = vertex_area.iter().map(|a| mat.density * a).collect();
-        let level_factor = |level: u8| match mat.stiffness_rule {
-            StiffnessRule::Consistent => 1.0,
-            StiffnessRule::PaperA => (2.0 as Scalar).powf(level as Scalar / 2.0),
-        };
-        let mut springs = Vec::with_capacity(mesh.edges.len() * 2);
-        for (e, edge) in mesh.edges.iter().enumerate() {
-            let rest = mesh.rest_length(e);
-            let tris = edge
-                .triangles
-                .iter()
-                .filter(|&&t| t != crate::mesh::NO_TRIANGLE);
-            let level = tris
-                .clone()
-                .map(|&t| mesh.levels[t as usize])
-                .max()
-                .unwrap_or(0);
-            let k = match mat.stiffness_rule {
-                StiffnessRule::Consistent => {
-                    mat.stretch * tris.map(|&t| area[t as usize]).sum::<Scalar>() / (rest * rest)
-                }
-                StiffnessRule::PaperA => mat.stretch * level_factor(level),
-            };
-            springs.push(Spring {
-                v: edge.vertices,
-                rest,
-                k,
-                c: mat.damping * k,
-            });
-        }
-        let mut hinges = Vec::new();
+        let mut springs = stretch_springs(mesh, mat, &area);
         let shape_triangles =
             if mat.bending > 0.0 && mat.bending_model == BendingModel::ShapeOperator {
                 build_shape_triangles(mesh, &area, mat.bending, clamped)
             } else {
                 Vec::new()
             };
-        if mat.bending > 0.0 && mat.bending_model != BendingModel::ShapeOperator {
-            for (e, edge) in mesh
-                .edges
-                .iter()
-                .enumerate()
-                .filter(|(_, e)| e.is_interior())
-            {
-                let [t0, t1] = edge.triangles;
-                // Orient the edge as it runs in t0 (counter-clockwise) so that the
-                // signed angle has a consistent meaning.
-                let [a, b] = oriented_in(&mesh.triangles[t0 as usize], edge.vertices);
-                let (p, q) = (
-                    mesh.opposite_vertex(t0, edge),
-                    mesh.opposite_vertex(t1, edge),
-                );
-                let level = mesh.levels[t0 as usize].max(mesh.levels[t1 as usize]);
-                match mat.bending_model {
-                    BendingModel::Dihedral => {
-                        let len = mesh.rest_length(e);
-                        let k = mat.bending * len * len / (area[t0 as usize] + area[t1 as usize]);
-                        hinges.push(Hinge { v: [a, b, p, q], k });
-                    }
-                    BendingModel::ShapeOperator => unreachable!("built above"),
-                    BendingModel::HingeSpring => {
-                        let rest = material_distance(&mesh.material, p, q);
-                        let k = mat.bending / (rest * rest) * level_factor(level);
-                        springs.push(Spring {
-                            v: [p, q],
-                            rest,
-                            k,
-                            c: mat.damping * k,
-                        });
-                    }
-                }
+        let hinges = edge_bending(mesh, mat, &area, &mut springs);
+        let tables = GatherTables::build(n, mesh, &springs, &hinges, &shape_triangles);
+        Elements {
+            mass,
+            vertex_area,
+            springs,
+            hinges,
+            shape_triangles,
+            spring_first: tables.spring_first,
+            spring_second: tables.spring_second,
+            hinge_slots: tables.hinge_slots,
+            shape_slots: tables.shape_slots,
+            vertex_triangles: tables.vertex_triangles,
+        }
+    }
+
+    /// Total mass, kg.
+    pub fn total_mass(&self) -> Scalar {
+        self.mass.iter().sum()
+    }
+}
+
+/// The stiffening of a level-`level` spring under the stiffness rule (paper A:
+/// `2^(n/2)`; consistent: none).
+fn level_factor(rule: StiffnessRule, level: u8) -> Scalar {
+    match rule {
+        StiffnessRule::Consistent => 1.0,
+        StiffnessRule::PaperA => (2.0 as Scalar).powf(level as Scalar / 2.0),
+    }
+}
+
+/// One stretch spring per edge (module docs: stiffness derivations); `area` is
+/// each triangle's rest area.
+fn stretch_springs(mesh: &Mesh, mat: &MaterialParams, area: &[Scalar]) -> Vec<Spring> {
+    let mut springs = Vec::with_capacity(mesh.edges.len() * 2);
+    for (e, edge) in mesh.edges.iter().enumerate() {
+        let rest = mesh.rest_length(e);
+        let tris = edge
+            .triangles
+            .iter()
+            .filter(|&&t| t != crate::mesh::NO_TRIANGLE);
+        let level = tris
+            .clone()
+            .map(|&t| mesh.levels[t as usize])
+            .max()
+            .unwrap_or(0);
+        let k = match mat.stiffness_rule {
+            StiffnessRule::Consistent => {
+                mat.stretch * tris.map(|&t| area[t as usize]).sum::<Scalar>() / (rest * rest)
+            }
+            StiffnessRule::PaperA => mat.stretch * level_factor(mat.stiffness_rule, level),
+        };
+        springs.push(Spring {
+            v: edge.vertices,
+            rest,
+            k,
+            c: mat.damping * k,
+        });
+    }
+    springs
+}
+
+/// The bending elements of the edge-based models: dihedral hinges (returned) or
+/// hinge springs (appended to `springs`); none for the shape-operator model or
+/// zero rigidity.
+fn edge_bending(
+    mesh: &Mesh,
+    mat: &MaterialParams,
+    area: &[Scalar],
+    springs: &mut Vec<Spring>,
+) -> Vec<Hinge> {
+    let mut hinges = Vec::new();
+    if mat.bending <= 0.0 || mat.bending_model == BendingModel::ShapeOperator {
+        return hinges;
+    }
+    for (e, edge) in mesh
+        .edges
+        .iter()
+        .enumerate()
+        .filter(|(_, e)| e.is_interior())
+    {
+        let [t0, t1] = edge.triangles;
+        // Orient the edge as it runs in t0 (counter-clockwise) so that the
+        // signed angle has a consistent meaning.
+        let [a, b] = oriented_in(&mesh.triangles[t0 as usize], edge.vertices);
+        let (p, q) = (
+            mesh.opposite_vertex(t0, edge),
+            mesh.opposite_vertex(t1, edge),
+        );
+        let level = mesh.levels[t0 as usize].max(mesh.levels[t1 as usize]);
+        match mat.bending_model {
+            BendingModel::Dihedral => {
+                let len = mesh.rest_length(e);
+                let k = mat.bending * len * len / (area[t0 as usize] + area[t1 as usize]);
+                hinges.push(Hinge { v: [a, b, p, q], k });
+            }
+            BendingModel::ShapeOperator => unreachable!("returned above"),
+            BendingModel::HingeSpring => {
+                let rest = material_distance(&mesh.material, p, q);
+                let k = mat.bending / (rest * rest) * level_factor(mat.stiffness_rule, level);
+                springs.push(Spring {
+                    v: [p, q],
+                    rest,
+                    k,
+                    c: mat.damping * k,
+                });
             }
         }
-        let spring_first = Incidence::from_pairs(
-            n,
-            springs
-                .iter()
-                .enumerate()
-                .map(|(s, sp)| (sp.v[0], s as u32)),
-        );
-        let spring_second = Incidence::from_pairs(
-            n,
-            springs
-                .iter()
-                .enumerate()
-                .map(|(s, sp)| (sp.v[1], s as u32)),
-        );
+    }
+    hinges
+}
+
+/// The per-vertex gather lists of a set of elements.
+struct GatherTables {
+    spring_first: Incidence,
+    spring_second: Incidence,
+    hinge_slots: Incidence,
+    shape_slots: Incidence,
+    vertex_triangles: Incidence,
+}
+
+impl GatherTables {
+    fn build(
+        n: usize,
+        mesh: &Mesh,
+        springs: &[Spring],
+        hinges: &[Hinge],
+        shape_triangles: &[ShapeTriangle],
+    ) -> GatherTables {
+        let ends = |end: usize| {
+            let pairs = springs.iter().enumerate();
+            Incidence::from_pairs(n, pairs.map(move |(s, sp)| (sp.v[end], s as u32)))
+        };
         let hinge_slots = Incidence::from_pairs(
             n,
             hinges
@@ -262,7 +316,6 @@ impl Elements {
                     .map(move |(k, v)| (v, (SHAPE_SLOTS * p + k) as u32))
             })
             .collect();
-        let shape_slots = Incidence::from_pairs(n, shape_pairs.iter().copied());
         let vertex_triangles = Incidence::from_pairs(
             n,
             mesh.triangles
@@ -270,23 +323,13 @@ impl Elements {
                 .enumerate()
                 .flat_map(|(t, tri)| tri.iter().map(move |&v| (v, t as u32))),
         );
-        Elements {
-            mass,
-            vertex_area,
-            springs,
-            hinges,
-            shape_triangles,
-            spring_first,
-            spring_second,
+        GatherTables {
+            spring_first: ends(0),
+            spring_second: ends(1),
             hinge_slots,
-            shape_slots,
+            shape_slots: Incidence::from_pairs(n, shape_pairs.iter().copied()),
             vertex_triangles,
         }
-    }
-
-    /// Total mass, kg.
-    pub fn total_mass(&self) -> Scalar {
-        self.mass.iter().sum()
     }
 }
 
