@@ -177,10 +177,14 @@ pub fn measure(
 }
 
 /// The cantilever measurements of a finished run, when the scene is one: a
-/// rectangle whose pins are all fixed for good and hold exactly one end.
+/// rectangle whose pins are all fixed for good and hold exactly one end, loaded
+/// by gravity alone (no wind, no obstacle: the elastica it is compared with
+/// assumes nothing else; a flag in wind was reported as a 9 deg "cantilever").
 pub fn for_run(scene: &Scene, world: &World, mat: &MaterialParams) -> Option<CantileverSummary> {
     let fixed = |p: &crate::scene::Pin| p.motion == PinMotion::Fixed && p.release_time.is_none();
-    if scene.cloth.shape != ClothShape::Rectangle || !scene.pin.iter().all(fixed) {
+    let gravity_alone = scene.wind.is_none() && scene.obstacle.is_empty();
+    if scene.cloth.shape != ClothShape::Rectangle || !scene.pin.iter().all(fixed) || !gravity_alone
+    {
         return None;
     }
     let mut held = vec![false; world.x.len()];

@@ -452,3 +452,36 @@ fn every_shipped_scene_and_the_default_pass_check() {
     assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
     assert!(stdout(&out).starts_with("scene `default`"));
 }
+
+/// Regression: the flag (held along one edge, in wind) got a cantilever report
+/// ("chord angle 8.94 deg, elastica 90.19 deg"); the test needs gravity alone.
+#[test]
+fn cantilever_report_only_for_a_strip_under_gravity_alone() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dir = temp_dir("cantilever-report");
+    for (scene, expect) in [("flag", false), ("cantilever", true)] {
+        let path = root.join("scenes").join(format!("{scene}.toml"));
+        let summary = dir.join(format!("{scene}.json"));
+        let args = [
+            "run",
+            path_str(&path),
+            "--set",
+            "simulation.duration=0.05",
+            "--no-record",
+            "--summary",
+            path_str(&summary),
+            "-q",
+        ];
+        let out = drape(&args, &dir);
+        assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+        let s = read_json(&summary);
+        assert_eq!(
+            !s["cantilever"].is_null(),
+            expect,
+            "{scene}: {}",
+            s["cantilever"]
+        );
+        assert_eq!(stdout(&out).contains("Cantilever:"), expect, "{scene}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
