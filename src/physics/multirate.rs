@@ -81,61 +81,9 @@ impl Levels {
         for (v, &l) in vlevel.iter().enumerate() {
             groups[l as usize].vertices.push(v as u32);
         }
-        let mut mark = vec![usize::MAX; n];
+        let mark = assign_elements(&mut groups, mesh, el);
         for g in groups.iter_mut() {
-            for &v in &g.vertices {
-                mark[v as usize] = g.level as usize;
-            }
-        }
-        for (s, sp) in el.springs.iter().enumerate() {
-            touch(
-                &mut groups,
-                sp.v.iter().map(|&v| mark[v as usize]),
-                s as u32,
-                |g| &mut g.springs,
-            );
-        }
-        for (h, hg) in el.hinges.iter().enumerate() {
-            touch(
-                &mut groups,
-                hg.v.iter().map(|&v| mark[v as usize]),
-                h as u32,
-                |g| &mut g.hinges,
-            );
-        }
-        for (p, st) in el.shape_triangles.iter().enumerate() {
-            touch(
-                &mut groups,
-                st.slots().map(|(_, v)| mark[v as usize]),
-                p as u32,
-                |g| &mut g.shape,
-            );
-        }
-        for (t, tri) in mesh.triangles.iter().enumerate() {
-            touch(
-                &mut groups,
-                tri.iter().map(|&v| mark[v as usize]),
-                t as u32,
-                |g| &mut g.triangles,
-            );
-        }
-        for g in groups.iter_mut() {
-            let mut halo: Vec<u32> = g
-                .springs
-                .iter()
-                .flat_map(|&s| el.springs[s as usize].v)
-                .chain(g.hinges.iter().flat_map(|&h| el.hinges[h as usize].v))
-                .chain(
-                    g.shape
-                        .iter()
-                        .flat_map(|&p| el.shape_triangles[p as usize].slots().map(|(_, v)| v)),
-                )
-                .chain(g.triangles.iter().flat_map(|&t| mesh.triangles[t as usize]))
-                .filter(|&v| mark[v as usize] != g.level as usize)
-                .collect();
-            halo.sort_unstable();
-            halo.dedup();
-            g.halo = halo;
+            g.halo = halo_of(g, mesh, el, &mark);
         }
         let limits = vertex_limits(mesh, el, drag_per_area);
         let mut macro_dt = Scalar::INFINITY;
@@ -160,6 +108,70 @@ impl Levels {
             .map(|g| (g.level, g.vertices.len(), g.substeps))
             .collect()
     }
+}
+
+/// Each vertex's group (its level), and every element added to the groups of
+/// the vertices it touches.
+fn assign_elements(groups: &mut [Group], mesh: &Mesh, el: &Elements) -> Vec<usize> {
+    let mut mark = vec![usize::MAX; mesh.vertex_count()];
+    for g in groups.iter() {
+        for &v in &g.vertices {
+            mark[v as usize] = g.level as usize;
+        }
+    }
+    for (s, sp) in el.springs.iter().enumerate() {
+        touch(
+            groups,
+            sp.v.iter().map(|&v| mark[v as usize]),
+            s as u32,
+            |g| &mut g.springs,
+        );
+    }
+    for (h, hg) in el.hinges.iter().enumerate() {
+        touch(
+            groups,
+            hg.v.iter().map(|&v| mark[v as usize]),
+            h as u32,
+            |g| &mut g.hinges,
+        );
+    }
+    for (p, st) in el.shape_triangles.iter().enumerate() {
+        touch(
+            groups,
+            st.slots().map(|(_, v)| mark[v as usize]),
+            p as u32,
+            |g| &mut g.shape,
+        );
+    }
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        touch(
+            groups,
+            tri.iter().map(|&v| mark[v as usize]),
+            t as u32,
+            |g| &mut g.triangles,
+        );
+    }
+    mark
+}
+
+/// The vertices of other groups that group `g`'s elements touch, sorted.
+fn halo_of(g: &Group, mesh: &Mesh, el: &Elements, mark: &[usize]) -> Vec<u32> {
+    let mut halo: Vec<u32> = g
+        .springs
+        .iter()
+        .flat_map(|&s| el.springs[s as usize].v)
+        .chain(g.hinges.iter().flat_map(|&h| el.hinges[h as usize].v))
+        .chain(
+            g.shape
+                .iter()
+                .flat_map(|&p| el.shape_triangles[p as usize].slots().map(|(_, v)| v)),
+        )
+        .chain(g.triangles.iter().flat_map(|&t| mesh.triangles[t as usize]))
+        .filter(|&v| mark[v as usize] != g.level as usize)
+        .collect();
+    halo.sort_unstable();
+    halo.dedup();
+    halo
 }
 
 /// Adds element `e` to every group one of whose vertices it touches (once).

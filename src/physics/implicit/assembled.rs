@@ -248,24 +248,8 @@ fn iterate(
             if pap <= 0.0 || !pap.is_finite() {
                 break 'restart Err(SolveFailure::NotPositiveDefinite);
             }
-            let alpha = rz / pap;
-            a.y.par_iter_mut()
-                .zip(a.r.par_iter_mut())
-                .zip(a.p.par_iter().zip(a.ap.par_iter()))
-                .with_min_len(PAR_MIN)
-                .for_each(|((y, r), (p, ap))| {
-                    *y += *p * alpha;
-                    *r -= *ap * alpha;
-                });
-            a.factorization.solve(&a.r, &mut a.z);
+            rz = pcg_update(a, rz / pap, rz);
             st.stats.factor_solves += 1;
-            let rz_new = dot(&a.r, &a.z);
-            let beta = rz_new / rz;
-            rz = rz_new;
-            a.p.par_iter_mut()
-                .zip(a.z.par_iter())
-                .with_min_len(PAR_MIN)
-                .for_each(|(p, z)| *p = *z + *p * beta);
             total += 1;
             since_factor += 1;
         }
@@ -273,6 +257,28 @@ fn iterate(
     st.stats.cg_iterations += total as u64;
     st.stats.solve_s += started.elapsed().as_secs_f64();
     outcome
+}
+
+/// One conjugate-gradient update with step `alpha`: `y += alpha p`,
+/// `r -= alpha A p`, `z = M^-1 r` (one solve with the factor), `p = z + beta p`
+/// with `beta = r.z / rz`. Returns the new `r.z`.
+fn pcg_update(a: &mut AssembledScratch, alpha: Scalar, rz: Scalar) -> Scalar {
+    a.y.par_iter_mut()
+        .zip(a.r.par_iter_mut())
+        .zip(a.p.par_iter().zip(a.ap.par_iter()))
+        .with_min_len(PAR_MIN)
+        .for_each(|((y, r), (p, ap))| {
+            *y += *p * alpha;
+            *r -= *ap * alpha;
+        });
+    a.factorization.solve(&a.r, &mut a.z);
+    let rz_new = dot(&a.r, &a.z);
+    let beta = rz_new / rz;
+    a.p.par_iter_mut()
+        .zip(a.z.par_iter())
+        .with_min_len(PAR_MIN)
+        .for_each(|(p, z)| *p = *z + *p * beta);
+    rz_new
 }
 
 /// `r = b_s - A_s y`.
