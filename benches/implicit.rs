@@ -13,6 +13,9 @@
 //! After the Criterion groups, the time split per step (assembly, factorization,
 //! solve, the rest) of 60 further steps is printed for each case.
 //!
+//! A second group, `remesh_tables`, times what a remesh rebuilds before the
+//! symbolic factorization: the element tables and the block pattern.
+//!
 //! Run with `cargo bench --bench implicit`; `docs/performance.md` has the figures.
 
 use std::hint::black_box;
@@ -20,6 +23,8 @@ use std::time::{Duration, Instant};
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group};
 use drape::math::{Scalar, Vector};
+use drape::physics::block::BlockPattern;
+use drape::physics::elements::Elements;
 use drape::physics::{
     ExternalForces, MaterialParams, Model, Solver, SolverSettings, StepStats, Stepper,
 };
@@ -148,7 +153,40 @@ fn difference(a: &StepStats, b: &StepStats) -> StepStats {
     }
 }
 
-criterion_group!(benches, implicit_step);
+/// What a remesh costs the implicit solver before its symbolic factorization:
+/// the element tables and the block pattern of the new mesh, with the default
+/// shape-operator bending (`pattern_build`: `BlockPattern::build` alone).
+fn remesh_tables(c: &mut Criterion) {
+    let mut group = c.benchmark_group("remesh_tables");
+    group
+        .warm_up_time(Duration::from_secs(1))
+        .measurement_time(Duration::from_secs(3))
+        .sample_size(10);
+    for resolution in [63u32, 127] {
+        let mesh = drape::mesh::rectangle(1.0, 1.0, resolution, DiagonalPattern::Alternating)
+            .expect("valid rectangle");
+        let material = MaterialParams {
+            density: 0.15,
+            stretch: 200.0,
+            bending: 1e-5,
+            damping: 0.001,
+            bending_model: BendingModel::ShapeOperator,
+            stiffness_rule: StiffnessRule::Consistent,
+        };
+        let vertices = mesh.vertex_count();
+        group.throughput(Throughput::Elements(vertices as u64));
+        group.bench_function(BenchmarkId::new("elements_build", vertices), |b| {
+            b.iter(|| Elements::build(black_box(&mesh), &material))
+        });
+        let elements = Elements::build(&mesh, &material);
+        group.bench_function(BenchmarkId::new("pattern_build", vertices), |b| {
+            b.iter(|| BlockPattern::build(vertices, black_box(&elements), false))
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, implicit_step, remesh_tables);
 
 fn main() {
     if std::env::var_os("DRAPE_BENCH_SPLIT_ONLY").is_none() {
