@@ -138,14 +138,24 @@ pub fn describe(scene: &Scene) -> Result<String, RunError> {
     if let Some(a) = &adapt {
         let _ = writeln!(
             s,
-            "adaptive meshing: {}, refine above {} deg, coarsen below {} deg (and below half the upper threshold), levels 0..{}, every {} steps{}{}",
+            "adaptive meshing: {}, {}, levels 0..{}, every {} steps{}{}",
             match a.method {
                 crate::scene::AdaptMethod::Edge =>
                     "edge (paper B: longest-edge splits, Delaunay flips, guarded collapses)",
                 _ => "red_green (paper A)",
             },
-            a.refine_angle,
-            a.coarsen_angle,
+            match a.criterion {
+                crate::scene::AdaptCriterion::Angle => format!(
+                    "angle criterion: refine above {} deg, coarsen below {} deg (and below half the upper threshold)",
+                    a.refine_angle, a.coarsen_angle
+                ),
+                crate::scene::AdaptCriterion::Sizing => format!(
+                    "sizing criterion: refine where curvature x spacing exceeds {} deg, merge where the parent would carry at most {} deg (hysteresis {})",
+                    a.refine_angle,
+                    a.refine_angle / a.hysteresis,
+                    a.hysteresis
+                ),
+            },
             a.max_level,
             a.every,
             if a.min_edge_length > 0.0 {

@@ -25,6 +25,8 @@ fn config() -> AdaptConfig {
         every: 1,
         rollback: false,
         max_rollbacks: 3,
+        criterion: drape::scene::AdaptCriterion::Angle,
+        hysteresis: 2.0,
     }
 }
 
