@@ -575,7 +575,11 @@ fn override_errors_name_the_set() {
         Kind::NotApplicable,
     );
     set_error(
-        &["adapt.method=red_green", "adapt.hysteresis=2"],
+        &[
+            "adapt.method=red_green",
+            "adapt.criterion=angle",
+            "adapt.hysteresis=2",
+        ],
         "adapt.hysteresis",
         Kind::NotApplicable,
     );
