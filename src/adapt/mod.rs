@@ -1,6 +1,6 @@
-//! Adaptive meshing (SPEC section 4): refine where the angle between the normals
-//! of the two triangles at an interior edge exceeds the upper threshold, coarsen
-//! where every relevant angle is below the lower one.
+//! Adaptive meshing (SPEC section 4): the papers' `angle` criterion (refine where
+//! the angle between the normals at an interior edge exceeds the upper threshold,
+//! coarsen where every angle around is below the lower one) or `sizing.rs`.
 //!
 //! An adaptation pass: measure angles -> choose operations -> apply them to the
 //! refinement hierarchy -> close the mesh -> transfer the state onto the new
