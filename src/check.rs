@@ -8,8 +8,8 @@ use crate::physics::timestep::fit_to_frame;
 use crate::physics::{Elements, ExternalForces, MaterialParams, Model, Stepper};
 use crate::run::RunError;
 use crate::scene::{
-    AdaptMethod, BendingModel, Integrator, PinMotion, Scene, Simulation, Solver, StiffnessRule,
-    TimeStep,
+    AdaptCriterion, AdaptMethod, BendingModel, Integrator, PinMotion, Scene, Simulation, Solver,
+    StiffnessRule, TimeStep,
 };
 use crate::world::World;
 
@@ -179,14 +179,24 @@ fn not_modelled(
 fn describe_adapt(s: &mut String, scene: &Scene, a: &AdaptConfig) {
     let _ = writeln!(
         s,
-        "adaptive meshing: {}, refine above {} deg, coarsen below {} deg (and below half the upper threshold), levels 0..{}, every {} steps{}{}",
+        "adaptive meshing: {}, {}, levels 0..{}, every {} steps{}{}",
         match a.method {
             AdaptMethod::Edge =>
                 "edge (paper B: longest-edge splits, Delaunay flips, guarded collapses)",
             _ => "red_green (paper A)",
         },
-        a.refine_angle,
-        a.coarsen_angle,
+        match a.criterion {
+            AdaptCriterion::Angle => format!(
+                "angle criterion: refine above {} deg, coarsen below {} deg (and below half the upper threshold)",
+                a.refine_angle, a.coarsen_angle
+            ),
+            AdaptCriterion::Sizing => format!(
+                "sizing criterion: refine where curvature x spacing exceeds {} deg, merge where the parent would carry at most {} deg (hysteresis {})",
+                a.refine_angle,
+                a.refine_angle / a.hysteresis,
+                a.hysteresis
+            ),
+        },
         a.max_level,
         a.every,
         if a.min_edge_length > 0.0 {

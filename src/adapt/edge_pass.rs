@@ -7,6 +7,7 @@ use super::transfer::{compact, transfer};
 use super::{AdaptEvent, Adapter, EventKind, edge, edge_angles};
 use crate::math::{Scalar, Vector};
 use crate::mesh::MeshError;
+use crate::spec::AdaptCriterion;
 use crate::world::World;
 
 impl Adapter {
@@ -56,7 +57,9 @@ impl Adapter {
                 soup.collapse(u, v, &pinned, &limits, &mut ops);
             }
         }
+        let max_level = self.config.max_level;
         if ops.is_empty() {
+            self.stats.note_levels(world, max_level);
             return Ok(false);
         }
         if cfg!(debug_assertions)
@@ -68,6 +71,7 @@ impl Adapter {
         self.report_edge_ops(world, &ops, &map, &asked, step);
         self.stats.changed_passes += 1;
         self.stats.max_ops_per_pass = self.stats.max_ops_per_pass.max(ops.len() as u64);
+        self.stats.note_levels(world, max_level);
         self.debug_check(world);
         Ok(true)
     }
@@ -128,11 +132,15 @@ impl Adapter {
         limits: &edge::Limits,
     ) -> Vec<(Scalar, u32, u32)> {
         let m = &world.mesh;
-        // Flat vertices: every edge at them below both thresholds' limit.
-        let flat_limit = self
-            .config
-            .coarsen_angle
-            .min(0.5 * self.config.refine_angle);
+        // Flat vertices: every edge at them below both thresholds' limit, or
+        // for the sizing criterion (`sizing.rs`) below refine / (2 hysteresis).
+        let flat_limit = match self.config.criterion {
+            AdaptCriterion::Angle => self
+                .config
+                .coarsen_angle
+                .min(0.5 * self.config.refine_angle),
+            AdaptCriterion::Sizing => 0.5 * self.config.refine_angle / self.config.hysteresis,
+        };
         let mut vertex_max = vec![0.0 as Scalar; m.vertex_count()];
         for (e, edge) in m.edges.iter().enumerate() {
             for &v in &edge.vertices {

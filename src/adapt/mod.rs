@@ -1,6 +1,6 @@
-//! Adaptive meshing (SPEC section 4): refine where the angle between the normals
-//! of the two triangles at an interior edge exceeds the upper threshold, coarsen
-//! where every relevant angle is below the lower one.
+//! Adaptive meshing (SPEC section 4): the papers' `angle` criterion (refine where
+//! the angle between the normals at an interior edge exceeds the upper threshold,
+//! coarsen where every angle around is below the lower one) or `sizing.rs`.
 //!
 //! An adaptation pass: measure angles -> choose operations -> apply them to the
 //! refinement hierarchy -> close the mesh -> transfer the state onto the new
@@ -10,6 +10,7 @@ mod check;
 pub mod edge;
 mod edge_pass;
 pub mod red_green;
+pub mod sizing;
 pub mod soup;
 pub mod transfer;
 mod tri_list;
@@ -20,7 +21,7 @@ use rayon::prelude::*;
 
 use crate::math::{Scalar, Vector};
 use crate::mesh::MeshError;
-use crate::spec::{Adapt, AdaptMethod};
+use crate::spec::{Adapt, AdaptCriterion, AdaptMethod, DEFAULT_HYSTERESIS};
 use crate::world::World;
 use red_green::{Applied, RedGreen, RedGreenOp};
 use transfer::{compact, transfer};
@@ -78,6 +79,24 @@ pub struct AdaptStats {
     pub changed_passes: u64,
     /// Largest number of operations in one pass.
     pub max_ops_per_pass: u64,
+    /// Mean over the passes of the fraction of triangles at `max_level` or
+    /// finer (closure triangles of the finest red level included).
+    pub top_level_fraction_mean: Scalar,
+    /// That fraction after the last pass.
+    pub top_level_fraction_final: Scalar,
+}
+
+impl AdaptStats {
+    /// Adds the fraction of `world`'s triangles at level `top` or finer to the
+    /// running mean (called once per pass).
+    fn note_levels(&mut self, world: &World, top: u8) {
+        let levels = &world.mesh.levels;
+        let at_top = levels.iter().filter(|&&l| l >= top).count();
+        let f = at_top as Scalar / levels.len().max(1) as Scalar;
+        let n = self.passes.max(1) as Scalar;
+        self.top_level_fraction_mean += (f - self.top_level_fraction_mean) / n;
+        self.top_level_fraction_final = f;
+    }
 }
 
 /// Adaptivity settings (the scene's `[adapt]`, resolved).
@@ -99,6 +118,11 @@ pub struct AdaptConfig {
     pub rollback: bool,
     /// Rollbacks per step.
     pub max_rollbacks: u32,
+    /// What decides where to refine and coarsen.
+    pub criterion: AdaptCriterion,
+    /// Sizing criterion: merge when the parent carries at most
+    /// `refine_angle / hysteresis` (see `sizing.rs`); unused by the angle one.
+    pub hysteresis: Scalar,
 }
 
 impl AdaptConfig {
@@ -114,6 +138,8 @@ impl AdaptConfig {
             every: a.every.max(1) as u64,
             rollback: a.rollback,
             max_rollbacks: a.max_rollbacks,
+            criterion: a.criterion,
+            hysteresis: a.hysteresis.unwrap_or(DEFAULT_HYSTERESIS),
         })
     }
 }
@@ -219,11 +245,14 @@ impl Adapter {
         &self.hierarchy
     }
 
-    /// Leaves the angle criterion asks to split, with the angle that asked,
+    /// Leaves the criterion asks to split, with the (largest) angle that asked,
     /// from angles measured on the world's current shape.
     pub fn refinement_marks(&self, world: &World, angles: &[Scalar]) -> Vec<(u32, Scalar)> {
         if self.edge.is_some() {
             return Vec::new(); // rollback is paper A's, with red_green only
+        }
+        if self.config.criterion == AdaptCriterion::Sizing {
+            return self.sizing_refinement_marks(&self.leaf_curvatures(world, angles));
         }
         let mut marks: Vec<(u32, Scalar)> = Vec::new();
         for (e, edge) in world.mesh.edges.iter().enumerate() {
@@ -232,10 +261,7 @@ impl Adapter {
             }
             for &t in &edge.triangles {
                 let leaf = self.owner[t as usize];
-                let finer = self.hierarchy.level(leaf) as u32 + 2;
-                let long_enough = self.config.min_edge_length <= 0.0
-                    || 0.5 * self.hierarchy.shortest_edge(leaf) >= self.config.min_edge_length;
-                if finer <= self.config.max_level as u32 && long_enough {
+                if self.may_split(leaf) {
                     marks.push((leaf, angles[e]));
                 }
             }
@@ -286,15 +312,26 @@ impl Adapter {
             return self.edge_pass(world, step, limits);
         }
         let angles = edge_angles(world);
-        let merges = self.merge_marks(world, &angles);
-        let splits = self.refinement_marks(world, &angles);
+        let (merges, splits) = match self.config.criterion {
+            AdaptCriterion::Angle => (
+                self.merge_marks(world, &angles),
+                self.refinement_marks(world, &angles),
+            ),
+            AdaptCriterion::Sizing => {
+                let curv = self.leaf_curvatures(world, &angles);
+                let merges = self.sizing_merge_marks(&curv);
+                (merges, self.sizing_refinement_marks(&curv))
+            }
+        };
         self.stats.passes += 1;
         let mut ops: Vec<(RedGreenOp, Option<Scalar>)> = merges
             .iter()
             .map(|&(p, a)| (RedGreenOp::Merge(p), Some(a)))
             .collect();
         ops.extend(splits.iter().map(|&(l, a)| (RedGreenOp::Split(l), Some(a))));
-        self.apply(world, &ops, step)
+        let changed = self.apply(world, &ops, step);
+        self.stats.note_levels(world, self.config.max_level);
+        changed
     }
 
     /// Refines the leaves in `marks` (from [`Adapter::refinement_marks`]) and

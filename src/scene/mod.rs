@@ -16,6 +16,7 @@ mod schema;
 mod serde_errors;
 mod spans;
 mod validate;
+mod validate_adapt;
 mod validate_collide;
 
 use std::path::Path;

@@ -8,8 +8,9 @@ use serde::Deserialize;
 
 // The engine's own types, deserialised straight from the file (see `crate::spec`).
 pub use crate::spec::{
-    Adapt, AdaptMethod, BendingModel, ClothShape, DEFAULT_THICKNESS, DiagonalPattern, Integrator,
-    Obstacle, ObstacleShape, Pin, PinMotion, SelfCollision, Solver, StiffnessRule,
+    Adapt, AdaptCriterion, AdaptMethod, BendingModel, ClothShape, DEFAULT_THICKNESS,
+    DiagonalPattern, Integrator, Obstacle, ObstacleShape, Pin, PinMotion, SelfCollision, Solver,
+    StiffnessRule,
 };
 
 /// A whole scene file.

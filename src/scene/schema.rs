@@ -88,6 +88,8 @@ pub(crate) fn allowed(path: &str) -> Option<&'static str> {
         "adapt.rollback" => "true or false",
         "adapt.max_rollbacks" => "an integer >= 0",
         "adapt.multirate" => "true or false (explicit integrators only)",
+        "adapt.criterion" => "\"angle\" or \"sizing\"",
+        "adapt.hysteresis" => "a finite number > 1 (criterion = \"sizing\" only)",
         _ => return None,
     })
 }

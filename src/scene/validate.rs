@@ -7,10 +7,7 @@ use toml::{Table, Value};
 
 use super::error::{Issue, KeyPath, SceneErrorKind as Kind, Seg, dotted, keys, num};
 use super::schema;
-use super::{
-    Adapt, AdaptMethod, Air, Cloth, ClothShape, Integrator, Material, Pin, PinMotion, Scene,
-    Simulation, TimeStep, Wind,
-};
+use super::{Air, Cloth, ClothShape, Material, Pin, PinMotion, Scene, Simulation, TimeStep, Wind};
 
 /// The first problem in `scene`, if any. `doc` is the document it came from
 /// (after `--set`), used to tell keys that were written from defaults.
@@ -43,7 +40,7 @@ pub(crate) fn validate(scene: &Scene, doc: &Table) -> Result<(), Issue> {
         super::validate_collide::self_collision(s)?;
     }
     if let Some(a) = &scene.adapt {
-        adapt(a, scene.simulation.integrator)?;
+        super::validate_adapt::adapt(a, scene.simulation.integrator)?;
     }
     Ok(())
 }
@@ -401,55 +398,4 @@ fn air(a: &Air) -> Result<(), Issue> {
 fn wind(w: &Wind) -> Result<(), Issue> {
     all_finite(keys(&["wind", "velocity"]), &w.velocity)?;
     non_negative(keys(&["wind", "coefficient"]), w.coefficient)
-}
-
-fn adapt(a: &Adapt, integrator: Integrator) -> Result<(), Issue> {
-    let angle = |key: &str, x: f64| -> Result<(), Issue> {
-        positive(keys(&["adapt", key]), x)?;
-        if x >= 180.0 {
-            return Err(out_of_range(
-                keys(&["adapt", key]),
-                format!("{} degrees is out of range: must be < 180", num(x)),
-            ));
-        }
-        Ok(())
-    };
-    angle("refine_angle", a.refine_angle)?;
-    angle("coarsen_angle", a.coarsen_angle)?;
-    if a.coarsen_angle >= a.refine_angle {
-        return Err(out_of_range(
-            keys(&["adapt", "coarsen_angle"]),
-            format!(
-                "the lower threshold {} is not below the upper threshold refine_angle = {}",
-                a.coarsen_angle, a.refine_angle
-            ),
-        ));
-    }
-    if !(1..=254).contains(&a.max_level) {
-        return Err(out_of_range(
-            keys(&["adapt", "max_level"]),
-            format!("{} is out of range", a.max_level),
-        ));
-    }
-    non_negative(keys(&["adapt", "min_edge_length"]), a.min_edge_length)?;
-    if a.every == 0 {
-        return Err(out_of_range(
-            keys(&["adapt", "every"]),
-            "0 is out of range: must be >= 1",
-        ));
-    }
-    if a.method == AdaptMethod::Edge && a.rollback {
-        let path = keys(&["adapt", "rollback"]);
-        return Err(Issue::new(
-            path,
-            Kind::NotApplicable,
-            "rollback is paper A's and works with method = \"red_green\" only",
-        ));
-    }
-    if a.multirate && integrator == Integrator::Implicit {
-        let path = keys(&["adapt", "multirate"]);
-        let why = "multirate stepping is for the explicit integrators (symplectic_euler, rk4)";
-        return Err(Issue::new(path, Kind::Unsupported, why));
-    }
-    Ok(())
 }

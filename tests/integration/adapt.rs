@@ -25,6 +25,8 @@ fn config() -> AdaptConfig {
         every: 1,
         rollback: false,
         max_rollbacks: 3,
+        criterion: drape::scene::AdaptCriterion::Angle,
+        hysteresis: 2.0,
     }
 }
 
@@ -417,10 +419,16 @@ fn close_thresholds_do_not_thrash() {
 fn hanging_sheet_run_refines_rolls_back_and_reports_counts() {
     use std::sync::atomic::AtomicBool;
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/hanging_sheet.toml");
-    let sets: Vec<String> = ["simulation.duration=0.5", "cloth.resolution=8"]
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
+    // Paper A's behaviour: its criterion, adapting every step.
+    let sets: Vec<String> = [
+        "simulation.duration=0.5",
+        "cloth.resolution=8",
+        "adapt.criterion=angle",
+        "adapt.every=1",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
     let scene = drape::scene::load_scene_file(&path, &sets).unwrap();
     let opts = drape::run::RunOptions::default();
     let summary = drape::run::run(&scene, &opts, &AtomicBool::new(false), &mut |_| {}).unwrap();

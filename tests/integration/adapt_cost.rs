@@ -63,6 +63,8 @@ fn cost(method: AdaptMethod) {
         every: 1,
         rollback: false,
         max_rollbacks: 3,
+        criterion: drape::scene::AdaptCriterion::Angle,
+        hysteresis: 2.0,
     };
     let mat = MaterialParams {
         density: 0.15,

@@ -310,6 +310,12 @@ fn a_lower_threshold_above_the_upper_is_refused() {
     );
     refused_sets("dt", &[("simulation.dt", "0.1")], "longer than one frame");
     refused_sets("angle", &[("adapt.refine_angle", "180")], "must be < 180");
+    // The sizing criterion (the default) merges by hysteresis, which must exceed 1.
+    refused_sets(
+        "hysteresis",
+        &[("adapt.hysteresis", "1"), ("adapt.hysteresis", "0.5")],
+        "must be > 1",
+    );
 }
 
 #[test]

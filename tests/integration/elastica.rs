@@ -177,6 +177,8 @@ pub fn settle_adaptive(overhang: Scalar, mat: &MaterialParams) -> Settled {
         every: 1,
         rollback: false,
         max_rollbacks: 0,
+        criterion: drape::scene::AdaptCriterion::Angle,
+        hysteresis: 2.0,
     };
     let mut adapter = Adapter::new(config, &world, mat.density);
     let mut settled = settle_on(&world.mesh.clone(), &mut world.x, mat, overhang);

@@ -42,6 +42,8 @@ fn adapted_mesh() -> Mesh {
         every: 1,
         rollback: false,
         max_rollbacks: 0,
+        criterion: drape::scene::AdaptCriterion::Angle,
+        hysteresis: 2.0,
     };
     let mut adapter = Adapter::new(config, &world, 0.15);
     for pass in 0..3 {

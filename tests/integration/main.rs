@@ -3,6 +3,7 @@
 
 mod adapt;
 mod adapt_cost;
+mod adapt_sizing;
 mod bad_cli;
 mod bad_input;
 mod bad_obj;

@@ -80,6 +80,8 @@ fn samples_are_the_same_cloth_points_on_an_adapted_mesh() {
         every: 1,
         rollback: false,
         max_rollbacks: 0,
+        criterion: drape::scene::AdaptCriterion::Angle,
+        hysteresis: 2.0,
     };
     let mut ad = Adapter::new(cfg, &w, 0.15);
     let leaves: Vec<_> = ad

@@ -220,6 +220,8 @@ fn incremental_tables_equal_a_rebuild_over_draping_passes() {
             every: 1,
             rollback: false,
             max_rollbacks: 3,
+            criterion: drape::scene::AdaptCriterion::Angle,
+            hysteresis: 2.0,
         };
         let mut ad = Adapter::new(config, &w, 0.15);
         let mut changed = 0;

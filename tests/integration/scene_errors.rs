@@ -574,6 +574,29 @@ fn override_errors_name_the_set() {
         "adapt.rollback",
         Kind::NotApplicable,
     );
+    set_error(
+        &[
+            "adapt.method=red_green",
+            "adapt.criterion=angle",
+            "adapt.hysteresis=2",
+        ],
+        "adapt.hysteresis",
+        Kind::NotApplicable,
+    );
+    set_error(
+        &[
+            "adapt.method=red_green",
+            "adapt.criterion=sizing",
+            "adapt.hysteresis=1",
+        ],
+        "adapt.hysteresis",
+        Kind::OutOfRange,
+    );
+    set_error(
+        &["adapt.criterion=curvature"],
+        "adapt.criterion",
+        Kind::BadValue,
+    );
     let e = load_scene_str(BASE, "test.toml", &sets(&["cloth.resolution"])).expect_err("no =");
     assert_eq!(e.kind, Kind::BadOverride, "{e}");
     assert!(e.to_string().contains("--set cloth.resolution"), "{e}");

@@ -1,0 +1,82 @@
+//! Checks of the `[adapt]` table; each check names the key path, which
+//! `parse.rs` turns into a line of the file or a `--set`.
+
+use super::error::{Issue, SceneErrorKind as Kind, keys, num};
+use super::validate::{finite, non_negative, out_of_range, positive};
+use super::{Adapt, AdaptCriterion, AdaptMethod, Integrator};
+
+/// The `[adapt]` table's ranges and the keys that do not apply to its settings.
+pub(super) fn adapt(a: &Adapt, integrator: Integrator) -> Result<(), Issue> {
+    let angle = |key: &str, x: f64| -> Result<(), Issue> {
+        positive(keys(&["adapt", key]), x)?;
+        if x >= 180.0 {
+            return Err(out_of_range(
+                keys(&["adapt", key]),
+                format!("{} degrees is out of range: must be < 180", num(x)),
+            ));
+        }
+        Ok(())
+    };
+    angle("refine_angle", a.refine_angle)?;
+    angle("coarsen_angle", a.coarsen_angle)?;
+    if a.coarsen_angle >= a.refine_angle {
+        return Err(out_of_range(
+            keys(&["adapt", "coarsen_angle"]),
+            format!(
+                "the lower threshold {} is not below the upper threshold refine_angle = {}",
+                a.coarsen_angle, a.refine_angle
+            ),
+        ));
+    }
+    if !(1..=254).contains(&a.max_level) {
+        return Err(out_of_range(
+            keys(&["adapt", "max_level"]),
+            format!("{} is out of range", a.max_level),
+        ));
+    }
+    non_negative(keys(&["adapt", "min_edge_length"]), a.min_edge_length)?;
+    if a.every == 0 {
+        return Err(out_of_range(
+            keys(&["adapt", "every"]),
+            "0 is out of range: must be >= 1",
+        ));
+    }
+    if a.method == AdaptMethod::Edge && a.rollback {
+        let path = keys(&["adapt", "rollback"]);
+        return Err(Issue::new(
+            path,
+            Kind::NotApplicable,
+            "rollback is paper A's and works with method = \"red_green\" only",
+        ));
+    }
+    if a.multirate && integrator == Integrator::Implicit {
+        let path = keys(&["adapt", "multirate"]);
+        let why = "multirate stepping is for the explicit integrators (symplectic_euler, rk4)";
+        return Err(Issue::new(path, Kind::Unsupported, why));
+    }
+    criterion(a)
+}
+
+/// The sizing criterion's own key: `hysteresis` > 1, and only with `criterion = "sizing"`.
+fn criterion(a: &Adapt) -> Result<(), Issue> {
+    let Some(h) = a.hysteresis else {
+        return Ok(());
+    };
+    let path = keys(&["adapt", "hysteresis"]);
+    if a.criterion != AdaptCriterion::Sizing {
+        let why =
+            "hysteresis belongs to criterion = \"sizing\" (the angle criterion uses coarsen_angle)";
+        return Err(Issue::new(path, Kind::NotApplicable, why));
+    }
+    finite(&path, h)?;
+    if h <= 1.0 {
+        return Err(out_of_range(
+            path,
+            format!(
+                "{} is out of range: must be > 1 (at 1 a merged parent would split again at once)",
+                num(h)
+            ),
+        ));
+    }
+    Ok(())
+}
