@@ -87,8 +87,12 @@ pub fn frames_csv(rows: &[Row]) -> String {
     out
 }
 
-fn pct(x: Scalar) -> String {
-    if x.is_finite() {
+/// A fraction in percent: three decimals, or three significant digits below
+/// 0.01 % (so that small errors do not print as 0.000).
+pub fn pct(x: Scalar) -> String {
+    if x.is_finite() && (100.0 * x).abs() < 0.01 && x != 0.0 {
+        format!("{:.2e}", 100.0 * x)
+    } else if x.is_finite() {
         format!("{:.3}", 100.0 * x)
     } else {
         "-".into()

@@ -8,7 +8,7 @@ use std::sync::atomic::AtomicBool;
 
 use super::bench::{row, temp_dir, tiny_scene};
 use drape::bench::order::{loglog_slope, spatial, temporal};
-use drape::bench::report::target_checks;
+use drape::bench::report::{pct, target_checks};
 use drape::bench::steps::{TIME_LADDER_DIVISORS, TIME_REFERENCE_DIVISOR, time_ladder};
 use drape::bench::{BenchOptions, Compare, Ladder, Row, Rung, StepPolicy, bench};
 
@@ -35,6 +35,14 @@ set = ["cloth.resolution=4"]
     assert_eq!("rest".parse::<Compare>(), Ok(Compare::Rest));
     assert!("own".parse::<Compare>().is_err());
     assert_eq!("common".parse::<StepPolicy>(), Ok(StepPolicy::Common));
+}
+
+#[test]
+fn small_errors_keep_their_digits_in_the_report() {
+    assert_eq!(pct(0.012344), "1.234");
+    assert_eq!(pct(2.586e-8), "2.59e-6");
+    assert_eq!(pct(0.0), "0.000");
+    assert_eq!(pct(f64::NAN), "-");
 }
 
 #[test]
