@@ -330,4 +330,41 @@ fn bench_cli_lists_the_default_ladder_and_rejects_unknown_rungs() {
         .expect("run drape");
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("no rung labelled `nope`"));
+    // The time-step ladder: three halvings of the implicit automatic step; it
+    // brings its own reference, so `--ladder` with it is a usage error.
+    let out = Command::new(env!("CARGO_BIN_EXE_drape"))
+        .args([
+            "bench",
+            scene.to_str().expect("utf-8"),
+            "--time-ladder",
+            "--list",
+        ])
+        .output()
+        .expect("run drape");
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success());
+    assert_eq!(text.lines().count(), 3, "{text}");
+    assert!(text.contains("dt/4 2.083e-3: adapt.method=none"), "{text}");
+    let out = Command::new(env!("CARGO_BIN_EXE_drape"))
+        .args([
+            "bench",
+            scene.to_str().expect("utf-8"),
+            "--time-ladder",
+            "--ladder",
+            "x.toml",
+        ])
+        .output()
+        .expect("run drape");
+    assert_eq!(out.status.code(), Some(2));
+    let out = Command::new(env!("CARGO_BIN_EXE_drape"))
+        .args([
+            "bench",
+            scene.to_str().expect("utf-8"),
+            "--compare",
+            "sometimes",
+        ])
+        .output()
+        .expect("run drape");
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("expected `frames` or `rest`"));
 }
