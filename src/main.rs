@@ -77,9 +77,18 @@ struct BenchArgs {
     /// Override a scene value for every run and the reference, e.g. `--set simulation.frame_rate=15` (repeatable).
     #[arg(long = "set", value_name = "KEY=VALUE")]
     overrides: Vec<String>,
-    /// Ladder file: `[[rung]]` tables with `label` and `set = ["key=value", ...]`, and an optional `reference = [...]` (default: a ladder built from the scene, see README).
+    /// Ladder file: `[[rung]]` tables with `label` and `set = ["key=value", ...]`, and optional `reference = [...]`, `compare` and `step` (default: a ladder built from the scene, see README).
     #[arg(long, value_name = "FILE.toml")]
     ladder: Option<PathBuf>,
+    /// Run the time-step ladder instead: one uniform mesh at the scene's step, 1/2 and 1/4 of it, against 1/32 of it (files SCENE-time.*).
+    #[arg(long, conflicts_with_all = ["ladder", "reference_resolution", "step"])]
+    time_ladder: bool,
+    /// What the error compares: `frames` (every recorded frame, mean; dynamic scenes) or `rest` (the last frame; quasi-static scenes). Default: the ladder's `compare`, else `frames`.
+    #[arg(long, value_name = "HOW")]
+    compare: Option<drape::bench::Compare>,
+    /// Which step the runs take: `common` (one fixed step for every run and the reference: the error is the mesh's) or `own` (each run's scene setting). Default: the ladder's `step`, else `common`.
+    #[arg(long, value_name = "POLICY")]
+    step: Option<drape::bench::StepPolicy>,
     /// Run only these rungs of the ladder, by label (comma-separated).
     #[arg(long, value_name = "LABEL,...", value_delimiter = ',')]
     rungs: Vec<String>,
@@ -288,38 +297,18 @@ fn cmd_inspect(args: InspectArgs) -> Result<ExitCode> {
 }
 
 fn cmd_bench(args: BenchArgs) -> Result<ExitCode> {
-    use drape::bench::{BenchOptions, Ladder, bench, ladder::default_ladder};
-    let ladder = match &args.ladder {
-        Some(path) => Some(Ladder::load(path)?),
-        None => None,
-    };
-    if args.list {
-        let mut ladder = match ladder {
-            Some(l) => l,
-            None => default_ladder(&load_scene_file(&args.scene, &args.overrides)?),
-        };
-        if !args.rungs.is_empty() {
-            ladder.select(&args.rungs)?;
-        }
-        for r in &ladder.rung {
-            println!("{}: {}", r.label, r.set.join(" "));
-        }
-        return Ok(ExitCode::SUCCESS);
-    }
-    if args.replot {
-        let name = load_scene_file(&args.scene, &args.overrides)?.name;
-        let rows = drape::bench::replot::read_csv(&args.out_dir.join(format!("{name}.csv")))?;
-        let svg = args.out_dir.join(format!("{name}.svg"));
-        std::fs::write(&svg, drape::bench::chart::svg(&name, &rows))
-            .with_context(|| format!("cannot write {}", svg.display()))?;
-        println!("wrote {}", svg.display());
-        return Ok(ExitCode::SUCCESS);
-    }
+    use drape::bench::{BenchOptions, Ladder, bench};
     let opts = BenchOptions {
         scene: args.scene.clone(),
         overrides: args.overrides.clone(),
-        ladder,
+        ladder: match &args.ladder {
+            Some(path) => Some(Ladder::load(path)?),
+            None => None,
+        },
+        time_ladder: args.time_ladder,
         rungs: args.rungs.clone(),
+        compare: args.compare,
+        step: args.step,
         reps: args.reps as usize,
         duration: args.duration,
         threads: args.threads.map(|n| n as usize),
@@ -328,6 +317,23 @@ fn cmd_bench(args: BenchArgs) -> Result<ExitCode> {
         reference_resolution: args.reference_resolution,
         grid: args.samples as usize,
     };
+    if args.list {
+        for r in &drape::bench::resolved_ladder(&opts)?.rung {
+            println!("{}: {}", r.label, r.set.join(" "));
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
+    if args.replot {
+        let name = load_scene_file(&args.scene, &args.overrides)?.name;
+        let stem = if args.time_ladder {
+            format!("{name}-time")
+        } else {
+            name
+        };
+        let svg = drape::bench::replot::replot(&args.out_dir, &stem)?;
+        println!("wrote {}", svg.display());
+        return Ok(ExitCode::SUCCESS);
+    }
     let interrupt = Arc::new(AtomicBool::new(false));
     {
         let flag = interrupt.clone();

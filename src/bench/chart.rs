@@ -1,64 +1,60 @@
-//! The benchmark's chart, hand-written SVG: mean error against wall time on
-//! log-log axes, uniform runs as blue circles, adaptive runs as orange
-//! squares, the Pareto front as a line through ringed points; points are
-//! numbered, with the key of numbers to labels on the right.
+//! The benchmark's chart, drawn with `plotters` (SVG backend): the compared
+//! error against wall time on log-log axes, uniform runs as blue circles,
+//! adaptive runs as orange squares, the Pareto front as a dashed staircase
+//! through ringed points; points are numbered, with the key of numbers to
+//! labels on the right.
 
-use std::fmt::Write as _;
+use plotters::coord::Shift;
+use plotters::coord::combinators::WithKeyPoints;
+use plotters::prelude::*;
 
-use super::Row;
+use super::{BenchError, Compare, Row};
 
-const W: f64 = 820.0;
-const H: f64 = 500.0;
-const LEFT: f64 = 80.0;
-const RIGHT: f64 = 260.0;
-const TOP: f64 = 40.0;
-const BOTTOM: f64 = 60.0;
+const W: u32 = 900;
+const H: u32 = 520;
+/// Width of the key of point numbers on the right.
+const KEY_W: u32 = 250;
+const UNIFORM: RGBColor = RGBColor(0x2e, 0x86, 0xde);
+const ADAPTIVE: RGBColor = RGBColor(0xe6, 0x7e, 0x22);
 
-/// A log10 axis spanning whole decades around the data.
-#[derive(Debug, Clone, Copy)]
-struct Axis {
-    lo: f64,
-    hi: f64,
+/// Whole decades around the positive finite `values` (`1..10` when there are none).
+fn decades(values: impl Iterator<Item = f64>) -> (f64, f64) {
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for v in values.filter(|v| v.is_finite() && *v > 0.0) {
+        lo = lo.min(v.log10());
+        hi = hi.max(v.log10());
+    }
+    if !lo.is_finite() {
+        return (1.0, 10.0);
+    }
+    let (lo, hi) = (lo.floor(), hi.ceil());
+    let hi = if hi > lo { hi } else { lo + 1.0 };
+    (10f64.powf(lo), 10f64.powf(hi))
 }
 
-impl Axis {
-    fn around(values: impl Iterator<Item = f64>) -> Axis {
-        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-        for v in values.filter(|v| v.is_finite() && *v > 0.0) {
-            lo = lo.min(v.log10());
-            hi = hi.max(v.log10());
-        }
-        if !lo.is_finite() {
-            return Axis { lo: 0.0, hi: 1.0 };
-        }
-        let (lo, hi) = (lo.floor(), hi.ceil());
-        Axis {
-            lo,
-            hi: if hi > lo { hi } else { lo + 1.0 },
-        }
-    }
-
-    /// Position of `v` in 0..1 along the axis.
-    fn frac(&self, v: f64) -> f64 {
-        (v.log10() - self.lo) / (self.hi - self.lo)
-    }
-
-    /// Tick values: 1, 2 and 5 times each power of ten in range.
-    fn ticks(&self) -> Vec<(f64, bool)> {
-        let mut out = Vec::new();
-        for d in (self.lo as i32)..=(self.hi as i32) {
-            for (m, major) in [(1.0, true), (2.0, false), (5.0, false)] {
-                let v = m * 10f64.powi(d);
-                if v.log10() <= self.hi + 1e-9 {
-                    out.push((v, major));
-                }
+/// Tick values in `lo..=hi` (whole decades): labelled ones at 1, 2 and 5
+/// times each power of ten, light grid lines at 1 to 9 times.
+fn ticks(lo: f64, hi: f64) -> (Vec<f64>, Vec<f64>) {
+    let (mut bold, mut light) = (Vec::new(), Vec::new());
+    let (d0, d1) = (lo.log10().round() as i32, hi.log10().round() as i32);
+    for d in d0..=d1 {
+        for m in 1..=9 {
+            let v = f64::from(m) * 10f64.powi(d);
+            if v > hi * (1.0 + 1e-9) {
+                break;
+            }
+            if matches!(m, 1 | 2 | 5) {
+                bold.push(v);
+            } else {
+                light.push(v);
             }
         }
-        out
     }
+    (bold, light)
 }
 
-fn fmt_tick(v: f64) -> String {
+/// A tick label: plain for ordinary magnitudes, exponent form otherwise.
+fn tick(v: f64) -> String {
     if (1e-3..1e4).contains(&v) {
         format!("{}", (v * 1e6).round() / 1e6)
     } else {
@@ -66,183 +62,125 @@ fn fmt_tick(v: f64) -> String {
     }
 }
 
-fn escape(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
+/// True when the row can be drawn on log axes.
+fn drawable(r: &Row) -> bool {
+    r.wall_s.is_finite() && r.wall_s > 0.0 && r.error.is_finite() && r.error > 0.0
 }
 
-/// The chart of `rows` (wall time against mean error in percent) as SVG text.
-pub fn svg(scene: &str, rows: &[Row]) -> String {
-    let ok: Vec<&Row> = rows
-        .iter()
-        .filter(|r| r.wall_s.is_finite() && r.mean_error.is_finite() && r.mean_error > 0.0)
-        .collect();
-    let xa = Axis::around(ok.iter().map(|r| r.wall_s));
-    let ya = Axis::around(ok.iter().map(|r| 100.0 * r.mean_error));
-    let (pw, ph) = (W - LEFT - RIGHT, H - TOP - BOTTOM);
-    let px = |v: f64| LEFT + pw * xa.frac(v);
-    let py = |v: f64| TOP + ph * (1.0 - ya.frac(v));
-    let mut s = String::new();
-    let _ = writeln!(
-        s,
-        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{W}" height="{H}" viewBox="0 0 {W} {H}" font-family="sans-serif" font-size="12">"#
-    );
-    let _ = writeln!(s, r#"<rect width="{W}" height="{H}" fill="white"/>"#);
-    let _ = writeln!(
-        s,
-        r#"<text x="{}" y="22" text-anchor="middle" font-size="15">{}: error against wall time</text>"#,
-        LEFT + pw / 2.0,
-        escape(scene)
-    );
-    for (v, major) in xa.ticks() {
-        let x = px(v);
-        let _ = writeln!(
-            s,
-            r##"<line x1="{x:.1}" y1="{TOP}" x2="{x:.1}" y2="{:.1}" stroke="{}"/>"##,
-            TOP + ph,
-            if major { "#ccc" } else { "#eee" }
-        );
-        let _ = writeln!(
-            s,
-            r#"<text x="{x:.1}" y="{:.1}" text-anchor="middle">{}</text>"#,
-            TOP + ph + 16.0,
-            fmt_tick(v)
-        );
+/// The chart of `rows` (wall time against the compared error in percent) as
+/// SVG text, titled `title`.
+pub fn svg(title: &str, rows: &[Row]) -> Result<String, BenchError> {
+    let mut out = String::new();
+    {
+        let root = SVGBackend::with_string(&mut out, (W, H)).into_drawing_area();
+        draw(&root, title, rows).map_err(|e| BenchError::Chart(e.to_string()))?;
+        root.present()
+            .map_err(|e| BenchError::Chart(e.to_string()))?;
     }
-    for (v, major) in ya.ticks() {
-        let y = py(v);
-        let _ = writeln!(
-            s,
-            r##"<line x1="{LEFT}" y1="{y:.1}" x2="{:.1}" y2="{y:.1}" stroke="{}"/>"##,
-            LEFT + pw,
-            if major { "#ccc" } else { "#eee" }
-        );
-        let _ = writeln!(
-            s,
-            r#"<text x="{:.1}" y="{:.1}" text-anchor="end">{}</text>"#,
-            LEFT - 6.0,
-            y + 4.0,
-            fmt_tick(v)
-        );
-    }
-    let _ = writeln!(
-        s,
-        r#"<rect x="{LEFT}" y="{TOP}" width="{pw}" height="{ph}" fill="none" stroke="black"/>"#
-    );
-    let _ = writeln!(
-        s,
-        r#"<text x="{:.1}" y="{:.1}" text-anchor="middle">wall time, s (median; log scale)</text>"#,
-        LEFT + pw / 2.0,
-        H - 18.0
-    );
-    let _ = writeln!(
-        s,
-        r#"<text transform="translate(20 {:.1}) rotate(-90)" text-anchor="middle">mean error, % of the diagonal (log scale)</text>"#,
-        TOP + ph / 2.0
-    );
+    Ok(out)
+}
+
+/// A log axis over whole decades with [`ticks`] as its key points.
+fn log_axis(lo: f64, hi: f64) -> WithKeyPoints<LogCoord<f64>> {
+    let (bold, light) = ticks(lo, hi);
+    (lo..hi)
+        .log_scale()
+        .with_key_points(bold)
+        .with_light_points(light)
+}
+
+type DrawResult = Result<(), DrawingAreaErrorKind<std::io::Error>>;
+
+fn draw(root: &DrawingArea<SVGBackend<'_>, Shift>, title: &str, rows: &[Row]) -> DrawResult {
+    root.fill(&WHITE)?;
+    let (plot, key) = root.split_horizontally(W - KEY_W);
+    let point = |r: &Row| (r.wall_s, 100.0 * r.error);
+    let ok: Vec<&Row> = rows.iter().filter(|r| drawable(r)).collect();
+    let (x0, x1) = decades(ok.iter().map(|r| r.wall_s));
+    let (y0, y1) = decades(ok.iter().map(|r| 100.0 * r.error));
+    let mut chart = ChartBuilder::on(&plot)
+        .caption(
+            format!("{title}: error against wall time"),
+            ("sans-serif", 17),
+        )
+        .margin(12)
+        .x_label_area_size(45)
+        .y_label_area_size(65)
+        .build_cartesian_2d(log_axis(x0, x1), log_axis(y0, y1))?;
+    let y_desc = match rows.first().map(|r| r.compare) {
+        Some(Compare::Rest) => "error at rest, % of the diagonal (log)",
+        _ => "mean error, % of the diagonal (log)",
+    };
+    chart
+        .configure_mesh()
+        .x_desc("wall time, s (median; log)")
+        .y_desc(y_desc)
+        .x_label_formatter(&|v| tick(*v))
+        .y_label_formatter(&|v| tick(*v))
+        .light_line_style(RGBColor(0xee, 0xee, 0xee))
+        .bold_line_style(RGBColor(0xcc, 0xcc, 0xcc))
+        .draw()?;
     // The Pareto front: a staircase through its points in order of cost.
-    let mut front: Vec<&&Row> = ok.iter().filter(|r| r.pareto).collect();
+    let mut front: Vec<&Row> = ok.iter().copied().filter(|r| r.pareto).collect();
     front.sort_by(|a, b| a.wall_s.total_cmp(&b.wall_s));
-    if !front.is_empty() {
-        let mut d = String::new();
-        for (i, r) in front.iter().enumerate() {
-            let (x, y) = (px(r.wall_s), py(100.0 * r.mean_error));
-            if i == 0 {
-                let _ = write!(d, "M{x:.1},{y:.1}");
-            } else {
-                let _ = write!(d, " H{x:.1} V{y:.1}");
-            }
+    let mut stair = Vec::new();
+    for (i, r) in front.iter().enumerate() {
+        if i > 0 {
+            stair.push((r.wall_s, 100.0 * front[i - 1].error));
         }
-        let _ = writeln!(
-            s,
-            r#"<path d="{d}" fill="none" stroke="black" stroke-dasharray="5,3"/>"#
-        );
+        stair.push(point(r));
     }
-    for (n, r) in rows.iter().enumerate() {
-        if !ok.iter().any(|o| std::ptr::eq(*o, r)) {
-            continue;
-        }
-        let (x, y) = (px(r.wall_s), py(100.0 * r.mean_error));
-        if r.pareto {
-            let _ = writeln!(
-                s,
-                r#"<circle cx="{x:.1}" cy="{y:.1}" r="9" fill="none" stroke="black" stroke-width="1.5"/>"#
-            );
-        }
-        if r.adaptive {
-            let _ = writeln!(
-                s,
-                r##"<rect x="{:.1}" y="{:.1}" width="9" height="9" fill="#e67e22"/>"##,
-                x - 4.5,
-                y - 4.5
-            );
-        } else {
-            let _ = writeln!(
-                s,
-                r##"<circle cx="{x:.1}" cy="{y:.1}" r="5" fill="#2e86de"/>"##
-            );
-        }
-        let _ = writeln!(
-            s,
-            r##"<text x="{:.1}" y="{:.1}" font-size="10" fill="#333">{}</text>"##,
-            x + 7.0,
-            y - 5.0,
-            n + 1
-        );
-    }
-    legend(&mut s, rows.len() - ok.len());
-    // The key of the point numbers.
-    for (n, r) in rows.iter().enumerate() {
-        let failed = if ok.iter().any(|o| std::ptr::eq(*o, r)) {
-            ""
-        } else {
-            " (failed)"
-        };
-        let _ = writeln!(
-            s,
-            r#"<text x="{:.1}" y="{:.1}" font-size="11">{} {}{failed}</text>"#,
-            W - RIGHT + 20.0,
-            TOP + 100.0 + 15.0 * n as f64,
-            n + 1,
-            escape(&r.label)
-        );
-    }
-    s.push_str("</svg>\n");
-    s
+    chart
+        .draw_series(DashedLineSeries::new(stair, 6, 4, BLACK.into()))?
+        .label("Pareto front")
+        .legend(|(x, y)| Circle::new((x, y), 8, BLACK.stroke_width(2)));
+    chart.draw_series(
+        front
+            .iter()
+            .map(|r| Circle::new(point(r), 9, BLACK.stroke_width(2))),
+    )?;
+    chart
+        .draw_series(
+            ok.iter()
+                .filter(|r| !r.adaptive)
+                .map(|r| Circle::new(point(r), 5, UNIFORM.filled())),
+        )?
+        .label("uniform mesh")
+        .legend(|(x, y)| Circle::new((x, y), 5, UNIFORM.filled()));
+    chart
+        .draw_series(ok.iter().filter(|r| r.adaptive).map(|r| {
+            EmptyElement::at(point(r)) + Rectangle::new([(-4, -4), (5, 5)], ADAPTIVE.filled())
+        }))?
+        .label("adaptive")
+        .legend(|(x, y)| Rectangle::new([(x - 4, y - 4), (x + 5, y + 5)], ADAPTIVE.filled()));
+    chart.draw_series(
+        rows.iter()
+            .enumerate()
+            .filter(|(_, r)| drawable(r))
+            .map(|(n, r)| {
+                EmptyElement::at(point(r))
+                    + Text::new(format!("{}", n + 1), (7, -15), ("sans-serif", 11))
+            }),
+    )?;
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()?;
+    draw_key(&key, rows)
 }
 
-fn legend(s: &mut String, failed: usize) {
-    let x = W - RIGHT + 20.0;
-    let y = TOP + 10.0;
-    let _ = writeln!(
-        s,
-        r##"<circle cx="{:.1}" cy="{y:.1}" r="5" fill="#2e86de"/><text x="{:.1}" y="{:.1}">uniform mesh</text>"##,
-        x + 5.0,
-        x + 16.0,
-        y + 4.0
-    );
-    let _ = writeln!(
-        s,
-        r##"<rect x="{:.1}" y="{:.1}" width="9" height="9" fill="#e67e22"/><text x="{:.1}" y="{:.1}">adaptive</text>"##,
-        x + 0.5,
-        y + 15.5,
-        x + 16.0,
-        y + 24.0
-    );
-    let _ = writeln!(
-        s,
-        r#"<circle cx="{:.1}" cy="{:.1}" r="9" fill="none" stroke="black" stroke-width="1.5"/><text x="{:.1}" y="{:.1}">Pareto front</text>"#,
-        x + 5.0,
-        y + 40.0,
-        x + 16.0,
-        y + 44.0
-    );
-    if failed > 0 {
-        let _ = writeln!(
-            s,
-            r#"<text x="{x:.1}" y="{:.1}">{failed} failed run(s) not shown</text>"#,
-            y + 64.0
-        );
+/// The key of point numbers to run labels.
+fn draw_key(key: &DrawingArea<SVGBackend<'_>, Shift>, rows: &[Row]) -> DrawResult {
+    key.draw(&Text::new("runs", (10, 50), ("sans-serif", 13)))?;
+    for (n, r) in rows.iter().enumerate() {
+        let failed = if drawable(r) { "" } else { " (not drawn)" };
+        key.draw(&Text::new(
+            format!("{} {}{failed}", n + 1, r.label),
+            (10, 72 + 15 * n as i32),
+            ("sans-serif", 11),
+        ))?;
     }
+    Ok(())
 }

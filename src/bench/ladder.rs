@@ -4,7 +4,9 @@
 //! A ladder file (`drape bench --ladder FILE.toml`) looks like
 //!
 //! ```toml
-//! reference = ["cloth.resolution=128", "simulation.dt=0.002"]  # optional
+//! reference = ["cloth.resolution=128"]  # optional: the reference's own overrides
+//! compare = "rest"                      # optional: "frames" (default) or "rest"
+//! step = "common"                       # optional: "common" (default) or "own"
 //!
 //! [[rung]]
 //! label = "uniform 32"
@@ -20,8 +22,74 @@ use std::path::Path;
 use serde::Deserialize;
 
 use super::BenchError;
-use crate::physics::timestep::IMPLICIT_MAX_DT;
-use crate::scene::{AdaptMethod, Integrator, Scene, TimeStep};
+use crate::scene::{AdaptMethod, Integrator, Scene};
+
+/// What the error compares.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Compare {
+    /// Every recorded frame against the reference's at the same time; the
+    /// error is the mean over the frames (dynamic scenes).
+    Frames,
+    /// The end state only, after the scene has settled; the error is the last
+    /// frame's (quasi-static scenes: cantilever, hanging sheet at rest).
+    Rest,
+}
+
+impl Compare {
+    /// The name used in ladder files, on the command line and in the CSV.
+    pub fn name(self) -> &'static str {
+        match self {
+            Compare::Frames => "frames",
+            Compare::Rest => "rest",
+        }
+    }
+}
+
+impl std::str::FromStr for Compare {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Compare, String> {
+        match s {
+            "frames" => Ok(Compare::Frames),
+            "rest" => Ok(Compare::Rest),
+            _ => Err(format!("`{s}`: expected `frames` or `rest`")),
+        }
+    }
+}
+
+/// Which time step the runs take.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum StepPolicy {
+    /// Every rung and the reference take one fixed step (the scene's fixed step,
+    /// the implicit automatic step, or the explicit automatic step of the
+    /// reference's mesh, the finest of the benchmark): the error is the mesh's.
+    Common,
+    /// Every run takes its own scene setting (an automatic explicit step then
+    /// follows each mesh): realistic costs, but the error mixes in the step's.
+    Own,
+}
+
+impl StepPolicy {
+    /// The name used in ladder files and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            StepPolicy::Common => "common",
+            StepPolicy::Own => "own",
+        }
+    }
+}
+
+impl std::str::FromStr for StepPolicy {
+    type Err = String;
+    fn from_str(s: &str) -> Result<StepPolicy, String> {
+        match s {
+            "common" => Ok(StepPolicy::Common),
+            "own" => Ok(StepPolicy::Own),
+            _ => Err(format!("`{s}`: expected `common` or `own`")),
+        }
+    }
+}
 
 /// One run of the ladder.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -34,13 +102,20 @@ pub struct Rung {
     pub set: Vec<String>,
 }
 
-/// The runs of a benchmark and, optionally, the reference's own overrides.
+/// The runs of a benchmark and, optionally, the reference's own overrides, the
+/// comparison and the step policy.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Ladder {
     /// Overrides of the reference run (`None`: [`reference_overrides`] decides).
     #[serde(default)]
     pub reference: Option<Vec<String>>,
+    /// What the error compares (`None`: frame by frame, unless the command line says).
+    #[serde(default)]
+    pub compare: Option<Compare>,
+    /// Which step the runs take (`None`: common, unless the command line says).
+    #[serde(default)]
+    pub step: Option<StepPolicy>,
     /// The runs, in order.
     #[serde(default)]
     pub rung: Vec<Rung>,
@@ -53,15 +128,17 @@ impl Ladder {
             path: path.to_path_buf(),
             source,
         })?;
-        let ladder: Ladder = toml::from_str(&text).map_err(|e| BenchError::Ladder {
+        Ladder::parse(&text).map_err(|message| BenchError::Ladder {
             path: path.to_path_buf(),
-            message: e.to_string(),
-        })?;
+            message,
+        })
+    }
+
+    /// Parses a ladder file's text; the error says what is wrong.
+    pub fn parse(text: &str) -> Result<Ladder, String> {
+        let ladder: Ladder = toml::from_str(text).map_err(|e| e.to_string())?;
         if ladder.rung.is_empty() {
-            return Err(BenchError::Ladder {
-                path: path.to_path_buf(),
-                message: "no `[[rung]]`: the ladder needs at least one run".into(),
-            });
+            return Err("no `[[rung]]`: the ladder needs at least one run".into());
         }
         Ok(ladder)
     }
@@ -97,8 +174,10 @@ fn rung(label: String, set: &[String]) -> Rung {
 /// The default ladder for `scene`: uniform meshes of 16 to 64 segments, and
 /// adaptive runs whose finest edges match 32 or 64 segments, with the scene's
 /// remeshing method (red-green if it has none), the other method, tighter and
-/// looser thresholds, and, for explicit integrators, multirate stepping.
-pub fn default_ladder(scene: &Scene) -> Ladder {
+/// looser thresholds, and, for explicit integrators under [`StepPolicy::Own`],
+/// multirate stepping (under a common fixed step it would only subdivide
+/// that step further: it is a choice of step, not of mesh).
+pub fn default_ladder(scene: &Scene, step: StepPolicy) -> Ladder {
     let method = match scene.adapt.as_ref().map(|a| a.method) {
         Some(AdaptMethod::Edge) => "edge",
         _ => "red_green",
@@ -154,7 +233,7 @@ pub fn default_ladder(scene: &Scene) -> Ladder {
         &adaptive(method, 16, 4, &loose),
     ));
     rungs.push(rung(format!("{other} 16 L4"), &adaptive(other, 16, 4, &[])));
-    if scene.simulation.integrator != Integrator::Implicit {
+    if scene.simulation.integrator != Integrator::Implicit && step == StepPolicy::Own {
         rungs.push(rung(
             format!("{method} 16 L4 multirate"),
             &adaptive(method, 16, 4, &["adapt.multirate=true"]),
@@ -162,6 +241,8 @@ pub fn default_ladder(scene: &Scene) -> Ladder {
     }
     Ladder {
         reference: None,
+        compare: None,
+        step: None,
         rung: rungs,
     }
 }
@@ -178,23 +259,15 @@ pub fn finest_resolution(scene: &Scene) -> u32 {
     }
 }
 
-/// The reference run's overrides: uniform, `resolution` segments (the caller
-/// picks one finer than every rung), and a smaller step: half the scene's fixed
-/// step, half the implicit integrator's automatic step, or, for the explicit
-/// integrators' automatic step, the stability estimate of the finer mesh
-/// (already smaller than any rung's).
-pub fn reference_overrides(scene: &Scene, resolution: u32) -> Vec<String> {
-    let mut set = vec![
+/// The reference run's overrides: uniform, without multirate, `resolution`
+/// segments (the caller picks one finer than every rung). The step is not
+/// touched here: under [`StepPolicy::Common`] the caller sets one step for
+/// every run and the reference; under [`StepPolicy::Own`] the reference keeps
+/// the scene's setting.
+pub fn reference_overrides(resolution: u32) -> Vec<String> {
+    vec![
         "adapt.method=none".to_owned(),
         "adapt.multirate=false".to_owned(),
         format!("cloth.resolution={resolution}"),
-    ];
-    match (scene.simulation.dt, scene.simulation.integrator) {
-        (TimeStep::Fixed(dt), _) => set.push(format!("simulation.dt={:e}", dt / 2.0)),
-        (TimeStep::Auto, Integrator::Implicit) => {
-            set.push(format!("simulation.dt={:e}", IMPLICIT_MAX_DT / 2.0));
-        }
-        (TimeStep::Auto, _) => {}
-    }
-    set
+    ]
 }

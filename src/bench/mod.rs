@@ -4,26 +4,35 @@
 //! writes a CSV, a Markdown table and an SVG chart.
 //!
 //! ```text
-//! ladder (rungs = --set lists) -> reference (cached) -> each rung: sampled run,
-//! errors per frame, median wall time over reps -> Pareto front -> CSV, MD, SVG
+//! ladder (rungs = --set lists) -> one common step (default) -> reference
+//! (cached) -> each rung: sampled run, errors per frame (or at rest), median
+//! wall time over reps -> Pareto front, convergence order -> CSV, MD, SVG
 //! ```
+//!
+//! The spatial ladder runs every rung and the reference at one step, so that
+//! the error is the mesh's; the time-step ladder (`--time-ladder`) keeps one
+//! mesh and varies the step (SPEC section 8).
 
 pub mod chart;
 pub mod ladder;
+pub mod measure;
 pub mod metric;
+pub mod order;
 pub mod pareto;
 pub mod reference;
 pub mod replot;
 pub mod report;
 pub mod sampling;
+pub mod steps;
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
 use crate::math::Scalar;
-use crate::run::{RunError, RunOptions, run};
-use crate::scene::{AdaptMethod, Integrator, Scene, SceneError, TimeStep, load_scene_file};
-pub use ladder::{Ladder, Rung};
+use crate::run::{RunError, RunOptions};
+use crate::scene::{Scene, SceneError, load_scene_file};
+pub use ladder::{Compare, Ladder, Rung, StepPolicy};
+pub use measure::{integrator_name, median};
 pub use reference::Reference;
 
 /// Why a benchmark failed.
@@ -70,6 +79,9 @@ pub enum BenchError {
     /// The user interrupted the benchmark.
     #[error("interrupted")]
     Interrupted,
+    /// The chart could not be drawn.
+    #[error("drawing the chart: {0}")]
+    Chart(String),
 }
 
 /// What to benchmark and how.
@@ -79,10 +91,16 @@ pub struct BenchOptions {
     pub scene: PathBuf,
     /// The user's `--set` overrides, applied to every run and the reference.
     pub overrides: Vec<String>,
-    /// The runs (`None`: [`ladder::default_ladder`]).
+    /// The runs (`None`: [`ladder::default_ladder`], or the time-step ladder).
     pub ladder: Option<Ladder>,
+    /// Run the time-step ladder ([`steps::time_ladder`]) instead of `ladder`.
+    pub time_ladder: bool,
     /// Only these rungs of the ladder (empty: all).
     pub rungs: Vec<String>,
+    /// What the error compares (`None`: the ladder's `compare`, else frame by frame).
+    pub compare: Option<Compare>,
+    /// Which step the runs take (`None`: the ladder's `step`, else common).
+    pub step: Option<StepPolicy>,
     /// Repetitions of each rung; the median wall time is reported.
     pub reps: usize,
     /// Simulated time of every run (`None`: the scene's duration).
@@ -142,9 +160,14 @@ pub struct Row {
     pub mean_error: Scalar,
     /// Error at the last frame (`NaN` if failed).
     pub final_error: Scalar,
+    /// What `error` is: the mean over the frames or the error at rest.
+    pub compare: Compare,
+    /// The error the report compares: `mean_error` for [`Compare::Frames`],
+    /// `final_error` for [`Compare::Rest`].
+    pub error: Scalar,
     /// `(time, error)` at every recorded frame.
     pub errors: Vec<(Scalar, Scalar)>,
-    /// On the Pareto front of (wall time, mean error).
+    /// On the Pareto front of (wall time, error).
     pub pareto: bool,
 }
 
@@ -163,6 +186,19 @@ pub struct BenchResult {
     pub duration: Scalar,
     /// The files written.
     pub files: Vec<PathBuf>,
+    /// Stem of the file names: the scene's name, with `-time` for the time-step ladder.
+    pub stem: String,
+    /// True for the time-step ladder.
+    pub time_ladder: bool,
+    /// What the errors compare.
+    pub compare: Compare,
+    /// Which step the runs took.
+    pub step: StepPolicy,
+    /// The common step and where it comes from (under [`StepPolicy::Common`]).
+    pub common_dt: Option<(Scalar, String)>,
+    /// How far the reference's samples moved over its last frame, relative to
+    /// the diagonal (a check that a scene compared at rest has settled).
+    pub reference_last_motion: Option<Scalar>,
 }
 
 fn load(path: &Path, overrides: &[String], context: &str) -> Result<Scene, BenchError> {
@@ -172,30 +208,68 @@ fn load(path: &Path, overrides: &[String], context: &str) -> Result<Scene, Bench
     })
 }
 
-/// Runs the benchmark, reporting progress lines through `log`.
-pub fn bench(
-    opts: &BenchOptions,
-    interrupt: &AtomicBool,
-    log: &mut dyn FnMut(&str),
-) -> Result<BenchResult, BenchError> {
+/// Everything resolved before any run: the ladder, every rung's scene, the
+/// reference's scene and overrides, the comparison and the step.
+struct Plan {
+    base: Scene,
+    ladder: Ladder,
+    scenes: Vec<Scene>,
+    ref_own: Vec<String>,
+    ref_set: Vec<String>,
+    ref_scene: Scene,
+    compare: Compare,
+    step: StepPolicy,
+    common_dt: Option<(Scalar, String)>,
+}
+
+/// `a` then `b` then `c`, as one override list.
+fn chain(a: &[String], b: &[String], c: &[String]) -> Vec<String> {
+    a.iter().chain(b).chain(c).cloned().collect()
+}
+
+/// Resolves the ladder and every scene; a bad override fails before any run.
+fn plan(opts: &BenchOptions) -> Result<Plan, BenchError> {
     let mut base_set = opts.overrides.clone();
     if let Some(d) = opts.duration {
         base_set.push(format!("simulation.duration={d:e}"));
     }
     let base = load(&opts.scene, &base_set, "scene")?;
-    let mut ladder = opts
-        .ladder
-        .clone()
-        .unwrap_or_else(|| ladder::default_ladder(&base));
+    let mut ladder = if opts.time_ladder {
+        let uniform = [
+            "adapt.method=none".to_owned(),
+            "adapt.multirate=false".to_owned(),
+        ];
+        let scene = load(&opts.scene, &chain(&base_set, &uniform, &[]), "scene")?;
+        steps::time_ladder(steps::scene_step(&scene)?)
+    } else {
+        let step = opts
+            .step
+            .or(opts.ladder.as_ref().and_then(|l| l.step))
+            .unwrap_or(StepPolicy::Common);
+        opts.ladder
+            .clone()
+            .unwrap_or_else(|| ladder::default_ladder(&base, step))
+    };
+    let step = if opts.time_ladder {
+        StepPolicy::Own
+    } else {
+        opts.step.or(ladder.step).unwrap_or(StepPolicy::Common)
+    };
+    let compare = opts.compare.or(ladder.compare).unwrap_or(Compare::Frames);
     if !opts.rungs.is_empty() {
         ladder.select(&opts.rungs)?;
     }
-    // Resolve every rung first: a bad override fails before any run.
-    let mut scenes = Vec::new();
-    for r in &ladder.rung {
-        let set: Vec<String> = base_set.iter().chain(&r.set).cloned().collect();
-        scenes.push(load(&opts.scene, &set, &format!("rung `{}`", r.label))?);
-    }
+    let resolve = |step_set: &[String]| -> Result<Vec<Scene>, BenchError> {
+        ladder
+            .rung
+            .iter()
+            .map(|r| {
+                let set = chain(&base_set, step_set, &r.set);
+                load(&opts.scene, &set, &format!("rung `{}`", r.label))
+            })
+            .collect()
+    };
+    let mut scenes = resolve(&[])?;
     let finest = scenes
         .iter()
         .map(ladder::finest_resolution)
@@ -207,176 +281,143 @@ pub fn bench(
     let ref_own = ladder
         .reference
         .clone()
-        .unwrap_or_else(|| ladder::reference_overrides(&base, ref_res));
-    let ref_set: Vec<String> = base_set.iter().chain(&ref_own).cloned().collect();
-    let ref_scene = load(&opts.scene, &ref_set, "reference")?;
+        .unwrap_or_else(|| ladder::reference_overrides(ref_res));
+    let mut ref_scene = load(&opts.scene, &chain(&base_set, &ref_own, &[]), "reference")?;
+    let mut step_set = Vec::new();
+    let mut common_dt = None;
+    if step == StepPolicy::Common {
+        let dt = steps::scene_step(&ref_scene)?;
+        common_dt = Some((dt, steps::step_origin(&ref_scene).to_owned()));
+        step_set.push(steps::dt_override(dt));
+        scenes = resolve(&step_set)?;
+        ref_scene = load(
+            &opts.scene,
+            &chain(&base_set, &step_set, &ref_own),
+            "reference",
+        )?;
+    }
+    Ok(Plan {
+        base,
+        ref_set: chain(&base_set, &step_set, &ref_own),
+        ladder,
+        scenes,
+        ref_own,
+        ref_scene,
+        compare,
+        step,
+        common_dt,
+    })
+}
+
+/// The reference: from the cache when allowed and present, else computed.
+fn obtain_reference(
+    plan: &Plan,
+    opts: &BenchOptions,
+    run_opts: &RunOptions,
+    interrupt: &AtomicBool,
+    log: &mut dyn FnMut(&str),
+) -> Result<(Reference, bool), BenchError> {
     let scene_text = std::fs::read_to_string(&opts.scene).map_err(|source| BenchError::Io {
         path: opts.scene.clone(),
         source,
     })?;
-    let key = reference::cache_key(&scene_text, &ref_set, opts.grid);
-    let cache_file = reference::cache_path(&opts.out_dir, &base.name, &key);
+    let key = reference::cache_key(&scene_text, &plan.ref_set, opts.grid);
+    let cache_file = reference::cache_path(&opts.out_dir, &plan.base.name, &key);
+    if opts.cache
+        && let Some(r) = reference::load_cached(&cache_file, &key)
+    {
+        log(&format!("reference: cached {}", cache_file.display()));
+        return Ok((r, true));
+    }
+    log(&format!(
+        "reference: computing ({})",
+        plan.ref_own.join(" ")
+    ));
+    let r = reference::compute(
+        &plan.ref_scene,
+        plan.ref_set.clone(),
+        key,
+        opts.grid,
+        run_opts,
+        interrupt,
+    )?;
+    log(&format!(
+        "reference: {} vertices, {} steps, {:.1} s",
+        r.vertices, r.steps, r.wall_s
+    ));
+    if opts.cache {
+        reference::store(&cache_file, &r)?;
+    }
+    Ok((r, false))
+}
+
+/// Runs the benchmark, reporting progress lines through `log`.
+pub fn bench(
+    opts: &BenchOptions,
+    interrupt: &AtomicBool,
+    log: &mut dyn FnMut(&str),
+) -> Result<BenchResult, BenchError> {
+    let plan = plan(opts)?;
+    if let Some((dt, origin)) = &plan.common_dt {
+        log(&format!(
+            "time step: {dt:.4e} s ({origin}) for every run and the reference"
+        ));
+    }
     let run_opts = RunOptions {
         threads: opts.threads,
         ..RunOptions::default()
     };
-    let cached = if opts.cache {
-        reference::load_cached(&cache_file, &key)
-    } else {
-        None
-    };
-    let cache_hit = cached.is_some();
-    let reference = match cached {
-        Some(r) => {
-            log(&format!("reference: cached {}", cache_file.display()));
-            r
-        }
-        None => {
-            log(&format!("reference: computing ({})", ref_own.join(" ")));
-            let r = reference::compute(&ref_scene, ref_set, key, opts.grid, &run_opts, interrupt)?;
-            log(&format!(
-                "reference: {} vertices, {} steps, {:.1} s",
-                r.vertices, r.steps, r.wall_s
-            ));
-            if opts.cache {
-                reference::store(&cache_file, &r)?;
-            }
-            r
-        }
-    };
+    let (reference, cache_hit) = obtain_reference(&plan, opts, &run_opts, interrupt, log)?;
     let points = reference.sample_points();
     let mut rows = Vec::new();
-    for (i, (r, scene)) in ladder.rung.iter().zip(&scenes).enumerate() {
-        log(&format!("[{}/{}] {}", i + 1, scenes.len(), r.label));
-        let row = measure(r, scene, &reference, &points, opts, &run_opts, interrupt)?;
+    let n = plan.scenes.len();
+    for (i, (r, scene)) in plan.ladder.rung.iter().zip(&plan.scenes).enumerate() {
+        log(&format!("[{}/{n}] {}", i + 1, r.label));
+        let how = (opts.reps, plan.compare);
+        let row = measure::measure(r, scene, &reference, &points, how, &run_opts, interrupt)?;
         log(&format!(
-            "[{}/{}] {}: {} wall {:.2} s, {:.0} vertices (peak {:.0}), mean error {:.3e}",
+            "[{}/{n}] {}: {} wall {:.2} s, {:.0} vertices (peak {:.0}), error ({}) {:.3e}",
             i + 1,
-            scenes.len(),
             r.label,
             row.status,
             row.wall_s,
             row.mean_vertices,
             row.peak_vertices,
-            row.mean_error
+            plan.compare.name(),
+            row.error
         ));
         rows.push(row);
     }
-    let front = pareto::pareto_front(
-        &rows
-            .iter()
-            .map(|r| (r.wall_s, r.mean_error))
-            .collect::<Vec<_>>(),
-    );
+    let front = pareto::pareto_front(&rows.iter().map(|r| (r.wall_s, r.error)).collect::<Vec<_>>());
     for (row, on) in rows.iter_mut().zip(front) {
         row.pareto = on;
     }
+    let reference_last_motion = sampling::last_frame_motion(&reference.frames, reference.diagonal);
+    let stem = if opts.time_ladder {
+        format!("{}-time", plan.base.name)
+    } else {
+        plan.base.name.clone()
+    };
     let mut result = BenchResult {
-        scene: base.name.clone(),
+        scene: plan.base.name.clone(),
         rows,
         reference,
         cache_hit,
-        duration: base.simulation.duration,
+        duration: plan.base.simulation.duration,
         files: Vec::new(),
+        stem,
+        time_ladder: opts.time_ladder,
+        compare: plan.compare,
+        step: plan.step,
+        common_dt: plan.common_dt,
+        reference_last_motion,
     };
     result.files = report::write_all(&opts.out_dir, &result, &opts.scene)?;
     Ok(result)
 }
 
-fn measure(
-    rung: &Rung,
-    scene: &Scene,
-    reference: &Reference,
-    points: &[crate::math::Vector2],
-    opts: &BenchOptions,
-    run_opts: &RunOptions,
-    interrupt: &AtomicBool,
-) -> Result<Row, BenchError> {
-    let first = sampling::sampled_run(scene, run_opts, points, interrupt)?;
-    if first.summary.interrupted {
-        return Err(BenchError::Interrupted);
-    }
-    let mut walls = vec![first.summary.wall_time_s - first.sampling_s];
-    if first.failure.is_none() {
-        for _ in 1..opts.reps.max(1) {
-            let s = run(scene, run_opts, interrupt, &mut |_| {})?;
-            if s.interrupted {
-                return Err(BenchError::Interrupted);
-            }
-            walls.push(s.wall_time_s);
-        }
-    }
-    let errors = sampling::run_errors(&first.frames, &reference.frames, reference.diagonal);
-    let complete = first.failure.is_none() && errors.len() == first.frames.len();
-    let (mean_error, final_error) = if complete && !errors.is_empty() {
-        let mean = errors.iter().map(|e| e.1).sum::<Scalar>() / errors.len() as Scalar;
-        (mean, errors.last().map_or(Scalar::NAN, |e| e.1))
-    } else {
-        (Scalar::NAN, Scalar::NAN)
-    };
-    let status = match (&first.failure, complete) {
-        (Some(f), _) => format!("failed: {f}"),
-        (None, false) => "failed: frames do not match the reference's".to_owned(),
-        (None, true) => "ok".to_owned(),
-    };
-    let adapt = scene
-        .adapt
-        .as_ref()
-        .filter(|a| a.method != AdaptMethod::None);
-    Ok(Row {
-        label: rung.label.clone(),
-        set: rung.set.clone(),
-        adaptive: adapt.is_some(),
-        method: adapt
-            .map_or("none", |a| match a.method {
-                AdaptMethod::RedGreen => "red_green",
-                AdaptMethod::Edge => "edge",
-                AdaptMethod::None => "none",
-            })
-            .to_owned(),
-        resolution: scene.cloth.resolution.unwrap_or(0),
-        finest_resolution: ladder::finest_resolution(scene),
-        max_level: adapt.map_or(0, |a| a.max_level),
-        refine_angle: adapt.map_or(Scalar::NAN, |a| a.refine_angle),
-        coarsen_angle: adapt.map_or(Scalar::NAN, |a| a.coarsen_angle),
-        integrator: integrator_name(scene.simulation.integrator).to_owned(),
-        multirate: adapt.is_some_and(|a| a.multirate),
-        dt: match scene.simulation.dt {
-            TimeStep::Auto => "auto".into(),
-            TimeStep::Fixed(dt) => format!("{dt}"),
-        },
-        status,
-        reps: walls.len(),
-        wall_s: median(&mut walls),
-        steps: first.summary.steps,
-        mean_vertices: first.summary.vertices.mean,
-        peak_vertices: first.summary.vertices.max,
-        mean_error,
-        final_error,
-        errors,
-        pareto: false,
-    })
-}
-
-/// The integrator's name as scene files spell it.
-pub fn integrator_name(i: Integrator) -> &'static str {
-    match i {
-        Integrator::SymplecticEuler => "symplectic_euler",
-        Integrator::Rk4 => "rk4",
-        Integrator::Implicit => "implicit",
-    }
-}
-
-/// Median of `v` (mean of the middle two for an even count; `NaN` if empty).
-pub fn median(v: &mut [Scalar]) -> Scalar {
-    if v.is_empty() {
-        return Scalar::NAN;
-    }
-    v.sort_by(|a, b| a.total_cmp(b));
-    let n = v.len();
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        (v[n / 2 - 1] + v[n / 2]) / 2.0
-    }
+/// The ladder `bench` would run with `opts` (after `--rungs`), without running
+/// anything (`drape bench --list`).
+pub fn resolved_ladder(opts: &BenchOptions) -> Result<Ladder, BenchError> {
+    Ok(plan(opts)?.ladder)
 }

@@ -1,4 +1,5 @@
-//! The reference run: a uniform mesh finer than every rung with a smaller step,
+//! The reference run: a uniform mesh finer than every rung (at the rungs' step
+//! by default; at a much smaller step on the same mesh for the time-step ladder),
 //! computed once and cached under `OUT/cache/` by a hash of the scene text, the
 //! overrides, the sampling and drape's version.
 

@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use super::report::CSV_HEADER;
-use super::{BenchError, Row};
+use super::{BenchError, Compare, Row};
 use crate::math::Scalar;
 
 /// Splits one CSV line into fields (double quotes quote, `""` is a quote).
@@ -80,8 +80,14 @@ pub fn read_csv(path: &Path) -> Result<Vec<Row>, BenchError> {
             peak_vertices: num(&f[16]),
             mean_error: num(&f[17]),
             final_error: num(&f[18]),
-            pareto: f[19] == "true",
-            set: f[20]
+            compare: if f[19] == "rest" {
+                Compare::Rest
+            } else {
+                Compare::Frames
+            },
+            error: num(&f[20]),
+            pareto: f[21] == "true",
+            set: f[22]
                 .split(' ')
                 .filter(|s| !s.is_empty())
                 .map(str::to_owned)
@@ -90,4 +96,16 @@ pub fn read_csv(path: &Path) -> Result<Vec<Row>, BenchError> {
         });
     }
     Ok(rows)
+}
+
+/// Redraws `dir/stem.svg` from `dir/stem.csv` (`drape bench --replot`);
+/// returns the chart's path.
+pub fn replot(dir: &Path, stem: &str) -> Result<std::path::PathBuf, BenchError> {
+    let rows = read_csv(&dir.join(format!("{stem}.csv")))?;
+    let svg = dir.join(format!("{stem}.svg"));
+    std::fs::write(&svg, super::chart::svg(stem, &rows)?).map_err(|source| BenchError::Io {
+        path: svg.clone(),
+        source,
+    })?;
+    Ok(svg)
 }

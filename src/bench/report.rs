@@ -1,15 +1,21 @@
 //! The benchmark's files: `SCENE.csv` (one row per run), `SCENE-frames.csv`
 //! (the error at every recorded frame of every run), `SCENE.md` (a Markdown
-//! table with the reference's settings and the target check) and `SCENE.svg`.
+//! table with the comparison, the step, the reference's settings, the uniform
+//! runs' observed order of convergence and the target check) and `SCENE.svg`.
+//! The time-step ladder writes the same files as `SCENE-time.*`.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
+use super::ladder::StepPolicy;
+use super::order::{self, Convergence, Variable};
+use super::steps::TIME_REFERENCE_DIVISOR;
 use super::{BenchError, BenchResult, Row};
 use crate::math::Scalar;
 
-/// The CSV header: the settings, then the measurements.
-pub const CSV_HEADER: &str = "label,kind,method,resolution,finest_resolution,max_level,refine_angle,coarsen_angle,integrator,multirate,dt,status,reps,wall_s,steps,mean_vertices,peak_vertices,mean_error,final_error,pareto,overrides";
+/// The CSV header: the settings, then the measurements. `error` is the one
+/// compared (`compare`: `frames`, the mean over the frames; `rest`, the last frame's).
+pub const CSV_HEADER: &str = "label,kind,method,resolution,finest_resolution,max_level,refine_angle,coarsen_angle,integrator,multirate,dt,status,reps,wall_s,steps,mean_vertices,peak_vertices,mean_error,final_error,compare,error,pareto,overrides";
 
 /// A number for the CSV: empty when not a number.
 fn num(x: Scalar) -> String {
@@ -54,6 +60,8 @@ pub fn csv(rows: &[Row]) -> String {
             num(r.peak_vertices),
             num(r.mean_error),
             num(r.final_error),
+            r.compare.name().into(),
+            num(r.error),
             r.pareto.to_string(),
             field(&r.set.join(" ")),
         ];
@@ -79,8 +87,12 @@ pub fn frames_csv(rows: &[Row]) -> String {
     out
 }
 
-fn pct(x: Scalar) -> String {
-    if x.is_finite() {
+/// A fraction in percent: three decimals, or three significant digits below
+/// 0.01 % (so that small errors do not print as 0.000).
+pub fn pct(x: Scalar) -> String {
+    if x.is_finite() && (100.0 * x).abs() < 0.01 && x != 0.0 {
+        format!("{:.2e}", 100.0 * x)
+    } else if x.is_finite() {
         format!("{:.3}", 100.0 * x)
     } else {
         "-".into()
@@ -94,16 +106,21 @@ pub struct TargetCheck {
     pub adaptive: String,
     /// The uniform run it is compared with.
     pub uniform: String,
-    /// Adaptive mean error divided by the uniform's.
+    /// Adaptive error divided by the uniform's (the compared errors).
     pub error_ratio: Scalar,
     /// Adaptive wall time divided by the uniform's.
     pub time_ratio: Scalar,
-    /// Error at most the uniform's at a quarter of its wall time or less.
+    /// The error is within 10 % of the uniform run's (or below it).
+    pub within_10: bool,
+    /// Within 10 % of the uniform's error at a quarter of its wall time or less.
     pub met: bool,
+    /// Within 10 % of the uniform's error at a tenth of its wall time or less.
+    pub met_tenth: bool,
 }
 
 /// The target for every adaptive run that has a uniform counterpart
-/// (a uniform run whose resolution equals its finest resolution).
+/// (a uniform run whose resolution equals its finest resolution and that
+/// takes the same step setting).
 pub fn target_checks(rows: &[Row]) -> Vec<TargetCheck> {
     let ok = |r: &&Row| r.status == "ok";
     rows.iter()
@@ -113,25 +130,68 @@ pub fn target_checks(rows: &[Row]) -> Vec<TargetCheck> {
             let u = rows
                 .iter()
                 .filter(ok)
-                .find(|u| !u.adaptive && u.resolution == a.finest_resolution)?;
-            let error_ratio = a.mean_error / u.mean_error;
+                .find(|u| !u.adaptive && u.resolution == a.finest_resolution && u.dt == a.dt)?;
+            let error_ratio = a.error / u.error;
             let time_ratio = a.wall_s / u.wall_s;
+            let within_10 = error_ratio <= 1.1;
             Some(TargetCheck {
                 adaptive: a.label.clone(),
                 uniform: u.label.clone(),
                 error_ratio,
                 time_ratio,
-                met: error_ratio <= 1.0 && time_ratio <= 0.25,
+                within_10,
+                met: within_10 && time_ratio <= 0.25,
+                met_tenth: within_10 && time_ratio <= 0.1,
             })
         })
         .collect()
 }
 
-/// The Markdown report of one benchmark.
-pub fn markdown(res: &BenchResult, scene_path: &Path) -> String {
+/// The lines saying what is compared, at which step, against which reference.
+fn preamble(res: &BenchResult, scene_path: &Path) -> String {
     let r = &res.reference;
     let mut out = String::new();
-    let _ = writeln!(out, "## {} ({:.2} s simulated)\n", res.scene, res.duration);
+    let title = if res.time_ladder {
+        "time-step ladder, "
+    } else {
+        ""
+    };
+    let _ = writeln!(
+        out,
+        "## {} ({title}{:.2} s simulated)\n",
+        res.scene, res.duration
+    );
+    let frames = r.frames.len();
+    match res.compare {
+        super::Compare::Frames => {
+            let _ = writeln!(
+                out,
+                "Compared frame by frame: the error is the mean over the {frames} recorded frames.\n"
+            );
+        }
+        super::Compare::Rest => {
+            let t = r.frames.last().map_or(Scalar::NAN, |f| f.time);
+            let _ = writeln!(
+                out,
+                "Compared at rest: the error is the last frame's (t = {t:.3} s); over its last frame the reference's samples moved {} % of the diagonal.\n",
+                res.reference_last_motion
+                    .map_or("-".into(), |m| format!("{:.2e}", 100.0 * m))
+            );
+        }
+    }
+    if res.time_ladder {
+        let _ = writeln!(
+            out,
+            "One uniform mesh at the scene's step and its halves, against the same mesh at 1/{TIME_REFERENCE_DIVISOR} of the scene's step: the error is the step's.\n"
+        );
+    } else if let Some((dt, origin)) = &res.common_dt {
+        let _ = writeln!(
+            out,
+            "Time step: {dt:.4e} s ({origin}) for every run and the reference: the error is the mesh's.\n"
+        );
+    } else if res.step == StepPolicy::Own {
+        out.push_str("Time step: each run's own setting (an automatic explicit step follows each mesh): the error includes the step's.\n\n");
+    }
     let _ = writeln!(
         out,
         "Reference: `{}` with `{}`: {} vertices, {} steps (smallest step {:.3e} s, {}), {:.1} s wall{}; {} sample points, error relative to the diagonal {:.4} m.\n",
@@ -146,9 +206,15 @@ pub fn markdown(res: &BenchResult, scene_path: &Path) -> String {
         r.points.len(),
         r.diagonal,
     );
-    out.push_str("| run | kind | base res | finest res | integrator | wall s (median) | reps | steps | mean verts | peak verts | mean error % | final error % | Pareto |\n");
-    out.push_str("|---|---|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|:-:|\n");
-    for row in &res.rows {
+    out
+}
+
+/// The runs' table.
+fn table(rows: &[Row]) -> String {
+    let mut out = String::new();
+    out.push_str("| run | kind | base res | finest res | integrator | dt s | wall s (median) | reps | steps | mean verts | peak verts | mean error % | final error % | Pareto |\n");
+    out.push_str("|---|---|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|:-:|\n");
+    for row in rows {
         let status = if row.status == "ok" {
             String::new()
         } else {
@@ -156,7 +222,7 @@ pub fn markdown(res: &BenchResult, scene_path: &Path) -> String {
         };
         let _ = writeln!(
             out,
-            "| {}{} | {} | {} | {} | {}{} | {:.3} | {} | {} | {:.0} | {:.0} | {} | {} | {} |",
+            "| {}{} | {} | {} | {} | {}{} | {} | {:.3} | {} | {} | {:.0} | {:.0} | {} | {} | {} |",
             row.label,
             status,
             kind(row),
@@ -164,6 +230,9 @@ pub fn markdown(res: &BenchResult, scene_path: &Path) -> String {
             row.finest_resolution,
             row.integrator,
             if row.multirate { " multirate" } else { "" },
+            row.dt
+                .parse::<Scalar>()
+                .map_or(row.dt.clone(), |dt| format!("{dt:.4e}")),
             row.wall_s,
             row.reps,
             row.steps,
@@ -174,21 +243,77 @@ pub fn markdown(res: &BenchResult, scene_path: &Path) -> String {
             if row.pareto { "**yes**" } else { "" },
         );
     }
-    let checks = target_checks(&res.rows);
-    if !checks.is_empty() {
-        out.push_str("\nTarget (adaptive error <= the uniform run's with the same finest edges, at <= 1/4 of its wall time):\n\n");
-        for c in checks {
-            let _ = writeln!(
-                out,
-                "- {} vs {}: error x{:.2}, wall time x{:.3}: {}",
-                c.adaptive,
-                c.uniform,
-                c.error_ratio,
-                c.time_ratio,
-                if c.met { "met" } else { "not met" }
-            );
-        }
+    out
+}
+
+/// The convergence paragraph of one series.
+pub fn convergence_text(c: &Convergence) -> String {
+    let what = match c.variable {
+        Variable::EdgeLength => "edge length (1 / resolution)",
+        Variable::Step => "time step",
+    };
+    let mut out = format!(
+        "Uniform runs, error against {what} at {}: **observed order {:.2}** (error ~ h^{:.2}, least squares over {} runs; local orders from coarse to fine: {}).\n\n",
+        c.fixed,
+        c.order,
+        c.order,
+        c.points.len(),
+        c.local
+            .iter()
+            .map(|p| format!("{p:.2}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    out.push_str("| run | h | error % |\n|---|---:|---:|\n");
+    for (label, h, e) in &c.points {
+        let _ = writeln!(out, "| {label} | {h:.4e} | {} |", pct(*e));
     }
+    out
+}
+
+/// The target paragraph: every adaptive run against its uniform counterpart.
+fn targets(rows: &[Row]) -> String {
+    let checks = target_checks(rows);
+    if checks.is_empty() {
+        return String::new();
+    }
+    let mut out = String::from(
+        "\nTarget (an adaptive run within 10 % of the error of the uniform run with its finest edges, at <= 1/4 of that run's wall time on every scene, <= 1/10 on two):\n\n| adaptive | uniform | error ratio | within 10 % | wall time ratio | <= 1/4 | <= 1/10 |\n|---|---|---:|:-:|---:|:-:|:-:|\n",
+    );
+    let yes = |b: bool| if b { "**yes**" } else { "no" };
+    for c in checks {
+        let _ = writeln!(
+            out,
+            "| {} | {} | {:.2} | {} | {:.3} | {} | {} |",
+            c.adaptive,
+            c.uniform,
+            c.error_ratio,
+            yes(c.within_10),
+            c.time_ratio,
+            yes(c.met),
+            yes(c.met_tenth)
+        );
+    }
+    out
+}
+
+/// The Markdown report of one benchmark: what is compared, the runs, the
+/// uniform runs' convergence (before any adaptive comparison) and the target.
+pub fn markdown(res: &BenchResult, scene_path: &Path) -> String {
+    let mut out = preamble(res, scene_path);
+    out.push_str(&table(&res.rows));
+    out.push('\n');
+    let series: Vec<Convergence> = [order::spatial(&res.rows), order::temporal(&res.rows)]
+        .into_iter()
+        .flatten()
+        .collect();
+    if series.is_empty() {
+        out.push_str("Convergence: fewer than two uniform runs differing only in resolution or step: no order.\n");
+    }
+    for c in &series {
+        out.push_str(&convergence_text(c));
+    }
+    out.push_str(&targets(&res.rows));
     out
 }
 
@@ -202,14 +327,12 @@ pub fn write_all(
         path: dir.to_path_buf(),
         source,
     })?;
+    let stem = &res.stem;
     let files = [
-        (format!("{}.csv", res.scene), csv(&res.rows)),
-        (format!("{}-frames.csv", res.scene), frames_csv(&res.rows)),
-        (format!("{}.md", res.scene), markdown(res, scene_path)),
-        (
-            format!("{}.svg", res.scene),
-            super::chart::svg(&res.scene, &res.rows),
-        ),
+        (format!("{stem}.csv"), csv(&res.rows)),
+        (format!("{stem}-frames.csv"), frames_csv(&res.rows)),
+        (format!("{stem}.md"), markdown(res, scene_path)),
+        (format!("{stem}.svg"), super::chart::svg(stem, &res.rows)?),
     ];
     let mut paths = Vec::new();
     for (name, text) in files {

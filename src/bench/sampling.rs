@@ -137,3 +137,18 @@ pub fn run_errors(
         })
         .collect()
 }
+
+/// How far the samples moved between the last two frames, as the relative RMS
+/// distance (`None` with fewer than two frames or no sample found in both).
+pub fn last_frame_motion(frames: &[FrameSamples], diagonal: Scalar) -> Option<Scalar> {
+    let [.., a, b] = frames else {
+        return None;
+    };
+    let (p, q): (Vec<Vector>, Vec<Vector>) = a
+        .positions
+        .iter()
+        .zip(&b.positions)
+        .filter_map(|(p, q)| Some((Vector::from_array((*p)?), Vector::from_array((*q)?))))
+        .unzip();
+    (!p.is_empty()).then(|| relative_rms(&p, &q, diagonal))
+}

@@ -9,10 +9,10 @@ use drape::bench::pareto::pareto_front;
 use drape::bench::replot::read_csv;
 use drape::bench::report::{CSV_HEADER, csv, target_checks};
 use drape::bench::sampling::{FrameSamples, frame_error};
-use drape::bench::{BenchOptions, Ladder, Row, Rung, bench, median};
+use drape::bench::{BenchOptions, Compare, Ladder, Row, Rung, StepPolicy, bench, median};
 
 /// A fresh empty directory in the temp dir, unique per process and name.
-fn temp_dir(name: &str) -> PathBuf {
+pub(crate) fn temp_dir(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("drape-bench-test-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).expect("temp dir");
@@ -20,7 +20,7 @@ fn temp_dir(name: &str) -> PathBuf {
 }
 
 /// A small hanging sheet (0.5 m, resolution 4, implicit) as a scene file.
-fn tiny_scene(dir: &Path) -> PathBuf {
+pub(crate) fn tiny_scene(dir: &Path) -> PathBuf {
     let path = dir.join("tiny.toml");
     std::fs::write(
         &path,
@@ -56,7 +56,8 @@ fn rung(label: &str, set: &[&str]) -> Rung {
     }
 }
 
-fn row(label: &str, adaptive: bool, res: u32, finest: u32, wall: f64, err: f64) -> Row {
+/// A hand-made row (implicit, step `auto`, compared frame by frame).
+pub(crate) fn row(label: &str, adaptive: bool, res: u32, finest: u32, wall: f64, err: f64) -> Row {
     Row {
         label: label.into(),
         set: vec!["cloth.resolution=4".into(), "a,b".into()],
@@ -78,6 +79,8 @@ fn row(label: &str, adaptive: bool, res: u32, finest: u32, wall: f64, err: f64) 
         peak_vertices: 30.0,
         mean_error: err,
         final_error: err,
+        compare: Compare::Frames,
+        error: err,
         errors: vec![],
         pareto: false,
     }
@@ -188,6 +191,8 @@ fn tiny_ladder_end_to_end_with_cache_and_a_failed_rung() {
     let scene = tiny_scene(&dir);
     let ladder = Ladder {
         reference: None,
+        compare: None,
+        step: None,
         rung: vec![
             rung("uniform 4", &["adapt.method=none", "cloth.resolution=4"]),
             rung("uniform 6", &["adapt.method=none", "cloth.resolution=6"]),
@@ -215,7 +220,10 @@ fn tiny_ladder_end_to_end_with_cache_and_a_failed_rung() {
         scene: scene.clone(),
         overrides: vec![],
         ladder: Some(ladder),
+        time_ladder: false,
         rungs: vec![],
+        compare: None,
+        step: None,
         reps: 2,
         duration: Some(0.15),
         threads: Some(1),
@@ -236,6 +244,18 @@ fn tiny_ladder_end_to_end_with_cache_and_a_failed_rung() {
             .contains(&"cloth.resolution=12".to_owned())
     );
     assert_eq!(first.reference.vertices, 13 * 13);
+    // One common step: the scene's fixed 0.01 s for the reference and every
+    // rung that does not set its own.
+    assert_eq!(first.step, StepPolicy::Common);
+    assert!(
+        first
+            .reference
+            .overrides
+            .contains(&"simulation.dt=1e-2".to_owned())
+    );
+    for r in &first.rows[..3] {
+        assert_eq!(r.dt, "0.01", "{}", r.label);
+    }
     assert_eq!(first.rows.len(), 4);
     for r in &first.rows[..3] {
         assert_eq!(r.status, "ok", "{}", r.label);
@@ -310,4 +330,41 @@ fn bench_cli_lists_the_default_ladder_and_rejects_unknown_rungs() {
         .expect("run drape");
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("no rung labelled `nope`"));
+    // The time-step ladder: three halvings of the implicit automatic step; it
+    // brings its own reference, so `--ladder` with it is a usage error.
+    let out = Command::new(env!("CARGO_BIN_EXE_drape"))
+        .args([
+            "bench",
+            scene.to_str().expect("utf-8"),
+            "--time-ladder",
+            "--list",
+        ])
+        .output()
+        .expect("run drape");
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success());
+    assert_eq!(text.lines().count(), 3, "{text}");
+    assert!(text.contains("dt/4 2.083e-3: adapt.method=none"), "{text}");
+    let out = Command::new(env!("CARGO_BIN_EXE_drape"))
+        .args([
+            "bench",
+            scene.to_str().expect("utf-8"),
+            "--time-ladder",
+            "--ladder",
+            "x.toml",
+        ])
+        .output()
+        .expect("run drape");
+    assert_eq!(out.status.code(), Some(2));
+    let out = Command::new(env!("CARGO_BIN_EXE_drape"))
+        .args([
+            "bench",
+            scene.to_str().expect("utf-8"),
+            "--compare",
+            "sometimes",
+        ])
+        .output()
+        .expect("run drape");
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("expected `frames` or `rest`"));
 }

@@ -8,6 +8,7 @@ mod bad_cli;
 mod bad_input;
 mod bad_obj;
 mod bench;
+mod bench_convergence;
 mod canonical;
 mod cli;
 mod collide;

@@ -1,0 +1,118 @@
+//! One rung of the ladder: a sampled run (its errors against the reference),
+//! further timed repetitions, and the row of the report.
+
+use std::sync::atomic::AtomicBool;
+
+use super::ladder::{self, Compare, Rung};
+use super::sampling;
+use super::{BenchError, Reference, Row};
+use crate::math::{Scalar, Vector2};
+use crate::run::{RunOptions, run};
+use crate::scene::{AdaptMethod, Integrator, Scene, TimeStep};
+
+/// Runs `rung` (`scene` holds its overrides) once sampled and `reps - 1` more
+/// times timed, and measures its error against `reference` as `compare` says.
+pub fn measure(
+    rung: &Rung,
+    scene: &Scene,
+    reference: &Reference,
+    points: &[Vector2],
+    (reps, compare): (usize, Compare),
+    run_opts: &RunOptions,
+    interrupt: &AtomicBool,
+) -> Result<Row, BenchError> {
+    let first = sampling::sampled_run(scene, run_opts, points, interrupt)?;
+    if first.summary.interrupted {
+        return Err(BenchError::Interrupted);
+    }
+    let mut walls = vec![first.summary.wall_time_s - first.sampling_s];
+    if first.failure.is_none() {
+        for _ in 1..reps.max(1) {
+            let s = run(scene, run_opts, interrupt, &mut |_| {})?;
+            if s.interrupted {
+                return Err(BenchError::Interrupted);
+            }
+            walls.push(s.wall_time_s);
+        }
+    }
+    let errors = sampling::run_errors(&first.frames, &reference.frames, reference.diagonal);
+    let complete = first.failure.is_none()
+        && errors.len() == first.frames.len()
+        && errors.len() == reference.frames.len();
+    let (mean_error, final_error) = if complete && !errors.is_empty() {
+        let mean = errors.iter().map(|e| e.1).sum::<Scalar>() / errors.len() as Scalar;
+        (mean, errors.last().map_or(Scalar::NAN, |e| e.1))
+    } else {
+        (Scalar::NAN, Scalar::NAN)
+    };
+    let status = match (&first.failure, complete) {
+        (Some(f), _) => format!("failed: {f}"),
+        (None, false) => "failed: frames do not match the reference's".to_owned(),
+        (None, true) => "ok".to_owned(),
+    };
+    let adapt = scene
+        .adapt
+        .as_ref()
+        .filter(|a| a.method != AdaptMethod::None);
+    Ok(Row {
+        label: rung.label.clone(),
+        set: rung.set.clone(),
+        adaptive: adapt.is_some(),
+        method: adapt
+            .map_or("none", |a| match a.method {
+                AdaptMethod::RedGreen => "red_green",
+                AdaptMethod::Edge => "edge",
+                AdaptMethod::None => "none",
+            })
+            .to_owned(),
+        resolution: scene.cloth.resolution.unwrap_or(0),
+        finest_resolution: ladder::finest_resolution(scene),
+        max_level: adapt.map_or(0, |a| a.max_level),
+        refine_angle: adapt.map_or(Scalar::NAN, |a| a.refine_angle),
+        coarsen_angle: adapt.map_or(Scalar::NAN, |a| a.coarsen_angle),
+        integrator: integrator_name(scene.simulation.integrator).to_owned(),
+        multirate: adapt.is_some_and(|a| a.multirate),
+        dt: match scene.simulation.dt {
+            TimeStep::Auto => "auto".into(),
+            TimeStep::Fixed(dt) => format!("{dt}"),
+        },
+        status,
+        reps: walls.len(),
+        wall_s: median(&mut walls),
+        steps: first.summary.steps,
+        mean_vertices: first.summary.vertices.mean,
+        peak_vertices: first.summary.vertices.max,
+        mean_error,
+        final_error,
+        compare,
+        error: match compare {
+            Compare::Frames => mean_error,
+            Compare::Rest => final_error,
+        },
+        errors,
+        pareto: false,
+    })
+}
+
+/// The integrator's name as scene files spell it.
+pub fn integrator_name(i: Integrator) -> &'static str {
+    match i {
+        Integrator::SymplecticEuler => "symplectic_euler",
+        Integrator::Rk4 => "rk4",
+        Integrator::Implicit => "implicit",
+    }
+}
+
+/// Median of `v` (mean of the middle two for an even count; `NaN` if empty).
+pub fn median(v: &mut [Scalar]) -> Scalar {
+    if v.is_empty() {
+        return Scalar::NAN;
+    }
+    v.sort_by(|a, b| a.total_cmp(b));
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        (v[n / 2 - 1] + v[n / 2]) / 2.0
+    }
+}
