@@ -288,6 +288,17 @@ fn material(m: &Material, written: Option<&Table>, gravity: [f64; 3]) -> Result<
 fn check_pin(i: usize, p: &Pin, shape: ClothShape, written: Option<&Table>) -> Result<(), Issue> {
     let at = |k: &str| vec![Seg::Key("pin".into()), Seg::Index(i), Seg::Key(k.into())];
     let has = |k: &str| written.is_some_and(|t| t.contains_key(k));
+    check_pin_region(p, shape, &at, &has)?;
+    check_pin_motion(p, &at, &has)
+}
+
+/// A pin's `region` and, for a box, its corners.
+fn check_pin_region(
+    p: &Pin,
+    shape: ClothShape,
+    at: &dyn Fn(&str) -> Vec<Seg>,
+    has: &dyn Fn(&str) -> bool,
+) -> Result<(), Issue> {
     let region = p.region.as_str();
     let corner_or_edge = matches!(
         region,
@@ -350,6 +361,15 @@ fn check_pin(i: usize, p: &Pin, shape: ClothShape, written: Option<&Table>) -> R
         .allowed("remove it, or set region = \"box\"")
         .because(at("region")));
     }
+    Ok(())
+}
+
+/// A pin's motion and the keys that belong to it.
+fn check_pin_motion(
+    p: &Pin,
+    at: &dyn Fn(&str) -> Vec<Seg>,
+    has: &dyn Fn(&str) -> bool,
+) -> Result<(), Issue> {
     let (motion, foreign): (&str, &[&str]) = match p.motion {
         PinMotion::Fixed => (
             "fixed",
