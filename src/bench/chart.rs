@@ -164,7 +164,9 @@ fn draw(root: &DrawingArea<SVGBackend<'_>, Shift>, title: &str, rows: &[Row]) ->
     )?;
     chart
         .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
+        // Lower left: a front runs from the upper left to the lower right, so
+        // that corner (fast and accurate at once) is the one that stays empty.
+        .position(SeriesLabelPosition::LowerLeft)
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK)
         .draw()?;
