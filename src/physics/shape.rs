@@ -58,6 +58,22 @@
 //! for w = 2: the clamp treatment makes the clamp second-order accurate. It uses
 //! no resolution-dependent constant.
 //!
+//! # Sharing between triangles of different sizes
+//! Where the two triangles at an edge differ in size (a refined region next to
+//! a coarse one, red-green's green closure triangles), an equal split of the
+//! fold overstates the small triangle's curvature: the fold stands for the
+//! curvature between the two centroids, at distances `h_t / 3` and `h_o / 3`
+//! from the edge, so the small triangle covers less than half of it. Each
+//! triangle takes the part over it, `A_t / (A_t + A_o)` (the heights in
+//! proportion, for the shared edge), which is one half on a uniform mesh and
+//! keeps `sum_t A_t S_t = sum_e theta_e L_e t_e t_e^T` (the shares of an edge
+//! sum to 1), so the Jensen bound above still holds. Measured with the equal
+//! split on a cylinder imposed on the cantilever strip after 8 red-green splits
+//! near its clamp: the refined triangles carried 1.5 (level 2) and 1.9 (green,
+//! level 1) times the exact energy density `B / (2 R^2)` on average, up to 3.2
+//! times, and the settled strip's chord angle was 36.26 deg against 41.97 deg
+//! unrefined (elastica 41.5).
+//!
 //! Boundary edges have no angle, so an imposed curvature across a free edge loses
 //! the outer half row of triangles' share (the `1 - 1/n` of the cylinder test).
 //! At a free edge the plate's natural boundary condition is zero moment, so a
@@ -205,9 +221,13 @@ pub fn build_shape_triangles(
                 .expect("an edge's triangle has a vertex off the edge");
             out[t].v[3 + a] = mesh.opposite_vertex(o, e);
             out[t].interior[a] = true;
-            if held(o as usize) {
-                share[t][a] = 2.0;
-            }
+            // Twice the triangle's part of the fold (module docs, "Sharing"):
+            // all of it next to a clamp, else in proportion to area.
+            share[t][a] = if held(o as usize) {
+                2.0
+            } else {
+                2.0 * area[t] / (area[t] + area[o as usize])
+            };
         }
     }
     for (t, st) in out.iter_mut().enumerate() {
