@@ -44,8 +44,9 @@
 //! produce mean curvature (it has no discrete integration-by-parts identity).
 //!
 //! # Clamps
-//! Each edge's angle is shared equally by its two triangles because a
-//! piecewise-linear fold stands for curvature spread over both sides. A triangle
+//! Each edge's angle is shared by its two triangles (equally on a uniform mesh;
+//! by area in general, see "Sharing" below) because a piecewise-linear fold
+//! stands for curvature spread over both sides. A triangle
 //! held by one never-released pin (a clamp) cannot bend, so at the edge of a
 //! clamp the whole fold belongs to the free side: the free triangle takes the
 //! angle with share 2 (`M_ab` scaled by `s_a s_b`) and the held triangle has no
