@@ -17,16 +17,9 @@ const DENSITY: Scalar = 0.15;
 
 fn config() -> AdaptConfig {
     AdaptConfig {
-        method: drape::scene::AdaptMethod::RedGreen,
-        refine_angle: 15.0,
-        coarsen_angle: 1.5,
         max_level: 6,
-        min_edge_length: 0.0,
-        every: 1,
-        rollback: false,
         max_rollbacks: 3,
-        criterion: drape::scene::AdaptCriterion::Angle,
-        hysteresis: 2.0,
+        ..crate::common::angle_config(drape::scene::AdaptMethod::RedGreen)
     }
 }
 

@@ -169,16 +169,9 @@ pub fn settle_adaptive(overhang: Scalar, mat: &MaterialParams) -> Settled {
     let x: Vec<Vector> = m.material.iter().map(|p| p.extend(0.0)).collect();
     let mut world = World::new(m, x);
     let config = AdaptConfig {
-        method: AdaptMethod::RedGreen,
         refine_angle: 5.0,
         coarsen_angle: 0.5,
-        max_level: 4,
-        min_edge_length: 0.0,
-        every: 1,
-        rollback: false,
-        max_rollbacks: 0,
-        criterion: drape::scene::AdaptCriterion::Angle,
-        hysteresis: 2.0,
+        ..crate::common::angle_config(AdaptMethod::RedGreen)
     };
     let mut adapter = Adapter::new(config, &world, mat.density);
     let mut settled = settle_on(&world.mesh.clone(), &mut world.x, mat, overhang);

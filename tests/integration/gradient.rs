@@ -34,16 +34,9 @@ fn adapted_mesh() -> Mesh {
         .collect();
     let mut world = World::new(m, x);
     let config = AdaptConfig {
-        method: AdaptMethod::RedGreen,
         refine_angle: 10.0,
         coarsen_angle: 1.0,
-        max_level: 4,
-        min_edge_length: 0.0,
-        every: 1,
-        rollback: false,
-        max_rollbacks: 0,
-        criterion: drape::scene::AdaptCriterion::Angle,
-        hysteresis: 2.0,
+        ..crate::common::angle_config(AdaptMethod::RedGreen)
     };
     let mut adapter = Adapter::new(config, &world, 0.15);
     for pass in 0..3 {

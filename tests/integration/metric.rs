@@ -1,8 +1,8 @@
 //! The error metric: identical meshes give 0, a rigid offset gives exactly that
 //! offset, and samples are the same cloth points on a uniform and an adapted mesh.
 
+use drape::adapt::Adapter;
 use drape::adapt::red_green::RedGreenOp;
-use drape::adapt::{AdaptConfig, Adapter};
 use drape::bench::metric::{diagonal, grid_samples, locate, relative_rms, sample_positions};
 use drape::math::{Scalar, Vector};
 use drape::mesh;
@@ -71,18 +71,7 @@ fn samples_are_the_same_cloth_points_on_an_adapted_mesh() {
         .map(Option::unwrap)
         .collect();
     let before = sample_positions(&w.mesh, &w.x, &before_loc);
-    let cfg = AdaptConfig {
-        method: AdaptMethod::RedGreen,
-        refine_angle: 15.0,
-        coarsen_angle: 1.5,
-        max_level: 4,
-        min_edge_length: 0.0,
-        every: 1,
-        rollback: false,
-        max_rollbacks: 0,
-        criterion: drape::scene::AdaptCriterion::Angle,
-        hysteresis: 2.0,
-    };
+    let cfg = crate::common::angle_config(AdaptMethod::RedGreen);
     let mut ad = Adapter::new(cfg, &w, 0.15);
     let leaves: Vec<_> = ad
         .hierarchy()

@@ -502,23 +502,12 @@ fn results_are_bit_identical_with_one_and_two_threads() {
 /// chord angle after the same 8 splits is 37.78 deg with area shares).
 #[test]
 fn partly_refined_sheet_bends_like_the_continuum() {
-    use drape::adapt::{AdaptConfig, Adapter};
+    use drape::adapt::Adapter;
     let r: Scalar = 0.5;
     let m0 = mesh::rectangle(1.0, 1.0, 8, DiagonalPattern::Alternating).unwrap();
     let x0: Vec<Vector> = m0.material.iter().map(|p| p.extend(0.0)).collect();
     let mut world = World::new(m0, x0);
-    let config = AdaptConfig {
-        method: drape::scene::AdaptMethod::RedGreen,
-        refine_angle: 15.0,
-        coarsen_angle: 1.5,
-        max_level: 4,
-        min_edge_length: 0.0,
-        every: 1,
-        rollback: false,
-        max_rollbacks: 0,
-        criterion: drape::scene::AdaptCriterion::Angle,
-        hysteresis: 2.0,
-    };
+    let config = crate::common::angle_config(drape::scene::AdaptMethod::RedGreen);
     let mut adapter = Adapter::new(config, &world, 0.15);
     let h = adapter.hierarchy();
     let marks: Vec<(u32, Scalar)> = h

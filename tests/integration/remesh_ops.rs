@@ -212,16 +212,8 @@ fn incremental_tables_equal_a_rebuild_over_draping_passes() {
         let x = m.material.iter().map(|p| p.extend(0.78)).collect();
         let mut w = World::new(m, x);
         let config = AdaptConfig {
-            method,
-            refine_angle: 15.0,
-            coarsen_angle: 1.5,
-            max_level: 4,
-            min_edge_length: 0.0,
-            every: 1,
-            rollback: false,
             max_rollbacks: 3,
-            criterion: drape::scene::AdaptCriterion::Angle,
-            hysteresis: 2.0,
+            ..crate::common::angle_config(method)
         };
         let mut ad = Adapter::new(config, &w, 0.15);
         let mut changed = 0;
