@@ -56,7 +56,7 @@ fn corner(region: &str) -> Pin {
 }
 
 /// The swinging sheet at `resolution` after 30 steps, with its stepper.
-fn setup(resolution: u32, solver: Solver, refactor_iterations: u32) -> (World, Stepper) {
+fn setup(resolution: u32, solver: Solver, refactor_iterations: u32) -> Sheet {
     let mesh = drape::mesh::rectangle(1.0, 1.0, resolution, DiagonalPattern::Alternating)
         .expect("valid rectangle");
     let x = mesh.material.iter().map(|p| p.extend(1.0)).collect();
@@ -86,11 +86,40 @@ fn setup(resolution: u32, solver: Solver, refactor_iterations: u32) -> (World, S
             ..SolverSettings::default()
         },
     };
-    let mut stepper = Stepper::new(model, &world);
+    let stepper = Stepper::new(&model, &world);
+    let mut sheet = Sheet {
+        world,
+        model,
+        stepper,
+        warm_start: Vec::new(),
+    };
     for _ in 0..30 {
-        stepper.step(&mut world, DT).expect("solved");
+        sheet.step();
     }
-    (world, stepper)
+    sheet
+}
+
+/// A bench sheet: the world, its model, its stepper and the implicit warm start
+/// (the simulation state's, in a run).
+struct Sheet {
+    world: World,
+    model: Model,
+    stepper: Stepper,
+    warm_start: Vec<Vector>,
+}
+
+impl Sheet {
+    /// One implicit step of `DT`.
+    fn step(&mut self) {
+        self.stepper
+            .step(
+                &self.model,
+                black_box(&mut self.world),
+                &mut self.warm_start,
+                DT,
+            )
+            .expect("solved");
+    }
 }
 
 fn implicit_step(c: &mut Criterion) {
@@ -101,11 +130,11 @@ fn implicit_step(c: &mut Criterion) {
         .sample_size(10);
     for resolution in [63u32, 127] {
         for (label, solver, refactor) in CASES {
-            let (mut world, mut stepper) = setup(resolution, solver, refactor);
-            let vertices = world.mesh.vertex_count() as u64;
+            let mut sheet = setup(resolution, solver, refactor);
+            let vertices = sheet.world.mesh.vertex_count() as u64;
             group.throughput(Throughput::Elements(vertices));
             group.bench_function(BenchmarkId::new(label, vertices), |b| {
-                b.iter(|| stepper.step(black_box(&mut world), DT).expect("solved"))
+                b.iter(|| sheet.step())
             });
         }
     }
@@ -117,19 +146,19 @@ fn time_split() {
     println!("time split per step over 60 steps (after 30 warm-up steps), dt = 1/120 s:");
     for resolution in [63u32, 127] {
         for (label, solver, refactor) in CASES {
-            let (mut world, mut stepper) = setup(resolution, solver, refactor);
-            let before = stepper.stats;
+            let mut sheet = setup(resolution, solver, refactor);
+            let before = sheet.stepper.stats;
             let started = Instant::now();
             for _ in 0..60 {
-                stepper.step(&mut world, DT).expect("solved");
+                sheet.step();
             }
             let wall = started.elapsed().as_secs_f64();
-            let d = difference(&stepper.stats, &before);
+            let d = difference(&sheet.stepper.stats, &before);
             let ms = |s: f64| 1e3 * s / 60.0;
             println!(
                 "  {:>5} vertices {label:>17}: {:.2} ms/step = assembly {:.2} + factorization {:.2} + solve {:.2} + rest {:.2}; \
                  {:.2} factorizations, {:.2} CG iterations per step",
-                world.mesh.vertex_count(),
+                sheet.world.mesh.vertex_count(),
                 ms(wall),
                 ms(d.assembly_s),
                 ms(d.factorization_s),

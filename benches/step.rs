@@ -18,9 +18,17 @@ use drape::physics::{ExternalForces, MaterialParams, Model, Stepper};
 use drape::scene::{BendingModel, DiagonalPattern, Integrator, StiffnessRule};
 use drape::world::World;
 
+/// A bench sheet: its world, model, stepper and automatic step.
+struct Setup {
+    world: World,
+    model: Model,
+    stepper: Stepper,
+    dt: Scalar,
+}
+
 /// A free (unpinned) 1 m x 1 m sheet at `resolution`, gently rippled out of its
 /// plane so that no hinge is exactly flat, with its stepper and automatic step.
-fn setup(resolution: u32, bending_model: BendingModel) -> (World, Stepper, Scalar) {
+fn setup(resolution: u32, bending_model: BendingModel) -> Setup {
     let mesh = drape::mesh::rectangle(1.0, 1.0, resolution, DiagonalPattern::Alternating)
         .expect("valid rectangle");
     let x = mesh
@@ -47,9 +55,14 @@ fn setup(resolution: u32, bending_model: BendingModel) -> (World, Stepper, Scala
         cg_max_iterations: 500,
         solver: drape::physics::SolverSettings::default(),
     };
-    let stepper = Stepper::new(model, &world);
-    let dt = stepper.auto_dt(&world);
-    (world, stepper, dt)
+    let stepper = Stepper::new(&model, &world);
+    let dt = stepper.auto_dt(&model, &world);
+    Setup {
+        world,
+        model,
+        stepper,
+        dt,
+    }
 }
 
 /// Label of a bending model in benchmark ids.
@@ -74,13 +87,18 @@ fn step_default_pool(c: &mut Criterion) {
             BendingModel::Dihedral,
             BendingModel::ShapeOperator,
         ] {
-            let (mut world, mut stepper, dt) = setup(resolution, model);
+            let Setup {
+                mut world,
+                model: physics,
+                mut stepper,
+                dt,
+            } = setup(resolution, model);
             let vertices = world.mesh.vertex_count() as u64;
             group.throughput(Throughput::Elements(vertices));
             group.bench_function(BenchmarkId::new(label(model), vertices), |b| {
                 b.iter(|| {
                     stepper
-                        .step(black_box(&mut world), dt)
+                        .step(&physics, black_box(&mut world), &mut Vec::new(), dt)
                         .expect("explicit steps cannot fail")
                 })
             });
@@ -101,13 +119,18 @@ fn step_thread_scaling(c: &mut Criterion) {
             .num_threads(threads)
             .build()
             .expect("rayon pool");
-        let (mut world, mut stepper, dt) = setup(256, BendingModel::HingeSpring);
+        let Setup {
+            mut world,
+            model: physics,
+            mut stepper,
+            dt,
+        } = setup(256, BendingModel::HingeSpring);
         group.throughput(Throughput::Elements(world.mesh.vertex_count() as u64));
         group.bench_function(BenchmarkId::new("threads", threads), |b| {
             pool.install(|| {
                 b.iter(|| {
                     stepper
-                        .step(black_box(&mut world), dt)
+                        .step(&physics, black_box(&mut world), &mut Vec::new(), dt)
                         .expect("explicit steps cannot fail")
                 })
             })
@@ -124,10 +147,15 @@ fn consistency_check(spec: &str) {
     let (Some(Ok(resolution)), Some(Ok(steps))) = (parts.next(), parts.next()) else {
         panic!("DRAPE_BENCH_CHECK must be RES,STEPS, got {spec:?}");
     };
-    let (mut world, mut stepper, dt) = setup(resolution, BendingModel::HingeSpring);
+    let Setup {
+        mut world,
+        model: physics,
+        mut stepper,
+        dt,
+    } = setup(resolution, BendingModel::HingeSpring);
     for _ in 0..steps {
         stepper
-            .step(&mut world, dt)
+            .step(&physics, &mut world, &mut Vec::new(), dt)
             .expect("explicit steps cannot fail");
     }
     let n = world.x.len();

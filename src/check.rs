@@ -20,11 +20,11 @@ use crate::world::World;
 pub fn describe(scene: &Scene) -> Result<String, RunError> {
     let world = World::from_scene(scene)?;
     let model = Model::from_scene(scene);
-    let stepper = Stepper::new(model, &world);
+    let stepper = Stepper::new(&model, &world);
     let mut s = String::new();
     let _ = writeln!(s, "scene `{}`", scene.name);
     describe_cloth(&mut s, scene, &world, &stepper.elements);
-    let (ext, mat) = (&stepper.model.external, &stepper.model.material);
+    let (ext, mat) = (&model.external, &model.material);
     describe_forces(&mut s, &world, &stepper.elements, mat, ext);
     let adapt = AdaptConfig::from_scene(scene.adapt.as_ref());
     let collider = Collider::from_scene(scene)?;
@@ -39,7 +39,15 @@ pub fn describe(scene: &Scene) -> Result<String, RunError> {
     if let Some(a) = &adapt {
         describe_adapt(&mut s, scene, a);
     }
-    describe_time_step(&mut s, &scene.simulation, &stepper, &world, adapt.is_some());
+    let adaptive = adapt.is_some();
+    describe_time_step(
+        &mut s,
+        &scene.simulation,
+        &model,
+        &stepper,
+        &world,
+        adaptive,
+    );
     describe_pins(&mut s, scene, &world);
     Ok(s)
 }
@@ -223,6 +231,7 @@ fn describe_adapt(s: &mut String, scene: &Scene, a: &AdaptConfig) {
 fn describe_time_step(
     s: &mut String,
     sim: &Simulation,
+    model: &Model,
     stepper: &Stepper,
     world: &World,
     adaptive: bool,
@@ -235,11 +244,14 @@ fn describe_time_step(
                 Integrator::Implicit => "auto: implicit accuracy cap".to_string(),
                 _ if adaptive => format!(
                     "auto: stability estimate {:.3e} s on the initial mesh, recomputed whenever the mesh changes",
-                    stepper.auto_dt(world)
+                    stepper.auto_dt(model, world)
                 ),
-                _ => format!("auto: stability estimate {:.3e} s", stepper.auto_dt(world)),
+                _ => format!(
+                    "auto: stability estimate {:.3e} s",
+                    stepper.auto_dt(model, world)
+                ),
             };
-            (stepper.auto_dt(world), how)
+            (stepper.auto_dt(model, world), how)
         }
     };
     let (steps, dt) = fit_to_frame(target, interval);

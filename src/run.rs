@@ -19,7 +19,7 @@ pub use crate::sim::{
 use crate::math::{Scalar, Vector};
 use crate::record::{EdgeDisplay, LiveViewer, RecordError};
 use crate::scene::Scene;
-use crate::sim::{Pipeline, SimBuildError, SimState};
+use crate::sim::{SimBuildError, Simulation};
 use crate::summary::Summary;
 use crate::world::BuildError;
 
@@ -155,7 +155,7 @@ pub fn run_observed(
 /// validated: `drape run` builds it before opening any output).
 pub fn run_built(
     scene: &Scene,
-    sim: (SimState, Pipeline),
+    sim: Simulation,
     opts: &RunOptions,
     interrupt: &AtomicBool,
     progress: &mut (dyn FnMut(Progress) + Send),

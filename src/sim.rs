@@ -1,17 +1,24 @@
-//! One simulation as two values, in the manner of rapier's sets and pipeline:
+//! One simulation as three values, in the manner of rapier's parameters, sets and
+//! pipeline:
 //!
+//! - [`Model`]: the physics, fixed for the run (material, external forces,
+//!   integrator, solver settings). Every call that advances a state is given it.
 //! - [`SimState`]: everything a run's result depends on that changes as it runs
 //!   (mesh, positions, velocities, time, pins, the adaptive hierarchy, the resting
-//!   contacts, the work ledger and the counters). It is one cloneable value, so a
-//!   frame retry or a rollback is one `clone_from` and one restore.
+//!   contacts, the implicit solver's warm start, the work ledger and the counters).
+//!   It is one cloneable value, so a frame retry or a rollback is one `clone_from`
+//!   and one restore.
 //! - [`Pipeline`]: the machinery that advances a state by a step
-//!   ([`Pipeline::step`]) or a frame ([`Pipeline::advance_frame`]): the force model
-//!   and its element tables, the collision passes, the solver's factorization and
-//!   scratch memory. It holds no simulation state: it can be dropped and rebuilt
-//!   from the model and the state at any step ([`Pipeline::new`]). Only the implicit
-//!   solver's warm start and stored factorization are lost then; the next solve
-//!   starts cold and the result differs within the solve's tolerance
-//!   (`simulation.cg_tolerance`), not beyond it.
+//!   ([`Pipeline::step`]`(&model, &mut state, h)`) or a frame
+//!   ([`Pipeline::advance_frame`]): the element tables derived from the mesh, the
+//!   collision passes, the direct solver's stored factorization and scratch memory.
+//!   It holds no simulation state: it can be dropped and rebuilt from the model and
+//!   the state at any step ([`Pipeline::new`]). Only the stored factorization (the
+//!   direct solver's preconditioner, refreshed every `refactor_iterations`
+//!   iterations) is lost then; the next solve factors afresh and its result differs
+//!   within the solve's tolerance (`simulation.cg_tolerance`), not beyond it. With
+//!   `solver = "cg"` or an explicit integrator a rebuilt pipeline continues
+//!   bit-identically (test `sim::a_rebuilt_pipeline_continues_a_run_bit_identically`).
 //!
 //! A step is a short list of named phases, in [`Pipeline::step`]:
 //! **forces + integrate** (the stepper), **collide** (obstacles, then self-collision),
@@ -71,19 +78,29 @@ pub enum SimBuildError {
     Collide(#[from] CollideError),
 }
 
+/// A simulation ready to run: the model it integrates, its initial state and the
+/// pipeline that advances it (`pipeline.step(&model, &mut state, h)`).
+pub struct Simulation {
+    /// The physics, fixed for the run.
+    pub model: Model,
+    /// The state, at the start of the run.
+    pub state: SimState,
+    /// The machinery that advances the state (scratch only).
+    pub pipeline: Pipeline,
+}
+
 /// Builds the initial state and the pipeline of a specification. This is where a
 /// bad OBJ file or a pin that selects nothing is found, before any output is opened.
-pub fn build(spec: &SimSpec) -> Result<(SimState, Pipeline), SimBuildError> {
+pub fn build(spec: &SimSpec) -> Result<Simulation, SimBuildError> {
     let world = World::from_spec(&spec.cloth, &spec.pins)?;
     let adapter = spec.adapt.map(|c| Adapter::new(c, &world, spec.density));
     let collider = Collider::new(&spec.obstacles, spec.self_collision.as_ref())?;
-    let pipeline = Pipeline::new(
-        spec.model.clone(),
-        &world,
-        collider,
-        spec.fixed_dt,
-        spec.multirate,
-    );
-    let state = SimState::new(world, adapter, &pipeline);
-    Ok((state, pipeline))
+    let model = spec.model.clone();
+    let pipeline = Pipeline::new(&model, &world, collider, spec.fixed_dt, spec.multirate);
+    let state = SimState::new(&model, world, adapter, &pipeline);
+    Ok(Simulation {
+        model,
+        state,
+        pipeline,
+    })
 }

@@ -168,6 +168,14 @@ pub struct Adapter {
 /// Angle in degrees between the normals of the two triangles at each edge
 /// (0 at boundary edges).
 pub fn edge_angles(world: &World) -> Vec<Scalar> {
+    let mut angles = Vec::new();
+    edge_angles_into(world, &mut angles);
+    angles
+}
+
+/// [`edge_angles`] into `out` (its buffer reused: no allocation once it has
+/// grown to the mesh's edge count).
+pub fn edge_angles_into(world: &World, out: &mut Vec<Scalar>) {
     let (x, tris) = (&world.x, &world.mesh.triangles);
     let normal = |t: u32| {
         let [a, b, c] = tris[t as usize].map(|i| x[i as usize]);
@@ -185,7 +193,7 @@ pub fn edge_angles(world: &World) -> Vec<Scalar> {
             let (n0, n1) = (normal(e.triangles[0]), normal(e.triangles[1]));
             n0.cross(n1).length().atan2(n0.dot(n1)).to_degrees()
         })
-        .collect()
+        .collect_into_vec(out);
 }
 
 impl Adapter {
@@ -248,6 +256,44 @@ impl Adapter {
     /// Leaves the criterion asks to split, with the (largest) angle that asked,
     /// from angles measured on the world's current shape.
     pub fn refinement_marks(&self, world: &World, angles: &[Scalar]) -> Vec<(u32, Scalar)> {
+        debug_assert_eq!(
+            !self.refinement_marks_unchecked(world, angles).is_empty(),
+            self.needs_refinement(world, angles),
+            "needs_refinement disagrees with refinement_marks"
+        );
+        self.refinement_marks_unchecked(world, angles)
+    }
+
+    /// True when [`Adapter::refinement_marks`] would mark a leaf: the same rule,
+    /// checked edge by edge without allocating (paper A's rollback asks it after
+    /// every step, and nearly always gets no).
+    pub fn needs_refinement(&self, world: &World, angles: &[Scalar]) -> bool {
+        if self.edge.is_some() {
+            return false;
+        }
+        let sizing = self.config.criterion == AdaptCriterion::Sizing;
+        world.mesh.edges.iter().enumerate().any(|(e, edge)| {
+            let kappa = if sizing {
+                sizing::edge_curvature(world, edge, angles[e])
+            } else {
+                0.0
+            };
+            edge.triangles
+                .iter()
+                .filter(|&&t| t != crate::mesh::NO_TRIANGLE)
+                .any(|&t| {
+                    let leaf = self.owner[t as usize];
+                    let over = if sizing {
+                        self.sizing_wants_split(leaf, kappa)
+                    } else {
+                        angles[e] > self.config.refine_angle
+                    };
+                    over && self.may_split(leaf)
+                })
+        })
+    }
+
+    fn refinement_marks_unchecked(&self, world: &World, angles: &[Scalar]) -> Vec<(u32, Scalar)> {
         if self.edge.is_some() {
             return Vec::new(); // rollback is paper A's, with red_green only
         }
@@ -312,13 +358,28 @@ impl Adapter {
             return self.edge_pass(world, step, limits);
         }
         let angles = edge_angles(world);
+        self.pass_measured(world, step, &angles)
+    }
+
+    /// [`Adapter::pass`] given the world's current [`edge_angles`] (the rollback
+    /// check has just measured them): the same pass without measuring again.
+    pub fn pass_measured(
+        &mut self,
+        world: &mut World,
+        step: u64,
+        angles: &[Scalar],
+    ) -> Result<bool, MeshError> {
+        if let Some(limits) = self.edge {
+            return self.edge_pass(world, step, limits);
+        }
+        debug_assert_eq!(angles.len(), world.mesh.edges.len(), "stale edge angles");
         let (merges, splits) = match self.config.criterion {
             AdaptCriterion::Angle => (
-                self.merge_marks(world, &angles),
-                self.refinement_marks(world, &angles),
+                self.merge_marks(world, angles),
+                self.refinement_marks(world, angles),
             ),
             AdaptCriterion::Sizing => {
-                let curv = self.leaf_curvatures(world, &angles);
+                let curv = self.leaf_curvatures(world, angles);
                 let merges = self.sizing_merge_marks(&curv);
                 (merges, self.sizing_refinement_marks(&curv))
             }

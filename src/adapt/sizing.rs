@@ -71,7 +71,7 @@ use std::collections::HashMap;
 
 use super::Adapter;
 use crate::math::{Scalar, Vector2};
-use crate::mesh::NO_TRIANGLE;
+use crate::mesh::{Edge, NO_TRIANGLE};
 use crate::world::World;
 
 /// Centroid spacing of a material triangle, m: `4 A / (3 l_max)`, the distance
@@ -94,6 +94,20 @@ pub fn spacing(p: [Vector2; 3]) -> Scalar {
 /// the material centroids of the two triangles at it (0 at boundary edges).
 pub fn edge_curvatures(world: &World, angles: &[Scalar]) -> Vec<Scalar> {
     let m = &world.mesh;
+    m.edges
+        .iter()
+        .zip(angles)
+        .map(|(e, &deg)| edge_curvature(world, e, deg))
+        .collect()
+}
+
+/// Curvature across one edge of the world's mesh whose dihedral angle is `deg`
+/// degrees, rad/m (see [`edge_curvatures`]).
+pub fn edge_curvature(world: &World, e: &Edge, deg: Scalar) -> Scalar {
+    if !e.is_interior() || deg <= 0.0 {
+        return 0.0;
+    }
+    let m = &world.mesh;
     let centroid = |t: u32| {
         m.triangles[t as usize]
             .iter()
@@ -101,17 +115,8 @@ pub fn edge_curvatures(world: &World, angles: &[Scalar]) -> Vec<Scalar> {
             .sum::<Vector2>()
             / 3.0
     };
-    m.edges
-        .iter()
-        .zip(angles)
-        .map(|(e, &deg)| {
-            if !e.is_interior() || deg <= 0.0 {
-                return 0.0;
-            }
-            let d = centroid(e.triangles[0]).distance(centroid(e.triangles[1]));
-            if d > 0.0 { deg.to_radians() / d } else { 0.0 }
-        })
-        .collect()
+    let d = centroid(e.triangles[0]).distance(centroid(e.triangles[1]));
+    if d > 0.0 { deg.to_radians() / d } else { 0.0 }
 }
 
 /// Per leaf of the hierarchy: the largest curvature (rad/m) and the largest
@@ -151,15 +156,20 @@ impl Adapter {
     /// Leaves coarser than their target (`kappa * D > refine_angle`) that may
     /// still split, each with its largest measured angle (degrees).
     pub(super) fn sizing_refinement_marks(&self, curv: &LeafCurvature) -> Vec<(u32, Scalar)> {
-        let budget = self.config.refine_angle.to_radians();
         let mut marks: Vec<(u32, Scalar)> = curv
             .by_leaf
             .iter()
-            .filter(|&(&l, &(kappa, _))| kappa * self.node_spacing(l) > budget && self.may_split(l))
+            .filter(|&(&l, &(kappa, _))| self.sizing_wants_split(l, kappa) && self.may_split(l))
             .map(|(&l, &(_, angle))| (l, angle))
             .collect();
         marks.sort_by_key(|m| m.0);
         marks
+    }
+
+    /// True when leaf `l`, with curvature `kappa` (rad/m) measured at it, is
+    /// coarser than its target: `kappa * D > refine_angle`.
+    pub(super) fn sizing_wants_split(&self, l: u32, kappa: Scalar) -> bool {
+        kappa * self.node_spacing(l) > self.config.refine_angle.to_radians()
     }
 
     /// Parents whose four leaf children would, merged, still be finer than

@@ -28,9 +28,10 @@ pub fn scene_step(scene: &Scene) -> Result<Scalar, BenchError> {
         TimeStep::Fixed(dt) => dt,
         TimeStep::Auto => {
             let world = World::from_scene(scene).map_err(RunError::from)?;
-            let mut stepper = Stepper::new(Model::from_scene(scene), &world);
+            let model = Model::from_scene(scene);
+            let mut stepper = Stepper::new(&model, &world);
             stepper.multirate = false;
-            stepper.auto_dt(&world)
+            stepper.auto_dt(&model, &world)
         }
     };
     Ok(fit_to_frame(target, scene.simulation.frame_interval()).1)

@@ -6,8 +6,8 @@
 
 use rayon::prelude::*;
 
-use super::Stepper;
 use super::forces::{PAR_MIN, element_pass, gather};
+use super::{Model, Stepper};
 use crate::math::{Scalar, Vector};
 use crate::world::World;
 
@@ -21,18 +21,18 @@ pub struct Rk4Scratch {
 }
 
 /// One symplectic Euler step: `v += dt f(x, v) / m; x += dt v`.
-pub fn symplectic_euler(st: &mut Stepper, w: &mut World, dt: Scalar) {
+pub fn symplectic_euler(st: &mut Stepper, model: &Model, w: &mut World, dt: Scalar) {
     let t = w.time;
     w.pins.held_at(t, &mut st.held);
     element_pass(
         &st.elements,
-        &st.model.external,
+        &model.external,
         &w.mesh.triangles,
         &w.x,
         &w.v,
         &mut st.forces,
     );
-    let (el, ext, forces, held) = (&st.elements, &st.model.external, &st.forces, &st.held);
+    let (el, ext, forces, held) = (&st.elements, &model.external, &st.forces, &st.held);
     w.x.par_iter_mut()
         .zip(w.v.par_iter_mut())
         .enumerate()
@@ -48,7 +48,7 @@ pub fn symplectic_euler(st: &mut Stepper, w: &mut World, dt: Scalar) {
 }
 
 /// One classic fourth-order Runge-Kutta step on `(x, v)`.
-pub fn rk4(st: &mut Stepper, w: &mut World, dt: Scalar) {
+pub fn rk4(st: &mut Stepper, model: &Model, w: &mut World, dt: Scalar) {
     let t = w.time;
     let n = w.x.len();
     w.pins.held_at(t, &mut st.held);
@@ -67,14 +67,14 @@ pub fn rk4(st: &mut Stepper, w: &mut World, dt: Scalar) {
             };
             element_pass(
                 &st.elements,
-                &st.model.external,
+                &model.external,
                 &w.mesh.triangles,
                 xs,
                 vs,
                 &mut st.forces,
             );
         }
-        let (el, ext, forces, held) = (&st.elements, &st.model.external, &st.forces, &st.held);
+        let (el, ext, forces, held) = (&st.elements, &model.external, &st.forces, &st.held);
         let (x0, v0) = (&w.x, &w.v);
         let w_s = WEIGHT[stage];
         let c = if stage < 3 { NEXT[stage] * dt } else { 0.0 };

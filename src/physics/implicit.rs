@@ -69,7 +69,7 @@ use rayon::prelude::*;
 
 use super::forces::PAR_MIN;
 use super::shape::ShapeJacobian;
-use super::{Contact, Stepper};
+use super::{Contact, Model, Stepper};
 use crate::math::{Matrix3, Scalar, Vector, deterministic_sum};
 use crate::spec::Solver;
 use crate::world::World;
@@ -128,8 +128,9 @@ pub struct ImplicitScratch {
     inv_diag: Vec<Vector>,
     /// Right-hand side of the current linear solve.
     b: Vec<Vector>,
-    /// Solution of the current linear solve; on entry the first guess, with the
-    /// prescribed (pinned, contact-normal) parts already set.
+    /// Solution of the current linear solve; on entry the first guess (the
+    /// caller's warm start), with the prescribed (pinned, contact-normal) parts
+    /// already set.
     dv: Vec<Vector>,
     /// Per vertex: the contact normal whose direction is filtered out of the
     /// solve, or zero (see the module docs).
@@ -137,23 +138,29 @@ pub struct ImplicitScratch {
     /// Positions and velocities at the start of the step.
     x0: Vec<Vector>,
     v0: Vec<Vector>,
-    /// True when `dv` holds the previous step's solution on the same mesh, used
-    /// as the first guess (the velocity change varies slowly between steps).
-    warm: bool,
     cg: cg::CgScratch,
     assembled: assembled::AssembledScratch,
 }
 
 impl ImplicitScratch {
-    /// Forgets everything tied to the mesh (warm start, pattern, factorization).
+    /// Forgets everything tied to the mesh (pattern, factorization). The warm
+    /// start is simulation state, not scratch: its owner clears it.
     pub fn mesh_changed(&mut self) {
-        self.warm = false;
         self.assembled.mesh_changed();
     }
 }
 
-/// One backward Euler step (module docs).
-pub fn backward_euler(st: &mut Stepper, w: &mut World, h: Scalar) -> Result<(), SolveFailure> {
+/// One backward Euler step (module docs). `warm_start`: the last step's velocity
+/// change on the same mesh, the first guess of the solve (it varies slowly from
+/// step to step); empty or of another length, the solve starts from zero. The
+/// step's own velocity change is left there, whether or not it succeeded.
+pub fn backward_euler(
+    st: &mut Stepper,
+    model: &Model,
+    w: &mut World,
+    warm_start: &mut Vec<Vector>,
+    h: Scalar,
+) -> Result<(), SolveFailure> {
     let t = w.time;
     let n = w.x.len();
     w.pins.held_at(t, &mut st.held);
@@ -164,13 +171,14 @@ pub fn backward_euler(st: &mut Stepper, w: &mut World, h: Scalar) -> Result<(), 
         s.v0.clear();
         s.v0.extend_from_slice(&w.v);
     }
-    assemble(st, w, h, false);
+    assemble(st, model, w, h, false);
     let s = &mut st.implicit;
-    if !s.warm || s.dv.len() != n {
-        s.dv.clear();
+    s.dv.clear();
+    if warm_start.len() == n {
+        s.dv.extend_from_slice(warm_start);
+    } else {
+        s.dv.resize(n, Vector::ZERO);
     }
-    s.dv.resize(n, Vector::ZERO);
-    s.warm = true;
     // Prescribed velocity change of pinned vertices; the free ones start from
     // the previous step's solution.
     for a in &w.pins.anchors {
@@ -182,19 +190,27 @@ pub fn backward_euler(st: &mut Stepper, w: &mut World, h: Scalar) -> Result<(), 
     contact_filters(s, &st.contacts, &st.held, &w.v);
     // Taken out for the solve so that the solvers can borrow the stepper.
     let held = std::mem::take(&mut st.held);
-    let result = newton(st, w, h, &held);
+    let result = newton(st, model, w, h, &held);
     st.held = held;
+    warm_start.clear();
+    warm_start.extend_from_slice(&st.implicit.dv);
     result?;
     w.pins.apply(t + h, &mut w.x, &mut w.v);
     Ok(())
 }
 
 /// The Newton iterations of a step, the first one set up by the caller.
-fn newton(st: &mut Stepper, w: &mut World, h: Scalar, held: &[bool]) -> Result<(), SolveFailure> {
-    let settings = st.model.solver;
+fn newton(
+    st: &mut Stepper,
+    model: &Model,
+    w: &mut World,
+    h: Scalar,
+    held: &[bool],
+) -> Result<(), SolveFailure> {
+    let settings = model.solver;
     let reference = filtered_norm(&st.implicit, held);
     let single = settings.newton_iterations <= 1;
-    linear_solve(st, held, reference, single)?;
+    linear_solve(st, model, held, reference, single)?;
     st.stats.newton_iterations += 1;
     update_state(&st.implicit, w, h);
     if single {
@@ -202,7 +218,7 @@ fn newton(st: &mut Stepper, w: &mut World, h: Scalar, held: &[bool]) -> Result<(
     }
     let mut residual = Scalar::INFINITY;
     for k in 1..=settings.newton_iterations {
-        assemble(st, w, h, true);
+        assemble(st, model, w, h, true);
         residual = filtered_norm(&st.implicit, held) / reference.max(Scalar::MIN_POSITIVE);
         if residual <= settings.newton_tolerance || k == settings.newton_iterations {
             break;
@@ -210,7 +226,7 @@ fn newton(st: &mut Stepper, w: &mut World, h: Scalar, held: &[bool]) -> Result<(
         // The prescribed parts are already met: the correction is zero there.
         let s = &mut st.implicit;
         s.dv.iter_mut().for_each(|d| *d = Vector::ZERO);
-        linear_solve(st, held, reference, false)?;
+        linear_solve(st, model, held, reference, false)?;
         st.stats.newton_iterations += 1;
         let s = &mut st.implicit;
         // Accumulate into v (update_state expects dv relative to v0).
@@ -284,13 +300,14 @@ fn update_state(s: &ImplicitScratch, w: &mut World, h: Scalar) {
 /// contacts' normal impulses from the linear residual.
 fn linear_solve(
     st: &mut Stepper,
+    model: &Model,
     held: &[bool],
     reference: Scalar,
     contact_push: bool,
 ) -> Result<(), SolveFailure> {
-    match st.model.solver.solver {
-        Solver::Cg => cg::solve(st, held, reference, contact_push),
-        Solver::Direct => assembled::solve(st, held, reference, contact_push),
+    match model.solver.solver {
+        Solver::Cg => cg::solve(st, model, held, reference, contact_push),
+        Solver::Direct => assembled::solve(st, model, held, reference, contact_push),
     }
 }
 

@@ -2,7 +2,9 @@
 //!
 //! [`Model`] is the resolved, immutable physics of a scene; [`Stepper`] holds the
 //! force elements derived from the current mesh plus all scratch memory, and
-//! advances a [`World`] by one step with the chosen integrator.
+//! advances a [`World`] by one step of a model it is given with the model's
+//! integrator (the caller owns the model: the stepper holds no physics and no
+//! simulation state).
 
 pub mod bending;
 pub mod block;
@@ -136,11 +138,10 @@ pub struct Contact {
     pub normal_speed: Scalar,
 }
 
-/// Force elements of the current mesh plus scratch memory; no simulation state.
+/// Force elements of the current mesh plus scratch memory; no simulation state
+/// and no model (every call that needs the physics is given the [`Model`]).
 #[derive(Debug, Clone)]
 pub struct Stepper {
-    /// The physics being integrated.
-    pub model: Model,
     /// Springs, hinges and masses of the current mesh.
     pub elements: Elements,
     /// What has been done so far.
@@ -166,14 +167,13 @@ pub struct Stepper {
 
 impl Stepper {
     /// A stepper for `model` on the world's current mesh.
-    pub fn new(model: Model, world: &World) -> Stepper {
+    pub fn new(model: &Model, world: &World) -> Stepper {
         let elements = Elements::build_clamped(
             &world.mesh,
             &model.material,
             &world.pins.clamped(world.mesh.vertex_count()),
         );
         Stepper {
-            model,
             elements,
             stats: StepStats::default(),
             multirate: false,
@@ -188,11 +188,11 @@ impl Stepper {
         }
     }
 
-    /// Rebuilds the force elements after the world's mesh changed.
-    pub fn rebuild(&mut self, world: &World) {
+    /// Rebuilds the force elements of `model` after the world's mesh changed.
+    pub fn rebuild(&mut self, model: &Model, world: &World) {
         self.elements = Elements::build_clamped(
             &world.mesh,
-            &self.model.material,
+            &model.material,
             &world.pins.clamped(world.mesh.vertex_count()),
         );
         self.held.resize(world.mesh.vertex_count(), false);
@@ -202,20 +202,30 @@ impl Stepper {
         self.levels = None;
     }
 
-    /// Advances `world` by `dt` seconds with the model's integrator. An implicit step
-    /// whose equations could not be solved returns the reason; the world is then
-    /// left in an unspecified state and must be restored by the caller.
-    pub fn step(&mut self, world: &mut World, dt: Scalar) -> Result<(), SolveFailure> {
+    /// Advances `world` by `dt` seconds with `model`'s integrator. `warm_start`: the
+    /// implicit solver's first guess for the velocity change, one per vertex (the
+    /// last step's solution, part of the simulation state; empty or of another
+    /// length: start cold); the step leaves its own solution there. Explicit
+    /// integrators leave it untouched. An implicit step whose equations could not
+    /// be solved returns the reason; the world is then left in an unspecified
+    /// state and must be restored by the caller.
+    pub fn step(
+        &mut self,
+        model: &Model,
+        world: &mut World,
+        warm_start: &mut Vec<Vector>,
+        dt: Scalar,
+    ) -> Result<(), SolveFailure> {
         self.stats.steps += 1;
-        match self.model.integrator {
+        match model.integrator {
             Integrator::SymplecticEuler if self.multirate => {
-                multirate::symplectic_multirate(self, world, dt)
+                multirate::symplectic_multirate(self, model, world, dt)
             }
-            Integrator::SymplecticEuler => explicit::symplectic_euler(self, world, dt),
-            Integrator::Rk4 if self.multirate => multirate::rk4_multirate(self, world, dt),
-            Integrator::Rk4 => explicit::rk4(self, world, dt),
+            Integrator::SymplecticEuler => explicit::symplectic_euler(self, model, world, dt),
+            Integrator::Rk4 if self.multirate => multirate::rk4_multirate(self, model, world, dt),
+            Integrator::Rk4 => explicit::rk4(self, model, world, dt),
             Integrator::Implicit => {
-                if let Err(failure) = implicit::backward_euler(self, world, dt) {
+                if let Err(failure) = implicit::backward_euler(self, model, world, warm_start, dt) {
                     self.stats.failed_solves += 1;
                     if matches!(failure, SolveFailure::NotConverged { .. }) {
                         self.stats.cg_capped += 1;
@@ -228,19 +238,19 @@ impl Stepper {
         Ok(())
     }
 
-    /// Energies of the world's current state.
-    pub fn energy(&self, world: &World) -> Energy {
-        forces::energy(&self.elements, &self.model.external, &world.x, &world.v)
+    /// Energies of the world's current state under `model`.
+    pub fn energy(&self, model: &Model, world: &World) -> Energy {
+        forces::energy(&self.elements, &model.external, &world.x, &world.v)
     }
 
-    /// The automatic time step for this model on the current mesh (the macro
-    /// step when multirate).
-    pub fn auto_dt(&self, world: &World) -> Scalar {
-        if self.multirate && self.model.integrator != Integrator::Implicit {
-            let drag = self.model.external.drag.unwrap_or(0.0);
+    /// The automatic time step for `model` on the current mesh (the macro step
+    /// when multirate).
+    pub fn auto_dt(&self, model: &Model, world: &World) -> Scalar {
+        if self.multirate && model.integrator != Integrator::Implicit {
+            let drag = model.external.drag.unwrap_or(0.0);
             let macro_dt = multirate::Levels::build(&world.mesh, &self.elements, drag).macro_dt;
             // RK4's stability region reaches about 1.39 times further (timestep.rs).
-            let reach = if self.model.integrator == Integrator::Rk4 {
+            let reach = if model.integrator == Integrator::Rk4 {
                 1.39
             } else {
                 1.0
@@ -248,10 +258,10 @@ impl Stepper {
             return reach * macro_dt;
         }
         timestep::auto_dt(
-            self.model.integrator,
+            model.integrator,
             &world.mesh,
             &self.elements,
-            self.model.external.drag.unwrap_or(0.0),
+            model.external.drag.unwrap_or(0.0),
         )
     }
 }

@@ -29,12 +29,12 @@ use rayon::prelude::*;
 mod rk4;
 pub use rk4::rk4_multirate;
 
-use super::Stepper;
 use super::bending::dihedral_angle_and_gradient;
 use super::elements::Elements;
 use super::forces::{ForceScratch, gather, spring_force, wind_share};
 use super::shape::SHAPE_SLOTS;
 use super::timestep::{SAFETY, vertex_limits};
+use super::{Model, Stepper};
 use crate::math::{Scalar, Vector};
 use crate::mesh::Mesh;
 use crate::world::World;
@@ -194,21 +194,21 @@ fn touch(
 
 /// The stepper's levels, built for the current mesh if it has none (they are
 /// dropped when the mesh changes); the caller puts them back after the step.
-pub(super) fn take_levels(st: &mut Stepper, w: &World) -> Levels {
+pub(super) fn take_levels(st: &mut Stepper, model: &Model, w: &World) -> Levels {
     match st.levels.take() {
         Some(levels) => levels,
         None => {
-            let drag = st.model.external.drag.unwrap_or(0.0);
+            let drag = model.external.drag.unwrap_or(0.0);
             Levels::build(&w.mesh, &st.elements, drag)
         }
     }
 }
 
 /// One macro step of `big` seconds: each level in turn, finest first.
-pub fn symplectic_multirate(st: &mut Stepper, w: &mut World, big: Scalar) {
+pub fn symplectic_multirate(st: &mut Stepper, model: &Model, w: &mut World, big: Scalar) {
     let t = w.time;
     w.pins.held_at(t, &mut st.held);
-    let levels = take_levels(st, w);
+    let levels = take_levels(st, model, w);
     let mut rk = std::mem::take(&mut st.rk4_multirate);
     let scratch = &mut st.forces;
     let n_springs = st.elements.springs.len();
@@ -220,7 +220,7 @@ pub fn symplectic_multirate(st: &mut Stepper, w: &mut World, big: Scalar) {
         SHAPE_SLOTS * st.elements.shape_triangles.len(),
         Vector::ZERO,
     );
-    if st.model.external.wind.is_some() {
+    if model.external.wind.is_some() {
         scratch
             .triangle
             .resize(w.mesh.triangles.len(), Vector::ZERO);
@@ -237,7 +237,7 @@ pub fn symplectic_multirate(st: &mut Stepper, w: &mut World, big: Scalar) {
             let h = big / g.substeps as Scalar;
             level_forces(
                 &st.elements,
-                &st.model.external,
+                &model.external,
                 &w.mesh.triangles,
                 &w.x,
                 &w.v,
@@ -245,7 +245,7 @@ pub fn symplectic_multirate(st: &mut Stepper, w: &mut World, big: Scalar) {
                 scratch,
                 &mut rk.level,
             );
-            let (el, ext, held, forces) = (&st.elements, &st.model.external, &st.held, &*scratch);
+            let (el, ext, held, forces) = (&st.elements, &model.external, &st.held, &*scratch);
             g.vertices
                 .par_iter()
                 .with_min_len(256)

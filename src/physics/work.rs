@@ -15,8 +15,8 @@
 
 use rayon::prelude::*;
 
-use super::Stepper;
 use super::forces::{PAR_MIN, element_pass, gather, wind_share};
+use super::{Model, Stepper};
 use crate::math::{Scalar, Vector, deterministic_sum};
 use crate::spec::PinMotion;
 use crate::world::World;
@@ -32,8 +32,8 @@ pub struct PinnedStart {
 
 impl Stepper {
     /// Power of the wind and of moving air on the cloth, W (zero in still air).
-    pub fn air_power(&self, world: &World) -> Scalar {
-        let ext = &self.model.external;
+    pub fn air_power(&self, model: &Model, world: &World) -> Scalar {
+        let ext = &model.external;
         let el = &self.elements;
         let (x, v) = (&world.x, &world.v);
         let mut power = 0.0;
@@ -57,7 +57,7 @@ impl Stepper {
 
     /// The held vertices of moving pins with the cloth's force on them, at the start
     /// of a step (empty when no moving pin holds; then no force pass runs).
-    pub fn pinned_start(&mut self, world: &World) -> Vec<PinnedStart> {
+    pub fn pinned_start(&mut self, model: &Model, world: &World) -> Vec<PinnedStart> {
         let pins = &world.pins;
         let moving: Vec<u32> = pins
             .anchors
@@ -73,13 +73,13 @@ impl Stepper {
         }
         element_pass(
             &self.elements,
-            &self.model.external,
+            &model.external,
             &world.mesh.triangles,
             &world.x,
             &world.v,
             &mut self.forces,
         );
-        let (el, ext, scratch) = (&self.elements, &self.model.external, &self.forces);
+        let (el, ext, scratch) = (&self.elements, &model.external, &self.forces);
         moving
             .par_iter()
             .with_min_len(PAR_MIN)

@@ -9,9 +9,10 @@ use super::tally::{Tally, TallyEnd};
 use super::{FrameState, Progress, RunError, RunOptions};
 use crate::adapt::Adapter;
 use crate::math::{Scalar, Vector};
+use crate::physics::Model;
 use crate::record::{RecordError, RecordTarget, Recorder, obj::write_frame_obj};
 use crate::scene::Scene;
-use crate::sim::{FrameFailed, MAX_STEP_HALVINGS, Pipeline, SimState, StepFailure};
+use crate::sim::{FrameFailed, MAX_STEP_HALVINGS, Pipeline, SimState, Simulation, StepFailure};
 use crate::summary::Summary;
 
 /// A run in progress: the simulation, its outputs and its running statistics.
@@ -20,6 +21,7 @@ use crate::summary::Summary;
 /// the summary.
 pub struct FrameLoop<'a> {
     scene: &'a Scene,
+    model: Model,
     state: SimState,
     pipeline: Pipeline,
     recorder: Option<Recorder>,
@@ -54,11 +56,11 @@ struct FrameFailure {
 }
 
 impl<'a> FrameLoop<'a> {
-    /// A run of `scene` from the built simulation `(state, pipeline)`
-    /// ([`crate::sim::build`]); opens the recording and the OBJ directory.
+    /// A run of `scene` from the built simulation ([`crate::sim::build`]); opens
+    /// the recording and the OBJ directory.
     pub fn new(
         scene: &'a Scene,
-        (state, pipeline): (SimState, Pipeline),
+        sim: Simulation,
         opts: &RunOptions,
     ) -> Result<FrameLoop<'a>, RunError> {
         let recorder = match (&opts.record, &opts.live) {
@@ -83,9 +85,15 @@ impl<'a> FrameLoop<'a> {
             })?;
         }
         let frames = scene.simulation.frame_count();
-        let tally = Tally::new(&state.world, pipeline.stepper());
+        let Simulation {
+            model,
+            state,
+            pipeline,
+        } = sim;
+        let tally = Tally::new(&model, &state.world, pipeline.stepper());
         Ok(FrameLoop {
             scene,
+            model,
             state,
             pipeline,
             recorder,
@@ -134,7 +142,7 @@ impl<'a> FrameLoop<'a> {
         let t0 = Instant::now();
         match self
             .pipeline
-            .advance_frame(&mut self.state, self.frame_interval)
+            .advance_frame(&self.model, &mut self.state, self.frame_interval)
         {
             Ok(_) => {}
             Err(FrameFailed::Steps {
@@ -168,7 +176,7 @@ impl<'a> FrameLoop<'a> {
         observe: &mut (dyn FnMut(&FrameState) + Send),
     ) -> Result<(), RunError> {
         let world = &self.state.world;
-        let energy = self.pipeline.stepper().energy(world);
+        let energy = self.pipeline.stepper().energy(&self.model, world);
         self.tally.observe(world, energy);
         observe(&FrameState {
             frame: self.frame,
@@ -207,11 +215,14 @@ impl<'a> FrameLoop<'a> {
         };
         let snap = Snapshot {
             frame: self.frame,
-            energy: self.pipeline.stepper().energy(&self.state.world),
+            energy: self
+                .pipeline
+                .stepper()
+                .energy(&self.model, &self.state.world),
             timing: self.timing,
         };
         let (state, pipeline) = (&mut self.state, &mut self.pipeline);
-        recording::record_state(rec, state, pipeline, &snap, &mut self.normals)?;
+        recording::record_state(rec, &self.model, state, pipeline, &snap, &mut self.normals)?;
         self.recorded_frames += 1;
         self.last_recorded = Some(self.frame);
         Ok(())
@@ -246,8 +257,8 @@ impl<'a> FrameLoop<'a> {
                 dt: f.last_dt,
                 cause: format!(
                     "step {:.3e} s with the {:?} integrator; try a smaller `simulation.dt`, `dt = \"auto\"`, or `integrator = \"implicit\"`{}",
-                    self.pipeline.step_size(&self.state.world),
-                    self.pipeline.stepper().model.integrator,
+                    self.pipeline.step_size(&self.model, &self.state.world),
+                    self.model.integrator,
                     solver_hint(&f.what)
                 ),
                 summary: Box::new(summary),
@@ -260,7 +271,7 @@ impl<'a> FrameLoop<'a> {
         let dt = if state.effort.min_dt.is_finite() {
             state.effort.min_dt
         } else {
-            pipe.step_size(&state.world)
+            pipe.step_size(&self.model, &state.world)
         };
         let stepper = pipe.stepper();
         self.tally.finish(TallyEnd {
@@ -278,11 +289,7 @@ impl<'a> FrameLoop<'a> {
             cusick: pipe
                 .collider()
                 .and_then(|c| c.cusick(self.scene, &state.world)),
-            cantilever: crate::cantilever::for_run(
-                self.scene,
-                &state.world,
-                &stepper.model.material,
-            ),
+            cantilever: crate::cantilever::for_run(self.scene, &state.world, &self.model.material),
         })
     }
 }

@@ -3,7 +3,7 @@
 
 use crate::adapt::{AdaptEvent, Adapter, EventKind, edge_angles};
 use crate::math::Scalar;
-use crate::physics::Energy;
+use crate::physics::{Energy, Model};
 use crate::record::{EventMark, FrameView, Recorder};
 use crate::sim::{Pipeline, SimState};
 
@@ -35,6 +35,7 @@ pub(super) struct Snapshot {
 /// recorded frame).
 pub(super) fn record_state(
     rec: &mut Recorder,
+    model: &Model,
     state: &mut SimState,
     pipe: &mut Pipeline,
     snap: &Snapshot,
@@ -51,7 +52,7 @@ pub(super) fn record_state(
     let edges: Vec<[u32; 2]> = world.mesh.edges.iter().map(|e| e.vertices).collect();
     world.vertex_normals(normals);
     let pinned: Vec<u32> = world.pins.anchors.iter().map(|a| a.vertex).collect();
-    let dt_now = pipe.step_size(world);
+    let dt_now = pipe.step_size(model, world);
     let e = snap.energy;
     let mut scalars = vec![
         ("mesh/vertices", world.x.len() as f64),

@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use crate::math::Scalar;
-use crate::physics::{Energy, Stepper};
+use crate::physics::{Energy, Model, Stepper};
 use crate::sim::SimState;
 use crate::summary::{EnergySummary, Range, RecordingSummary, Summary};
 use crate::world::World;
@@ -38,8 +38,8 @@ pub(super) struct TallyEnd<'a> {
 }
 
 impl Tally {
-    pub(super) fn new(world: &World, stepper: &Stepper) -> Tally {
-        let e = stepper.energy(world).total();
+    pub(super) fn new(model: &Model, world: &World, stepper: &Stepper) -> Tally {
+        let e = stepper.energy(model, world).total();
         Tally {
             vertices: Range::empty(),
             triangles: Range::empty(),

@@ -1,7 +1,7 @@
 //! The energy bound a step is held to, and why a step is rejected.
 
 use crate::math::{Scalar, Vector, deterministic_sum};
-use crate::physics::{SolveFailure, Stepper};
+use crate::physics::{Model, SolveFailure, Stepper};
 use crate::world::World;
 
 /// A step "explodes" when the cloth's kinetic plus gravitational energy exceeds the
@@ -51,16 +51,11 @@ pub struct EnergyBound {
 }
 
 impl EnergyBound {
-    /// The bound of a run starting from `world`.
-    pub fn new(world: &World, stepper: &Stepper) -> EnergyBound {
-        let e = stepper.energy(world);
+    /// The bound of a run of `model` starting from `world`.
+    pub fn new(world: &World, stepper: &Stepper, model: &Model) -> EnergyBound {
+        let e = stepper.energy(model, world);
         let mass = stepper.elements.total_mass();
-        let g = stepper
-            .model
-            .external
-            .gravity
-            .unwrap_or(Vector::ZERO)
-            .length();
+        let g = model.external.gravity.unwrap_or(Vector::ZERO).length();
         let (lo, hi) = world
             .x
             .iter()
@@ -79,9 +74,15 @@ impl EnergyBound {
     /// so far. Elastic energy is left out (it is never negative, so the test stays
     /// sound) because it costs a pass over every element, where this costs one over
     /// the vertices.
-    pub fn check(&self, world: &World, stepper: &Stepper, work: Scalar) -> Result<(), StepFailure> {
+    pub fn check(
+        &self,
+        world: &World,
+        stepper: &Stepper,
+        model: &Model,
+        work: Scalar,
+    ) -> Result<(), StepFailure> {
         let mass = &stepper.elements.mass;
-        let g = stepper.model.external.gravity.unwrap_or(Vector::ZERO);
+        let g = model.external.gravity.unwrap_or(Vector::ZERO);
         let energy = deterministic_sum(world.x.len(), |i| {
             mass[i] * (0.5 * world.v[i].length_squared() - g.dot(world.x[i]))
         });

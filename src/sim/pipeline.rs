@@ -2,7 +2,7 @@
 
 use super::bound::is_finite;
 use super::{SimState, StepFailure};
-use crate::adapt::edge_angles;
+use crate::adapt::edge_angles_into;
 use crate::collide::{Collider, StepCloth};
 use crate::math::{Scalar, Vector};
 use crate::mesh::MeshError;
@@ -61,6 +61,12 @@ pub struct Pipeline {
     frame_start: Option<SimState>,
     /// The step's start, kept for paper A's rollback.
     step_start: StepStart,
+    /// The edge angles of the state as the rollback check last measured it
+    /// (buffer reused step to step).
+    angles: Vec<Scalar>,
+    /// True while `angles` are those of the state's current positions and mesh
+    /// (the adaptation pass after an accepted step then reuses them).
+    angles_fresh: bool,
 }
 
 /// What a rollback restores: the step's start positions, velocities, time and
@@ -76,8 +82,10 @@ struct StepStart {
 impl Pipeline {
     /// The pipeline of a run with `model` on `world`'s mesh. `fixed_dt`: the
     /// scene's step (`None`: automatic); `multirate`: paper A's multirate stepping.
+    /// The pipeline does not keep the model: every call that advances a state is
+    /// given it.
     pub fn new(
-        model: Model,
+        model: &Model,
         world: &World,
         collider: Option<Collider>,
         fixed_dt: Option<Scalar>,
@@ -94,6 +102,8 @@ impl Pipeline {
             failure: StepFailure::NonFinite,
             frame_start: None,
             step_start: StepStart::default(),
+            angles: Vec::new(),
+            angles_fresh: false,
         }
     }
 
@@ -121,6 +131,7 @@ impl Pipeline {
     /// of halvings spent.
     pub fn advance_frame(
         &mut self,
+        model: &Model,
         state: &mut SimState,
         frame_interval: Scalar,
     ) -> Result<u64, FrameFailed> {
@@ -131,26 +142,28 @@ impl Pipeline {
             }
             None => state.clone(),
         };
-        let result = self.retry_frame(state, &start, frame_interval);
+        let result = self.retry_frame(model, state, &start, frame_interval);
         self.frame_start = Some(start);
         result
     }
 
     fn retry_frame(
         &mut self,
+        model: &Model,
         state: &mut SimState,
         start: &SimState,
         frame_interval: Scalar,
     ) -> Result<u64, FrameFailed> {
         let t0 = state.world.time;
         // E - W at the frame start: without numerical error it can only fall.
-        let balance_start = self.stepper.energy(&state.world).total() - state.ledger.work();
+        let balance_start = self.stepper.energy(model, &state.world).total() - state.ledger.work();
         let mut last_gain = Scalar::INFINITY;
         for halving in 0..=MAX_STEP_HALVINGS {
-            let healthy = self.steps_through(state, frame_interval, halving)?;
+            let healthy = self.steps_through(model, state, frame_interval, halving)?;
             state.world.time = t0 + frame_interval;
             if healthy {
-                let balance = self.stepper.energy(&state.world).total() - state.ledger.work();
+                let balance =
+                    self.stepper.energy(model, &state.world).total() - state.ledger.work();
                 let gain = balance - balance_start;
                 let retry = gain > ENERGY_GAIN_TOLERANCE * state.ledger.bound.scale
                     && halving < MAX_ENERGY_HALVINGS
@@ -165,9 +178,9 @@ impl Pipeline {
                 state.effort.energy_retries += 1;
             }
             state.restore(start);
-            self.mesh_changed(state);
+            self.mesh_changed(model, state);
         }
-        let last_dt = self.step_size(&state.world) / (1u64 << MAX_STEP_HALVINGS) as Scalar;
+        let last_dt = self.step_size(model, &state.world) / (1u64 << MAX_STEP_HALVINGS) as Scalar;
         Err(FrameFailed::Steps {
             last_dt,
             failure: self.failure,
@@ -180,6 +193,7 @@ impl Pipeline {
     /// False when a step was rejected.
     fn steps_through(
         &mut self,
+        model: &Model,
         state: &mut SimState,
         frame_interval: Scalar,
         halving: u32,
@@ -188,9 +202,9 @@ impl Pipeline {
         let mut done = 0.0;
         while done < frame_interval * (1.0 - 1e-12) {
             let remaining = frame_interval - done;
-            let target = self.step_size(&state.world) / shrink;
+            let target = self.step_size(model, &state.world) / shrink;
             let h = remaining / (remaining / target * (1.0 - 1e-12)).ceil().max(1.0);
-            if !self.step(state, h)? {
+            if !self.step(model, state, h)? {
                 return Ok(false);
             }
             state.effort.min_dt = state.effort.min_dt.min(h);
@@ -199,14 +213,14 @@ impl Pipeline {
         Ok(true)
     }
 
-    /// The step for the current mesh: the fixed one, or the automatic estimate.
-    pub fn step_size(&mut self, world: &World) -> Scalar {
+    /// The step for the current mesh: the fixed one, or `model`'s automatic estimate.
+    pub fn step_size(&mut self, model: &Model, world: &World) -> Scalar {
         if let Some(dt) = self.fixed_dt {
             return dt;
         }
         *self
             .auto_dt
-            .get_or_insert_with(|| self.stepper.auto_dt(world))
+            .get_or_insert_with(|| self.stepper.auto_dt(model, world))
     }
 
     /// One step of `h` seconds, in phases: forces + integrate, collide, account,
@@ -214,7 +228,12 @@ impl Pipeline {
     /// step on a refined mesh when it bent past the upper threshold), adapt.
     /// Returns false when the step was rejected ([`Pipeline::failure`] says why);
     /// the state is then not restored (the frame retry does that).
-    pub fn step(&mut self, state: &mut SimState, h: Scalar) -> Result<bool, MeshError> {
+    pub fn step(
+        &mut self,
+        model: &Model,
+        state: &mut SimState,
+        h: Scalar,
+    ) -> Result<bool, MeshError> {
         debug_assert_eq!(
             self.stepper.elements.mass.len(),
             state.world.x.len(),
@@ -223,36 +242,42 @@ impl Pipeline {
         let rollback = state.adapter.as_ref().is_some_and(|a| a.config.rollback);
         let mut tries = 0;
         loop {
+            self.angles_fresh = false;
             if rollback {
                 self.remember_step_start(state);
             }
-            if let Err(why) = self.attempt(state, h) {
+            if let Err(why) = self.attempt(model, state, h) {
                 self.failure = why;
                 return Ok(false);
             }
-            if rollback && self.rollback(state, &mut tries)? {
+            if rollback && self.rollback(model, state, &mut tries)? {
                 continue;
             }
             break;
         }
         state.ledger.steps_done += 1;
-        self.adapt(state)?;
+        self.adapt(model, state)?;
         Ok(true)
     }
 
     /// The phases of one attempt at a step: forces + integrate, collide, account,
     /// health check. The contacts the last step ended in go to the implicit solve
     /// (filtered there, see [`crate::physics::implicit`]).
-    fn attempt(&mut self, state: &mut SimState, h: Scalar) -> Result<(), StepFailure> {
+    fn attempt(
+        &mut self,
+        model: &Model,
+        state: &mut SimState,
+        h: Scalar,
+    ) -> Result<(), StepFailure> {
         let air0 = match self.air_power.take() {
             Some(p) => p,
-            None => self.stepper.air_power(&state.world),
+            None => self.stepper.air_power(model, &state.world),
         };
-        let pinned = self.stepper.pinned_start(&state.world);
-        self.integrate(state, h)?;
-        self.collide(state, h)?;
+        let pinned = self.stepper.pinned_start(model, &state.world);
+        self.integrate(model, state, h)?;
+        self.collide(model, state, h)?;
         // Account: the work of the air (trapezoid over the step) and of moving pins.
-        let air1 = self.stepper.air_power(&state.world);
+        let air1 = self.stepper.air_power(model, &state.world);
         self.air_power = Some(air1);
         state.ledger.external_work +=
             0.5 * h * (air0 + air1) + self.stepper.pin_work(&pinned, &state.world, h);
@@ -260,19 +285,27 @@ impl Pipeline {
         state
             .ledger
             .bound
-            .check(&state.world, &self.stepper, state.ledger.work())
+            .check(&state.world, &self.stepper, model, state.ledger.work())
     }
 
-    /// Forces + integrate: the stepper's step from the state's positions, velocities
-    /// and resting contacts; its counters go to the state's [`super::Effort`].
-    fn integrate(&mut self, state: &mut SimState, h: Scalar) -> Result<(), StepFailure> {
+    /// Forces + integrate: the stepper's step from the state's positions, velocities,
+    /// resting contacts and warm start; its counters go to the state's
+    /// [`super::Effort`].
+    fn integrate(
+        &mut self,
+        model: &Model,
+        state: &mut SimState,
+        h: Scalar,
+    ) -> Result<(), StepFailure> {
         if let Some(c) = self.collider.as_mut() {
             c.begin_step(&state.world);
             // Resting contacts from the last step: the vertices are on the surface now.
             self.stepper.contacts.clear();
             self.stepper.contacts.extend_from_slice(&state.contacts);
         }
-        let solved = self.stepper.step(&mut state.world, h);
+        let solved = self
+            .stepper
+            .step(model, &mut state.world, &mut state.warm_start, h);
         absorb(&mut state.effort.solver, &mut self.stepper.stats);
         solved.map_err(StepFailure::Solver)?;
         if !is_finite(&state.world.x) {
@@ -283,7 +316,12 @@ impl Pipeline {
 
     /// Collide: obstacles, then self-collision; the contacts found become the
     /// state's resting contacts.
-    fn collide(&mut self, state: &mut SimState, h: Scalar) -> Result<(), StepFailure> {
+    fn collide(
+        &mut self,
+        model: &Model,
+        state: &mut SimState,
+        h: Scalar,
+    ) -> Result<(), StepFailure> {
         let Some(c) = self.collider.as_mut() else {
             return Ok(());
         };
@@ -292,7 +330,7 @@ impl Pipeline {
         state
             .ledger
             .bound
-            .check(&state.world, &self.stepper, work)?;
+            .check(&state.world, &self.stepper, model, work)?;
         let cloth = StepCloth {
             pushed: &self.stepper.contact_push,
             mass: &self.stepper.elements.mass,
@@ -314,17 +352,27 @@ impl Pipeline {
     /// Rollback (paper A): when the step bent an edge past the upper threshold and
     /// rollbacks are left, restores the step's start (positions, velocities, time,
     /// ledger), refines the marked edges and returns true (redo the step).
-    fn rollback(&mut self, state: &mut SimState, tries: &mut u32) -> Result<bool, MeshError> {
+    fn rollback(
+        &mut self,
+        model: &Model,
+        state: &mut SimState,
+        tries: &mut u32,
+    ) -> Result<bool, MeshError> {
         let Some(ad) = state.adapter.as_mut() else {
             return Ok(false);
         };
         if *tries >= ad.config.max_rollbacks {
             return Ok(false);
         }
-        let marks = ad.refinement_marks(&state.world, &edge_angles(&state.world));
-        if marks.is_empty() {
+        edge_angles_into(&state.world, &mut self.angles);
+        self.angles_fresh = true;
+        // Nearly every step bends no edge past the threshold: answered without
+        // allocating; the marks are collected only for a rollback.
+        if !ad.needs_refinement(&state.world, &self.angles) {
             return Ok(false);
         }
+        let marks = ad.refinement_marks(&state.world, &self.angles);
+        self.angles_fresh = false;
         let s = &mut self.step_start;
         std::mem::swap(&mut state.world.x, &mut s.x);
         std::mem::swap(&mut state.world.v, &mut s.v);
@@ -335,32 +383,55 @@ impl Pipeline {
         }
         ad.note_rollback(&state.world, state.ledger.steps_done);
         ad.refine(&mut state.world, &marks, state.ledger.steps_done)?;
-        self.mesh_changed(state);
+        self.mesh_changed(model, state);
         *tries += 1;
         Ok(true)
     }
 
-    /// Adapt: the remeshing pass, every `adapt.every` accepted steps.
-    fn adapt(&mut self, state: &mut SimState) -> Result<(), MeshError> {
-        if let Some(ad) = state.adapter.as_mut()
-            && state.ledger.steps_done.is_multiple_of(ad.config.every)
-            && ad.pass(&mut state.world, state.ledger.steps_done)?
-        {
-            self.mesh_changed(state);
+    /// Adapt: the remeshing pass, every `adapt.every` accepted steps (reusing the
+    /// edge angles the rollback check measured on the same state).
+    fn adapt(&mut self, model: &Model, state: &mut SimState) -> Result<(), MeshError> {
+        let Some(ad) = state.adapter.as_mut() else {
+            return Ok(());
+        };
+        if !state.ledger.steps_done.is_multiple_of(ad.config.every) {
+            return Ok(());
+        }
+        let step = state.ledger.steps_done;
+        let changed = if self.angles_fresh {
+            ad.pass_measured(&mut state.world, step, &self.angles)?
+        } else {
+            ad.pass(&mut state.world, step)?
+        };
+        self.angles_fresh = false;
+        if changed {
+            self.mesh_changed(model, state);
         }
         Ok(())
     }
 
-    /// After the state's mesh changed (remeshing, or a restored start): rebuilds the
-    /// force elements and forgets the step size, the air power and the (now stale)
-    /// contacts. The pipeline calls it after its own remeshing and restores; call it
-    /// before stepping a state whose mesh was changed or restored outside the
-    /// pipeline, or a state the pipeline was not built for.
-    pub fn mesh_changed(&mut self, state: &mut SimState) {
-        self.stepper.rebuild(&state.world);
+    /// Makes the pipeline that of `state`'s mesh under `model`: rebuilds the element
+    /// tables and forgets every cache (step size, air power, stored factorization).
+    /// The state is not touched, so a state saved from another pipeline continues
+    /// exactly as it would have there (its contacts and warm start are its own).
+    /// Call it before stepping a state this pipeline was not built for.
+    pub fn attach(&mut self, model: &Model, state: &SimState) {
+        self.stepper.rebuild(model, &state.world);
         self.auto_dt = None;
         self.air_power = None;
+        self.angles_fresh = false;
+    }
+
+    /// After the state's mesh changed (remeshing, or a restored start): rebuilds
+    /// `model`'s force elements and forgets the step size, the air power, and the
+    /// state's (now stale) contacts and warm start. The pipeline calls it after its
+    /// own remeshing and restores; call it after changing a state's mesh outside the
+    /// pipeline (for a state saved elsewhere, whose contacts and warm start still
+    /// fit its mesh, [`Pipeline::attach`] keeps them).
+    pub fn mesh_changed(&mut self, model: &Model, state: &mut SimState) {
+        self.attach(model, state);
         state.contacts.clear();
+        state.warm_start.clear();
     }
 }
 

@@ -2,8 +2,8 @@
 
 use crate::adapt::Adapter;
 use crate::collide::CollisionStats;
-use crate::math::Scalar;
-use crate::physics::{Contact, StepStats};
+use crate::math::{Scalar, Vector};
+use crate::physics::{Contact, Model, StepStats};
 use crate::world::World;
 
 use super::{EnergyBound, Pipeline};
@@ -24,6 +24,12 @@ pub struct SimState {
     /// the first step, after a remesh, or without obstacles); the next implicit
     /// step filters them (see [`crate::physics::implicit`]).
     pub contacts: Vec<Contact>,
+    /// The implicit solver's first guess for the next step: the last step's
+    /// velocity change, one per vertex (empty before the first implicit step,
+    /// after a remesh or a restored frame start, or with explicit integrators).
+    /// State rather than scratch: it steers the next solve, so a pipeline rebuilt
+    /// from this state continues exactly as the old one would have.
+    pub warm_start: Vec<Vector>,
     /// The energy accounting and the accepted steps.
     pub ledger: Ledger,
     /// What the computer did, retried work included.
@@ -80,13 +86,19 @@ impl Default for Effort {
 }
 
 impl SimState {
-    /// The state at the start of a run (no steps taken) on `world`.
-    pub fn new(world: World, adapter: Option<Adapter>, pipeline: &Pipeline) -> SimState {
-        let bound = EnergyBound::new(&world, pipeline.stepper());
+    /// The state at the start of a run of `model` (no steps taken) on `world`.
+    pub fn new(
+        model: &Model,
+        world: World,
+        adapter: Option<Adapter>,
+        pipeline: &Pipeline,
+    ) -> SimState {
+        let bound = EnergyBound::new(&world, pipeline.stepper(), model);
         SimState {
             world,
             adapter,
             contacts: Vec::new(),
+            warm_start: Vec::new(),
             ledger: Ledger {
                 steps_done: 0,
                 external_work: 0.0,
@@ -113,19 +125,21 @@ impl Clone for SimState {
             world: self.world.clone(),
             adapter: self.adapter.clone(),
             contacts: self.contacts.clone(),
+            warm_start: self.warm_start.clone(),
             ledger: self.ledger,
             effort: self.effort,
         }
     }
 
-    /// Reuses the position, velocity and contact buffers: the frame retry saves a
-    /// state every frame.
+    /// Reuses the position, velocity, contact and warm-start buffers: the frame
+    /// retry saves a state every frame.
     fn clone_from(&mut self, source: &SimState) {
         // Destructured so that a new field cannot be forgotten here.
         let SimState {
             world,
             adapter,
             contacts,
+            warm_start,
             ledger,
             effort,
         } = source;
@@ -143,6 +157,7 @@ impl Clone for SimState {
         self.world.pins.clone_from(pins);
         self.adapter.clone_from(adapter);
         self.contacts.clone_from(contacts);
+        self.warm_start.clone_from(warm_start);
         self.ledger = *ledger;
         self.effort = *effort;
     }

@@ -16,7 +16,7 @@ use std::path::Path;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 use drape::scene::load_scene_file;
-use drape::sim::build;
+use drape::sim::{Simulation, build};
 
 struct Counting;
 
@@ -87,8 +87,12 @@ const WARM_FRAME: f64 = 1.0 / 30.0;
 fn allocations(scene: &str, overrides: &[&str], warm: usize, steps: usize) -> Count {
     let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
     let scene = load_scene_file(Path::new(scene), &overrides).expect("scene");
-    let (mut state, mut pipe) = build(&scene.resolve().expect("resolve")).expect("build");
-    let h = pipe.step_size(&state.world);
+    let Simulation {
+        model,
+        mut state,
+        pipeline: mut pipe,
+    } = build(&scene.resolve().expect("resolve")).expect("build");
+    let h = pipe.step_size(&model, &state.world);
     let base_vertices = state.world.x.len();
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
@@ -96,20 +100,35 @@ fn allocations(scene: &str, overrides: &[&str], warm: usize, steps: usize) -> Co
         .expect("pool");
     pool.install(|| {
         for _ in 0..warm {
-            pipe.advance_frame(&mut state, WARM_FRAME)
+            pipe.advance_frame(&model, &mut state, WARM_FRAME)
                 .expect("warm-up frame");
         }
         // Adaptive cases: the mesh adapted during the warm-up and is now frozen
-        // (remeshing allocates the new mesh and elements by design).
+        // (remeshing allocates the new mesh and elements by design). With paper
+        // A's rollback the check still runs after every step, in full (no edge
+        // can pass an infinite threshold, so it never stops early and never
+        // refines).
+        let mut rollback_checked = false;
         if let Some(a) = state.adapter.as_mut() {
             a.config.every = u64::MAX;
+            if a.config.rollback && a.config.max_rollbacks > 0 {
+                a.config.refine_angle = f64::INFINITY;
+                rollback_checked = true;
+            }
         }
+        // One step on the frozen mesh before counting: the warm-up's last step
+        // may have remeshed, and the solver builds its tables for a new mesh
+        // lazily, on its first solve.
+        assert!(
+            pipe.step(&model, &mut state, h).expect("remesh"),
+            "step rejected"
+        );
         ALLOCATIONS.store(0, Ordering::Relaxed);
         BYTES.store(0, Ordering::Relaxed);
         let before = state.ledger.collision;
         COUNTING.store(true, Ordering::Relaxed);
         for _ in 0..steps {
-            let ok = pipe.step(&mut state, h).expect("remesh");
+            let ok = pipe.step(&model, &mut state, h).expect("remesh");
             assert!(ok, "step rejected");
         }
         COUNTING.store(false, Ordering::Relaxed);
@@ -121,6 +140,7 @@ fn allocations(scene: &str, overrides: &[&str], warm: usize, steps: usize) -> Co
             self_pairs: after.self_pairs_tested - before.self_pairs_tested,
             vertices: state.world.x.len(),
             base_vertices,
+            rollback_checked,
         }
     })
 }
@@ -136,6 +156,8 @@ struct Count {
     vertices: usize,
     /// Vertices of the mesh the run started from.
     base_vertices: usize,
+    /// Paper A's rollback check ran after every counted step.
+    rollback_checked: bool,
 }
 
 /// Runs one case and prints its count; returns the number of allocations.
@@ -164,6 +186,9 @@ enum Exercises {
     /// A refined mesh (more vertices than the base mesh), so multirate has
     /// more than one level.
     Refinement,
+    /// Paper A's rollback check (edge angles, curvature rule) after each step,
+    /// on a refined mesh.
+    RollbackCheck,
 }
 
 /// One test so that the cases never overlap (the counter is global).
@@ -182,6 +207,7 @@ fn steps_of_an_unchanging_mesh_do_not_allocate() {
             Exercises::Contact => c.contacts > 0,
             Exercises::SelfCollision => c.contacts > 0 && c.self_pairs > 0,
             Exercises::Refinement => c.vertices > c.base_vertices,
+            Exercises::RollbackCheck => c.rollback_checked && c.vertices > c.base_vertices,
         };
         assert!(
             covered,
@@ -245,6 +271,25 @@ fn steps_of_an_unchanging_mesh_do_not_allocate() {
         15,
         100,
         Exercises::Refinement,
+    );
+    // Paper A's rollback check after every step (issue 13: it measured the edge
+    // angles, and with the sizing rule the leaf curvatures, into new vectors
+    // and maps every step), on the implicit hanging sheet.
+    check(
+        "hanging_sheet, red-green with rollback (sizing rule), implicit",
+        "scenes/hanging_sheet.toml",
+        &[],
+        40,
+        20,
+        Exercises::RollbackCheck,
+    );
+    check(
+        "hanging_sheet, red-green with rollback (angle rule), implicit",
+        "scenes/hanging_sheet.toml",
+        &["adapt.criterion=angle"],
+        40,
+        20,
+        Exercises::RollbackCheck,
     );
     assert!(failures.is_empty(), "steps allocated: {failures:?}");
 }

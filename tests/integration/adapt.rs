@@ -46,8 +46,8 @@ fn swinging_stepper(
     w: &World,
     integrator: drape::scene::Integrator,
     damping: Scalar,
-) -> drape::physics::Stepper {
-    use drape::physics::{ExternalForces, MaterialParams, Model, Stepper};
+) -> crate::common::BareStepper {
+    use drape::physics::{ExternalForces, MaterialParams, Model};
     use drape::scene::{BendingModel, StiffnessRule};
     let material = MaterialParams {
         density: DENSITY,
@@ -61,7 +61,7 @@ fn swinging_stepper(
         gravity: Some(Vector::new(0.0, 0.0, -9.81)),
         ..Default::default()
     };
-    Stepper::new(
+    crate::common::BareStepper::new(
         Model {
             material,
             external,

@@ -3,8 +3,9 @@
 //! incline, self-collision after crumpling, Volino culling, determinism.
 
 use drape::math::{Scalar, Vector};
+use drape::physics::Model;
 use drape::scene::{Scene, load_scene_str};
-use drape::sim::{EnergyBound, Pipeline, SimState, build};
+use drape::sim::{EnergyBound, Pipeline, SimState, Simulation, build};
 
 /// A scene: a `size` m square sheet at `resolution`, with extra TOML appended.
 fn scene(size: Scalar, resolution: u32, z: Scalar, extra: &str) -> Scene {
@@ -37,24 +38,35 @@ damping = 0.001
 /// A scene's simulation, stepped by the public pipeline (the run's own step:
 /// forces + integrate, collide, account, health check).
 struct Sim {
+    model: Model,
     state: SimState,
     pipe: Pipeline,
 }
 
 impl Sim {
     fn new(scene: &Scene) -> Sim {
-        let (state, pipe) = build(&scene.resolve().expect("resolve")).expect("simulation");
+        let Simulation {
+            model,
+            state,
+            pipeline: pipe,
+        } = build(&scene.resolve().expect("resolve")).expect("simulation");
         assert!(pipe.collider().is_some(), "the scene collides");
-        Sim { state, pipe }
+        Sim { model, state, pipe }
     }
 
     fn step(&mut self, h: Scalar) {
-        let accepted = self.pipe.step(&mut self.state, h).expect("remesh");
+        let accepted = self
+            .pipe
+            .step(&self.model, &mut self.state, h)
+            .expect("remesh");
         assert!(accepted, "step rejected: {}", self.pipe.failure());
     }
 
     fn kinetic(&self) -> Scalar {
-        self.pipe.stepper().energy(&self.state.world).kinetic
+        self.pipe
+            .stepper()
+            .energy(&self.model, &self.state.world)
+            .kinetic
     }
 
     fn com(&self) -> Vector {
@@ -153,7 +165,7 @@ fn a_20_m_per_s_sheet_does_not_tunnel_through_a_5_mm_box() {
             *v = Vector::new(0.0, 0.0, -20.0);
         }
         // The run's energy bound includes the kinetic energy given here.
-        sim.state.ledger.bound = EnergyBound::new(&sim.state.world, sim.pipe.stepper());
+        sim.state.ledger.bound = EnergyBound::new(&sim.state.world, sim.pipe.stepper(), &sim.model);
         let mut lowest: Scalar = Scalar::INFINITY;
         let steps = (0.1 / dt) as usize;
         for _ in 0..steps {
@@ -433,11 +445,20 @@ friction_kinetic = 0.4
 "#,
     );
     let mut sim = Sim::new(&s);
-    let e0 = sim.pipe.stepper().energy(&sim.state.world).total();
+    let e0 = sim
+        .pipe
+        .stepper()
+        .energy(&sim.model, &sim.state.world)
+        .total();
     let mut e_max: Scalar = e0;
     for _ in 0..200 {
         sim.step(0.004);
-        e_max = e_max.max(sim.pipe.stepper().energy(&sim.state.world).total());
+        e_max = e_max.max(
+            sim.pipe
+                .stepper()
+                .energy(&sim.model, &sim.state.world)
+                .total(),
+        );
     }
     let mesh = &sim.state.world.mesh;
     let max_strain = (0..mesh.edges.len())

@@ -1,7 +1,10 @@
 //! Helpers shared by the test modules.
 
 use drape::adapt::AdaptConfig;
+use drape::math::{Scalar, Vector};
+use drape::physics::{Energy, Model, SolveFailure, Stepper};
 use drape::scene::{AdaptCriterion, AdaptMethod, Pin, PinMotion};
+use drape::world::World;
 
 /// A fixed pin on `region` with every other key at its default.
 pub fn pin(region: &str) -> Pin {
@@ -34,5 +37,64 @@ pub fn angle_config(method: AdaptMethod) -> AdaptConfig {
         max_rollbacks: 0,
         criterion: AdaptCriterion::Angle,
         hysteresis: 2.0,
+    }
+}
+
+/// A stepper driven without the pipeline (the physics tests step a bare world):
+/// it keeps the model and the implicit warm start that [`drape::sim::Pipeline`]
+/// would otherwise pass to [`Stepper`] from the run and its state.
+pub struct BareStepper {
+    /// The physics integrated.
+    pub model: Model,
+    /// The stepper itself (its fields are reachable through `Deref`).
+    pub stepper: Stepper,
+    /// The implicit solver's warm start (the state's, in a real run).
+    pub warm_start: Vec<Vector>,
+}
+
+impl BareStepper {
+    /// A stepper for `model` on the world's current mesh.
+    pub fn new(model: Model, world: &World) -> BareStepper {
+        let stepper = Stepper::new(&model, world);
+        BareStepper {
+            model,
+            stepper,
+            warm_start: Vec::new(),
+        }
+    }
+
+    /// One step of `dt` s ([`Stepper::step`]).
+    pub fn step(&mut self, world: &mut World, dt: Scalar) -> Result<(), SolveFailure> {
+        self.stepper
+            .step(&self.model, world, &mut self.warm_start, dt)
+    }
+
+    /// Rebuilds the elements after the mesh changed, and forgets the warm start.
+    pub fn rebuild(&mut self, world: &World) {
+        self.stepper.rebuild(&self.model, world);
+        self.warm_start.clear();
+    }
+
+    /// The world's energies ([`Stepper::energy`]).
+    pub fn energy(&self, world: &World) -> Energy {
+        self.stepper.energy(&self.model, world)
+    }
+
+    /// The automatic step ([`Stepper::auto_dt`]).
+    pub fn auto_dt(&self, world: &World) -> Scalar {
+        self.stepper.auto_dt(&self.model, world)
+    }
+}
+
+impl std::ops::Deref for BareStepper {
+    type Target = Stepper;
+    fn deref(&self) -> &Stepper {
+        &self.stepper
+    }
+}
+
+impl std::ops::DerefMut for BareStepper {
+    fn deref_mut(&mut self) -> &mut Stepper {
+        &mut self.stepper
     }
 }

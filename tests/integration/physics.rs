@@ -5,9 +5,7 @@ use drape::math::{Scalar, Vector};
 use drape::mesh::{self, Mesh};
 use drape::physics::bending::dihedral_angle_and_gradient;
 use drape::physics::forces::{ForceScratch, element_pass, gather};
-use drape::physics::{
-    Elements, ExternalForces, MaterialParams, Model, SolverSettings, Stepper, WindForce,
-};
+use drape::physics::{Elements, ExternalForces, MaterialParams, Model, SolverSettings, WindForce};
 use drape::scene::{BendingModel, DiagonalPattern, Integrator, StiffnessRule};
 use drape::world::World;
 
@@ -74,7 +72,7 @@ fn free_fall_matches_each_integrators_discrete_trajectory() {
             gravity: Some(G),
             ..Default::default()
         };
-        let mut st = Stepper::new(
+        let mut st = crate::common::BareStepper::new(
             model(
                 material(BendingModel::Dihedral, StiffnessRule::Consistent),
                 ext,
@@ -327,7 +325,7 @@ fn symplectic_euler_keeps_energy_bounded_over_ten_thousand_steps() {
         gravity: Some(G),
         ..Default::default()
     };
-    let mut st = Stepper::new(model(mat, ext, Integrator::SymplecticEuler), &w);
+    let mut st = crate::common::BareStepper::new(model(mat, ext, Integrator::SymplecticEuler), &w);
     let dt = st.auto_dt(&w)
         * std::env::var("DTF")
             .map(|s| s.parse::<f64>().unwrap())
@@ -383,7 +381,7 @@ fn implicit_is_stable_at_a_sixtieth_of_a_second_on_stiff_fabric() {
         gravity: Some(G),
         ..Default::default()
     };
-    let mut st = Stepper::new(
+    let mut st = crate::common::BareStepper::new(
         Model {
             cg_tolerance: 1e-6,
             cg_max_iterations: 1000,
@@ -440,7 +438,7 @@ fn final_state(threads: usize, integrator: Integrator) -> Vec<Vector> {
             air_velocity: wind.velocity,
             wind: Some(wind),
         };
-        let mut st = Stepper::new(
+        let mut st = crate::common::BareStepper::new(
             Model {
                 cg_tolerance: 1e-6,
                 ..model(

@@ -7,9 +7,7 @@ use std::sync::atomic::AtomicBool;
 
 use drape::math::{Scalar, Vector};
 use drape::mesh;
-use drape::physics::{
-    ExternalForces, MaterialParams, Model, Solver, SolverSettings, Stepper, WindForce,
-};
+use drape::physics::{ExternalForces, MaterialParams, Model, Solver, SolverSettings, WindForce};
 use drape::record::inspect::inspect;
 use drape::run::{RunError, RunOptions, run};
 use drape::scene::{BendingModel, DiagonalPattern, Integrator, StiffnessRule, default_scene};
@@ -74,7 +72,8 @@ fn direct_and_cg_agree_to_the_cg_tolerance_on_the_same_step() {
     let mut result = Vec::new();
     for solver in [Solver::Direct, Solver::Cg] {
         let mut w = bent_sheet(32);
-        let mut st = Stepper::new(implicit(fabric(2000.0), ext, solver, tol), &w);
+        let mut st =
+            crate::common::BareStepper::new(implicit(fabric(2000.0), ext, solver, tol), &w);
         st.step(&mut w, 1.0 / 60.0).expect("solved");
         println!("{solver:?}: {}", st.stats.describe());
         result.push(w.v);
@@ -109,7 +108,8 @@ fn free_fall_matches_the_discrete_trajectory_with_both_solvers() {
             gravity: Some(G),
             ..Default::default()
         };
-        let mut st = Stepper::new(implicit(fabric(200.0), ext, solver, 1e-12), &w);
+        let mut st =
+            crate::common::BareStepper::new(implicit(fabric(200.0), ext, solver, 1e-12), &w);
         let z0 = w.center_of_mass(&st.elements.mass).z;
         for _ in 0..steps {
             st.step(&mut w, dt).expect("solved");
@@ -146,7 +146,7 @@ fn flag_state(threads: usize, solver: Solver, newton: u32) -> Vec<Vector> {
         };
         let mut model = implicit(fabric(2000.0), ext, solver, 1e-6);
         model.solver.newton_iterations = newton;
-        let mut st = Stepper::new(model, &w);
+        let mut st = crate::common::BareStepper::new(model, &w);
         for _ in 0..12 {
             st.step(&mut w, 0.01).expect("solved");
         }

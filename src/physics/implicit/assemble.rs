@@ -9,7 +9,7 @@ use super::super::bending::dihedral_angle_and_gradient;
 use super::super::elements::Elements;
 use super::super::forces::{PAR_MIN, spring_force, wind_share};
 use super::super::shape::{SHAPE_SLOTS, rates, spread};
-use super::super::{ExternalForces, Stepper};
+use super::super::{ExternalForces, Model, Stepper};
 use super::ImplicitScratch;
 use crate::math::{Matrix3, Scalar, Vector};
 use crate::spec::Solver;
@@ -18,9 +18,9 @@ use crate::world::World;
 /// Builds the per-element blocks, the right-hand side `b` and the diagonal. With
 /// `newton`, `b` is the residual `h f(x, v) - M (v - v0)` at the current iterate
 /// instead of Baraff and Witkin's `h f(x0, v0) - h^2 K v0`.
-pub(super) fn assemble(st: &mut Stepper, w: &World, h: Scalar, newton: bool) {
+pub(super) fn assemble(st: &mut Stepper, model: &Model, w: &World, h: Scalar, newton: bool) {
     let started = std::time::Instant::now();
-    let (el, ext) = (&st.elements, &st.model.external);
+    let (el, ext) = (&st.elements, &model.external);
     let (x, v) = (&w.x, &w.v);
     let s = &mut st.implicit;
     // The `-h^2 K v` term of the linearised step (none in a Newton residual).
@@ -42,7 +42,7 @@ pub(super) fn assemble(st: &mut Stepper, w: &World, h: Scalar, newton: bool) {
             });
     }
     // The diagonal of `A` is the Jacobi preconditioner of `solver = "cg"` only.
-    let jacobi = st.model.solver.solver == Solver::Cg;
+    let jacobi = model.solver.solver == Solver::Cg;
     gather(s, el, ext, v, h, newton, jacobi);
     st.stats.assembly_s += started.elapsed().as_secs_f64();
 }

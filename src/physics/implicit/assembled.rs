@@ -31,10 +31,10 @@ use rayon::prelude::*;
 use super::cg::dot;
 use super::{ImplicitScratch, SolveFailure};
 use crate::math::{Matrix3, Scalar, Vector};
-use crate::physics::Stepper;
 use crate::physics::block::{BlockPattern, ElementBlocks};
 use crate::physics::direct::{FactorError, Factorization};
 use crate::physics::forces::PAR_MIN;
+use crate::physics::{Model, Stepper};
 
 /// Iterations with a fresh factor of the reduced matrix (block module docs) after
 /// which the tip-tip blocks are factored too. A factor with them costs 2.5 to 4 times
@@ -88,6 +88,7 @@ impl AssembledScratch {
 /// prescribed parts are kept; `reference`: the norm the tolerance is relative to.
 pub(super) fn solve(
     st: &mut Stepper,
+    model: &Model,
     held: &[bool],
     reference: Scalar,
     contact_push: bool,
@@ -129,7 +130,7 @@ pub(super) fn solve(
         .for_each(|((r, (b, ap)), proj)| *r = project(*proj, *b - *ap));
     pattern.project(&a.raw, &a.projection, &st.elements.mass, &mut a.system);
     st.stats.assembly_s += started.elapsed().as_secs_f64();
-    let outcome = iterate(st, &pattern, reference);
+    let outcome = iterate(st, model, &pattern, reference);
     let s = &mut st.implicit;
     let a = &mut s.assembled;
     // dv = dv_c + y.
@@ -183,13 +184,14 @@ fn project(proj: Option<Vector>, v: Vector) -> Vector {
 /// refactoring when the factor is stale (module docs).
 fn iterate(
     st: &mut Stepper,
+    model: &Model,
     pattern: &BlockPattern,
     reference: Scalar,
 ) -> Result<(), SolveFailure> {
-    let tolerance = st.model.cg_tolerance;
+    let tolerance = model.cg_tolerance;
     let goal = tolerance * reference;
-    let refactor_after = st.model.solver.refactor_iterations;
-    let cap = st.model.cg_max_iterations;
+    let refactor_after = model.solver.refactor_iterations;
+    let cap = model.cg_max_iterations;
     let a = &mut st.implicit.assembled;
     let mut fresh = false;
     if !a.factorization.is_valid() {

@@ -10,9 +10,9 @@ use rayon::prelude::*;
 
 use super::{SolveFailure, without};
 use crate::math::{Scalar, Vector, deterministic_sum, deterministic_sum2};
-use crate::physics::Stepper;
 use crate::physics::forces::PAR_MIN;
 use crate::physics::shape::{SHAPE_SLOTS, rates, spread};
+use crate::physics::{Model, Stepper};
 
 /// Vectors of the iteration, kept between steps.
 #[derive(Debug, Default, Clone)]
@@ -27,6 +27,7 @@ pub(super) struct CgScratch {
 /// the norm the tolerance is relative to.
 pub(super) fn solve(
     st: &mut Stepper,
+    model: &Model,
     held: &[bool],
     reference: Scalar,
     contact_push: bool,
@@ -57,14 +58,14 @@ pub(super) fn solve(
     precondition(&mut c.z, &c.r, &s.inv_diag, &s.filter);
     c.p.copy_from_slice(&c.z);
     let (mut rz, mut rr) = dot2(&c.r, &c.z);
-    let tolerance = st.model.cg_tolerance;
+    let tolerance = model.cg_tolerance;
     let goal = tolerance * reference;
     let mut iterations = 0;
     let outcome = loop {
         if rr.sqrt() <= goal {
             break Ok(());
         }
-        if iterations >= st.model.cg_max_iterations {
+        if iterations >= model.cg_max_iterations {
             break Err(SolveFailure::NotConverged {
                 iterations,
                 residual: rr.sqrt() / reference.max(Scalar::MIN_POSITIVE),

@@ -4,19 +4,19 @@ use rayon::prelude::*;
 
 use super::{Group, Rk4MultirateScratch, level_forces, take_levels};
 use crate::math::{Scalar, Vector};
-use crate::physics::Stepper;
 use crate::physics::forces::gather;
 use crate::physics::shape::SHAPE_SLOTS;
+use crate::physics::{Model, Stepper};
 use crate::world::World;
 
 /// One RK4 macro step of `big` seconds. Each level integrates its own vertices
 /// with RK4 at its own substep; the vertices of other levels that its elements
 /// touch move at their velocity from the start of the macro step (paper A:
 /// their motion is unchanged, zero acceleration). With one level this is RK4.
-pub fn rk4_multirate(st: &mut Stepper, w: &mut World, big: Scalar) {
+pub fn rk4_multirate(st: &mut Stepper, model: &Model, w: &mut World, big: Scalar) {
     let t = w.time;
     w.pins.held_at(t, &mut st.held);
-    let levels = take_levels(st, w);
+    let levels = take_levels(st, model, w);
     let mut rk = std::mem::take(&mut st.rk4_multirate);
     for (buf, src) in [
         (&mut rk.xs, &w.x),
@@ -27,11 +27,11 @@ pub fn rk4_multirate(st: &mut Stepper, w: &mut World, big: Scalar) {
         buf.clear();
         buf.extend_from_slice(src);
     }
-    size_force_scratch(st, w);
+    size_force_scratch(st, model, w);
     for g in &levels.groups {
         let h = big / g.substeps as Scalar;
         for sub in 0..g.substeps {
-            substep(st, w, &mut rk, g, sub as Scalar * h, h);
+            substep(st, model, w, &mut rk, g, sub as Scalar * h, h);
         }
     }
     std::mem::swap(&mut w.x, &mut rk.x_new);
@@ -43,14 +43,14 @@ pub fn rk4_multirate(st: &mut Stepper, w: &mut World, big: Scalar) {
 
 /// Sizes the per-element force slots for the current elements (no allocation
 /// once they have grown to the mesh).
-fn size_force_scratch(st: &mut Stepper, w: &World) {
+fn size_force_scratch(st: &mut Stepper, model: &Model, w: &World) {
     let (scratch, el) = (&mut st.forces, &st.elements);
     scratch.spring.resize(el.springs.len(), Vector::ZERO);
     scratch.hinge.resize(4 * el.hinges.len(), Vector::ZERO);
     scratch
         .shape
         .resize(SHAPE_SLOTS * el.shape_triangles.len(), Vector::ZERO);
-    if st.model.external.wind.is_some() {
+    if model.external.wind.is_some() {
         scratch
             .triangle
             .resize(w.mesh.triangles.len(), Vector::ZERO);
@@ -65,6 +65,7 @@ const AT: [Scalar; 4] = [0.0, 0.5, 0.5, 1.0];
 /// of group `g`'s vertices (in `rk.x_new`, `rk.v_new`).
 fn substep(
     st: &mut Stepper,
+    model: &Model,
     w: &World,
     rk: &mut Rk4MultirateScratch,
     g: &Group,
@@ -83,7 +84,7 @@ fn substep(
     rk.stage.clear();
     rk.stage.extend_from_slice(&rk.y0);
     for s in 0..4 {
-        stage_derivatives(st, w, rk, g, t_sub + AT[s] * h);
+        stage_derivatives(st, model, w, rk, g, t_sub + AT[s] * h);
         for (k, &(dx, dv)) in rk.derivs.iter().enumerate() {
             rk.acc[k].0 += dx * WEIGHT[s];
             rk.acc[k].1 += dv * WEIGHT[s];
@@ -107,6 +108,7 @@ fn substep(
 /// `rk.derivs`.
 fn stage_derivatives(
     st: &mut Stepper,
+    model: &Model,
     w: &World,
     rk: &mut Rk4MultirateScratch,
     g: &Group,
@@ -125,7 +127,7 @@ fn stage_derivatives(
     let scratch = &mut st.forces;
     level_forces(
         &st.elements,
-        &st.model.external,
+        &model.external,
         &w.mesh.triangles,
         &rk.xs,
         &rk.vs,
@@ -133,7 +135,7 @@ fn stage_derivatives(
         scratch,
         &mut rk.level,
     );
-    let (el, ext, held, forces) = (&st.elements, &st.model.external, &st.held, &*scratch);
+    let (el, ext, held, forces) = (&st.elements, &model.external, &st.held, &*scratch);
     g.vertices
         .par_iter()
         .zip(rk.stage.par_iter())
