@@ -187,7 +187,7 @@ fn not_modelled(
 fn describe_adapt(s: &mut String, scene: &Scene, a: &AdaptConfig) {
     let _ = writeln!(
         s,
-        "adaptive meshing: {}, {}, levels 0..{}, every {} steps{}{}",
+        "adaptive meshing: {}, {}, levels 0..{}, {}{}{}",
         match a.method {
             AdaptMethod::Edge =>
                 "edge (paper B: longest-edge splits, Delaunay flips, guarded collapses)",

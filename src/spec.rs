@@ -292,9 +292,10 @@ pub struct Adapt {
     /// Shortest edge refinement may create, in material space (m); 0: no limit.
     #[serde(default)]
     pub min_edge_length: f64,
-    /// Adapt every this many steps (default 4, see `default_every`).
+    /// When to adapt: every this many steps (default 4, see `default_every`), or
+    /// once per frame.
     #[serde(default = "default_every")]
-    pub every: u32,
+    pub every: AdaptEvery,
     /// Paper A's rollback: redo a step after refining where it bent too far.
     #[serde(default)]
     pub rollback: bool,
@@ -358,8 +359,68 @@ fn default_max_level() -> u32 {
 /// `tablecloth` adapting every step took 3.3 times the steps (retried frames)
 /// and 3.2 times the wall time of every 4; on `hanging_sheet` and
 /// `drape_sphere` every 4 had the same or a lower error than every step.
-fn default_every() -> u32 {
-    4
+fn default_every() -> AdaptEvery {
+    AdaptEvery::Steps(4)
+}
+
+/// When the adaptation pass runs (`adapt.every`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AdaptEvery {
+    /// After every this many accepted steps (`every = 4`).
+    Steps(u32),
+    /// Once per frame, after the frame's last step (`every = "frame"`), as
+    /// ARCSim does.
+    Frame,
+}
+
+impl AdaptEvery {
+    /// True when the pass runs after accepted step number `steps_done`.
+    pub fn after_step(self, steps_done: u64) -> bool {
+        match self {
+            AdaptEvery::Steps(n) => steps_done.is_multiple_of(n.max(1) as u64),
+            AdaptEvery::Frame => false,
+        }
+    }
+}
+
+impl std::fmt::Display for AdaptEvery {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            AdaptEvery::Steps(1) => f.write_str("every step"),
+            AdaptEvery::Steps(n) => write!(f, "every {n} steps"),
+            AdaptEvery::Frame => f.write_str("once per frame"),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for AdaptEvery {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl serde::de::Visitor<'_> for V {
+            type Value = AdaptEvery;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("an integer >= 1 (steps) or \"frame\"")
+            }
+            fn visit_str<E: serde::de::Error>(self, s: &str) -> Result<AdaptEvery, E> {
+                if s == "frame" {
+                    Ok(AdaptEvery::Frame)
+                } else {
+                    Err(E::invalid_value(serde::de::Unexpected::Str(s), &self))
+                }
+            }
+            fn visit_i64<E: serde::de::Error>(self, x: i64) -> Result<AdaptEvery, E> {
+                u32::try_from(x)
+                    .map(AdaptEvery::Steps)
+                    .map_err(|_| E::invalid_value(serde::de::Unexpected::Signed(x), &self))
+            }
+            fn visit_u64<E: serde::de::Error>(self, x: u64) -> Result<AdaptEvery, E> {
+                u32::try_from(x)
+                    .map(AdaptEvery::Steps)
+                    .map_err(|_| E::invalid_value(serde::de::Unexpected::Unsigned(x), &self))
+            }
+        }
+        d.deserialize_any(V)
+    }
 }
 fn default_max_rollbacks() -> u32 {
     3

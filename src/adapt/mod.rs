@@ -21,7 +21,7 @@ use rayon::prelude::*;
 
 use crate::math::{Scalar, Vector};
 use crate::mesh::MeshError;
-use crate::spec::{Adapt, AdaptCriterion, AdaptMethod, DEFAULT_HYSTERESIS};
+use crate::spec::{Adapt, AdaptCriterion, AdaptEvery, AdaptMethod, DEFAULT_HYSTERESIS};
 use crate::world::World;
 use red_green::{Applied, RedGreen, RedGreenOp};
 use transfer::{compact, transfer};
@@ -112,8 +112,8 @@ pub struct AdaptConfig {
     pub max_level: u8,
     /// Shortest edge refinement may create (material space), m.
     pub min_edge_length: Scalar,
-    /// Adapt every this many steps.
-    pub every: u64,
+    /// When the adaptation pass runs.
+    pub every: AdaptEvery,
     /// Redo steps that bent too far.
     pub rollback: bool,
     /// Rollbacks per step.
@@ -135,7 +135,7 @@ impl AdaptConfig {
             coarsen_angle: a.coarsen_angle,
             max_level: a.max_level.min(254) as u8,
             min_edge_length: a.min_edge_length,
-            every: a.every.max(1) as u64,
+            every: a.every,
             rollback: a.rollback,
             max_rollbacks: a.max_rollbacks,
             criterion: a.criterion,

@@ -8,7 +8,7 @@ use serde::Deserialize;
 
 // The engine's own types, deserialised straight from the file (see `crate::spec`).
 pub use crate::spec::{
-    Adapt, AdaptCriterion, AdaptMethod, BendingModel, ClothShape, DEFAULT_THICKNESS,
+    Adapt, AdaptCriterion, AdaptEvery, AdaptMethod, BendingModel, ClothShape, DEFAULT_THICKNESS,
     DiagonalPattern, Integrator, Obstacle, ObstacleShape, Pin, PinMotion, SelfCollision, Solver,
     StiffnessRule,
 };

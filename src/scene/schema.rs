@@ -84,7 +84,7 @@ pub(crate) fn allowed(path: &str) -> Option<&'static str> {
         "adapt.coarsen_angle" => "a finite number of degrees in (0, refine_angle)",
         "adapt.max_level" => "an integer >= 1 (at most 254)",
         "adapt.min_edge_length" => "a finite number >= 0 (m, material space; 0: no limit)",
-        "adapt.every" => "an integer >= 1 (steps)",
+        "adapt.every" => "an integer >= 1 (steps) or \"frame\"",
         "adapt.rollback" => "true or false",
         "adapt.max_rollbacks" => "an integer >= 0",
         "adapt.multirate" => "true or false (explicit integrators only)",

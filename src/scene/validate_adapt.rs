@@ -3,7 +3,7 @@
 
 use super::error::{Issue, SceneErrorKind as Kind, keys, num};
 use super::validate::{finite, non_negative, out_of_range, positive};
-use super::{Adapt, AdaptCriterion, AdaptMethod, Integrator};
+use super::{Adapt, AdaptCriterion, AdaptEvery, AdaptMethod, Integrator};
 
 /// The `[adapt]` table's ranges and the keys that do not apply to its settings.
 pub(super) fn adapt(a: &Adapt, integrator: Integrator) -> Result<(), Issue> {
@@ -35,7 +35,7 @@ pub(super) fn adapt(a: &Adapt, integrator: Integrator) -> Result<(), Issue> {
         ));
     }
     non_negative(keys(&["adapt", "min_edge_length"]), a.min_edge_length)?;
-    if a.every == 0 {
+    if a.every == AdaptEvery::Steps(0) {
         return Err(out_of_range(
             keys(&["adapt", "every"]),
             "0 is out of range: must be >= 1",

@@ -7,6 +7,7 @@ use crate::collide::{Collider, StepCloth};
 use crate::math::{Scalar, Vector};
 use crate::mesh::MeshError;
 use crate::physics::{Model, StepStats, Stepper};
+use crate::spec::AdaptEvery;
 use crate::world::World;
 
 /// How often a failing frame is retried with half the step before giving up.
@@ -172,6 +173,7 @@ impl Pipeline {
                     let excess = balance - state.ledger.bound.initial;
                     state.ledger.excess_max = state.ledger.excess_max.max(excess);
                     state.effort.step_halvings += halving as u64;
+                    self.adapt_at_frame_end(model, state)?;
                     return Ok(halving as u64);
                 }
                 last_gain = gain;
@@ -388,15 +390,31 @@ impl Pipeline {
         Ok(true)
     }
 
-    /// Adapt: the remeshing pass, every `adapt.every` accepted steps (reusing the
-    /// edge angles the rollback check measured on the same state).
+    /// Adapt: the remeshing pass after every `adapt.every` accepted steps.
     fn adapt(&mut self, model: &Model, state: &mut SimState) -> Result<(), MeshError> {
+        match state.adapter.as_ref() {
+            Some(ad) if ad.config.every.after_step(state.ledger.steps_done) => {
+                self.remesh(model, state)
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// Adapt, with `adapt.every = "frame"`: the remeshing pass once the frame's
+    /// steps are accepted.
+    fn adapt_at_frame_end(&mut self, model: &Model, state: &mut SimState) -> Result<(), MeshError> {
+        match state.adapter.as_ref() {
+            Some(ad) if ad.config.every == AdaptEvery::Frame => self.remesh(model, state),
+            _ => Ok(()),
+        }
+    }
+
+    /// The remeshing pass on the state as it is (reusing the edge angles the
+    /// rollback check measured on it, when it did).
+    fn remesh(&mut self, model: &Model, state: &mut SimState) -> Result<(), MeshError> {
         let Some(ad) = state.adapter.as_mut() else {
             return Ok(());
         };
-        if !state.ledger.steps_done.is_multiple_of(ad.config.every) {
-            return Ok(());
-        }
         let step = state.ledger.steps_done;
         let changed = if self.angles_fresh {
             ad.pass_measured(&mut state.world, step, &self.angles)?

@@ -110,7 +110,7 @@ fn allocations(scene: &str, overrides: &[&str], warm: usize, steps: usize) -> Co
         // refines).
         let mut rollback_checked = false;
         if let Some(a) = state.adapter.as_mut() {
-            a.config.every = u64::MAX;
+            a.config.every = drape::spec::AdaptEvery::Steps(u32::MAX);
             if a.config.rollback && a.config.max_rollbacks > 0 {
                 a.config.refine_angle = f64::INFINITY;
                 rollback_checked = true;

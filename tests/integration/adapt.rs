@@ -408,6 +408,47 @@ fn close_thresholds_do_not_thrash() {
     }
 }
 
+/// `adapt.every = "frame"` runs one pass per frame, after the frame's steps
+/// (none after the initial frame), and `every = N` one after every N-th
+/// accepted step; both adapt the falling sheet.
+#[test]
+fn adaptation_runs_once_per_frame_or_every_n_steps() {
+    use std::sync::atomic::AtomicBool;
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/hanging_sheet.toml");
+    for every in ["\"frame\"", "4", "1"] {
+        let sets: Vec<String> = [
+            "simulation.duration=1.0",
+            // 6 steps a frame, so that once per frame differs from every 4.
+            "simulation.frame_rate=20",
+            "adapt.rollback=false",
+            &format!("adapt.every={every}"),
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+        let scene = drape::scene::load_scene_file(&path, &sets).unwrap();
+        let opts = drape::run::RunOptions::default();
+        let summary = drape::run::run(&scene, &opts, &AtomicBool::new(false), &mut |_| {}).unwrap();
+        let a = summary.adapt.expect("adaptive run");
+        println!(
+            "every {every}: {} frames, {} steps, {} passes ({} changed the mesh), {} splits, {} merges",
+            summary.frames,
+            summary.steps,
+            a.passes,
+            a.changed_passes,
+            summary.splits,
+            summary.merges
+        );
+        let expected = match every {
+            "4" => summary.steps / 4,
+            "1" => summary.steps,
+            _ => summary.frames - 1,
+        };
+        assert_eq!(a.passes, expected, "every {every}: passes");
+        assert!(summary.splits > 0, "every {every}: the sheet is refined");
+    }
+}
+
 #[test]
 fn hanging_sheet_run_refines_rolls_back_and_reports_counts() {
     use std::sync::atomic::AtomicBool;
@@ -575,7 +616,7 @@ fn swinging_explicit(
     let mut ad = Adapter::new(
         AdaptConfig {
             max_level: 4,
-            every: 20,
+            every: drape::scene::AdaptEvery::Steps(20),
             ..config()
         },
         &w,

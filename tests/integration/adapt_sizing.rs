@@ -20,7 +20,7 @@ fn sizing(refine_angle: Scalar, max_level: u8) -> AdaptConfig {
         coarsen_angle: 0.1 * refine_angle,
         max_level,
         min_edge_length: 0.0,
-        every: 1,
+        every: drape::scene::AdaptEvery::Steps(1),
         rollback: false,
         max_rollbacks: 0,
         criterion: AdaptCriterion::Sizing,

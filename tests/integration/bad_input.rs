@@ -319,6 +319,20 @@ fn a_lower_threshold_above_the_upper_is_refused() {
 }
 
 #[test]
+fn adapt_every_is_a_step_count_or_frame() {
+    refused_sets(
+        "every",
+        &[
+            ("adapt.every", "0"),
+            ("adapt.every", "-3"),
+            ("adapt.every", "\"often\""),
+            ("adapt.every", "2.5"),
+        ],
+        "an integer >= 1 (steps) or \"frame\"",
+    );
+}
+
+#[test]
 fn resolution_zero_or_above_the_cap_is_refused() {
     refused_sets(
         "res-zero",

@@ -32,7 +32,7 @@ pub fn angle_config(method: AdaptMethod) -> AdaptConfig {
         coarsen_angle: 1.5,
         max_level: 4,
         min_edge_length: 0.0,
-        every: 1,
+        every: drape::scene::AdaptEvery::Steps(1),
         rollback: false,
         max_rollbacks: 0,
         criterion: AdaptCriterion::Angle,

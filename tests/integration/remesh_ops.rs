@@ -238,3 +238,86 @@ fn incremental_tables_equal_a_rebuild_over_draping_passes() {
         );
     }
 }
+
+/// The world's triangles as sorted triples of material points (bit patterns),
+/// sorted: a mesh compared by what it covers, whatever its vertex numbering.
+fn by_position(material: &[drape::math::Vector2], tris: &[[u32; 3]]) -> Vec<[(u64, u64); 3]> {
+    let mut out: Vec<[(u64, u64); 3]> = tris
+        .iter()
+        .map(|t| {
+            let mut p = t.map(|v| {
+                let q = material[v as usize];
+                (q.x.to_bits(), q.y.to_bits())
+            });
+            p.sort_unstable();
+            p
+        })
+        .collect();
+    out.sort_unstable();
+    out
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
+
+    /// Property (issue 14: incremental updates against a full rebuild, at any
+    /// adaptation cadence). A sheet is draped into a random sequence of folds
+    /// (each a `adapt_cost::drape` shape of random radius) and adapted after
+    /// every `cadence`-th shape, by either method and either criterion. After
+    /// every pass: the mesh is consistent (manifold, conforming, exact mass) and
+    /// the hierarchy's incrementally kept lookup tables equal tables rebuilt
+    /// from its forest (`Adapter::check`); with red-green, the world's mesh is
+    /// the one built afresh from the hierarchy's leaves; and the rollback's
+    /// allocation-free check (`needs_refinement`) agrees with the marks it
+    /// stands for.
+    #[test]
+    fn remeshing_equals_a_rebuild_over_random_drapes_and_cadences(
+        shapes in prop::collection::vec(0usize..60, 6..16),
+        cadence in 1usize..4,
+        edge_method in any::<bool>(),
+        sizing in any::<bool>(),
+    ) {
+        use drape::adapt::{AdaptConfig, Adapter, edge_angles};
+        use drape::scene::{AdaptCriterion, AdaptMethod};
+        use drape::world::World;
+        let method = if edge_method { AdaptMethod::Edge } else { AdaptMethod::RedGreen };
+        let m = mesh::rectangle(1.6, 1.6, 8, DiagonalPattern::Alternating).unwrap();
+        let x = m.material.iter().map(|p| p.extend(0.78)).collect();
+        let mut w = World::new(m, x);
+        let criterion = if sizing { AdaptCriterion::Sizing } else { AdaptCriterion::Angle };
+        let config = AdaptConfig {
+            criterion,
+            refine_angle: if sizing { 10.0 } else { 15.0 },
+            ..crate::common::angle_config(method)
+        };
+        let mut ad = Adapter::new(config, &w, 0.15);
+        for (j, &k) in shapes.iter().enumerate() {
+            for (x, p) in w.x.iter_mut().zip(&w.mesh.material) {
+                *x = crate::adapt_cost::drape(*p, k);
+            }
+            let angles = edge_angles(&w);
+            prop_assert_eq!(
+                ad.needs_refinement(&w, &angles),
+                !ad.refinement_marks(&w, &angles).is_empty(),
+                "shape {}: the rollback check disagrees with the marks", j
+            );
+            if j % cadence != 0 {
+                continue;
+            }
+            ad.pass(&mut w, j as u64).unwrap();
+            if let Err(e) = ad.check(&w) {
+                prop_assert!(false, "{:?} pass after shape {}: {}", method, j, e);
+            }
+            if method == AdaptMethod::RedGreen {
+                let h = ad.hierarchy();
+                let (tris, _, _) = h.build();
+                prop_assert_eq!(
+                    by_position(&w.mesh.material, &w.mesh.triangles),
+                    by_position(h.material(), &tris),
+                    "pass after shape {}: the world's mesh is not the hierarchy's", j
+                );
+            }
+        }
+        prop_assert!(ad.stats.splits > 0, "the folds refine the sheet");
+    }
+}

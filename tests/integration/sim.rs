@@ -76,7 +76,7 @@ fn rollback_keeps_only_the_accepted_attempts_work() {
     let mut trial = saved.clone();
     if let Some(a) = trial.adapter.as_mut() {
         a.config.rollback = false;
-        a.config.every = u64::MAX;
+        a.config.every = drape::spec::AdaptEvery::Steps(u32::MAX);
     }
     assert!(twin_pipe.step(&model, &mut trial, h).expect("remesh"));
     let ad = trial.adapter.as_ref().expect("adaptive");
