@@ -1,12 +1,14 @@
 //! drape: adaptive mass-spring cloth simulation recorded to Rerun `.rrd` files.
 //!
 //! Data flows one way (SPEC section 2):
-//! scene file -> [`scene::Scene`] -> [`sim::build`] -> a [`sim::SimState`] and the
-//! [`sim::Pipeline`] that advances it -> per frame ([`run::FrameLoop`]): the step's
-//! phases (forces + integrate, collide, account, health check, rollback, adapt; see
-//! [`sim`]) until the frame's time, then observe and record. The state is one
-//! cloneable value; the pipeline holds only scratch, as in rapier's sets and
-//! pipeline.
+//! scene file -> [`scene::Scene`] -> [`sim::build`] -> a [`sim::Simulation`]: the
+//! [`physics::Model`] (fixed for the run), a [`sim::SimState`] and the
+//! [`sim::Pipeline`] that advances it (`pipeline.step(&model, &mut state, h)`) ->
+//! per frame ([`run::FrameLoop`]): the step's phases (forces + integrate, collide,
+//! account, health check, rollback, adapt; see [`sim`]) until the frame's time,
+//! then observe and record. The state is one cloneable value (the implicit
+//! solver's warm start included); the pipeline holds only scratch, as in rapier's
+//! parameters, sets and pipeline.
 
 pub mod adapt;
 pub mod bench;

@@ -314,6 +314,12 @@ pub struct Adapt {
     /// (> 1; absent: [`DEFAULT_HYSTERESIS`]).
     #[serde(default)]
     pub hysteresis: Option<f64>,
+    /// Sizing criterion with red-green only: also split a leaf where the
+    /// membrane (Green) strain jumps across one of its edges by more than this
+    /// (dimensionless); absent: curvature alone. See `src/adapt/sizing.rs`,
+    /// "Strain jumps".
+    #[serde(default)]
+    pub refine_strain: Option<f64>,
 }
 
 /// The hysteresis of the sizing criterion when `[adapt]` does not set it.

@@ -123,6 +123,9 @@ pub struct AdaptConfig {
     /// Sizing criterion: merge when the parent carries at most
     /// `refine_angle / hysteresis` (see `sizing.rs`); unused by the angle one.
     pub hysteresis: Scalar,
+    /// Sizing criterion: also split where the strain jumps across an edge by
+    /// more than this (`None`: curvature alone; see `sizing.rs`).
+    pub refine_strain: Option<Scalar>,
 }
 
 impl AdaptConfig {
@@ -140,6 +143,7 @@ impl AdaptConfig {
             max_rollbacks: a.max_rollbacks,
             criterion: a.criterion,
             hysteresis: a.hysteresis.unwrap_or(DEFAULT_HYSTERESIS),
+            refine_strain: a.refine_strain,
         })
     }
 }
@@ -272,9 +276,15 @@ impl Adapter {
             return false;
         }
         let sizing = self.config.criterion == AdaptCriterion::Sizing;
+        let strain = sizing && self.config.refine_strain.is_some();
         world.mesh.edges.iter().enumerate().any(|(e, edge)| {
             let kappa = if sizing {
                 sizing::edge_curvature(world, edge, angles[e])
+            } else {
+                0.0
+            };
+            let jump = if strain {
+                sizing::edge_strain_jump(world, edge)
             } else {
                 0.0
             };
@@ -284,7 +294,7 @@ impl Adapter {
                 .any(|&t| {
                     let leaf = self.owner[t as usize];
                     let over = if sizing {
-                        self.sizing_wants_split(leaf, kappa)
+                        self.sizing_wants_split(leaf, kappa, jump)
                     } else {
                         angles[e] > self.config.refine_angle
                     };

@@ -61,6 +61,40 @@
 //! might save some of the rollbacks: 234 against the angle criterion's 183 on
 //! hanging_sheet over 4 s).
 //!
+//! # Strain jumps (`refine_strain`, off by default)
+//! Curvature cannot see where the membrane strain concentrates. A sheet hung
+//! from two point pins (`hanging_sheet_rest`) stretches most at the pins, a
+//! singularity a finer mesh resolves further (a point load's displacement
+//! grows like the log of the mesh size), so the whole sheet hangs a few
+//! millimetres lower on each finer mesh: at rest, uniform 16 against uniform
+//! 64, every vertex of the lower two thirds sat 4.8 to 5.3 mm apart (the
+//! largest gaps, 18 to 32 mm, were along the swag of the top edge). The
+//! uniform runs converge at only about first order there, and a curvature
+//! rule leaves the pins coarse.
+//!
+//! The indicator: the Green strain `E = (F^T F - I) / 2` of each triangle (in
+//! material axes, so neighbours compare directly) and, per interior edge, the
+//! Frobenius norm of the difference between its two triangles' strains. Where
+//! the strain is smooth the jump is about `|grad E| d` and halves with every
+//! split, as `kappa * D` does; at a point pin it stays of order one however
+//! fine the mesh, so the rule grades the mesh down to `max_level` there (the
+//! mesh an a-posteriori estimator of the Zienkiewicz-Zhu kind asks for). A
+//! leaf splits when a jump at its edges exceeds `refine_strain`; four children
+//! merge only when twice their largest jump is at most `refine_strain / H`.
+//! Red-green only (the edge method's collapse test has no such term).
+//!
+//! Measured (`drape bench scenes/hanging_sheet_rest.toml`, ladder with the
+//! rungs below, red_green 16 L4; uniform 64 1.139e-3 of the diagonal in
+//! 15.7 s): no strain term 3.38e-3 in 3.9 s; `refine_strain = 0.02` 1.54e-3 in
+//! 6.3 s (689 -> 1122 mean vertices); 0.005 1.42e-3 in 11.6 s; 0.002 1.62e-3
+//! in 26.9 s with 3,759 vertices, nearly uniform 64's 4,225 and still worse
+//! than it. So the indicator buys most of what refinement can give here, and
+//! what is left is not where the mesh is coarse: a red-green mesh refined
+//! everywhere is a different triangulation from the uniform grid (its
+//! diagonals run other ways), and a mass-spring membrane's stiffness depends
+//! on the triangulation, so the two converge to the reference from different
+//! sides. Not the default: it is measured on one scene.
+//!
 //! The edge method (paper B) with this criterion keeps its splits (an edge's
 //! measured angle is its own `kappa_e * d_e`, so the rule is the angle rule
 //! there) and coarsens by the same hysteresis: a vertex's edges may collapse
@@ -119,29 +153,91 @@ pub fn edge_curvature(world: &World, e: &Edge, deg: Scalar) -> Scalar {
     if d > 0.0 { deg.to_radians() / d } else { 0.0 }
 }
 
-/// Per leaf of the hierarchy: the largest curvature (rad/m) and the largest
-/// angle (degrees) at the edges of the world triangles it owns.
+/// The membrane (Green) strain of world triangle `t` in material axes,
+/// `[E_uu, E_vv, E_uv]`, from its deformation gradient `F = [x1 - x0, x2 - x0]
+/// [m1 - m0, m2 - m0]^-1`: `E = (F^T F - I) / 2`.
+pub fn triangle_strain(world: &World, t: u32) -> [Scalar; 3] {
+    let tri = world.mesh.triangles[t as usize];
+    let [m0, m1, m2] = tri.map(|v| world.mesh.material[v as usize]);
+    let [x0, x1, x2] = tri.map(|v| world.x[v as usize]);
+    let (d1, d2, e1, e2) = (m1 - m0, m2 - m0, x1 - x0, x2 - x0);
+    let det = d1.perp_dot(d2);
+    let fu = (e1 * d2.y - e2 * d1.y) / det;
+    let fv = (e2 * d1.x - e1 * d2.x) / det;
+    [
+        0.5 * (fu.dot(fu) - 1.0),
+        0.5 * (fv.dot(fv) - 1.0),
+        0.5 * fu.dot(fv),
+    ]
+}
+
+/// How much the membrane strain jumps across edge `e` of the world's mesh: the
+/// Frobenius norm of the difference of its two triangles' strains (0 at boundary
+/// edges). See the module docs, "Strain jumps".
+pub fn edge_strain_jump(world: &World, e: &Edge) -> Scalar {
+    if !e.is_interior() {
+        return 0.0;
+    }
+    let [a, b] = [e.triangles[0], e.triangles[1]].map(|t| triangle_strain(world, t));
+    let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+    (d[0] * d[0] + d[1] * d[1] + 2.0 * d[2] * d[2]).sqrt()
+}
+
+/// What the sizing criterion measured at one leaf of the hierarchy, over the
+/// edges of the world triangles it owns (0 where nothing was measured).
+#[derive(Debug, Default, Clone, Copy)]
+pub(super) struct LeafMeasure {
+    /// The largest curvature, rad/m.
+    pub kappa: Scalar,
+    /// The largest dihedral angle, degrees.
+    pub angle: Scalar,
+    /// The largest strain jump (0 unless `refine_strain` is set).
+    pub jump: Scalar,
+}
+
+impl LeafMeasure {
+    fn max(self, o: LeafMeasure) -> LeafMeasure {
+        LeafMeasure {
+            kappa: self.kappa.max(o.kappa),
+            angle: self.angle.max(o.angle),
+            jump: self.jump.max(o.jump),
+        }
+    }
+}
+
+/// Per leaf of the hierarchy: its [`LeafMeasure`].
 #[derive(Debug, Default)]
 pub(super) struct LeafCurvature {
-    by_leaf: HashMap<u32, (Scalar, Scalar)>,
+    by_leaf: HashMap<u32, LeafMeasure>,
 }
 
 impl LeafCurvature {
-    /// Curvature and angle of leaf `l` (0 where nothing was measured).
-    pub(super) fn get(&self, l: u32) -> (Scalar, Scalar) {
-        self.by_leaf.get(&l).copied().unwrap_or((0.0, 0.0))
+    /// What was measured at leaf `l`.
+    pub(super) fn get(&self, l: u32) -> LeafMeasure {
+        self.by_leaf.get(&l).copied().unwrap_or_default()
     }
 }
 
 impl Adapter {
-    /// The curvature of every leaf from the edge angles of the world's mesh.
+    /// The curvature of every leaf from the edge angles of the world's mesh
+    /// (and the strain jumps, when `refine_strain` is set).
     pub(super) fn leaf_curvatures(&self, world: &World, angles: &[Scalar]) -> LeafCurvature {
         let kappa = edge_curvatures(world, angles);
-        let mut by_leaf: HashMap<u32, (Scalar, Scalar)> = HashMap::new();
+        let strain = self.config.refine_strain.is_some();
+        let mut by_leaf: HashMap<u32, LeafMeasure> = HashMap::new();
         for (e, edge) in world.mesh.edges.iter().enumerate() {
+            let here = LeafMeasure {
+                kappa: kappa[e],
+                angle: angles[e],
+                jump: if strain {
+                    edge_strain_jump(world, edge)
+                } else {
+                    0.0
+                },
+            };
             for &t in edge.triangles.iter().filter(|&&t| t != NO_TRIANGLE) {
-                let m = by_leaf.entry(self.owner[t as usize]).or_insert((0.0, 0.0));
-                *m = (m.0.max(kappa[e]), m.1.max(angles[e]));
+                let m = by_leaf.entry(self.owner[t as usize]).or_default();
+                *m = m.max(here);
             }
         }
         LeafCurvature { by_leaf }
@@ -153,40 +249,48 @@ impl Adapter {
         spacing(self.hierarchy.vertices(n).map(|v| mat[v as usize]))
     }
 
-    /// Leaves coarser than their target (`kappa * D > refine_angle`) that may
-    /// still split, each with its largest measured angle (degrees).
+    /// Leaves coarser than their target (`kappa * D > refine_angle`, or a strain
+    /// jump above `refine_strain`) that may still split, each with its largest
+    /// measured angle (degrees).
     pub(super) fn sizing_refinement_marks(&self, curv: &LeafCurvature) -> Vec<(u32, Scalar)> {
         let mut marks: Vec<(u32, Scalar)> = curv
             .by_leaf
             .iter()
-            .filter(|&(&l, &(kappa, _))| self.sizing_wants_split(l, kappa) && self.may_split(l))
-            .map(|(&l, &(_, angle))| (l, angle))
+            .filter(|&(&l, m)| self.sizing_wants_split(l, m.kappa, m.jump) && self.may_split(l))
+            .map(|(&l, m)| (l, m.angle))
             .collect();
         marks.sort_by_key(|m| m.0);
         marks
     }
 
-    /// True when leaf `l`, with curvature `kappa` (rad/m) measured at it, is
-    /// coarser than its target: `kappa * D > refine_angle`.
-    pub(super) fn sizing_wants_split(&self, l: u32, kappa: Scalar) -> bool {
+    /// True when leaf `l`, with curvature `kappa` (rad/m) and strain jump `jump`
+    /// measured at it, is coarser than its target: `kappa * D > refine_angle`,
+    /// or `jump > refine_strain` when that is set.
+    pub(super) fn sizing_wants_split(&self, l: u32, kappa: Scalar, jump: Scalar) -> bool {
         kappa * self.node_spacing(l) > self.config.refine_angle.to_radians()
+            || self.config.refine_strain.is_some_and(|s| jump > s)
     }
 
     /// Parents whose four leaf children would, merged, still be finer than
-    /// their target by the hysteresis: `kappa_p * 2 D_child <= refine_angle / H`.
+    /// their target by the hysteresis: `kappa_p * 2 D_child <= refine_angle / H`,
+    /// and with `refine_strain` set, twice the children's largest strain jump
+    /// (a merge doubles the spacing the jump spans) at most `refine_strain / H`.
     pub(super) fn sizing_merge_marks(&self, curv: &LeafCurvature) -> Vec<(u32, Scalar)> {
-        let limit = self.config.refine_angle.to_radians() / self.config.hysteresis;
+        let h = self.config.hysteresis;
+        let limit = self.config.refine_angle.to_radians() / h;
         let mut out = Vec::new();
         for p in self.hierarchy.mergeable_parents() {
             let children = self.hierarchy.children(p).unwrap_or_default();
-            let (kappa, angle) = children
+            let m = children
                 .iter()
                 .map(|&c| curv.get(c))
-                .fold((0.0 as Scalar, 0.0 as Scalar), |a, b| {
-                    (a.0.max(b.0), a.1.max(b.1))
-                });
-            if kappa * self.node_spacing(p) <= limit {
-                out.push((p, angle));
+                .fold(LeafMeasure::default(), LeafMeasure::max);
+            let strain_ok = self
+                .config
+                .refine_strain
+                .is_none_or(|s| 2.0 * m.jump <= s / h);
+            if m.kappa * self.node_spacing(p) <= limit && strain_ok {
+                out.push((p, m.angle));
             }
         }
         out

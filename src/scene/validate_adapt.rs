@@ -57,8 +57,17 @@ pub(super) fn adapt(a: &Adapt, integrator: Integrator) -> Result<(), Issue> {
     criterion(a)
 }
 
-/// The sizing criterion's own key: `hysteresis` > 1, and only with `criterion = "sizing"`.
+/// The sizing criterion's own keys: `hysteresis` > 1, and only with `criterion =
+/// "sizing"`; `refine_strain` > 0, and only with the sizing criterion on red-green.
 fn criterion(a: &Adapt) -> Result<(), Issue> {
+    if let Some(s) = a.refine_strain {
+        let path = keys(&["adapt", "refine_strain"]);
+        if a.criterion != AdaptCriterion::Sizing || a.method != AdaptMethod::RedGreen {
+            let why = "refine_strain belongs to criterion = \"sizing\" with method = \"red_green\"";
+            return Err(Issue::new(path, Kind::NotApplicable, why));
+        }
+        positive(path, s)?;
+    }
     let Some(h) = a.hysteresis else {
         return Ok(());
     };

@@ -25,6 +25,7 @@ fn sizing(refine_angle: Scalar, max_level: u8) -> AdaptConfig {
         max_rollbacks: 0,
         criterion: AdaptCriterion::Sizing,
         hysteresis: 2.0,
+        refine_strain: None,
     }
 }
 
@@ -227,4 +228,73 @@ fn a_passing_fold_leaves_the_region_coarse_again() {
         .after_left
         .expect("the region coarsens after the fold has passed");
     assert!(after <= 4, "coarse again after {after} passes");
+}
+
+/// `refine_strain` (sizing.rs, "Strain jumps"): a sheet hanging from two point
+/// pins is graded down to the finest level at the pins, where the strain
+/// concentrates and curvature alone leaves the mesh coarse. The rest area of
+/// the triangles at each pinned corner after 1 s, with and without the term,
+/// is printed.
+#[test]
+fn strain_jumps_refine_the_mesh_at_point_pins() {
+    use std::sync::atomic::AtomicBool;
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/hanging_sheet_rest.toml");
+    let corner_area = |strain: Option<&str>| {
+        let mut sets: Vec<String> = [
+            "simulation.duration=1.0",
+            "cloth.resolution=8",
+            "adapt.max_level=4",
+            "adapt.rollback=false",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+        if let Some(s) = strain {
+            sets.push(format!("adapt.refine_strain={s}"));
+        }
+        let scene = drape::scene::load_scene_file(&path, &sets).expect("scene");
+        let mut last: Option<(Vec<drape::math::Vector2>, Vec<[u32; 3]>)> = None;
+        drape::run::run_observed(
+            &scene,
+            &drape::run::RunOptions::default(),
+            &AtomicBool::new(false),
+            &mut |_| {},
+            &mut |f| last = Some((f.material.to_vec(), f.triangles.to_vec())),
+        )
+        .expect("run");
+        let (material, triangles) = last.expect("frames");
+        // The smallest rest area among the triangles at each top corner.
+        [-0.5, 0.5].map(|u| {
+            let corner = drape::math::Vector2::new(u, 0.5);
+            triangles
+                .iter()
+                .filter(|t| {
+                    t.iter()
+                        .any(|&v| material[v as usize].distance(corner) < 1e-9)
+                })
+                .map(|t| {
+                    let [a, b, c] = t.map(|v| material[v as usize]);
+                    0.5 * (b - a).perp_dot(c - a).abs()
+                })
+                .fold(Scalar::INFINITY, Scalar::min)
+        })
+    };
+    let coarse = corner_area(None);
+    let graded = corner_area(Some("0.02"));
+    // Base cells are 1/8 m: a base triangle has 1/128 m^2, the finest (level 4,
+    // two red splits) 1/2048 m^2.
+    println!(
+        "corner triangle areas: curvature only {coarse:?} m^2, with refine_strain 0.02 {graded:?} m^2"
+    );
+    for k in 0..2 {
+        assert!(
+            graded[k] <= 1.0 / 2048.0 * 1.0001,
+            "corner {k}: not at the finest level"
+        );
+        assert!(
+            coarse[k] > graded[k],
+            "corner {k}: the strain term refines more"
+        );
+    }
 }

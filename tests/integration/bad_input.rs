@@ -319,6 +319,45 @@ fn a_lower_threshold_above_the_upper_is_refused() {
 }
 
 #[test]
+fn refine_strain_needs_the_sizing_rule_on_red_green_and_a_positive_value() {
+    // With the full scene's red_green and the default sizing rule it is valid.
+    let dir = scene_dir("strain");
+    let out = drape(
+        &dir,
+        &["check", "full.toml", "--set", "adapt.refine_strain=0.01"],
+    );
+    assert_eq!(out.status.code(), Some(0), "{out:?}");
+    for other in ["adapt.criterion=\"angle\"", "adapt.method=\"edge\""] {
+        let args = [
+            "check",
+            "full.toml",
+            "--set",
+            "adapt.refine_strain=0.01",
+            "--set",
+            other,
+        ];
+        refused(
+            &drape(&dir, &args),
+            1,
+            &[
+                "error: full.toml",
+                "key `adapt.refine_strain`",
+                "refine_strain belongs to criterion = \"sizing\" with method = \"red_green\"",
+            ],
+        );
+    }
+    std::fs::remove_dir_all(&dir).ok();
+    refused_sets(
+        "strain-range",
+        &[
+            ("adapt.refine_strain", "0"),
+            ("adapt.refine_strain", "-0.1"),
+        ],
+        "must be > 0",
+    );
+}
+
+#[test]
 fn adapt_every_is_a_step_count_or_frame() {
     refused_sets(
         "every",

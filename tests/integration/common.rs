@@ -37,6 +37,7 @@ pub fn angle_config(method: AdaptMethod) -> AdaptConfig {
         max_rollbacks: 0,
         criterion: AdaptCriterion::Angle,
         hysteresis: 2.0,
+        refine_strain: None,
     }
 }
 

@@ -263,7 +263,8 @@ proptest! {
     /// Property (issue 14: incremental updates against a full rebuild, at any
     /// adaptation cadence). A sheet is draped into a random sequence of folds
     /// (each a `adapt_cost::drape` shape of random radius) and adapted after
-    /// every `cadence`-th shape, by either method and either criterion. After
+    /// every `cadence`-th shape, by either method and either criterion (the
+    /// sizing one with or without its strain-jump term). After
     /// every pass: the mesh is consistent (manifold, conforming, exact mass) and
     /// the hierarchy's incrementally kept lookup tables equal tables rebuilt
     /// from its forest (`Adapter::check`); with red-green, the world's mesh is
@@ -276,6 +277,7 @@ proptest! {
         cadence in 1usize..4,
         edge_method in any::<bool>(),
         sizing in any::<bool>(),
+        strain in any::<bool>(),
     ) {
         use drape::adapt::{AdaptConfig, Adapter, edge_angles};
         use drape::scene::{AdaptCriterion, AdaptMethod};
@@ -288,6 +290,8 @@ proptest! {
         let config = AdaptConfig {
             criterion,
             refine_angle: if sizing { 10.0 } else { 15.0 },
+            // The strain-jump term (sizing with red-green only).
+            refine_strain: (sizing && strain && !edge_method).then_some(1e-3),
             ..crate::common::angle_config(method)
         };
         let mut ad = Adapter::new(config, &w, 0.15);
