@@ -318,8 +318,14 @@ fn cmd_bench(args: BenchArgs) -> Result<ExitCode> {
         grid: args.samples as usize,
     };
     if args.list {
+        use std::io::Write;
+        let mut out = std::io::stdout().lock();
         for r in &drape::bench::resolved_ladder(&opts)?.rung {
-            println!("{}: {}", r.label, r.set.join(" "));
+            // A closed pipe (`drape bench --list | head`) ends the listing
+            // quietly instead of panicking in `println!`.
+            if writeln!(out, "{}: {}", r.label, r.set.join(" ")).is_err() {
+                break;
+            }
         }
         return Ok(ExitCode::SUCCESS);
     }
