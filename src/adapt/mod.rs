@@ -9,6 +9,7 @@
 mod check;
 pub mod edge;
 mod edge_pass;
+mod marks;
 pub mod red_green;
 pub mod sizing;
 pub mod soup;
@@ -16,8 +17,7 @@ pub mod transfer;
 mod tri_list;
 
 pub use check::{ConsistencyError, boundary_length, check_consistency};
-
-use rayon::prelude::*;
+pub use marks::{edge_angles, edge_angles_into};
 
 use crate::math::{Scalar, Vector};
 use crate::mesh::MeshError;
@@ -169,37 +169,6 @@ pub struct Adapter {
     boundary: Scalar,
 }
 
-/// Angle in degrees between the normals of the two triangles at each edge
-/// (0 at boundary edges).
-pub fn edge_angles(world: &World) -> Vec<Scalar> {
-    let mut angles = Vec::new();
-    edge_angles_into(world, &mut angles);
-    angles
-}
-
-/// [`edge_angles`] into `out` (its buffer reused: no allocation once it has
-/// grown to the mesh's edge count).
-pub fn edge_angles_into(world: &World, out: &mut Vec<Scalar>) {
-    let (x, tris) = (&world.x, &world.mesh.triangles);
-    let normal = |t: u32| {
-        let [a, b, c] = tris[t as usize].map(|i| x[i as usize]);
-        (b - a).cross(c - a)
-    };
-    world
-        .mesh
-        .edges
-        .par_iter()
-        .with_min_len(1024)
-        .map(|e| {
-            if !e.is_interior() {
-                return 0.0;
-            }
-            let (n0, n1) = (normal(e.triangles[0]), normal(e.triangles[1]));
-            n0.cross(n1).length().atan2(n0.dot(n1)).to_degrees()
-        })
-        .collect_into_vec(out);
-}
-
 impl Adapter {
     /// Starts adapting `world`'s mesh (its current triangles become level 0).
     pub fn new(config: AdaptConfig, world: &World, density: Scalar) -> Adapter {
@@ -255,110 +224,6 @@ impl Adapter {
     /// The refinement hierarchy (for tests and inspection).
     pub fn hierarchy(&self) -> &RedGreen {
         &self.hierarchy
-    }
-
-    /// Leaves the criterion asks to split, with the (largest) angle that asked,
-    /// from angles measured on the world's current shape.
-    pub fn refinement_marks(&self, world: &World, angles: &[Scalar]) -> Vec<(u32, Scalar)> {
-        debug_assert_eq!(
-            !self.refinement_marks_unchecked(world, angles).is_empty(),
-            self.needs_refinement(world, angles),
-            "needs_refinement disagrees with refinement_marks"
-        );
-        self.refinement_marks_unchecked(world, angles)
-    }
-
-    /// True when [`Adapter::refinement_marks`] would mark a leaf: the same rule,
-    /// checked edge by edge without allocating (paper A's rollback asks it after
-    /// every step, and nearly always gets no).
-    pub fn needs_refinement(&self, world: &World, angles: &[Scalar]) -> bool {
-        if self.edge.is_some() {
-            return false;
-        }
-        let sizing = self.config.criterion == AdaptCriterion::Sizing;
-        let strain = sizing && self.config.refine_strain.is_some();
-        world.mesh.edges.iter().enumerate().any(|(e, edge)| {
-            let kappa = if sizing {
-                sizing::edge_curvature(world, edge, angles[e])
-            } else {
-                0.0
-            };
-            let jump = if strain {
-                sizing::edge_strain_jump(world, edge)
-            } else {
-                0.0
-            };
-            edge.triangles
-                .iter()
-                .filter(|&&t| t != crate::mesh::NO_TRIANGLE)
-                .any(|&t| {
-                    let leaf = self.owner[t as usize];
-                    let over = if sizing {
-                        self.sizing_wants_split(leaf, kappa, jump)
-                    } else {
-                        angles[e] > self.config.refine_angle
-                    };
-                    over && self.may_split(leaf)
-                })
-        })
-    }
-
-    fn refinement_marks_unchecked(&self, world: &World, angles: &[Scalar]) -> Vec<(u32, Scalar)> {
-        if self.edge.is_some() {
-            return Vec::new(); // rollback is paper A's, with red_green only
-        }
-        if self.config.criterion == AdaptCriterion::Sizing {
-            return self.sizing_refinement_marks(&self.leaf_curvatures(world, angles));
-        }
-        let mut marks: Vec<(u32, Scalar)> = Vec::new();
-        for (e, edge) in world.mesh.edges.iter().enumerate() {
-            if angles[e] <= self.config.refine_angle {
-                continue;
-            }
-            for &t in &edge.triangles {
-                let leaf = self.owner[t as usize];
-                if self.may_split(leaf) {
-                    marks.push((leaf, angles[e]));
-                }
-            }
-        }
-        marks.sort_by(|a, b| a.0.cmp(&b.0).then(b.1.total_cmp(&a.1)));
-        marks.dedup_by_key(|m| m.0);
-        marks
-    }
-
-    /// Parents whose children may merge: every angle at the edges of their
-    /// triangles is below the lower threshold, and below half the upper one (a
-    /// merge about doubles the angles, so this keeps a merge from being split
-    /// again at once when the thresholds are close).
-    fn merge_marks(&self, world: &World, angles: &[Scalar]) -> Vec<(u32, Scalar)> {
-        let mut leaf_max: std::collections::HashMap<u32, Scalar> = std::collections::HashMap::new();
-        for (e, edge) in world.mesh.edges.iter().enumerate() {
-            for &t in edge
-                .triangles
-                .iter()
-                .filter(|&&t| t != crate::mesh::NO_TRIANGLE)
-            {
-                let m = leaf_max.entry(self.owner[t as usize]).or_insert(0.0);
-                *m = m.max(angles[e]);
-            }
-        }
-        let limit = self
-            .config
-            .coarsen_angle
-            .min(0.5 * self.config.refine_angle);
-        let mut out = Vec::new();
-        for p in self.hierarchy.mergeable_parents() {
-            let children = self.hierarchy.children(p).unwrap_or_default();
-            let worst = children
-                .iter()
-                .map(|c| leaf_max.get(c).copied().unwrap_or(0.0))
-                .fold(0.0, Scalar::max);
-            if worst < limit {
-                out.push((p, worst));
-            }
-        }
-        out
     }
 
     /// One adaptation pass on `world` after step `step`: merges, then splits,

@@ -2,13 +2,14 @@
 
 use super::bound::is_finite;
 use super::{SimState, StepFailure};
-use crate::adapt::edge_angles_into;
 use crate::collide::{Collider, StepCloth};
-use crate::math::{Scalar, Vector};
+use crate::math::Scalar;
 use crate::mesh::MeshError;
 use crate::physics::{Model, StepStats, Stepper};
-use crate::spec::AdaptEvery;
 use crate::world::World;
+
+mod remesh;
+use remesh::StepStart;
 
 /// How often a failing frame is retried with half the step before giving up.
 pub const MAX_STEP_HALVINGS: u32 = 4;
@@ -68,16 +69,6 @@ pub struct Pipeline {
     /// True while `angles` are those of the state's current positions and mesh
     /// (the adaptation pass after an accepted step then reuses them).
     angles_fresh: bool,
-}
-
-/// What a rollback restores: the step's start positions, velocities, time and
-/// ledger (so the rejected attempt's work and collision counts leave no trace).
-#[derive(Default)]
-struct StepStart {
-    x: Vec<Vector>,
-    v: Vec<Vector>,
-    time: Scalar,
-    ledger: Option<super::Ledger>,
 }
 
 impl Pipeline {
@@ -339,92 +330,6 @@ impl Pipeline {
         };
         let (world, contacts) = (&mut state.world, &mut state.contacts);
         c.end_step(world, h, cloth, contacts, &mut state.ledger.collision);
-        Ok(())
-    }
-
-    /// Saves what a rollback restores.
-    fn remember_step_start(&mut self, state: &SimState) {
-        let s = &mut self.step_start;
-        s.x.clone_from(&state.world.x);
-        s.v.clone_from(&state.world.v);
-        s.time = state.world.time;
-        s.ledger = Some(state.ledger);
-    }
-
-    /// Rollback (paper A): when the step bent an edge past the upper threshold and
-    /// rollbacks are left, restores the step's start (positions, velocities, time,
-    /// ledger), refines the marked edges and returns true (redo the step).
-    fn rollback(
-        &mut self,
-        model: &Model,
-        state: &mut SimState,
-        tries: &mut u32,
-    ) -> Result<bool, MeshError> {
-        let Some(ad) = state.adapter.as_mut() else {
-            return Ok(false);
-        };
-        if *tries >= ad.config.max_rollbacks {
-            return Ok(false);
-        }
-        edge_angles_into(&state.world, &mut self.angles);
-        self.angles_fresh = true;
-        // Nearly every step bends no edge past the threshold: answered without
-        // allocating; the marks are collected only for a rollback.
-        if !ad.needs_refinement(&state.world, &self.angles) {
-            return Ok(false);
-        }
-        let marks = ad.refinement_marks(&state.world, &self.angles);
-        self.angles_fresh = false;
-        let s = &mut self.step_start;
-        std::mem::swap(&mut state.world.x, &mut s.x);
-        std::mem::swap(&mut state.world.v, &mut s.v);
-        state.world.time = s.time;
-        debug_assert!(s.ledger.is_some(), "rollback without a saved step start");
-        if let Some(ledger) = s.ledger {
-            state.ledger = ledger;
-        }
-        ad.note_rollback(&state.world, state.ledger.steps_done);
-        ad.refine(&mut state.world, &marks, state.ledger.steps_done)?;
-        self.mesh_changed(model, state);
-        *tries += 1;
-        Ok(true)
-    }
-
-    /// Adapt: the remeshing pass after every `adapt.every` accepted steps.
-    fn adapt(&mut self, model: &Model, state: &mut SimState) -> Result<(), MeshError> {
-        match state.adapter.as_ref() {
-            Some(ad) if ad.config.every.after_step(state.ledger.steps_done) => {
-                self.remesh(model, state)
-            }
-            _ => Ok(()),
-        }
-    }
-
-    /// Adapt, with `adapt.every = "frame"`: the remeshing pass once the frame's
-    /// steps are accepted.
-    fn adapt_at_frame_end(&mut self, model: &Model, state: &mut SimState) -> Result<(), MeshError> {
-        match state.adapter.as_ref() {
-            Some(ad) if ad.config.every == AdaptEvery::Frame => self.remesh(model, state),
-            _ => Ok(()),
-        }
-    }
-
-    /// The remeshing pass on the state as it is (reusing the edge angles the
-    /// rollback check measured on it, when it did).
-    fn remesh(&mut self, model: &Model, state: &mut SimState) -> Result<(), MeshError> {
-        let Some(ad) = state.adapter.as_mut() else {
-            return Ok(());
-        };
-        let step = state.ledger.steps_done;
-        let changed = if self.angles_fresh {
-            ad.pass_measured(&mut state.world, step, &self.angles)?
-        } else {
-            ad.pass(&mut state.world, step)?
-        };
-        self.angles_fresh = false;
-        if changed {
-            self.mesh_changed(model, state);
-        }
         Ok(())
     }
 

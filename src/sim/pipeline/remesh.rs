@@ -1,0 +1,113 @@
+//! The pipeline's remeshing phases: paper A's rollback (redo a step that bent
+//! too far on a refined mesh) and the adaptation pass, after a step or at the
+//! end of a frame.
+
+use super::Pipeline;
+use crate::adapt::edge_angles_into;
+use crate::math::{Scalar, Vector};
+use crate::mesh::MeshError;
+use crate::physics::Model;
+use crate::sim::{Ledger, SimState};
+use crate::spec::AdaptEvery;
+
+/// What a rollback restores: the step's start positions, velocities, time and
+/// ledger (so the rejected attempt's work and collision counts leave no trace).
+#[derive(Default)]
+pub(super) struct StepStart {
+    x: Vec<Vector>,
+    v: Vec<Vector>,
+    time: Scalar,
+    ledger: Option<Ledger>,
+}
+
+impl Pipeline {
+    /// Saves what a rollback restores.
+    pub(super) fn remember_step_start(&mut self, state: &SimState) {
+        let s = &mut self.step_start;
+        s.x.clone_from(&state.world.x);
+        s.v.clone_from(&state.world.v);
+        s.time = state.world.time;
+        s.ledger = Some(state.ledger);
+    }
+
+    /// Rollback (paper A): when the step bent an edge past the upper threshold and
+    /// rollbacks are left, restores the step's start (positions, velocities, time,
+    /// ledger), refines the marked edges and returns true (redo the step).
+    pub(super) fn rollback(
+        &mut self,
+        model: &Model,
+        state: &mut SimState,
+        tries: &mut u32,
+    ) -> Result<bool, MeshError> {
+        let Some(ad) = state.adapter.as_mut() else {
+            return Ok(false);
+        };
+        if *tries >= ad.config.max_rollbacks {
+            return Ok(false);
+        }
+        edge_angles_into(&state.world, &mut self.angles);
+        self.angles_fresh = true;
+        // Nearly every step bends no edge past the threshold: answered without
+        // allocating; the marks are collected only for a rollback.
+        if !ad.needs_refinement(&state.world, &self.angles) {
+            return Ok(false);
+        }
+        let marks = ad.refinement_marks(&state.world, &self.angles);
+        self.angles_fresh = false;
+        let s = &mut self.step_start;
+        std::mem::swap(&mut state.world.x, &mut s.x);
+        std::mem::swap(&mut state.world.v, &mut s.v);
+        state.world.time = s.time;
+        debug_assert!(s.ledger.is_some(), "rollback without a saved step start");
+        if let Some(ledger) = s.ledger {
+            state.ledger = ledger;
+        }
+        ad.note_rollback(&state.world, state.ledger.steps_done);
+        ad.refine(&mut state.world, &marks, state.ledger.steps_done)?;
+        self.mesh_changed(model, state);
+        *tries += 1;
+        Ok(true)
+    }
+
+    /// Adapt: the remeshing pass after every `adapt.every` accepted steps.
+    pub(super) fn adapt(&mut self, model: &Model, state: &mut SimState) -> Result<(), MeshError> {
+        match state.adapter.as_ref() {
+            Some(ad) if ad.config.every.after_step(state.ledger.steps_done) => {
+                self.remesh(model, state)
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// Adapt, with `adapt.every = "frame"`: the remeshing pass once the frame's
+    /// steps are accepted.
+    pub(super) fn adapt_at_frame_end(
+        &mut self,
+        model: &Model,
+        state: &mut SimState,
+    ) -> Result<(), MeshError> {
+        match state.adapter.as_ref() {
+            Some(ad) if ad.config.every == AdaptEvery::Frame => self.remesh(model, state),
+            _ => Ok(()),
+        }
+    }
+
+    /// The remeshing pass on the state as it is (reusing the edge angles the
+    /// rollback check measured on it, when it did).
+    pub(super) fn remesh(&mut self, model: &Model, state: &mut SimState) -> Result<(), MeshError> {
+        let Some(ad) = state.adapter.as_mut() else {
+            return Ok(());
+        };
+        let step = state.ledger.steps_done;
+        let changed = if self.angles_fresh {
+            ad.pass_measured(&mut state.world, step, &self.angles)?
+        } else {
+            ad.pass(&mut state.world, step)?
+        };
+        self.angles_fresh = false;
+        if changed {
+            self.mesh_changed(model, state);
+        }
+        Ok(())
+    }
+}
