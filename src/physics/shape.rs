@@ -161,7 +161,7 @@
 //! settled sheet has no curvature across it there, and no energy is lost.
 
 use super::bending::dihedral_angle_and_gradient;
-use crate::math::{Scalar, Vector, Vector2};
+use crate::math::{Matrix3, Scalar, Vector, Vector2};
 use crate::mesh::Mesh;
 
 /// Vertex slots of a shape triangle: its three vertices, then the tips across
@@ -339,36 +339,19 @@ pub fn build_shape_triangles(
 
 /// A symmetric 2 x 2 tensor as `[xx, yy, xy]`.
 type Sym = [Scalar; 3];
-type Mat3 = [[Scalar; 3]; 3];
 
-fn mat_mul(a: &Mat3, b: &Mat3) -> Mat3 {
-    [0, 1, 2].map(|i| [0, 1, 2].map(|j| (0..3).map(|k| a[i][k] * b[k][j]).sum()))
-}
-
-fn transpose(a: &Mat3) -> Mat3 {
-    [0, 1, 2].map(|i| [0, 1, 2].map(|j| a[j][i]))
-}
-
-/// Inverse of a non-singular 3 x 3 matrix (cofactors).
-fn inverse(a: &Mat3) -> Mat3 {
-    let cof = |i: usize, j: usize| {
-        let (i1, i2, j1, j2) = ((i + 1) % 3, (i + 2) % 3, (j + 1) % 3, (j + 2) % 3);
-        a[i1][j1] * a[i2][j2] - a[i1][j2] * a[i2][j1]
-    };
-    let det = (0..3).map(|j| a[0][j] * cof(0, j)).sum::<Scalar>();
-    [0, 1, 2].map(|i| [0, 1, 2].map(|j| cof(j, i) / det))
+/// The 3 x 3 matrix with these rows (glam's matrices are built from columns).
+fn from_rows(rows: [[Scalar; 3]; 3]) -> Matrix3 {
+    Matrix3::from_cols_array_2d(&rows).transpose()
 }
 
 /// Pseudo-inverse of `a` (regularised: `(a^T a + eps I)^-1 a^T` with `eps`
 /// 1e-9 of the trace), so that directions `a` does not see (or barely sees) are
 /// left alone rather than amplified.
-fn pseudo_inverse(a: &Mat3) -> Mat3 {
-    let mut g = mat_mul(&transpose(a), a);
-    let eps = 1e-9 * (g[0][0] + g[1][1] + g[2][2]);
-    for (i, row) in g.iter_mut().enumerate() {
-        row[i] += eps;
-    }
-    mat_mul(&inverse(&g), &transpose(a))
+fn pseudo_inverse(a: Matrix3) -> Matrix3 {
+    let g = a.transpose() * a;
+    let eps = 1e-9 * (g.x_axis.x + g.y_axis.y + g.z_axis.z);
+    (g + Matrix3::from_diagonal(Vector::splat(eps))).inverse() * a.transpose()
 }
 
 /// `M` of a transition triangle (module docs, "Transitions"): the shape operator
@@ -384,7 +367,7 @@ fn transition_m(
     share: [Scalar; 3],
     area: Scalar,
     bending: Scalar,
-) -> Mat3 {
+) -> [[Scalar; 3]; 3] {
     let corners = |t: usize| mesh.triangles[t].map(|v| mesh.material[v as usize]);
     let p = corners(t);
     let origin = (p[0] + p[1] + p[2]) / 3.0;
@@ -426,13 +409,10 @@ fn transition_m(
             theta[a][j] = n[a].dot(other - own);
         }
     }
-    let ct = mat_mul(&c, &theta);
-    let miss: Mat3 = [0, 1, 2].map(|i| [0, 1, 2].map(|j| (i == j) as u8 as Scalar - ct[i][j]));
-    let fix = mat_mul(&miss, &pseudo_inverse(&theta));
-    let pm: Mat3 = [0, 1, 2].map(|i| [0, 1, 2].map(|j| c[i][j] + fix[i][j]));
-    let w = [1.0, 1.0, 2.0];
-    [0, 1, 2].map(|a| {
-        [0, 1, 2]
-            .map(|b| bending * area * (0..3).map(|k| w[k] * pm[k][a] * pm[k][b]).sum::<Scalar>())
-    })
+    let (c, theta) = (from_rows(c), from_rows(theta));
+    let p = c + (Matrix3::IDENTITY - c * theta) * pseudo_inverse(theta);
+    let w = Matrix3::from_diagonal(Vector::new(1.0, 1.0, 2.0));
+    ((bending * area) * p.transpose() * w * p)
+        .transpose()
+        .to_cols_array_2d()
 }
