@@ -84,6 +84,13 @@ pub struct AdaptStats {
     pub top_level_fraction_mean: Scalar,
     /// That fraction after the last pass.
     pub top_level_fraction_final: Scalar,
+    /// Mean over the passes of the share of the cloth's rest area that those
+    /// triangles cover (a level-4 region has 16 times the triangles of the same
+    /// area at level 0, so this is the smaller, and the one that says how much
+    /// of the cloth is refined).
+    pub top_level_area_fraction_mean: Scalar,
+    /// That share after the last pass.
+    pub top_level_area_fraction_final: Scalar,
 }
 
 impl AdaptStats {
@@ -93,9 +100,18 @@ impl AdaptStats {
         let levels = &world.mesh.levels;
         let at_top = levels.iter().filter(|&&l| l >= top).count();
         let f = at_top as Scalar / levels.len().max(1) as Scalar;
+        let m = &world.mesh;
+        let top_area: Scalar = (0..levels.len())
+            .filter(|&t| levels[t] >= top)
+            .map(|t| m.rest_area(t))
+            .sum();
+        let total = m.total_rest_area();
+        let a = if total > 0.0 { top_area / total } else { 0.0 };
         let n = self.passes.max(1) as Scalar;
         self.top_level_fraction_mean += (f - self.top_level_fraction_mean) / n;
         self.top_level_fraction_final = f;
+        self.top_level_area_fraction_mean += (a - self.top_level_area_fraction_mean) / n;
+        self.top_level_area_fraction_final = a;
     }
 }
 

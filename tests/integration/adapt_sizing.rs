@@ -298,3 +298,32 @@ fn strain_jumps_refine_the_mesh_at_point_pins() {
         );
     }
 }
+
+/// The two top-level statistics of a pass: a fold refined to the finest level
+/// over a band covers a smaller share of the cloth's area than of its
+/// triangles (a level-4 triangle has 1/16 of the area of a base one), and the
+/// area share is the band's: checked against the rest areas summed here.
+#[test]
+fn top_level_statistics_count_triangles_and_area() {
+    let mut w = flat_world(16, DiagonalPattern::Alternating);
+    let mut ad = Adapter::new(sizing(15.0, 4), &w, DENSITY);
+    settle(&mut w, &mut ad, fold(0.0, 0.08, 0.05));
+    let m = &w.mesh;
+    let top: Vec<usize> = (0..m.triangles.len())
+        .filter(|&t| m.levels[t] >= 4)
+        .collect();
+    let by_count = top.len() as Scalar / m.triangles.len() as Scalar;
+    let by_area = top.iter().map(|&t| m.rest_area(t)).sum::<Scalar>() / m.total_rest_area();
+    let s = ad.stats;
+    println!(
+        "fold at level 4: {} of {} triangles ({by_count:.3}), {by_area:.3} of the area; stats {:.3} / {:.3}",
+        top.len(),
+        m.triangles.len(),
+        s.top_level_fraction_final,
+        s.top_level_area_fraction_final
+    );
+    assert!(!top.is_empty(), "the fold reaches the finest level");
+    assert!((s.top_level_fraction_final - by_count).abs() < 1e-12);
+    assert!((s.top_level_area_fraction_final - by_area).abs() < 1e-12);
+    assert!(by_area < 0.5 * by_count, "fine triangles are small");
+}
