@@ -93,6 +93,10 @@ pub fn heavy_elastica(lambda: Scalar) -> (Scalar, Scalar) {
 fn increasing_root(f: impl Fn(Scalar) -> Scalar, lo: Scalar, hi: Scalar, tol: Scalar) -> Scalar {
     let (mut lo, mut hi) = (lo, hi);
     let (mut f_lo, mut f_hi) = (f(lo), f(hi));
+    debug_assert!(
+        f_lo <= 0.0 && f_hi >= 0.0,
+        "no root bracketed: f({lo}) = {f_lo}, f({hi}) = {f_hi}"
+    );
     if f_lo >= 0.0 {
         return lo;
     }

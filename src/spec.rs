@@ -383,7 +383,10 @@ impl AdaptEvery {
     /// True when the pass runs after accepted step number `steps_done`.
     pub fn after_step(self, steps_done: u64) -> bool {
         match self {
-            AdaptEvery::Steps(n) => steps_done.is_multiple_of(n.max(1) as u64),
+            AdaptEvery::Steps(n) => {
+                debug_assert!(n > 0, "adapt.every = 0 passed validation");
+                steps_done.is_multiple_of(n.max(1) as u64)
+            }
             AdaptEvery::Frame => false,
         }
     }

@@ -152,8 +152,9 @@ impl ImplicitScratch {
 
 /// One backward Euler step (module docs). `warm_start`: the last step's velocity
 /// change on the same mesh, the first guess of the solve (it varies slowly from
-/// step to step); empty or of another length, the solve starts from zero. The
-/// step's own velocity change is left there, whether or not it succeeded.
+/// step to step); empty, the solve starts from zero. One of another length is
+/// stale (a bug: asserted in debug builds, then a cold start). The step's own
+/// velocity change is left there, whether or not it succeeded.
 pub fn backward_euler(
     st: &mut Stepper,
     model: &Model,
@@ -174,6 +175,12 @@ pub fn backward_euler(
     assemble(st, model, w, h, false);
     let s = &mut st.implicit;
     s.dv.clear();
+    // A warm start of another mesh should have been cleared with that mesh.
+    debug_assert!(
+        warm_start.is_empty() || warm_start.len() == n,
+        "a warm start of {} vertices for a mesh of {n}",
+        warm_start.len()
+    );
     if warm_start.len() == n {
         s.dv.extend_from_slice(warm_start);
     } else {

@@ -204,9 +204,9 @@ impl Stepper {
 
     /// Advances `world` by `dt` seconds with `model`'s integrator. `warm_start`: the
     /// implicit solver's first guess for the velocity change, one per vertex (the
-    /// last step's solution, part of the simulation state; empty or of another
-    /// length: start cold); the step leaves its own solution there. Explicit
-    /// integrators leave it untouched. An implicit step whose equations could not
+    /// last step's solution, part of the simulation state; empty: start cold; of
+    /// another length: a bug, asserted in debug builds); the step leaves its own
+    /// solution there. Explicit integrators leave it untouched. An implicit step whose equations could not
     /// be solved returns the reason; the world is then left in an unspecified
     /// state and must be restored by the caller.
     pub fn step(

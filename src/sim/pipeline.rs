@@ -220,7 +220,9 @@ impl Pipeline {
     /// health check (together [`Pipeline::attempt`]), rollback (paper A: redo the
     /// step on a refined mesh when it bent past the upper threshold), adapt.
     /// Returns false when the step was rejected ([`Pipeline::failure`] says why);
-    /// the state is then not restored (the frame retry does that).
+    /// the state is then not restored (the frame retry does that). With
+    /// `adapt.every = "frame"` the adaptation pass is not part of the step: it
+    /// runs in [`Pipeline::advance_frame`], once the frame's steps are accepted.
     pub fn step(
         &mut self,
         model: &Model,
