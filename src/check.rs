@@ -191,7 +191,8 @@ fn describe_adapt(s: &mut String, scene: &Scene, a: &AdaptConfig) {
         match a.method {
             AdaptMethod::Edge =>
                 "edge (paper B: longest-edge splits, Delaunay flips, guarded collapses)",
-            _ => "red_green (paper A)",
+            _ if a.alternate_diagonals => "red_green (paper A; red splits' diagonals alternating)",
+            _ => "red_green (paper A; red splits' diagonals as split)",
         },
         match a.criterion {
             AdaptCriterion::Angle => format!(
@@ -199,8 +200,11 @@ fn describe_adapt(s: &mut String, scene: &Scene, a: &AdaptConfig) {
                 a.refine_angle, a.coarsen_angle
             ),
             AdaptCriterion::Sizing => format!(
-                "sizing criterion: refine where curvature x spacing exceeds {} deg, merge where the parent would carry at most {} deg (hysteresis {})",
+                "sizing criterion: refine where curvature x spacing exceeds {} deg{}, merge where the parent would carry at most {} deg (hysteresis {})",
                 a.refine_angle,
+                a.refine_strain
+                    .map(|j| format!(" or the strain jumps by more than {j} at an edge"))
+                    .unwrap_or_default(),
                 a.refine_angle / a.hysteresis,
                 a.hysteresis
             ),

@@ -320,6 +320,26 @@ pub struct Adapt {
     /// "Strain jumps".
     #[serde(default)]
     pub refine_strain: Option<f64>,
+    /// Red-green only: how the children of red splits are triangulated
+    /// (absent: [`RedDiagonals::Alternating`]). See `src/adapt/red_green/mesh.rs`,
+    /// "Alternating diagonals".
+    #[serde(default)]
+    pub diagonals: Option<RedDiagonals>,
+}
+
+/// How the simulation mesh triangulates the children of a red (1-4) split.
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum RedDiagonals {
+    /// The diagonal of the square at a right (or obtuse) corner of a split
+    /// triangle is flipped, so that a refined grid alternates its diagonals
+    /// like the uniform grid of the same edge length (and is that grid where
+    /// refined everywhere).
+    #[default]
+    Alternating,
+    /// The four children exactly as the split made them (paper A): inside a
+    /// split grid square every diagonal runs the same way.
+    AsSplit,
 }
 
 /// The hysteresis of the sizing criterion when `[adapt]` does not set it.

@@ -21,7 +21,9 @@ pub use marks::{edge_angles, edge_angles_into};
 
 use crate::math::{Scalar, Vector};
 use crate::mesh::MeshError;
-use crate::spec::{Adapt, AdaptCriterion, AdaptEvery, AdaptMethod, DEFAULT_HYSTERESIS};
+use crate::spec::{
+    Adapt, AdaptCriterion, AdaptEvery, AdaptMethod, DEFAULT_HYSTERESIS, RedDiagonals,
+};
 use crate::world::World;
 use red_green::{Applied, RedGreen, RedGreenOp};
 use transfer::{compact, transfer};
@@ -142,6 +144,9 @@ pub struct AdaptConfig {
     /// Sizing criterion: also split where the strain jumps across an edge by
     /// more than this (`None`: curvature alone; see `sizing.rs`).
     pub refine_strain: Option<Scalar>,
+    /// Red-green: flip the corner squares of red splits so that refined grids
+    /// alternate their diagonals (`red_green/mesh.rs`, "Alternating diagonals").
+    pub alternate_diagonals: bool,
 }
 
 impl AdaptConfig {
@@ -160,6 +165,7 @@ impl AdaptConfig {
             criterion: a.criterion,
             hysteresis: a.hysteresis.unwrap_or(DEFAULT_HYSTERESIS),
             refine_strain: a.refine_strain,
+            alternate_diagonals: a.diagonals.unwrap_or_default() == RedDiagonals::Alternating,
         })
     }
 }
@@ -367,7 +373,7 @@ impl Adapter {
     /// Builds the conforming mesh from the hierarchy, compacts the vertices and
     /// transfers the world's state onto it (the world is unchanged on error).
     fn rebuild_world(&mut self, world: &mut World) -> Result<(), MeshError> {
-        let (tris, levels, owner) = self.hierarchy.build();
+        let (tris, levels, owner) = self.hierarchy.build(self.config.alternate_diagonals);
         let (first_new, created) = self.hierarchy.created();
         let (map, remeshed) = compact(self.hierarchy.material(), first_new, created, &tris, levels);
         let material = remeshed.material.clone();

@@ -90,6 +90,7 @@ pub(crate) fn allowed(path: &str) -> Option<&'static str> {
         "adapt.multirate" => "true or false (explicit integrators only)",
         "adapt.criterion" => "\"angle\" or \"sizing\"",
         "adapt.hysteresis" => "a finite number > 1 (criterion = \"sizing\" only)",
+        "adapt.diagonals" => "\"alternating\" or \"as_split\" (method = \"red_green\" only)",
         "adapt.refine_strain" => {
             "a finite number > 0 (criterion = \"sizing\" with method = \"red_green\" only)"
         }

@@ -60,6 +60,11 @@ pub(super) fn adapt(a: &Adapt, integrator: Integrator) -> Result<(), Issue> {
 /// The sizing criterion's own keys: `hysteresis` > 1, and only with `criterion =
 /// "sizing"`; `refine_strain` > 0, and only with the sizing criterion on red-green.
 fn criterion(a: &Adapt) -> Result<(), Issue> {
+    if a.diagonals.is_some() && a.method != AdaptMethod::RedGreen {
+        let path = keys(&["adapt", "diagonals"]);
+        let why = "diagonals belongs to method = \"red_green\" (the edge method splits edges one at a time)";
+        return Err(Issue::new(path, Kind::NotApplicable, why));
+    }
     if let Some(s) = a.refine_strain {
         let path = keys(&["adapt", "refine_strain"]);
         if a.criterion != AdaptCriterion::Sizing || a.method != AdaptMethod::RedGreen {

@@ -26,6 +26,7 @@ fn sizing(refine_angle: Scalar, max_level: u8) -> AdaptConfig {
         criterion: AdaptCriterion::Sizing,
         hysteresis: 2.0,
         refine_strain: None,
+        alternate_diagonals: true,
     }
 }
 

@@ -358,6 +358,39 @@ fn refine_strain_needs_the_sizing_rule_on_red_green_and_a_positive_value() {
 }
 
 #[test]
+fn red_green_diagonals_are_named_and_belong_to_red_green() {
+    let dir = scene_dir("diagonals");
+    for value in ["\"alternating\"", "\"as_split\""] {
+        let set = format!("adapt.diagonals={value}");
+        let out = drape(&dir, &["check", "full.toml", "--set", &set]);
+        assert_eq!(out.status.code(), Some(0), "{set}: {out:?}");
+    }
+    let args = [
+        "check",
+        "full.toml",
+        "--set",
+        "adapt.diagonals=\"as_split\"",
+        "--set",
+        "adapt.method=\"edge\"",
+    ];
+    refused(
+        &drape(&dir, &args),
+        1,
+        &[
+            "error: full.toml",
+            "key `adapt.diagonals`",
+            "diagonals belongs to method = \"red_green\"",
+        ],
+    );
+    std::fs::remove_dir_all(&dir).ok();
+    refused_sets(
+        "diagonals-name",
+        &[("adapt.diagonals", "\"regular\""), ("adapt.diagonals", "1")],
+        "\"alternating\" or \"as_split\"",
+    );
+}
+
+#[test]
 fn adapt_every_is_a_step_count_or_frame() {
     refused_sets(
         "every",

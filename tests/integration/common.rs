@@ -38,6 +38,7 @@ pub fn angle_config(method: AdaptMethod) -> AdaptConfig {
         criterion: AdaptCriterion::Angle,
         hysteresis: 2.0,
         refine_strain: None,
+        alternate_diagonals: true,
     }
 }
 

@@ -1,5 +1,39 @@
 //! The red forest as a mesh: the conforming simulation mesh built from the
 //! leaves, and the renumbering that follows the world's vertex compaction.
+//!
+//! # Alternating diagonals (`adapt.diagonals`, issue 14)
+//! A red split of a grid square's two triangles gives four sub-squares whose
+//! diagonals all run the way the square's did, where the uniform grid of the
+//! same edge length alternates them in a checkerboard. The mass-spring
+//! membrane is not isotropic on either triangulation, and the difference
+//! showed: on `hanging_sheet_rest` at rest (error against uniform 96, relative
+//! to the diagonal) uniform 64 has 0.114 %, uniform 64 with its diagonals all
+//! one way 0.912 %, and base 16 refined everywhere to the same edges 0.163 %.
+//! Node by node the red-green family was the worse discretisation against a
+//! red-green reference too, so this was a floor under every adaptive run, not
+//! a bias of the reference (`docs/speed-vs-error.md`).
+//!
+//! So the mesh is emitted with one flip per red split: in a split triangle
+//! with a corner of at least 90 degrees (a grid triangle's right angle), the
+//! corner child and the middle child form a square (a rectangle at a right
+//! angle), and its diagonal is flipped from the midpoint edge to the one from
+//! the corner to the midpoint of the opposite side. For a grid triangle that
+//! makes the four sub-squares of a split square alternate like the uniform
+//! grid, with the same phase at every level, so a grid refined everywhere is
+//! the uniform alternating grid triangle for triangle (the test
+//! `red_green_refined_everywhere_is_the_uniform_grid`), and `hanging_sheet_rest`
+//! refined everywhere has uniform 64's 0.114 %. At an obtuse corner the flip
+//! takes the shorter diagonal (the Delaunay one); triangles without such a
+//! corner (a disk's) are emitted as split.
+//!
+//! The flip belongs to the emitted mesh only: the forest, its operations and
+//! their inverses are unchanged, and a pair is flipped only while both
+//! children are leaves without hanging nodes (else the corner child or the
+//! middle one is split further or green-closed, and the children are emitted
+//! as before). The flipped square's two triangles keep the children's level;
+//! the one at the corner is owned by the corner child, the other by the
+//! middle child, for the marks. `diagonals = "as_split"` keeps paper A's
+//! children exactly.
 
 use super::{RedGreen, sorted};
 use crate::math::Vector2;
@@ -8,7 +42,13 @@ use crate::mesh::PairMap;
 impl RedGreen {
     /// The conforming simulation mesh: each leaf, or its two green halves when it
     /// has one hanging node. Returns triangles, their levels and their leaf.
-    pub fn build(&self) -> (Vec<[u32; 3]>, Vec<u8>, Vec<u32>) {
+    ///
+    /// With `alternate`, a red split of a right (or obtuse) triangle is emitted
+    /// with the diagonal of its corner square flipped wherever that corner child
+    /// and the middle child are both whole leaves (module docs, "Alternating
+    /// diagonals"): the first triangle of the flipped pair is owned by the corner
+    /// child, the second by the middle child.
+    pub fn build(&self, alternate: bool) -> (Vec<[u32; 3]>, Vec<u8>, Vec<u32>) {
         let leaves = self.leaves();
         let mut tris = Vec::with_capacity(leaves.len() + leaves.len() / 4);
         let mut levels = Vec::with_capacity(tris.capacity());
@@ -16,11 +56,19 @@ impl RedGreen {
         for t in leaves {
             let v = self.vertices(t);
             let level = self.level(t);
-            let hanging = (0..3).find_map(|k| {
-                let (p, q) = (v[k], v[(k + 1) % 3]);
-                self.mid.get(&sorted(p, q)).map(|&m| (k, m))
-            });
-            match hanging {
+            if alternate {
+                match self.flipped_pair(t) {
+                    Some(Flip::Middle) => continue, // emitted with its corner child
+                    Some(Flip::Corner { pair, middle }) => {
+                        tris.extend(pair);
+                        levels.extend([level, level]);
+                        owner.extend([t, middle]);
+                        continue;
+                    }
+                    None => {}
+                }
+            }
+            match self.hanging_node(t) {
                 None => {
                     tris.push(v);
                     levels.push(level);
@@ -35,6 +83,59 @@ impl RedGreen {
             }
         }
         (tris, levels, owner)
+    }
+
+    /// The first edge of leaf `t` (from corner k to k + 1) that carries a
+    /// hanging node, with that node.
+    fn hanging_node(&self, t: u32) -> Option<(usize, u32)> {
+        let v = self.vertices(t);
+        (0..3).find_map(|k| {
+            let (p, q) = (v[k], v[(k + 1) % 3]);
+            self.mid.get(&sorted(p, q)).map(|&m| (k, m))
+        })
+    }
+
+    /// The corner of node `n` whose angle is at least a right angle (to a
+    /// relative 1e-9, so that a grid's right angles count despite rounding),
+    /// if any.
+    fn square_corner(&self, n: u32) -> Option<usize> {
+        let v = self.vertices(n).map(|i| self.material[i as usize]);
+        (0..3).find(|&k| {
+            let (a, b) = (v[(k + 2) % 3] - v[k], v[(k + 1) % 3] - v[k]);
+            a.dot(b) <= 1e-9 * a.length() * b.length()
+        })
+    }
+
+    /// Whether leaf `t` is half of a flipped pair (module docs).
+    fn flipped_pair(&self, t: u32) -> Option<Flip> {
+        let parent = self.parent(t)?;
+        let children = self.children(parent)?;
+        let k = self.square_corner(parent)?;
+        let (corner, middle) = (children[k], children[3]);
+        if (t != corner && t != middle)
+            || !self.is_leaf(corner)
+            || !self.is_leaf(middle)
+            || self.hanging_node(corner).is_some()
+            || self.hanging_node(middle).is_some()
+        {
+            return None;
+        }
+        if t == middle {
+            return Some(Flip::Middle);
+        }
+        // The corner child holds v_k at position k, then m_next (the midpoint
+        // of the edge from v_k, counter-clockwise) and m_prev (`split` makes
+        // them so); the middle child holds m_opp, the midpoint of the edge
+        // opposite v_k, at position k + 1. Their common square v_k, m_next,
+        // m_opp, m_prev (counter-clockwise) gets the diagonal v_k - m_opp
+        // instead of m_next - m_prev.
+        let c = self.vertices(corner);
+        let (v_k, m_next, m_prev) = (c[k], c[(k + 1) % 3], c[(k + 2) % 3]);
+        let m_opp = self.vertices(middle)[(k + 1) % 3];
+        Some(Flip::Corner {
+            pair: [[v_k, m_next, m_opp], [v_k, m_opp, m_prev]],
+            middle,
+        })
     }
 
     /// Follows the world's vertex compaction: `map[old]` is the new index of
@@ -117,4 +218,17 @@ fn rekey<V: Copy>(
         stays
     });
     table.extend(moved);
+}
+
+/// A leaf's part in a flipped pair.
+enum Flip {
+    /// The corner child: emits the pair.
+    Corner {
+        /// The two triangles of the flipped square, counter-clockwise.
+        pair: [[u32; 3]; 2],
+        /// The middle child, which owns the second triangle.
+        middle: u32,
+    },
+    /// The middle child: emits nothing.
+    Middle,
 }
