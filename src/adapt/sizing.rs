@@ -95,6 +95,13 @@
 //! on the triangulation: refined everywhere to 64 it is 0.226 % of the
 //! diagonal from uniform 128 and 0.290 % from itself refined to 128, where
 //! uniform 64 is 0.186 % and 0.236 % from them (`docs/speed-vs-error.md`).
+//! Those figures are with the red children as split; with the alternating
+//! diagonals that came after (`red_green/mesh.rs`, now the default) a mesh
+//! refined everywhere is the uniform grid, and the same ladder (third sitting,
+//! 3 repetitions; uniform 64 1.139e-3 in 18.5 s) gives `refine_strain = 0.02`
+//! 1.71e-3 in 4.5 s (894 mean vertices: the alternating mesh's strain is
+//! smoother, so the same threshold refines less), 0.01 1.28e-3 in 12.0 s,
+//! 0.01 without rollback 1.21e-3 (x1.07) in 5.9 s, 0.005 1.15e-3 in 30.7 s.
 //! Not the default: it is measured on one scene.
 //!
 //! The edge method (paper B) with this criterion keeps its splits (an edge's
