@@ -30,7 +30,17 @@
 //! their inverses are unchanged, and a pair is flipped only while both
 //! children are leaves without hanging nodes (else the corner child or the
 //! middle one is split further or green-closed, and the children are emitted
-//! as before). The flipped square's two triangles keep the children's level;
+//! as before) and the corner child's two outer sides face the boundary or a
+//! whole leaf of its own level. That last condition came from a failure: with
+//! squares flipped next to a level transition, a green triangle across the
+//! flipped square's side had a shape operator blind to a bend (its three
+//! folds no longer determine the curvature tensor, `shape.rs`,
+//! "Transitions"): on a sheet refined over `x < -0.15`, six of its sixteen
+//! greens carried 0.905 of the continuum's energy for a cylinder about y
+//! (test `partly_refined_sheet_bends_like_the_continuum`), and the
+//! cantilever's partly refined rungs were up to twice as far from the
+//! reference as with the children as split (red_green 10 L6 r0.5: 0.024 %
+//! against 0.012 %; with the condition 0.0137 %). The flipped square's two triangles keep the children's level;
 //! the one at the corner is owned by the corner child, the other by the
 //! middle child, for the marks. `diagonals = "as_split"` keeps paper A's
 //! children exactly.
@@ -106,6 +116,26 @@ impl RedGreen {
         })
     }
 
+    /// Whether the two outer sides of corner child `corner` (at corner `k` of
+    /// its parent) each face the mesh boundary or a leaf of its own level that
+    /// is emitted whole (module docs: a flipped triangle next to a green one
+    /// leaves that green's transition operator blind to a bend).
+    fn level_outside(&self, corner: u32, k: usize) -> bool {
+        let c = self.vertices(corner);
+        [(c[k], c[(k + 1) % 3]), (c[(k + 2) % 3], c[k])]
+            .into_iter()
+            .all(|(p, q)| match self.leaf_by_edge.get(&(q, p)) {
+                Some(&n) => self.hanging_node(n).is_none(),
+                // No leaf across: a boundary side, or one of a coarser leaf
+                // (the side is half of the parent's edge, whose other side
+                // is a leaf).
+                None => self
+                    .half_of
+                    .get(&(p, q))
+                    .is_none_or(|&(pp, qq)| !self.leaf_by_edge.contains_key(&(qq, pp))),
+            })
+    }
+
     /// Whether leaf `t` is half of a flipped pair (module docs).
     fn flipped_pair(&self, t: u32) -> Option<Flip> {
         let parent = self.parent(t)?;
@@ -117,6 +147,7 @@ impl RedGreen {
             || !self.is_leaf(middle)
             || self.hanging_node(corner).is_some()
             || self.hanging_node(middle).is_some()
+            || !self.level_outside(corner, k)
         {
             return None;
         }
