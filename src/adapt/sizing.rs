@@ -98,10 +98,11 @@
 //! Those figures are with the red children as split; with the alternating
 //! diagonals that came after (`red_green/mesh.rs`, now the default) a mesh
 //! refined everywhere is the uniform grid, and the same ladder (third sitting,
-//! 3 repetitions; uniform 64 1.139e-3 in 18.5 s) gives `refine_strain = 0.02`
-//! 1.71e-3 in 4.5 s (894 mean vertices: the alternating mesh's strain is
-//! smoother, so the same threshold refines less), 0.01 1.28e-3 in 12.0 s,
-//! 0.01 without rollback 1.21e-3 (x1.07) in 5.9 s, 0.005 1.15e-3 in 30.7 s.
+//! 3 repetitions; uniform 64 1.139e-3 in 22.6 s on a slower day) gives
+//! `refine_strain = 0.02` 1.43e-3 in 10.5 s (997 mean vertices), 0.01 1.27e-3
+//! in 10.7 s, 0.01 without rollback 1.19e-3 (x1.05) in 9.1 s, 0.005 1.13e-3
+//! in 47.8 s (rollbacks: 1,375 steps for 600); with `refine_angle = 8`, 0.02
+//! 1.24e-3 (x1.09) in 7.0 s against uniform 64's 24.1 s in the same run.
 //! Not the default: it is measured on one scene.
 //!
 //! The edge method (paper B) with this criterion keeps its splits (an edge's
