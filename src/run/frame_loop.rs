@@ -220,6 +220,7 @@ impl<'a> FrameLoop<'a> {
                 .stepper()
                 .energy(&self.model, &self.state.world),
             timing: self.timing,
+            frame_interval: self.frame_interval,
         };
         let (state, pipeline) = (&mut self.state, &mut self.pipeline);
         recording::record_state(rec, &self.model, state, pipeline, &snap, &mut self.normals)?;

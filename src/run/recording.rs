@@ -28,6 +28,8 @@ pub(super) struct Snapshot {
     pub energy: Energy,
     /// Wall times to plot.
     pub timing: FrameTiming,
+    /// Simulated seconds between frames.
+    pub frame_interval: Scalar,
 }
 
 /// Records the world's current state as frame `snap.frame`, with the events since the previous
@@ -52,7 +54,7 @@ pub(super) fn record_state(
     let edges: Vec<[u32; 2]> = world.mesh.edges.iter().map(|e| e.vertices).collect();
     world.vertex_normals(normals);
     let pinned: Vec<u32> = world.pins.anchors.iter().map(|a| a.vertex).collect();
-    let dt_now = pipe.step_size(model, world);
+    let dt_now = pipe.step_taken(model, world, snap.frame_interval);
     let e = snap.energy;
     let mut scalars = vec![
         ("mesh/vertices", world.x.len() as f64),

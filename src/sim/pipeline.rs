@@ -69,6 +69,8 @@ pub struct Pipeline {
     /// True while `angles` are those of the state's current positions and mesh
     /// (the adaptation pass after an accepted step then reuses them).
     angles_fresh: bool,
+    /// The size of the last accepted step (for the recording's step plot).
+    last_step: Option<Scalar>,
 }
 
 impl Pipeline {
@@ -95,6 +97,7 @@ impl Pipeline {
             frame_start: None,
             step_start: StepStart::default(),
             angles: Vec::new(),
+            last_step: None,
             angles_fresh: false,
         }
     }
@@ -201,9 +204,22 @@ impl Pipeline {
                 return Ok(false);
             }
             state.effort.min_dt = state.effort.min_dt.min(h);
+            self.last_step = Some(h);
             done += h;
         }
         Ok(true)
+    }
+
+    /// The step the run takes, for display: the last accepted step (the current
+    /// mesh's step evened out so that the frame ends on its time, and halved
+    /// on a retried frame), or before the first step the one a frame of
+    /// `frame_interval` seconds will take.
+    pub fn step_taken(&mut self, model: &Model, world: &World, frame_interval: Scalar) -> Scalar {
+        if let Some(h) = self.last_step {
+            return h;
+        }
+        let target = self.step_size(model, world);
+        frame_interval / (frame_interval / target * (1.0 - 1e-12)).ceil().max(1.0)
     }
 
     /// The step for the current mesh: the fixed one, or `model`'s automatic estimate.

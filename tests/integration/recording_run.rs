@@ -458,3 +458,43 @@ fn sigint_leaves_a_complete_recording() {
     assert_eq!(ins.entities["/cloth/mesh"].temporal as u64, frames);
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Regression: the step plot showed the automatic step's target (10 ms on
+/// `hanging_sheet_rest`), not the step taken (8.333 ms: the target evened out
+/// so that four steps end each 1/30 s frame). Now every frame plots the step
+/// the run took, here the frame interval over the steps per frame.
+#[test]
+fn step_plot_shows_the_step_taken_not_the_target() {
+    let scene = scene_file(
+        "hanging_sheet_rest.toml",
+        &[
+            "adapt.method=\"none\"",
+            "cloth.resolution=8",
+            "simulation.duration=0.5",
+        ],
+    );
+    let out = temp_path("dt.rrd");
+    let summary = record(&scene, &out, RunOptions::default()).expect("run");
+    let taken_ms = 1e3 * summary.sim_time / summary.steps as f64;
+    let ins = inspect(&out).expect("decodes");
+    let plotted: Vec<f64> = ins
+        .frames
+        .values()
+        .filter_map(|f| f.scalars.get("time/dt_ms").copied())
+        .collect();
+    println!(
+        "{} steps in {:.3} s: {taken_ms:.4} ms a step; plotted {:?} ms over {} frames",
+        summary.steps,
+        summary.sim_time,
+        plotted.first(),
+        plotted.len()
+    );
+    assert_eq!(plotted.len() as u64, summary.frames);
+    for (n, ms) in plotted.iter().enumerate() {
+        assert!(
+            (ms - taken_ms).abs() <= 1e-9 * taken_ms,
+            "frame {n}: plotted {ms} ms, taken {taken_ms} ms"
+        );
+    }
+    std::fs::remove_file(&out).ok();
+}
