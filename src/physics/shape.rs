@@ -140,6 +140,20 @@
 //! with 40 splits (`refine_angle = 3`) 41.47 -> 41.67.
 //!
 //! What is given up, and what was not done:
+//! * A transition triangle whose three folds cannot tell some constant `H`
+//!   from zero (a singular `Theta`; the pseudo-inverse then leaves that part
+//!   as `C` does) is not exact for it. Single green triangles of this kind
+//!   appear at second-level transitions: on the 8 x 8 sheet refined one red
+//!   level over `x < b1` and a second over `x < b2` (a scratch probe, not
+//!   kept, 2026-11-23), for `(b1, b2)` = (-0.15, -0.3), (-0.1, -0.2) and
+//!   (0.1, -0.05), 6, 8 and 6 triangles carried 0.905 of the continuum's
+//!   energy (|ratio - 1| up to 0.0947 over the four shapes of the test below,
+//!   every other triangle within 0.003), with red-green's children as split
+//!   and with alternating diagonals alike; (0, -0.25) had none. A flipped
+//!   square next to a first-level green made the same blind greens, which is
+//!   why red-green leaves such squares as split (`adapt/red_green/mesh.rs`).
+//!   Reading a fourth fold (a neighbour's) where `Theta` is singular would fix
+//!   it; not done.
 //! * `sum_t A_t S_t` is no longer exactly the distributional Hessian across a
 //!   transition rim, so the Jensen argument above holds in the uniform parts
 //!   only; in the rim each triangle is instead exact for constant curvature,
