@@ -147,8 +147,9 @@
 //!   level over `x < b1` and a second over `x < b2` (a scratch probe, not
 //!   kept, 2026-11-23), for `(b1, b2)` = (-0.15, -0.3), (-0.1, -0.2) and
 //!   (0.1, -0.05), 6, 8 and 6 triangles carried 0.905 of the continuum's
-//!   energy (|ratio - 1| up to 0.0947 over the four shapes of the test below,
-//!   every other triangle within 0.003), with red-green's children as split
+//!   energy (|ratio - 1| up to 0.0947 over the four shapes of
+//!   `partly_refined_sheet_bends_like_the_continuum`, every other triangle
+//!   within 0.003), with red-green's children as split
 //!   and with alternating diagonals alike; (0, -0.25) had none. A flipped
 //!   square next to a first-level green made the same blind greens, which is
 //!   why red-green leaves such squares as split (`adapt/red_green/mesh.rs`).
