@@ -40,10 +40,10 @@
 //! (test `partly_refined_sheet_bends_like_the_continuum`), and the
 //! cantilever's partly refined rungs were up to twice as far from the
 //! reference as with the children as split (red_green 10 L6 r0.5: 0.024 %
-//! against 0.012 %; with the condition 0.0137 %). The flipped square's two triangles keep the children's level;
-//! the one at the corner is owned by the corner child, the other by the
-//! middle child, for the marks. `diagonals = "as_split"` keeps paper A's
-//! children exactly.
+//! against 0.012 %; with the condition 0.0137 %). The flipped square's two
+//! triangles keep the children's level; the one at the corner is owned by the
+//! corner child, the other by the middle child, for the marks.
+//! `diagonals = "as_split"` keeps paper A's children exactly.
 
 use super::{RedGreen, sorted};
 use crate::math::Vector2;
@@ -55,9 +55,10 @@ impl RedGreen {
     ///
     /// With `alternate`, a red split of a right (or obtuse) triangle is emitted
     /// with the diagonal of its corner square flipped wherever that corner child
-    /// and the middle child are both whole leaves (module docs, "Alternating
-    /// diagonals"): the first triangle of the flipped pair is owned by the corner
-    /// child, the second by the middle child.
+    /// and the middle child are both whole leaves and the square faces no
+    /// coarser leaf (module docs, "Alternating diagonals"): the first triangle
+    /// of the flipped pair is owned by the corner child, the second by the
+    /// middle child.
     pub fn build(&self, alternate: bool) -> (Vec<[u32; 3]>, Vec<u8>, Vec<u32>) {
         let leaves = self.leaves();
         let mut tris = Vec::with_capacity(leaves.len() + leaves.len() / 4);
