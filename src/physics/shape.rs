@@ -142,19 +142,22 @@
 //! What is given up, and what was not done:
 //! * A transition triangle whose three folds cannot tell some constant `H`
 //!   from zero (a singular `Theta`; the pseudo-inverse then leaves that part
-//!   as `C` does) is not exact for it. Single green triangles of this kind
-//!   appear at second-level transitions: on the 8 x 8 sheet refined one red
-//!   level over `x < b1` and a second over `x < b2` (a scratch probe, not
-//!   kept, 2026-11-23), for `(b1, b2)` = (-0.15, -0.3), (-0.1, -0.2) and
-//!   (0.1, -0.05), 6, 8 and 6 triangles carried 0.905 of the continuum's
-//!   energy (|ratio - 1| up to 0.0947 over the four shapes of
-//!   `partly_refined_sheet_bends_like_the_continuum`, every other triangle
-//!   within 0.003), with red-green's children as split
-//!   and with alternating diagonals alike; (0, -0.25) had none. A flipped
-//!   square next to a first-level green made the same blind greens, which is
-//!   why red-green leaves such squares as split (`adapt/red_green/mesh.rs`).
-//!   Reading a fourth fold (a neighbour's) where `Theta` is singular would fix
-//!   it; not done.
+//!   as `C` does) is not exact for it. Measured (2026-11-23, scratch probes,
+//!   not kept): a first-level green next to a flipped corner square (the
+//!   case `adapt/red_green/mesh.rs` now avoids) has `Theta` with singular
+//!   values 0.113 m, 0.094 m and 0 (folds per unit curvature, 1 m sheet),
+//!   null direction 0.555 xx - 0.832 xy, so it is blind to part of a bend
+//!   along x (0.905 of the continuum's energy for the cylinder about y); with
+//!   the square as split its null direction is pure twist. On the 8 x 8
+//!   sheet refined one red level over `x < b1` and a second over `x < b2`,
+//!   for `(b1, b2)` = (-0.15, -0.3), (-0.1, -0.2) and (0.1, -0.05), 6, 8 and
+//!   6 (triangle, shape) pairs were more than 5 % from the continuum over
+//!   the four shapes of `partly_refined_sheet_bends_like_the_continuum`
+//!   (worst |ratio - 1| 0.0947), with red-green's children as split and with
+//!   alternating diagonals alike; (0, -0.25) had none. Which triangles they
+//!   are and whether their `Theta` is singular was not checked. Reading a
+//!   fourth fold (a neighbour's) where `Theta` is singular might fix it; not
+//!   done.
 //! * `sum_t A_t S_t` is no longer exactly the distributional Hessian across a
 //!   transition rim, so the Jensen argument above holds in the uniform parts
 //!   only; in the rim each triangle is instead exact for constant curvature,

@@ -198,8 +198,7 @@ impl Pipeline {
         let mut done = 0.0;
         while done < frame_interval * (1.0 - 1e-12) {
             let remaining = frame_interval - done;
-            let target = self.step_size(model, &state.world) / shrink;
-            let h = remaining / (remaining / target * (1.0 - 1e-12)).ceil().max(1.0);
+            let h = evened_step(remaining, self.step_size(model, &state.world) / shrink);
             if !self.step(model, state, h)? {
                 return Ok(false);
             }
@@ -218,8 +217,7 @@ impl Pipeline {
         if let Some(h) = self.last_step {
             return h;
         }
-        let target = self.step_size(model, world);
-        frame_interval / (frame_interval / target * (1.0 - 1e-12)).ceil().max(1.0)
+        evened_step(frame_interval, self.step_size(model, world))
     }
 
     /// The step for the current mesh: the fixed one, or `model`'s automatic estimate.
@@ -402,4 +400,10 @@ fn absorb(total: &mut StepStats, step: &mut StepStats) {
     total.assembly_s += assembly_s;
     total.factorization_s += factorization_s;
     total.solve_s += solve_s;
+}
+
+/// The step at most `target` long (to a relative 1e-12) that divides `span`
+/// into whole steps: the steps of a frame end exactly on its time.
+fn evened_step(span: Scalar, target: Scalar) -> Scalar {
+    span / (span / target * (1.0 - 1e-12)).ceil().max(1.0)
 }

@@ -137,6 +137,27 @@ fn refused_sets(name: &str, cases: &[(&str, &str)], what: &str) {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// `drape check full.toml` with each of `sets` alone: accepted.
+fn accepted_sets(name: &str, sets: &[&str]) {
+    let dir = scene_dir(name);
+    for set in sets {
+        let out = drape(&dir, &["check", "full.toml", "--set", set]);
+        assert_eq!(out.status.code(), Some(0), "{set}: {out:?}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// `drape check full.toml` with `set` and then `other`: refused, naming the
+/// file, `set`'s key and `why` (a key valid alone that does not apply to the
+/// settings `other` makes).
+fn refused_with(name: &str, set: &str, other: &str, why: &str) {
+    let dir = scene_dir(name);
+    let out = drape(&dir, &["check", "full.toml", "--set", set, "--set", other]);
+    let key = set.split('=').next().unwrap_or(set);
+    refused(&out, 1, &["error: full.toml", &format!("key `{key}`"), why]);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 /// `drape check bad.toml` with `text` as the scene: refused with `needles`.
 fn refused_file(text: &[u8], needles: &[&str]) {
     let dir = temp_dir("file");
@@ -321,32 +342,15 @@ fn a_lower_threshold_above_the_upper_is_refused() {
 #[test]
 fn refine_strain_needs_the_sizing_rule_on_red_green_and_a_positive_value() {
     // With the full scene's red_green and the default sizing rule it is valid.
-    let dir = scene_dir("strain");
-    let out = drape(
-        &dir,
-        &["check", "full.toml", "--set", "adapt.refine_strain=0.01"],
-    );
-    assert_eq!(out.status.code(), Some(0), "{out:?}");
+    accepted_sets("strain", &["adapt.refine_strain=0.01"]);
     for other in ["adapt.criterion=\"angle\"", "adapt.method=\"edge\""] {
-        let args = [
-            "check",
-            "full.toml",
-            "--set",
+        refused_with(
+            "strain",
             "adapt.refine_strain=0.01",
-            "--set",
             other,
-        ];
-        refused(
-            &drape(&dir, &args),
-            1,
-            &[
-                "error: full.toml",
-                "key `adapt.refine_strain`",
-                "refine_strain belongs to criterion = \"sizing\" with method = \"red_green\"",
-            ],
+            "refine_strain belongs to criterion = \"sizing\" with method = \"red_green\"",
         );
     }
-    std::fs::remove_dir_all(&dir).ok();
     refused_sets(
         "strain-range",
         &[
@@ -359,30 +363,19 @@ fn refine_strain_needs_the_sizing_rule_on_red_green_and_a_positive_value() {
 
 #[test]
 fn red_green_diagonals_are_named_and_belong_to_red_green() {
-    let dir = scene_dir("diagonals");
-    for value in ["\"alternating\"", "\"as_split\""] {
-        let set = format!("adapt.diagonals={value}");
-        let out = drape(&dir, &["check", "full.toml", "--set", &set]);
-        assert_eq!(out.status.code(), Some(0), "{set}: {out:?}");
-    }
-    let args = [
-        "check",
-        "full.toml",
-        "--set",
-        "adapt.diagonals=\"as_split\"",
-        "--set",
-        "adapt.method=\"edge\"",
-    ];
-    refused(
-        &drape(&dir, &args),
-        1,
+    accepted_sets(
+        "diagonals",
         &[
-            "error: full.toml",
-            "key `adapt.diagonals`",
-            "diagonals belongs to method = \"red_green\"",
+            "adapt.diagonals=\"alternating\"",
+            "adapt.diagonals=\"as_split\"",
         ],
     );
-    std::fs::remove_dir_all(&dir).ok();
+    refused_with(
+        "diagonals",
+        "adapt.diagonals=\"as_split\"",
+        "adapt.method=\"edge\"",
+        "diagonals belongs to method = \"red_green\"",
+    );
     refused_sets(
         "diagonals-name",
         &[("adapt.diagonals", "\"regular\""), ("adapt.diagonals", "1")],
