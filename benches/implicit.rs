@@ -14,7 +14,9 @@
 //! solve, the rest) of 60 further steps is printed for each case.
 //!
 //! A second group, `remesh_tables`, times what a remesh rebuilds before the
-//! symbolic factorization: the element tables and the block pattern.
+//! symbolic factorization: the element tables and the block pattern, and the
+//! element tables of a local remesh and back, built afresh against rebuilt in
+//! place (`Elements::rebuild`).
 //!
 //! Run with `cargo bench --bench implicit`; `docs/performance.md` has the figures.
 
@@ -211,8 +213,69 @@ fn remesh_tables(c: &mut Criterion) {
         group.bench_function(BenchmarkId::new("pattern_build", vertices), |b| {
             b.iter(|| BlockPattern::build(vertices, black_box(&elements), false))
         });
+        // A local remesh and back: the sheet refined along one crease, then the
+        // original grid again; built afresh, and rebuilt in place (keeping the
+        // shape matrices whose stencils did not change).
+        let creased = creased(&mesh);
+        group.bench_function(
+            BenchmarkId::new("elements_build_remesh_and_back", vertices),
+            |b| {
+                b.iter(|| {
+                    let there = Elements::build(black_box(&creased), &material);
+                    let back = Elements::build(black_box(&mesh), &material);
+                    (there, back)
+                })
+            },
+        );
+        let mut rebuilt = Elements::build(&mesh, &material);
+        group.bench_function(
+            BenchmarkId::new("elements_rebuild_remesh_and_back", vertices),
+            |b| {
+                b.iter(|| {
+                    rebuilt.rebuild(black_box(&creased), &material, &[]);
+                    rebuilt.rebuild(black_box(&mesh), &material, &[]);
+                })
+            },
+        );
+        rebuilt.rebuild(&creased, &material, &[]);
+        println!(
+            "  {} -> {} triangles: {:?}",
+            mesh.triangles.len(),
+            creased.triangles.len(),
+            rebuilt.last_rebuild()
+        );
     }
     group.finish();
+}
+
+/// `mesh` after one red-green pass over a sheet bent 45 degrees along the line
+/// `x = 0.1` (15 / 1.5 deg, levels up to 2): refined along that crease only.
+fn creased(mesh: &drape::mesh::Mesh) -> drape::mesh::Mesh {
+    use drape::adapt::{AdaptConfig, Adapter};
+    use drape::scene::{AdaptCriterion, AdaptEvery, AdaptMethod};
+    let x = mesh
+        .material
+        .iter()
+        .map(|p| p.extend((p.x - 0.1).max(0.0)))
+        .collect();
+    let mut world = World::new(mesh.clone(), x);
+    let config = AdaptConfig {
+        method: AdaptMethod::RedGreen,
+        refine_angle: 15.0,
+        coarsen_angle: 1.5,
+        max_level: 2,
+        min_edge_length: 0.0,
+        every: AdaptEvery::Steps(1),
+        rollback: false,
+        max_rollbacks: 0,
+        criterion: AdaptCriterion::Angle,
+        hysteresis: 2.0,
+        refine_strain: None,
+        alternate_diagonals: true,
+    };
+    let mut adapter = Adapter::new(config, &world, 0.15);
+    adapter.pass(&mut world, 0).expect("a crease refines");
+    world.mesh
 }
 
 criterion_group!(benches, implicit_step, remesh_tables);

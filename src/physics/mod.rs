@@ -188,9 +188,10 @@ impl Stepper {
         }
     }
 
-    /// Rebuilds the force elements of `model` after the world's mesh changed.
+    /// Rebuilds the force elements of `model` after the world's mesh changed
+    /// (incrementally: [`Elements::rebuild`]).
     pub fn rebuild(&mut self, model: &Model, world: &World) {
-        self.elements = Elements::build_clamped(
+        self.elements.rebuild(
             &world.mesh,
             &model.material,
             &world.pins.clamped(world.mesh.vertex_count()),

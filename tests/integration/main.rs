@@ -14,6 +14,7 @@ mod cli;
 mod collide;
 mod common;
 mod elastica;
+mod elements;
 mod energy;
 mod fuzz;
 mod gradient;
