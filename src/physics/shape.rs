@@ -154,10 +154,17 @@
 //!   6 (triangle, shape) pairs were more than 5 % from the continuum over
 //!   the four shapes of `partly_refined_sheet_bends_like_the_continuum`
 //!   (worst |ratio - 1| 0.0947), with red-green's children as split and with
-//!   alternating diagonals alike; (0, -0.25) had none. Which triangles they
-//!   are and whether their `Theta` is singular was not checked. Reading a
-//!   fourth fold (a neighbour's) where `Theta` is singular might fix it; not
-//!   done.
+//!   alternating diagonals alike; (0, -0.25) had none. Checked since (the
+//!   test `second_level_transitions_bend_within_ten_percent_of_the_continuum`
+//!   and a scratch print of `Theta`): they are all second-level (level 3)
+//!   greens beside a level-4 triangle where the second level's rim runs along
+//!   y, each at 0.905 / 1.000 / 0.953 / 0.953 for the four shapes, and their
+//!   `Theta` is singular the same way (singular values 0.0563 m, 0.0469 m, 0;
+//!   null direction 0.555 xx - 0.832 xy); rims along x and round ones have
+//!   none. Of the probes' 1,320 transition operators (eight meshes) 116 had a
+//!   singular `Theta`: 96 blind to twist only, these 20 to part of a bend.
+//!   Reading a fourth fold (a neighbour's) where `Theta` is singular might fix
+//!   it; not done (it needs a seventh and eighth slot in the element).
 //! * `sum_t A_t S_t` is no longer exactly the distributional Hessian across a
 //!   transition rim, so the Jensen argument above holds in the uniform parts
 //!   only; in the rim each triangle is instead exact for constant curvature,

@@ -30,3 +30,4 @@ mod sim;
 mod solver;
 mod stability;
 mod statics;
+mod transitions;

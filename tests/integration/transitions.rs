@@ -1,0 +1,143 @@
+//! Transition triangles two refinement levels deep (issue 14, bending across
+//! adaptive meshes): each interior triangle's shape-operator energy under a
+//! constant curvature, against the continuum's.
+
+use drape::adapt::{AdaptConfig, Adapter};
+use drape::math::{Scalar, Vector, Vector2};
+use drape::mesh::{self, Mesh};
+use drape::physics::{Elements, MaterialParams};
+use drape::scene::{AdaptMethod, BendingModel, DiagonalPattern, StiffnessRule};
+use drape::world::World;
+
+/// The 8 x 8 sheet (1 m) refined one red level where `first` holds of a leaf's
+/// centre, then a second where `second` does.
+fn two_levels(
+    alternate: bool,
+    first: impl Fn(Vector2) -> bool,
+    second: impl Fn(Vector2) -> bool,
+) -> Mesh {
+    let m0 = mesh::rectangle(1.0, 1.0, 8, DiagonalPattern::Alternating).unwrap();
+    let x0: Vec<Vector> = m0.material.iter().map(|p| p.extend(0.0)).collect();
+    let mut world = World::new(m0, x0);
+    let config = AdaptConfig {
+        alternate_diagonals: alternate,
+        ..crate::common::angle_config(AdaptMethod::RedGreen)
+    };
+    let mut adapter = Adapter::new(config, &world, 0.15);
+    for inside in [&first as &dyn Fn(Vector2) -> bool, &second] {
+        let h = adapter.hierarchy();
+        let marks: Vec<(u32, Scalar)> = h
+            .leaves()
+            .into_iter()
+            .filter(|&t| {
+                let corners = h.vertices(t).map(|i| h.material()[i as usize]);
+                inside((corners[0] + corners[1] + corners[2]) / 3.0)
+            })
+            .map(|t| (t, 20.0))
+            .collect();
+        adapter.refine(&mut world, &marks, 0).expect("refine");
+    }
+    world.mesh
+}
+
+/// Each interior triangle's energy over the continuum's `B/2 |H|^2 A` for the
+/// constant curvatures `H = xx`, `yy`, sphere and saddle (height fields of
+/// curvature 1/50, so the folds are the height field's to 1e-4). Twist is left
+/// out: per triangle the alternating grid itself gives 0, 1.5 or 2 times the
+/// continuum's twist energy (only pairs add up), so a triangle's twist ratio
+/// says nothing about transitions.
+///
+/// Measured (2026-11-23): on the sheet refined over `x < 0` then `x < -0.3`
+/// (the second level's rim a line of greens along y), six level-3 green
+/// triangles next to a level-4 neighbour carry 0.905 / 1.000 / 0.953 / 0.953
+/// (the others within 5 %); after the same first band the second one over
+/// `x < -0.3, |y| < 0.25` gives four such; bands along x and disks give none;
+/// the same with red-green's children as split and with alternating
+/// diagonals. Their transition operators' `Theta` (a scratch print) is
+/// singular: singular values 0.0563 m, 0.0469 m and 0, null direction
+/// 0.555 xx - 0.832 xy, the direction the pseudo-inverse leaves blind
+/// (`shape.rs`, "What is given up"). The test fails if any triangle gets
+/// further than 10 % from the continuum, or if a triangle other than a
+/// level-3 one beside level 4 gets further than 5 %.
+#[test]
+fn second_level_transitions_bend_within_ten_percent_of_the_continuum() {
+    let probes: [(&str, fn(Vector2) -> bool, fn(Vector2) -> bool); 4] = [
+        (
+            "|y| < 0.25, then |y| < 0.1",
+            |c| c.y.abs() < 0.25,
+            |c| c.y.abs() < 0.1,
+        ),
+        ("x < 0, then x < -0.3", |c| c.x < 0.0, |c| c.x < -0.3),
+        (
+            "|y| < 0.25, then x < -0.3 and |y| < 0.25",
+            |c| c.y.abs() < 0.25,
+            |c| c.x < -0.3 && c.y.abs() < 0.25,
+        ),
+        (
+            "disks r < 0.375, then r < 0.15",
+            |c| c.length() < 0.375,
+            |c| c.length() < 0.15,
+        ),
+    ];
+    let curvatures: [[Scalar; 3]; 4] = [
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [1.0, -1.0, 0.0],
+    ];
+    let rs: Scalar = 50.0;
+    let mat = MaterialParams {
+        density: 0.15,
+        stretch: 200.0,
+        bending: 1e-3,
+        damping: 0.0,
+        bending_model: BendingModel::ShapeOperator,
+        stiffness_rule: StiffnessRule::Consistent,
+    };
+    for alternate in [false, true] {
+        for (name, first, second) in probes {
+            let m = two_levels(alternate, first, second);
+            let el = Elements::build(&m, &mat);
+            let mut finer_beside = vec![false; m.triangles.len()];
+            for e in m.edges.iter().filter(|e| e.is_interior()) {
+                let [a, b] = e.triangles.map(|t| t as usize);
+                finer_beside[a] |= m.levels[b] > m.levels[a];
+                finer_beside[b] |= m.levels[a] > m.levels[b];
+            }
+            let (mut over5, mut worst) = (0, 0.0 as Scalar);
+            for (t, st) in el.shape_triangles.iter().enumerate() {
+                if !st.interior.iter().all(|&i| i) {
+                    continue;
+                }
+                let ratios = curvatures.map(|h| {
+                    let height = |p: &Vector2| (h[0] * p.x * p.x + h[1] * p.y * p.y) / (2.0 * rs);
+                    let x: Vec<Vector> = m.material.iter().map(|p| p.extend(height(p))).collect();
+                    let continuum = m.rest_area(t) * mat.bending / 2.0
+                        * (h[0] * h[0] + h[1] * h[1])
+                        / (rs * rs);
+                    st.energy(&x) / continuum
+                });
+                let off = ratios
+                    .iter()
+                    .map(|r| (r - 1.0).abs())
+                    .fold(0.0, Scalar::max);
+                worst = worst.max(off);
+                if off > 0.05 {
+                    over5 += 1;
+                    assert!(
+                        m.levels[t] == 3 && finer_beside[t],
+                        "{name} (alternate {alternate}): triangle {t}, level {}, off by {off:.4}: {ratios:.4?}",
+                        m.levels[t]
+                    );
+                }
+            }
+            println!(
+                "{name}, alternating diagonals {alternate}: {over5} triangles more than 5 % off, worst |ratio - 1| {worst:.4}"
+            );
+            assert!(
+                worst < 0.10,
+                "{name} (alternate {alternate}): worst {worst:.4}"
+            );
+        }
+    }
+}
