@@ -9,6 +9,9 @@ use drape::physics::{Elements, MaterialParams};
 use drape::scene::{AdaptMethod, BendingModel, DiagonalPattern, StiffnessRule};
 use drape::world::World;
 
+/// Where a refinement applies, by a leaf's centre.
+type Region = fn(Vector2) -> bool;
+
 /// The 8 x 8 sheet (1 m) refined one red level where `first` holds of a leaf's
 /// centre, then a second where `second` does.
 fn two_levels(
@@ -61,7 +64,7 @@ fn two_levels(
 /// level-3 one beside level 4 gets further than 5 %.
 #[test]
 fn second_level_transitions_bend_within_ten_percent_of_the_continuum() {
-    let probes: [(&str, fn(Vector2) -> bool, fn(Vector2) -> bool); 4] = [
+    let probes: [(&str, Region, Region); 4] = [
         (
             "|y| < 0.25, then |y| < 0.1",
             |c| c.y.abs() < 0.25,
