@@ -37,7 +37,7 @@ mod csc;
 use rayon::prelude::*;
 
 use super::elements::Elements;
-use super::forces::PAR_MIN;
+use super::forces::{PAR_MIN, PAR_MIN_ROWS};
 use super::shape::{ShapeJacobian, ShapeTriangle};
 use crate::math::{Matrix3, Scalar, Vector};
 use buckets::{group_by_key, sorted_unique_rows};
@@ -277,7 +277,7 @@ impl BlockPattern {
         extra
             .par_iter_mut()
             .enumerate()
-            .with_min_len(PAR_MIN)
+            .with_min_len(PAR_MIN_ROWS)
             .for_each(|(i, out)| {
                 let range =
                     self.compensation_start[i] as usize..self.compensation_start[i + 1] as usize;
@@ -409,7 +409,7 @@ impl BlockPattern {
     pub fn multiply(&self, a: &[Matrix3], x: &[Vector], y: &mut [Vector]) {
         y.par_iter_mut()
             .enumerate()
-            .with_min_len(PAR_MIN)
+            .with_min_len(PAR_MIN_ROWS)
             .for_each(|(i, out)| {
                 let range = self.row_start[i] as usize..self.row_start[i + 1] as usize;
                 let mut acc = Vector::ZERO;
