@@ -8,6 +8,20 @@
 //! issue 11 reports (a 65 x 65 grid, 12,675 unknowns: 14.5 ms on 1 thread, 26 ms on
 //! 2; not re-measured here).
 //!
+//! # Supernodal always
+//! faer picks a simplicial (column by column) factorization when its estimate
+//! of flops per stored value is low, which it was for the adaptive meshes of
+//! about 1,000 to 3,000 vertices; the supernodal one (dense kernels on column
+//! blocks) is faster there. Measured (2026-11-23, one sitting, builds in turn,
+//! `drape run ... --no-record`): `hanging_sheet_rest` red-green 16 L4 at 8 /
+//! 0.8 deg with `refine_strain = 0.02` (about 1,200 vertices): factorization
+//! 2.17 / 2.16 s -> 1.33 / 1.32 s, solves 1.18 / 1.15 -> 1.48 / 1.45 s, wall
+//! 5.78 / 5.69 -> 5.22 / 5.14 s; the cantilever at resolution 20 (189
+//! vertices) 0.538 -> 0.463 s of stepping; at resolution 10 and 40 and uniform
+//! 64 no difference beyond the noise (faer already chose supernodal at 40 and
+//! 64). Results differ from the simplicial factor's in the last digits only
+//! (the cantilever's chord angle at resolution 10 by 1e-13 deg).
+//!
 //! Why faer: it is pure Rust (no system BLAS or SuiteSparse to install), maintained,
 //! has a supernodal LL^T and LDL^T with AMD, and exposes the symbolic and numeric
 //! phases separately. The alternatives on crates.io either wrap C libraries
@@ -17,6 +31,7 @@
 use std::sync::Arc;
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::linalg::cholesky::{
     CholeskySymbolicParams, LltRef, SymbolicCholesky, SymmetricOrdering,
     factorize_symbolic_cholesky,
@@ -116,7 +131,11 @@ impl Factorization {
             structure,
             Side::Lower,
             SymmetricOrdering::Amd,
-            CholeskySymbolicParams::default(),
+            CholeskySymbolicParams {
+                // Module docs, "Supernodal always".
+                supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+                ..Default::default()
+            },
         )
         .map_err(|_| FactorError::Setup)?;
         self.factor.clear();
