@@ -171,6 +171,7 @@ struct Scratch {
     shape: ShapeScratch,
     shape_pairs: Vec<(u32, u32)>,
     reuse: Reuse,
+    counts: RebuildCounts,
 }
 
 /// Scratch memory holds nothing the elements mean: two element sets are equal
@@ -223,22 +224,30 @@ impl Elements {
             .extend(self.vertex_area.iter().map(|a| mat.density * a));
         stretch_springs(mesh, mat, area, &mut self.springs);
         scratch.shapes.clear();
+        let mut kept = 0;
         if mat.bending > 0.0 && mat.bending_model == BendingModel::ShapeOperator {
             let (old, previous) = (&self.shape_triangles, &self.previous);
             let reuse = &mut scratch.reuse;
             reuse.match_previous(previous, &self.vertex_triangles, mesh, mat);
+            let reuse = &*reuse;
             build_shape_triangles_into(
                 mesh,
                 area,
                 mat.bending,
                 clamped,
                 &mut scratch.shape,
-                |t, stencil, across| reuse.kept(previous, old, t, stencil, across, clamped),
+                |t, stencil, across| {
+                    let m = reuse.kept(previous, old, t, stencil, across, clamped);
+                    kept += usize::from(m.is_some());
+                    m
+                },
                 &mut scratch.shapes,
             );
-        } else {
-            scratch.reuse.nothing_to_keep();
         }
+        scratch.counts = RebuildCounts {
+            kept,
+            computed: scratch.shapes.len() - kept,
+        };
         std::mem::swap(&mut self.shape_triangles, &mut scratch.shapes);
         edge_bending(mesh, mat, area, &mut self.springs, &mut self.hinges);
         self.fill_tables(n, mesh);
@@ -248,7 +257,7 @@ impl Elements {
 
     /// How the last [`Elements::rebuild`] made its shape triangles.
     pub fn last_rebuild(&self) -> RebuildCounts {
-        self.scratch.reuse.counts
+        self.scratch.counts
     }
 
     /// Total mass, kg.

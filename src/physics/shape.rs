@@ -154,14 +154,17 @@
 //!   6 (triangle, shape) pairs were more than 5 % from the continuum over
 //!   the four shapes of `partly_refined_sheet_bends_like_the_continuum`
 //!   (worst |ratio - 1| 0.0947), with red-green's children as split and with
-//!   alternating diagonals alike; (0, -0.25) had none. Checked since (the
-//!   test `second_level_transitions_bend_within_ten_percent_of_the_continuum`
-//!   and a scratch print of `Theta`): they are all second-level (level 3)
-//!   greens beside a level-4 triangle where the second level's rim runs along
-//!   y, each at 0.905 / 1.000 / 0.953 / 0.953 for the four shapes, and their
+//!   alternating diagonals alike; (0, -0.25) had none. Which triangles they
+//!   were was not recorded. On the four meshes of the test
+//!   `second_level_transitions_bend_within_ten_percent_of_the_continuum`
+//!   (among them `(b1, b2)` = (0, -0.3)), with a scratch print of `Theta`,
+//!   every triangle more than 5 % off is a second-level (level 3) green
+//!   beside a level-4 triangle where the second level's rim runs along y,
+//!   each at 0.905 / 1.000 / 0.953 / 0.953 for the four shapes, and its
 //!   `Theta` is singular the same way (singular values 0.0563 m, 0.0469 m, 0;
 //!   null direction 0.555 xx - 0.832 xy); rims along x and round ones have
-//!   none. Of the probes' 1,320 transition operators (eight meshes) 116 had a
+//!   none. Of those meshes' 1,320 transition operators (four meshes, both
+//!   diagonal settings) 116 had a
 //!   singular `Theta`: 96 blind to twist only, these 20 to part of a bend.
 //!   Reading a fourth fold (a neighbour's) where `Theta` is singular might fix
 //!   it; not done (it needs a seventh and eighth slot in the element).
@@ -187,7 +190,6 @@
 
 mod build;
 
-pub use build::build_shape_triangles;
 pub(crate) use build::{ShapeMatrix, ShapeScratch, build_shape_triangles_into};
 
 use super::bending::dihedral_angle_and_gradient;

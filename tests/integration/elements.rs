@@ -17,14 +17,7 @@ use drape::world::World;
 use proptest::prelude::*;
 
 fn material(bending_model: BendingModel) -> MaterialParams {
-    MaterialParams {
-        density: 0.15,
-        stretch: 200.0,
-        bending: 1e-5,
-        damping: 0.001,
-        bending_model,
-        stiffness_rule: StiffnessRule::Consistent,
-    }
+    crate::physics::material(bending_model, StiffnessRule::Consistent)
 }
 
 /// A made-up clamp: the vertices left of `x = -0.5` are held by pin 0, so that

@@ -90,12 +90,8 @@ fn second_level_transitions_bend_within_ten_percent_of_the_continuum() {
     ];
     let rs: Scalar = 50.0;
     let mat = MaterialParams {
-        density: 0.15,
-        stretch: 200.0,
         bending: 1e-3,
-        damping: 0.0,
-        bending_model: BendingModel::ShapeOperator,
-        stiffness_rule: StiffnessRule::Consistent,
+        ..crate::physics::material(BendingModel::ShapeOperator, StiffnessRule::Consistent)
     };
     for alternate in [false, true] {
         for (name, first, second) in probes {

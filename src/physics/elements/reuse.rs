@@ -91,7 +91,7 @@ fn clamp_of(clamped: &[u32], v: u32) -> u32 {
     clamped.get(v as usize).copied().unwrap_or(NONE)
 }
 
-/// The matching of a new mesh against the previous one, and its counts.
+/// The matching of a new mesh against the previous one.
 #[derive(Debug, Clone, Default)]
 pub(super) struct Reuse {
     by_point: PairMap<[u64; 2], u32>,
@@ -100,16 +100,13 @@ pub(super) struct Reuse {
     /// Per new triangle: the matching previous triangle, or `NONE` (empty: no
     /// previous mesh to match).
     old_triangle: Vec<u32>,
-    /// What the current rebuild kept and computed.
-    pub(super) counts: RebuildCounts,
 }
 
 impl Reuse {
-    /// A rebuild without shape triangles: nothing kept, nothing computed.
-    pub(super) fn nothing_to_keep(&mut self) {
+    /// Forgets the last matching: nothing is kept.
+    fn nothing_to_keep(&mut self) {
         self.old_vertex.clear();
         self.old_triangle.clear();
-        self.counts = RebuildCounts::default();
     }
 
     /// Matches `mesh`'s vertices and triangles against `previous` (whose
@@ -158,27 +155,9 @@ impl Reuse {
     }
 
     /// The matrix new triangle `t` keeps from `old_shapes` (the previous shape
-    /// triangles), given its stencil and neighbours, or `None`; counted.
+    /// triangles), given its stencil and neighbours, or `None` (module docs:
+    /// when a shape triangle is kept).
     pub(super) fn kept(
-        &mut self,
-        previous: &Previous,
-        old_shapes: &[ShapeTriangle],
-        t: usize,
-        stencil: &ShapeTriangle,
-        across: &[usize; 3],
-        clamped: &[u32],
-    ) -> Option<ShapeMatrix> {
-        let kept = self.find(previous, old_shapes, t, stencil, across, clamped);
-        match kept {
-            Some(_) => self.counts.kept += 1,
-            None => self.counts.computed += 1,
-        }
-        kept
-    }
-
-    /// [`Reuse::kept`] without the counting (module docs: when a shape triangle
-    /// is kept).
-    fn find(
         &self,
         previous: &Previous,
         old_shapes: &[ShapeTriangle],

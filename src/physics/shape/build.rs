@@ -22,24 +22,10 @@ pub(crate) struct ShapeScratch {
     share: Vec<[Scalar; 3]>,
 }
 
-/// One shape triangle per mesh triangle not held by a clamp, for rigidity
-/// `bending` (rest areas `area`; `clamped`: per vertex the pin holding it for
-/// good or `u32::MAX`, or empty for no clamp).
-pub fn build_shape_triangles(
-    mesh: &Mesh,
-    area: &[Scalar],
-    bending: Scalar,
-    clamped: &[u32],
-) -> Vec<ShapeTriangle> {
-    let mut out = Vec::new();
-    let mut scratch = ShapeScratch::default();
-    let fresh = |_: usize, _: &ShapeTriangle, _: &[usize; 3]| None;
-    build_shape_triangles_into(mesh, area, bending, clamped, &mut scratch, fresh, &mut out);
-    out
-}
-
-/// As [`build_shape_triangles`], into `out` (cleared first), with `kept(t,
-/// stencil, across)` offering a matrix for triangle `t` given its stencil (`m`
+/// Into `out` (cleared first): one shape triangle per mesh triangle not held by
+/// a clamp, for rigidity `bending` (rest areas `area`; `clamped`: per vertex the
+/// pin holding it for good or `u32::MAX`, or empty for no clamp). `kept(t,
+/// stencil, across)` may offer a matrix for triangle `t` given its stencil (`m`
 /// zero) and its neighbours: `Some` is used as it is, `None` computes it. Only a
 /// matrix computed from the same stencil may be offered (the caller checks it).
 pub(crate) fn build_shape_triangles_into(
