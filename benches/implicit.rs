@@ -16,7 +16,8 @@
 //! A second group, `remesh_tables`, times what a remesh rebuilds before the
 //! symbolic factorization: the element tables and the block pattern, and the
 //! element tables of a local remesh and back, built afresh against rebuilt in
-//! place (`Elements::rebuild`).
+//! place (`Elements::rebuild`), and the symbolic analysis of the new pattern
+//! (ordered by vertex, as drape does, and by scalar unknown, as faer does alone).
 //!
 //! Run with `cargo bench --bench implicit`; `docs/performance.md` has the figures.
 
@@ -26,6 +27,7 @@ use std::time::{Duration, Instant};
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group};
 use drape::math::{Scalar, Vector};
 use drape::physics::block::BlockPattern;
+use drape::physics::direct::{Factorization, Ordering};
 use drape::physics::elements::Elements;
 use drape::physics::{
     ExternalForces, MaterialParams, Model, Solver, SolverSettings, StepStats, Stepper,
@@ -213,6 +215,23 @@ fn remesh_tables(c: &mut Criterion) {
         group.bench_function(BenchmarkId::new("pattern_build", vertices), |b| {
             b.iter(|| BlockPattern::build(vertices, black_box(&elements), false))
         });
+        // The symbolic analysis that follows every remesh: drape's (AMD on the
+        // vertex graph, `Factorization::analyse`) against faer's AMD on the scalar
+        // pattern (`Ordering::ByUnknown`), which drape used before; stored values
+        // of the factor printed.
+        let pattern = BlockPattern::build(vertices, &elements, false);
+        let mut factorization = Factorization::default();
+        group.bench_function(BenchmarkId::new("analyse_by_vertex", vertices), |b| {
+            b.iter(|| factorization.analyse(black_box(&pattern)))
+        });
+        let by_vertex = factorization.stored_values();
+        group.bench_function(BenchmarkId::new("analyse_by_unknown", vertices), |b| {
+            b.iter(|| factorization.analyse_with(black_box(&pattern), Ordering::ByUnknown))
+        });
+        println!(
+            "  factor stored values: {by_vertex:?} ordered by vertex, {:?} by unknown",
+            factorization.stored_values()
+        );
         // A local remesh and back: the sheet refined along one crease, then the
         // original grid again; built afresh, and rebuilt in place (keeping the
         // shape matrices whose stencils did not change).

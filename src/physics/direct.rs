@@ -22,6 +22,24 @@
 //! 64). Results differ from the simplicial factor's in the last digits only
 //! (the cantilever's chord angle at resolution 10 by 1e-13 deg).
 //!
+//! # Ordering by vertex
+//! The fill-reducing ordering (AMD) runs on the vertex graph, one node per vertex
+//! (the factored blocks' pattern), and each vertex's three unknowns follow one
+//! another in the result. AMD on the scalar pattern finds the same structure
+//! (the three unknowns of a vertex are indistinguishable to it) but reads nine
+//! times the entries, and an adaptive run orders its matrix again after every
+//! remesh.
+//! `cargo bench --bench implicit -- remesh_tables/analyse` (2026-11-23, one
+//! sitting, criterion medians): a 64 x 64 grid (4,096 vertices) 5.24 ms by vertex
+//! against 7.24 ms by scalar unknown, 128 x 128 (16,384) 24.0 against 40.6 ms;
+//! the factor has the same number of stored values both ways (777,420 and
+//! 4,268,673; test `ordering_by_vertex_fills_no_more_than_scalar_amd`). Most of
+//! what remains is faer's symbolic factorization on the scalar pattern. On the
+//! adaptive `hanging_sheet_rest` (red-green 16 L4 tight, `refine_strain = 0.02`,
+//! 138 orderings) `perf` put about 2.5 % of the run in the ordering and symbolic
+//! factorization before (202 of 8,228 samples) and about 1.1 % after (101 of 9,179); the run's wall time moved less
+//! than its noise (7.40 / 7.61 s before, 7.63 / 7.23 s after, in turn).
+//!
 //! Why faer: it is pure Rust (no system BLAS or SuiteSparse to install), maintained,
 //! has a supernodal LL^T and LDL^T with AMD, and exposes the symbolic and numeric
 //! phases separately. The alternatives on crates.io either wrap C libraries
@@ -31,7 +49,9 @@
 use std::sync::Arc;
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::perm::PermRef;
 use faer::sparse::linalg::SupernodalThreshold;
+use faer::sparse::linalg::amd;
 use faer::sparse::linalg::cholesky::{
     CholeskySymbolicParams, LltRef, SymbolicCholesky, SymmetricOrdering,
     factorize_symbolic_cholesky,
@@ -51,6 +71,18 @@ pub enum FactorError {
     /// The symbolic analysis could not allocate or index the factor.
     #[error("the sparse factorization could not be set up (out of memory or too large)")]
     Setup,
+}
+
+/// The fill-reducing ordering of the symbolic analysis (module docs, "Ordering by
+/// vertex").
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Ordering {
+    /// AMD on the vertex graph, a vertex's three unknowns kept together: what
+    /// [`Factorization::analyse`] uses.
+    ByVertex,
+    /// faer's AMD on the scalar pattern (what drape used before; kept for the
+    /// benchmark and the test that compare the two).
+    ByUnknown,
 }
 
 /// Scratch memory for faer, recreated (empty) when cloned.
@@ -122,15 +154,40 @@ impl Factorization {
         self.symbolic.is_some()
     }
 
-    /// Ordering and symbolic analysis of `pattern` (once per topology).
+    /// Stored values of the factor of the analysed pattern (`None`: not analysed).
+    pub fn stored_values(&self) -> Option<usize> {
+        self.symbolic.as_ref().map(|s| s.len_val())
+    }
+
+    /// Ordering and symbolic analysis of `pattern` (once per topology), ordered
+    /// by vertex (module docs, "Ordering by vertex").
     pub fn analyse(&mut self, pattern: &BlockPattern) -> Result<(), FactorError> {
+        self.analyse_with(pattern, Ordering::ByVertex)
+    }
+
+    /// [`Factorization::analyse`] with the given fill-reducing ordering.
+    pub fn analyse_with(
+        &mut self,
+        pattern: &BlockPattern,
+        ordering: Ordering,
+    ) -> Result<(), FactorError> {
         let (col_ptr, rows) = pattern.csc_structure();
         let n = 3 * pattern.vertices();
         let structure = SymbolicSparseColMatRef::new_checked(n, n, col_ptr, None, rows);
+        let (forward, inverse) = match ordering {
+            Ordering::ByVertex => order_by_vertex(pattern)?,
+            Ordering::ByUnknown => (Vec::new(), Vec::new()),
+        };
+        let ordering = match ordering {
+            Ordering::ByVertex => {
+                SymmetricOrdering::Custom(PermRef::new_checked(&forward, &inverse, n))
+            }
+            Ordering::ByUnknown => SymmetricOrdering::Amd,
+        };
         let symbolic = factorize_symbolic_cholesky(
             structure,
             Side::Lower,
-            SymmetricOrdering::Amd,
+            ordering,
             CholeskySymbolicParams {
                 // Module docs, "Supernodal always".
                 supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
@@ -212,4 +269,35 @@ impl Factorization {
             *out = Vector::new(c[0], c[1], c[2]);
         }
     }
+}
+
+/// The fill-reducing ordering of `pattern`'s scalar unknowns (module docs,
+/// "Ordering by vertex"): AMD on the vertex graph, each vertex's three unknowns
+/// kept together in x, y, z order. Returns the forward and inverse permutations.
+fn order_by_vertex(pattern: &BlockPattern) -> Result<(Vec<u32>, Vec<u32>), FactorError> {
+    let vertices = pattern.vertices();
+    let (mut column_start, mut rows) = (Vec::new(), Vec::new());
+    pattern.vertex_structure(&mut column_start, &mut rows);
+    let graph =
+        SymbolicSparseColMatRef::new_checked(vertices, vertices, &column_start, None, &rows);
+    let (mut forward_v, mut inverse_v) = (vec![0u32; vertices], vec![0u32; vertices]);
+    let mut buffer = MemBuffer::try_new(amd::order_scratch::<u32>(vertices, rows.len()))
+        .map_err(|_| FactorError::Setup)?;
+    amd::order(
+        &mut forward_v,
+        &mut inverse_v,
+        graph,
+        amd::Control::default(),
+        MemStack::new(&mut buffer),
+    )
+    .map_err(|_| FactorError::Setup)?;
+    let forward: Vec<u32> = forward_v
+        .iter()
+        .flat_map(|&v| [3 * v, 3 * v + 1, 3 * v + 2])
+        .collect();
+    let mut inverse = vec![0u32; forward.len()];
+    for (new, &old) in forward.iter().enumerate() {
+        inverse[old as usize] = new as u32;
+    }
+    Ok((forward, inverse))
 }

@@ -40,6 +40,27 @@ impl BlockPattern {
         self.csc_source = source;
     }
 
+    /// The block-level (one row and column per vertex) CSC structure of the factored
+    /// lower triangle, diagonal included, rows ascending within each column: the
+    /// graph that the fill-reducing ordering reads ([`super::super::direct`],
+    /// "Ordering by vertex").
+    pub fn vertex_structure(&self, column_start: &mut Vec<u32>, rows: &mut Vec<u32>) {
+        let n = self.vertices();
+        column_start.clear();
+        rows.clear();
+        column_start.push(0);
+        for j in 0..n {
+            let (s, e) = (self.row_start[j] as usize, self.row_start[j + 1] as usize);
+            for slot in s..e {
+                let i = self.columns[slot];
+                if i as usize >= j && self.factored[slot] {
+                    rows.push(i);
+                }
+            }
+            column_start.push(rows.len() as u32);
+        }
+    }
+
     /// Column pointers and row indices of the lower triangle's scalar CSC form.
     pub fn csc_structure(&self) -> (&[u32], &[u32]) {
         (&self.csc_column_start, &self.csc_rows)
