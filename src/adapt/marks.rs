@@ -62,28 +62,33 @@ impl Adapter {
         }
         let sizing = self.config.criterion == AdaptCriterion::Sizing;
         let strain = sizing && self.config.refine_strain.is_some();
+        // The cheap test first: most leaves of a refined mesh are at the finest
+        // level and may not split, and for them nothing is measured. The edge's
+        // curvature and strain jump are measured once, for its first leaf that
+        // may split.
         world.mesh.edges.iter().enumerate().any(|(e, edge)| {
-            let kappa = if sizing {
-                sizing::edge_curvature(world, edge, angles[e])
-            } else {
-                0.0
-            };
-            let jump = if strain {
-                sizing::edge_strain_jump(world, edge)
-            } else {
-                0.0
-            };
+            let mut measured: Option<(Scalar, Scalar)> = None;
             edge.triangles
                 .iter()
                 .filter(|&&t| t != crate::mesh::NO_TRIANGLE)
                 .any(|&t| {
                     let leaf = self.owner[t as usize];
-                    let over = if sizing {
-                        self.sizing_wants_split(leaf, kappa, jump)
-                    } else {
-                        angles[e] > self.config.refine_angle
-                    };
-                    over && self.may_split(leaf)
+                    if !self.may_split(leaf) {
+                        return false;
+                    }
+                    if !sizing {
+                        return angles[e] > self.config.refine_angle;
+                    }
+                    let (kappa, jump) = *measured.get_or_insert_with(|| {
+                        let kappa = sizing::edge_curvature(world, edge, angles[e]);
+                        let jump = if strain {
+                            sizing::edge_strain_jump(world, edge)
+                        } else {
+                            0.0
+                        };
+                        (kappa, jump)
+                    });
+                    self.sizing_wants_split(leaf, kappa, jump)
                 })
         })
     }

@@ -277,8 +277,9 @@ impl Adapter {
     /// measured at it, is coarser than its target: `kappa * D > refine_angle`,
     /// or `jump > refine_strain` when that is set.
     pub(super) fn sizing_wants_split(&self, l: u32, kappa: Scalar, jump: Scalar) -> bool {
-        kappa * self.node_spacing(l) > self.config.refine_angle.to_radians()
-            || self.config.refine_strain.is_some_and(|s| jump > s)
+        // The strain test first: it needs no spacing.
+        self.config.refine_strain.is_some_and(|s| jump > s)
+            || kappa * self.node_spacing(l) > self.config.refine_angle.to_radians()
     }
 
     /// Parents whose four leaf children would, merged, still be finer than
