@@ -76,6 +76,15 @@ pub struct ElementBlocks<'a> {
 
 impl ElementBlocks<'_> {
     /// Block `(k, l)` of shape triangle `tri`: `h^2 sum_ab M_ab J_ak J_bl^T`.
+    ///
+    /// Tried and dropped (2026-11-23): computing `M J` once per triangle and
+    /// step into a second per-triangle array, so that a block only sums three
+    /// outer products. Same blocks to the last bit, but slower: this function
+    /// took 2,831 and 2,095 `perf` samples instead of 1,930 and 1,797 on
+    /// `hanging_sheet_rest` at uniform 48 (two runs each, in turn; wall 10.5 /
+    /// 9.0 against 8.6 / 8.3 s). The gather reads blocks in pattern order, not
+    /// triangle order, so the likely cause is that a second 432-byte row per
+    /// triangle costs more cache misses than the arithmetic it saves.
     fn shape_block(&self, tri: usize, k: usize, l: usize) -> Matrix3 {
         let (m, jac) = (&self.shape_triangles[tri].m, &self.shape_jacobians[tri]);
         let mut out = Matrix3::ZERO;
