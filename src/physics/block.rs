@@ -38,7 +38,7 @@ use rayon::prelude::*;
 
 use super::elements::Elements;
 use super::forces::{PAR_MIN, PAR_MIN_ROWS};
-use super::shape::{ShapeJacobian, ShapeTriangle};
+use super::shape::{SHAPE_SLOTS, ShapeJacobian, ShapeTriangle};
 use crate::math::{Matrix3, Scalar, Vector};
 use buckets::{group_by_key, sorted_unique_rows};
 
@@ -179,9 +179,7 @@ impl BlockPattern {
             ..Default::default()
         };
         p.diagonal = (0..n as u32).map(|i| p.slot(i, i)).collect();
-        p.mirror = (0..p.blocks())
-            .map(|b| p.slot(p.columns[b], p.rows[b]))
-            .collect();
+        p.mirror = p.mirrors();
         p.factored = (0..p.blocks())
             .map(|b| p.rows[b] == p.columns[b] || factor_tips)
             .collect();
@@ -201,17 +199,6 @@ impl BlockPattern {
             }
         }
         (p.compensation_start, p.compensation) = group_by_key(n, &tips);
-        let mut dropped: Vec<(u32, (u32, u8, u8))> = Vec::new();
-        for (ti, t) in elements.shape_triangles.iter().enumerate() {
-            for (k, i) in t.slots() {
-                for (l, j) in t.slots() {
-                    if i != j && !p.factored[p.slot(i, j) as usize] {
-                        dropped.push((i, (ti as u32, k as u8, l as u8)));
-                    }
-                }
-            }
-        }
-        (p.shape_dropped_start, p.shape_dropped) = group_by_key(n, &dropped);
         p.build_sources(elements);
         p.build_csc();
         p
@@ -260,18 +247,64 @@ impl BlockPattern {
                 }
             }
         }
+        // The shape triangles' sources, and the blocks the factorization drops
+        // (compensated on the diagonal: `shape_dropped`), from one lookup per
+        // pair of slots: `factored` is symmetric, so the lower block tells.
+        let mut dropped: Vec<(u32, (u32, u8, u8))> = Vec::new();
         for (ti, t) in elements.shape_triangles.iter().enumerate() {
+            let mut active = [(0usize, 0u32); SHAPE_SLOTS];
+            let mut count = 0;
             for (k, i) in t.slots() {
-                for (l, j) in t.slots() {
+                active[count] = (k, i);
+                count += 1;
+            }
+            let active = &active[..count];
+            let mut lower_slot = [[0u32; SHAPE_SLOTS]; SHAPE_SLOTS];
+            for (x, &(_, i)) in active.iter().enumerate() {
+                for (y, &(_, j)) in active.iter().enumerate().take(x + 1) {
+                    let b = if i == j {
+                        self.diagonal[i as usize]
+                    } else {
+                        lower(self, i, j)
+                    };
+                    (lower_slot[x][y], lower_slot[y][x]) = (b, b);
+                }
+            }
+            let tri = ti as u32;
+            for (x, &(k, i)) in active.iter().enumerate() {
+                for (y, &(l, j)) in active.iter().enumerate() {
+                    let (b, k, l) = (lower_slot[x][y], k as u8, l as u8);
+                    if i != j && !self.factored[b as usize] {
+                        dropped.push((i, (tri, k, l)));
+                    }
                     if j <= i {
-                        let (tri, k, l) = (ti as u32, k as u8, l as u8);
-                        tagged.push((self.slot(i, j), Source::Shape { tri, k, l }));
+                        tagged.push((b, Source::Shape { tri, k, l }));
                     }
                 }
             }
         }
+        (self.shape_dropped_start, self.shape_dropped) = group_by_key(self.vertices(), &dropped);
         // Grouped stably: the sources of a block stay in element order.
         (self.source_start, self.sources) = group_by_key(self.blocks(), &tagged);
+    }
+
+    /// Per block: the block holding its transpose. Row `j` lists its columns in
+    /// ascending order, and the rows are visited in ascending order, so the
+    /// blocks `(i, j)` of column `j` are met in the order of row `j`'s list: a
+    /// cursor per row finds every mirror without a search.
+    fn mirrors(&self) -> Vec<u32> {
+        let mut cursor: Vec<u32> = self.row_start[..self.vertices()].to_vec();
+        let mut mirror = vec![0u32; self.blocks()];
+        for (b, &j) in self.columns.iter().enumerate() {
+            let m = cursor[j as usize];
+            debug_assert_eq!(
+                self.columns[m as usize], self.rows[b],
+                "the pattern is not symmetric"
+            );
+            mirror[b] = m;
+            cursor[j as usize] += 1;
+        }
+        mirror
     }
 
     /// Per vertex: the diagonal compensation of the dropped tip-tip blocks (module

@@ -34,23 +34,28 @@ pub(super) fn group_by_key<T: Copy>(keys: usize, pairs: &[(u32, T)]) -> (Vec<u32
 /// The sorted, duplicate-free set of `(row, column)` pairs with rows below
 /// `rows`, as a row start array (length `rows + 1`) and the columns: the same as
 /// sorting the pairs and removing duplicates, in time linear in the pairs plus a
-/// sort of each (short) row.
+/// sort of each row's distinct columns. Duplicates are dropped before the sort
+/// by marking each column with the last row that kept it (a pattern's pairs
+/// repeat each block several times: every element that couples two vertices
+/// adds the pair again).
 pub(super) fn sorted_unique_rows(rows: usize, pairs: &[(u32, u32)]) -> (Vec<u32>, Vec<u32>) {
     let (start, mut columns) = group_by_key(rows, pairs);
+    let bound = columns.iter().map(|&c| c as usize + 1).max().unwrap_or(0);
+    let mut kept_in_row = vec![u32::MAX; bound];
     let mut row_start = vec![0u32; rows + 1];
     let mut kept = 0usize;
     for r in 0..rows {
         let (s, e) = (start[r] as usize, start[r + 1] as usize);
-        columns[s..e].sort_unstable();
-        let mut last = None;
+        let first = kept;
         for k in s..e {
             let c = columns[k];
-            if last != Some(c) {
+            if kept_in_row[c as usize] != r as u32 {
+                kept_in_row[c as usize] = r as u32;
                 columns[kept] = c;
                 kept += 1;
-                last = Some(c);
             }
         }
+        columns[first..kept].sort_unstable();
         row_start[r + 1] = kept as u32;
     }
     columns.truncate(kept);
