@@ -33,6 +33,8 @@
 //!
 mod buckets;
 mod csc;
+#[cfg(test)]
+mod tests;
 
 use rayon::prelude::*;
 
@@ -225,7 +227,8 @@ impl BlockPattern {
         (s + found.unwrap_or(0)) as u32
     }
 
-    /// The element terms of every lower block, in element order.
+    /// The element terms of every lower block, in element order, and the shape
+    /// triangles' blocks that the factorization drops (`shape_dropped`).
     fn build_sources(&mut self, elements: &Elements) {
         let mut tagged: Vec<(u32, Source)> = Vec::new();
         let lower = |s: &Self, i: u32, j: u32| if j <= i { s.slot(i, j) } else { s.slot(j, i) };
