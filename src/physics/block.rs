@@ -121,7 +121,15 @@ pub struct BlockPattern {
     /// Per vertex, CSC-like: the shape-triangle blocks `(tri, k, l)` of row `i` that
     /// the factorization drops; each is compensated by its Frobenius norm on the
     /// diagonal (`[[s I, -B], [-B^T, s I]]` is positive semi-definite for
-    /// `s >= |B|`), so the factored matrix stays positive definite.
+    /// `s >= |B|`), so the factored matrix stays positive definite. Tried and
+    /// dropped (2026-11-23): every such block involves a tip, whose angle
+    /// gradient feeds one angle only, so `B = u v^T` has rank one and the
+    /// tightest compensation is `B B^T / |B|` on row `i` (rank one along `u`)
+    /// instead of `|B| I`. It saved almost nothing: CG iterations 1,658 ->
+    /// 1,641 on `hanging_sheet_rest` at uniform 64 over 2 s, 637 -> 635 on
+    /// `drape_sphere` over 1 s (the factorization counts unchanged, 240 and
+    /// 87). A fresh factor's 5 or so iterations a step come from the
+    /// tolerance (1e-6) more than from the dropped blocks.
     shape_dropped_start: Vec<u32>,
     shape_dropped: Vec<(u32, u8, u8)>,
     /// Per block (lower blocks only; empty range for upper ones): its sources.
