@@ -128,8 +128,8 @@ pub struct BlockPattern {
     /// instead of `|B| I`. It saved almost nothing: CG iterations 1,658 ->
     /// 1,641 on `hanging_sheet_rest` at uniform 64 over 2 s, 637 -> 635 on
     /// `drape_sphere` over 1 s (the factorization counts unchanged, 240 and
-    /// 87). A fresh factor's 5 or so iterations a step come from the
-    /// tolerance (1e-6) more than from the dropped blocks.
+    /// 87): how the dropped blocks are compensated is not what makes a fresh
+    /// factor need about 5 iterations a step there (not measured further).
     shape_dropped_start: Vec<u32>,
     shape_dropped: Vec<(u32, u8, u8)>,
     /// Per block (lower blocks only; empty range for upper ones): its sources.
