@@ -37,8 +37,9 @@
 //! what remains is faer's symbolic factorization on the scalar pattern. On the
 //! adaptive `hanging_sheet_rest` (red-green 16 L4 tight, `refine_strain = 0.02`,
 //! 138 orderings) `perf` put about 2.5 % of the run in the ordering and symbolic
-//! factorization before (202 of 8,228 samples) and about 1.1 % after (101 of 9,179); the run's wall time moved less
-//! than its noise (7.40 / 7.61 s before, 7.63 / 7.23 s after, in turn).
+//! factorization before (202 of 8,228 samples) and about 1.1 % after (101 of
+//! 9,179); the run's wall time moved less than its noise (7.40 / 7.61 s
+//! before, 7.63 / 7.23 s after, in turn).
 //!
 //! Why faer: it is pure Rust (no system BLAS or SuiteSparse to install), maintained,
 //! has a supernodal LL^T and LDL^T with AMD, and exposes the symbolic and numeric
@@ -174,15 +175,15 @@ impl Factorization {
         let (col_ptr, rows) = pattern.csc_structure();
         let n = 3 * pattern.vertices();
         let structure = SymbolicSparseColMatRef::new_checked(n, n, col_ptr, None, rows);
-        let (forward, inverse) = match ordering {
-            Ordering::ByVertex => order_by_vertex(pattern)?,
-            Ordering::ByUnknown => (Vec::new(), Vec::new()),
+        let by_vertex = match ordering {
+            Ordering::ByVertex => Some(order_by_vertex(pattern)?),
+            Ordering::ByUnknown => None,
         };
-        let ordering = match ordering {
-            Ordering::ByVertex => {
-                SymmetricOrdering::Custom(PermRef::new_checked(&forward, &inverse, n))
+        let ordering = match &by_vertex {
+            Some((forward, inverse)) => {
+                SymmetricOrdering::Custom(PermRef::new_checked(forward, inverse, n))
             }
-            Ordering::ByUnknown => SymmetricOrdering::Amd,
+            None => SymmetricOrdering::Amd,
         };
         let symbolic = factorize_symbolic_cholesky(
             structure,
@@ -276,8 +277,7 @@ impl Factorization {
 /// kept together in x, y, z order. Returns the forward and inverse permutations.
 fn order_by_vertex(pattern: &BlockPattern) -> Result<(Vec<u32>, Vec<u32>), FactorError> {
     let vertices = pattern.vertices();
-    let (mut column_start, mut rows) = (Vec::new(), Vec::new());
-    pattern.vertex_structure(&mut column_start, &mut rows);
+    let (column_start, rows) = pattern.vertex_structure();
     let graph =
         SymbolicSparseColMatRef::new_checked(vertices, vertices, &column_start, None, &rows);
     let (mut forward_v, mut inverse_v) = (vec![0u32; vertices], vec![0u32; vertices]);

@@ -43,11 +43,10 @@ impl BlockPattern {
     /// The block-level (one row and column per vertex) CSC structure of the factored
     /// lower triangle, diagonal included, rows ascending within each column: the
     /// graph that the fill-reducing ordering reads ([`super::super::direct`],
-    /// "Ordering by vertex").
-    pub fn vertex_structure(&self, column_start: &mut Vec<u32>, rows: &mut Vec<u32>) {
+    /// "Ordering by vertex"), as column starts and row indices.
+    pub fn vertex_structure(&self) -> (Vec<u32>, Vec<u32>) {
         let n = self.vertices();
-        column_start.clear();
-        rows.clear();
+        let (mut column_start, mut rows) = (Vec::with_capacity(n + 1), Vec::new());
         column_start.push(0);
         for j in 0..n {
             let (s, e) = (self.row_start[j] as usize, self.row_start[j + 1] as usize);
@@ -59,6 +58,7 @@ impl BlockPattern {
             }
             column_start.push(rows.len() as u32);
         }
+        (column_start, rows)
     }
 
     /// Column pointers and row indices of the lower triangle's scalar CSC form.

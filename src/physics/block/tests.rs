@@ -4,55 +4,40 @@
 
 use super::BlockPattern;
 use crate::adapt::{AdaptConfig, Adapter};
-use crate::math::Scalar;
-use crate::mesh;
+use crate::mesh::Mesh;
+use crate::physics::Model;
 use crate::physics::elements::{Elements, MaterialParams};
-use crate::spec::{
-    AdaptCriterion, AdaptEvery, AdaptMethod, BendingModel, DiagonalPattern, StiffnessRule,
-};
+use crate::scene::default_scene;
 use crate::world::World;
 
-/// A 12 x 12 grid, and the same grid refined by red-green along a crease (so
-/// that the pattern has transitions, green triangles and shape tips).
-fn meshes() -> Vec<mesh::Mesh> {
-    let grid = mesh::rectangle(1.0, 1.0, 12, DiagonalPattern::Alternating).expect("grid");
+/// The default scene's sheet at 12 x 12 and its fabric, and the same grid
+/// refined by red-green (the papers' angle criterion) along a crease, so that
+/// the pattern has transitions, green triangles and shape tips.
+fn meshes() -> (Vec<Mesh>, MaterialParams) {
+    let overrides = [
+        "cloth.resolution=12",
+        "adapt.method=red_green",
+        "adapt.criterion=angle",
+    ];
+    let scene = default_scene(&overrides.map(String::from)).expect("the default scene");
+    let grid = World::from_scene(&scene).expect("its sheet").mesh;
     let bent = grid
         .material
         .iter()
-        .map(|p| p.extend((p.x - 0.1).max(0.0) as Scalar))
+        .map(|p| p.extend((p.x - 0.1).max(0.0)))
         .collect();
     let mut world = World::new(grid.clone(), bent);
-    let config = AdaptConfig {
-        method: AdaptMethod::RedGreen,
-        refine_angle: 15.0,
-        coarsen_angle: 1.5,
-        max_level: 4,
-        min_edge_length: 0.0,
-        every: AdaptEvery::Steps(1),
-        rollback: false,
-        max_rollbacks: 0,
-        criterion: AdaptCriterion::Angle,
-        hysteresis: 2.0,
-        refine_strain: None,
-        alternate_diagonals: true,
-    };
-    let mut adapter = Adapter::new(config, &world, 0.15);
+    let config = AdaptConfig::from_scene(scene.adapt.as_ref()).expect("it adapts");
+    let mut adapter = Adapter::new(config, &world, scene.material.density);
     adapter.pass(&mut world, 0).expect("the crease refines");
     assert!(world.mesh.triangles.len() > grid.triangles.len());
-    vec![grid, world.mesh]
+    (vec![grid, world.mesh], Model::from_scene(&scene).material)
 }
 
 #[test]
 fn mirrors_and_dropped_blocks_match_the_searches() {
-    let material = MaterialParams {
-        density: 0.15,
-        stretch: 200.0,
-        bending: 1e-5,
-        damping: 0.001,
-        bending_model: BendingModel::ShapeOperator,
-        stiffness_rule: StiffnessRule::Consistent,
-    };
-    for m in meshes() {
+    let (meshes, material) = meshes();
+    for m in meshes {
         let elements = Elements::build(&m, &material);
         let n = m.vertex_count();
         for factor_tips in [false, true] {
