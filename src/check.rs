@@ -279,7 +279,7 @@ fn describe_time_step(
 fn describe_implicit_solver(s: &mut String, sim: &Simulation) {
     let solver = match sim.solver {
         Solver::Direct => format!(
-            "direct (sparse Cholesky, reused as the preconditioner of conjugate gradients, refactored after {} iterations)",
+            "direct (sparse Cholesky, reused as the preconditioner of conjugate gradients, refactored when an older factor's iterations outweigh a factorization worth {} of them)",
             sim.refactor_iterations
         ),
         Solver::Cg => "cg (matrix-free, Jacobi preconditioner)".to_string(),

@@ -14,8 +14,8 @@
 //!   collision passes, the direct solver's stored factorization and scratch memory.
 //!   It holds no simulation state: it can be dropped and rebuilt from the model and
 //!   the state at any step ([`Pipeline::new`]). Only the stored factorization (the
-//!   direct solver's preconditioner, refreshed every `refactor_iterations`
-//!   iterations) is lost then; the next solve factors afresh and its result differs
+//!   direct solver's preconditioner, refreshed when an older factor's
+//!   iterations outweigh a factorization) is lost then; the next solve factors afresh and its result differs
 //!   within the solve's tolerance (`simulation.cg_tolerance`), not beyond it. With
 //!   `solver = "cg"` or an explicit integrator a rebuilt pipeline continues
 //!   bit-identically (test `sim::a_rebuilt_pipeline_continues_a_run_bit_identically`).

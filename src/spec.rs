@@ -57,8 +57,8 @@ pub enum ClothMesh {
 #[serde(rename_all = "snake_case")]
 pub enum Solver {
     /// Sparse Cholesky factorization (faer), reused over steps as the preconditioner
-    /// of conjugate gradients and refactored when they need more than
-    /// `refactor_iterations`.
+    /// of conjugate gradients and refactored when the iterations an older factor
+    /// costs outweigh a factorization (worth `refactor_iterations` of them).
     #[default]
     Direct,
     /// Matrix-free conjugate gradients with a Jacobi (diagonal) preconditioner.

@@ -27,7 +27,8 @@
 //! * `direct` (default, [`assembled`]): `A` assembled into a fixed block pattern and
 //!   factored by a sparse Cholesky; the factor is kept and used to precondition
 //!   conjugate gradients in the following steps, and the matrix is factored anew
-//!   when they need more than `refactor_iterations` (the stiffer the cloth and the
+//!   when the iterations the older factor costs outweigh a factorization, worth
+//!   `refactor_iterations` of them ([`refactor`] module docs) (the stiffer the cloth and the
 //!   larger the step, the more Jacobi-preconditioned CG needs; a factor of a nearby
 //!   matrix needs a few iterations whatever the stiffness).
 //! * `cg` ([`cg`]): matrix-free conjugate gradients with the diagonal of `A` as the
@@ -62,6 +63,7 @@
 mod assemble;
 mod assembled;
 mod cg;
+mod refactor;
 
 use assemble::assemble;
 

@@ -53,8 +53,9 @@ pub struct Model {
 pub struct SolverSettings {
     /// The linear solver.
     pub solver: Solver,
-    /// Direct solver: iterations allowed with an earlier step's factorization
-    /// before refactoring.
+    /// Direct solver: the cost of one factorization counted in conjugate-gradient
+    /// iterations, weighed against the iterations an older factor costs
+    /// (`implicit::refactor` module docs).
     pub refactor_iterations: u32,
     /// Newton iterations per step (1: Baraff and Witkin's linearised step).
     pub newton_iterations: u32,
@@ -63,11 +64,12 @@ pub struct SolverSettings {
 }
 
 impl Default for SolverSettings {
-    /// The scene defaults: direct solver, refactor after 4 iterations, one Newton step.
+    /// The scene defaults: direct solver, a factorization worth 7 iterations, one
+    /// Newton step.
     fn default() -> SolverSettings {
         SolverSettings {
             solver: Solver::Direct,
-            refactor_iterations: 4,
+            refactor_iterations: 7,
             newton_iterations: 1,
             newton_tolerance: 1e-3,
         }

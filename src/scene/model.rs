@@ -70,8 +70,9 @@ pub struct Simulation {
     /// Linear solver of the implicit integrator.
     #[serde(default)]
     pub solver: Solver,
-    /// Direct solver: preconditioned iterations allowed with a factorization from an
-    /// earlier step before the matrix is factored anew.
+    /// Direct solver: what one factorization costs, counted in preconditioned
+    /// iterations; the solver weighs it against the iterations an older factor costs
+    /// (`physics::implicit::refactor`).
     #[serde(default = "default_refactor_iterations")]
     pub refactor_iterations: u32,
     /// Newton iterations per implicit step (1: the linearised step of Baraff and Witkin).
@@ -209,7 +210,7 @@ fn default_cg_max_iterations() -> u32 {
     500
 }
 fn default_refactor_iterations() -> u32 {
-    4
+    7
 }
 fn default_newton_iterations() -> u32 {
     1

@@ -11,12 +11,14 @@
 //! prescribed component, so any factor of a nearby `A_s` is a good preconditioner.
 //!
 //! The factor is reused from step to step. The first preconditioned iterate is the
-//! solve with it; while the factor is fresh (this step's matrix) that is exact up to
-//! rounding and the residual test passes at once. With an older factor, conjugate
-//! gradients correct the difference; when they have not converged after
-//! `refactor_iterations`, the current matrix is factored and the iteration restarts
-//! from where it is. So the cost per step adapts to how fast the matrix changes:
-//! falling, folding cloth refactors often, cloth at rest almost never.
+//! solve with it; a fresh factor (this step's matrix) leaves only the dropped tip
+//! blocks to correct, in a few iterations. With an older factor, conjugate
+//! gradients correct the difference too; when the iterations it costs outweigh a
+//! factorization ([`super::refactor`] module docs: the rule weighs the two in
+//! iterations, at the start of a step and during it), the current matrix is factored
+//! and the iteration restarts from where it is. So the cost per step adapts to how
+//! fast the matrix changes: falling, folding cloth refactors often, cloth at rest
+//! almost never.
 //!
 //! Measured (docs/performance.md): on a falling, draping sheet (`drape_sphere`) the
 //! matrix changes enough in one step that the solver refactors at 567 of 607 steps,
@@ -29,6 +31,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 use super::cg::dot;
+use super::refactor::RefactorPolicy;
 use super::{ImplicitScratch, SolveFailure};
 use crate::math::{Matrix3, Scalar, Vector};
 use crate::physics::block::{BlockPattern, ElementBlocks};
@@ -66,6 +69,8 @@ pub(super) struct AssembledScratch {
     /// Per vertex: `None` free, `Some(0)` held, `Some(n)` contact normal.
     projection: Vec<Option<Vector>>,
     factorization: Factorization,
+    /// When to factor anew (its module docs).
+    policy: RefactorPolicy,
     prescribed: Vec<Vector>,
     /// `b_s`.
     rhs: Vec<Vector>,
@@ -190,12 +195,13 @@ fn iterate(
 ) -> Result<(), SolveFailure> {
     let tolerance = model.cg_tolerance;
     let goal = tolerance * reference;
-    let refactor_after = model.solver.refactor_iterations;
+    let factorization_cost = Scalar::from(model.solver.refactor_iterations);
     let cap = model.cg_max_iterations;
     let a = &mut st.implicit.assembled;
     let mut fresh = false;
-    if !a.factorization.is_valid() {
+    if !a.factorization.is_valid() || a.policy.renew_at_start(factorization_cost) {
         refactor(a, pattern, &mut st.stats)?;
+        a.policy.factored(false);
         fresh = true;
     }
     // r = b_s - A_s y.
@@ -209,6 +215,7 @@ fn iterate(
         st.stats.factor_solves += 1;
         a.p.clone_from(&a.z);
         let mut rz = dot(&a.r, &a.z);
+        let first = dot(&a.r, &a.r).sqrt();
         loop {
             let rr = dot(&a.r, &a.r);
             if rr.sqrt() <= goal {
@@ -232,13 +239,18 @@ fn iterate(
                 a.compensation.iter_mut().for_each(|m| *m = Matrix3::ZERO);
                 a.factorization.reset();
                 refactor(a, &full, &mut st.stats)?;
+                a.policy.factored(false);
                 started = Instant::now();
                 since_factor = 0;
                 continue 'restart;
             }
-            if !fresh && since_factor >= refactor_after {
+            if !fresh
+                && a.policy
+                    .give_up(factorization_cost, since_factor, first, rr.sqrt(), goal)
+            {
                 st.stats.solve_s += started.elapsed().as_secs_f64();
                 refactor(a, pattern, &mut st.stats)?;
+                a.policy.factored(true);
                 started = Instant::now();
                 fresh = true;
                 since_factor = 0;
@@ -257,6 +269,9 @@ fn iterate(
         }
     };
     st.stats.cg_iterations += total as u64;
+    if outcome.is_ok() {
+        st.implicit.assembled.policy.solved(since_factor);
+    }
     st.stats.solve_s += started.elapsed().as_secs_f64();
     outcome
 }
