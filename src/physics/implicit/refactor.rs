@@ -110,7 +110,8 @@ impl RefactorPolicy {
         }
         // Residual falls by `rate` per iteration on average so far.
         let rate = (now / first).powf(1.0 / Scalar::from(spent));
-        if !(rate < 1.0) {
+        // Not falling, or not a number (a zero first residual cannot reach here).
+        if rate >= 1.0 || rate.is_nan() {
             return true;
         }
         (goal / now).ln() / rate.ln() > budget
