@@ -377,11 +377,8 @@ fn a_sheet_hanging_at_rest_keeps_its_factor() {
     };
     let settled = counts(75);
     let rest = counts(15);
-    let (steps, factorizations, iterations) = (
-        rest.0 - settled.0,
-        rest.1 - settled.1,
-        rest.2 - settled.2,
-    );
+    let (steps, factorizations, iterations) =
+        (rest.0 - settled.0, rest.1 - settled.1, rest.2 - settled.2);
     println!(
         "2.5 to 3 s at rest: {factorizations} factorizations and {iterations} iterations in {steps} steps (to 2.5 s: {} and {} in {})",
         settled.1, settled.2, settled.0
