@@ -216,9 +216,10 @@ fn iterate(
         st.stats.factor_solves += 1;
         a.p.clone_from(&a.z);
         let mut rz = dot(&a.r, &a.z);
-        let first = dot(&a.r, &a.r).sqrt();
+        // `r.r` of the iterate at hand; `first`: its norm when this (re)start began.
+        let mut rr = dot(&a.r, &a.r);
+        let first = rr.sqrt();
         loop {
-            let rr = dot(&a.r, &a.r);
             if rr.sqrt() <= goal {
                 break 'restart Ok(());
             }
@@ -264,6 +265,7 @@ fn iterate(
                 break 'restart Err(SolveFailure::NotPositiveDefinite);
             }
             rz = pcg_update(a, rz / pap, rz);
+            rr = dot(&a.r, &a.r);
             st.stats.factor_solves += 1;
             total += 1;
             since_factor += 1;

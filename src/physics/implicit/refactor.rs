@@ -49,7 +49,7 @@ use crate::math::Scalar;
 /// failed try (at most `F + k_0` wasted iterations, about 10) once in 33 solves adds
 /// about 3 % to a solve that factors anyway (about 10 iterations' worth), and cloth
 /// that has stopped moving keeps factoring at every solve for at most 32 more.
-pub(super) const MAX_WAIT: u32 = 32;
+const MAX_WAIT: u32 = 32;
 
 /// Iterations with an older factor before the residual's fall is extrapolated
 /// (rule 2): one iteration's ratio is too noisy (conjugate-gradient residuals do not
