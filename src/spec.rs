@@ -33,6 +33,8 @@ pub enum ClothMesh {
         height: f64,
         /// Segments along the longer side.
         resolution: u32,
+        /// Segments along the shorter side (`None`: square cells).
+        short_side_segments: Option<u32>,
         /// Which diagonal splits each grid square.
         diagonals: DiagonalPattern,
     },

@@ -63,9 +63,16 @@ impl World {
                 width,
                 height,
                 resolution,
+                short_side_segments,
                 diagonals,
             } => {
-                let m = mesh::rectangle(width, height, resolution, diagonals)?;
+                let m = mesh::rectangle_cells(
+                    width,
+                    height,
+                    resolution,
+                    short_side_segments,
+                    diagonals,
+                )?;
                 let local = m.material.iter().map(|p| p.extend(0.0)).collect();
                 (m, local)
             }

@@ -13,7 +13,31 @@ pub fn rectangle(
     resolution: u32,
     pattern: DiagonalPattern,
 ) -> Result<Mesh, MeshError> {
-    let (nx, ny) = grid_counts(width, height, resolution);
+    rectangle_cells(width, height, resolution, None, pattern)
+}
+
+/// [`rectangle`] with `short_side_segments` segments along the shorter side
+/// (`None`: as many as make square cells, as [`rectangle`]). Fewer give cells
+/// longer across the sheet than along it, each split into two right triangles:
+/// for a strip that bends along its length only (the cantilever), where
+/// resolution across it buys nothing (`docs/speed-vs-error.md`, "Anisotropic
+/// cells").
+pub fn rectangle_cells(
+    width: Scalar,
+    height: Scalar,
+    resolution: u32,
+    short_side_segments: Option<u32>,
+    pattern: DiagonalPattern,
+) -> Result<Mesh, MeshError> {
+    let (mut nx, mut ny) = grid_counts(width, height, resolution);
+    if let Some(short) = short_side_segments {
+        let short = short.max(1) as usize;
+        if width >= height {
+            ny = short;
+        } else {
+            nx = short;
+        }
+    }
     let mut material = Vec::with_capacity((nx + 1) * (ny + 1));
     for j in 0..=ny {
         for i in 0..=nx {

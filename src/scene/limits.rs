@@ -34,6 +34,21 @@ pub(super) fn resolution(resolution: Option<u32>) -> Result<(), Issue> {
     }
 }
 
+/// `cloth.short_side_segments` from 1 to [`MAX_RESOLUTION`].
+pub(super) fn short_side_segments(segments: Option<u32>) -> Result<(), Issue> {
+    match segments {
+        Some(0) => Err(out_of_range(
+            keys(&["cloth", "short_side_segments"]),
+            "0 is out of range: must be >= 1",
+        )),
+        Some(s) if s > MAX_RESOLUTION => Err(out_of_range(
+            keys(&["cloth", "short_side_segments"]),
+            format!("{s} is out of range: must be <= {MAX_RESOLUTION}"),
+        )),
+        _ => Ok(()),
+    }
+}
+
 /// The number of frames and of fixed steps at most [`MAX_COUNT`]. Call after the
 /// values themselves are known to be finite and positive.
 pub(super) fn counts(s: &Simulation) -> Result<(), Issue> {

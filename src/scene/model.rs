@@ -120,6 +120,8 @@ pub struct Cloth {
     pub radius: Option<f64>,
     /// Segments along the longer side (rectangle) or the diameter (disk).
     pub resolution: Option<u32>,
+    /// Rectangle only: segments along the shorter side (default: square cells).
+    pub short_side_segments: Option<u32>,
     /// Diagonal pattern of the rectangle's grid.
     #[serde(default)]
     pub diagonals: DiagonalPattern,

@@ -46,6 +46,7 @@ pub fn cloth_spec(c: &Cloth) -> Result<ClothSpec, BuildError> {
                 width: need(c.width, "width")?,
                 height: need(c.height, "height")?,
                 resolution,
+                short_side_segments: c.short_side_segments,
                 diagonals: c.diagonals,
             }
         }

@@ -198,12 +198,26 @@ fn shape_keys(
         ClothShape::Disk => (
             "disk",
             &["radius", "resolution"],
-            &["width", "height", "diagonals", "path", "uv_scale"],
+            &[
+                "width",
+                "height",
+                "diagonals",
+                "short_side_segments",
+                "path",
+                "uv_scale",
+            ],
         ),
         ClothShape::Obj => (
             "obj",
             &["path"],
-            &["width", "height", "radius", "resolution", "diagonals"],
+            &[
+                "width",
+                "height",
+                "radius",
+                "resolution",
+                "short_side_segments",
+                "diagonals",
+            ],
         ),
     }
 }
@@ -247,6 +261,7 @@ fn cloth(c: &Cloth, written: Option<&Table>) -> Result<(), Issue> {
         ));
     }
     super::limits::resolution(c.resolution)?;
+    super::limits::short_side_segments(c.short_side_segments)?;
     if c.path.as_deref().is_some_and(|p| p.trim().is_empty()) {
         let allowed = allowed_for(&at("path"));
         return Err(Issue::new(at("path"), Kind::BadValue, "the path is empty").allowed(allowed));

@@ -420,6 +420,39 @@ fn rectangle_has_resolution_segments_along_the_longer_side() {
 }
 
 #[test]
+fn short_side_segments_set_the_cells_across_the_shorter_side() {
+    for pattern in [DiagonalPattern::Alternating, DiagonalPattern::Regular] {
+        // A 5 x 2 strip, 40 segments along: 16 across by default (square cells).
+        let square = mesh::rectangle_cells(5.0, 2.0, 40, None, pattern).expect("strip");
+        assert_eq!(square.vertex_count(), 41 * 17, "{pattern:?}");
+        assert_eq!(
+            square.material,
+            mesh::rectangle(5.0, 2.0, 40, pattern)
+                .expect("strip")
+                .material
+        );
+        let thin = mesh::rectangle_cells(5.0, 2.0, 40, Some(2), pattern).expect("strip");
+        assert_eq!(thin.vertex_count(), 41 * 3, "{pattern:?}");
+        assert_eq!(thin.triangles.len(), 2 * 40 * 2);
+        assert!((thin.total_rest_area() - 10.0).abs() < 1e-12);
+        // The cells are 0.125 along and 1.0 across: every edge is one of those,
+        // or a diagonal, and the longest is the diagonal.
+        let longest = (0..thin.triangles.len())
+            .flat_map(|t| {
+                let [a, b, c] = thin.triangles[t].map(|i| thin.material[i as usize]);
+                [a.distance(b), b.distance(c), c.distance(a)]
+            })
+            .fold(0.0, f64::max);
+        assert!((longest - (1.0f64 + 0.125 * 0.125).sqrt()).abs() < 1e-12);
+        // Tall: the shorter side is u.
+        let tall = mesh::rectangle_cells(2.0, 5.0, 40, Some(1), pattern).expect("tall");
+        assert_eq!(tall.vertex_count(), 2 * 41, "{pattern:?}");
+        let (lo, hi) = tall.material_bounds();
+        assert_eq!((lo, hi), (Vector2::new(-1.0, -2.5), Vector2::new(1.0, 2.5)));
+    }
+}
+
+#[test]
 fn rectangle_is_a_manifold_disk_with_both_diagonal_patterns() {
     for pattern in [DiagonalPattern::Alternating, DiagonalPattern::Regular] {
         let (nx, ny) = (8usize, 4usize);

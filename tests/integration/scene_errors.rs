@@ -384,6 +384,28 @@ fn shape_keys_must_match_the_shape() {
         "cloth.height",
         Kind::MissingKey,
     );
+    error_at(
+        &edit("resolution = 4", "resolution = 4\nshort_side_segments = 0"),
+        9,
+        "cloth.short_side_segments",
+        Kind::OutOfRange,
+    );
+    error_at(
+        &edit(
+            "resolution = 4",
+            "resolution = 4\nshort_side_segments = 4096",
+        ),
+        9,
+        "cloth.short_side_segments",
+        Kind::OutOfRange,
+    );
+    let two = load_scene_str(
+        &edit("resolution = 4", "resolution = 4\nshort_side_segments = 2"),
+        "t",
+        &[],
+    )
+    .expect("short_side_segments on a rectangle");
+    assert_eq!(two.cloth.short_side_segments, Some(2));
     let disk = "shape = \"disk\"\nradius = 0.5\nresolution = 4\n";
     let rect = "shape = \"rectangle\"\nwidth = 1.0\nheight = 1.0\nresolution = 4\n";
     let pins = "[[pin]]\nregion = \"corner:top_left\"\n[[pin]]\nregion = \"corner:top_right\"\n";
@@ -400,6 +422,21 @@ fn shape_keys_must_match_the_shape() {
     assert_eq!(
         (e.kind, e.line, e.key.as_deref()),
         (Kind::MissingKey, Some(4), Some("cloth.radius")),
+        "{e}"
+    );
+    let e = load_scene_str(
+        &disk_scene.replacen("radius = 0.5", "radius = 0.5\nshort_side_segments = 2", 1),
+        "test.toml",
+        &[],
+    )
+    .expect_err("short_side_segments on disk");
+    assert_eq!(
+        (e.kind, e.line, e.key.as_deref()),
+        (
+            Kind::NotApplicable,
+            Some(7),
+            Some("cloth.short_side_segments")
+        ),
         "{e}"
     );
     let e = load_scene_str(
