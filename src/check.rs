@@ -8,8 +8,8 @@ use crate::physics::timestep::fit_to_frame;
 use crate::physics::{Elements, ExternalForces, MaterialParams, Model, Stepper};
 use crate::run::RunError;
 use crate::scene::{
-    AdaptCriterion, AdaptMethod, BendingModel, Integrator, PinMotion, Scene, Simulation, Solver,
-    StiffnessRule, TimeStep,
+    AdaptCriterion, AdaptMethod, BendingModel, ClothShape, Integrator, PinMotion, Scene,
+    Simulation, Solver, StiffnessRule, TimeStep,
 };
 use crate::world::World;
 
@@ -52,11 +52,24 @@ pub fn describe(scene: &Scene) -> Result<String, RunError> {
     Ok(s)
 }
 
-/// The `cloth:` line: shape, mesh size, rest area and mass.
+/// The `cloth:` line: shape (a rectangle's grid of cells), mesh size, rest
+/// area and mass.
 fn describe_cloth(s: &mut String, scene: &Scene, world: &World, el: &Elements) {
+    let c = &scene.cloth;
+    let grid = match (c.shape, c.width, c.height, c.resolution) {
+        (ClothShape::Rectangle, Some(w), Some(h), Some(r)) => {
+            let (nx, ny) = crate::mesh::cell_counts(w, h, r, c.short_side_segments);
+            format!(
+                " ({nx} x {ny} cells of {:.4} x {:.4} m)",
+                w / nx as f64,
+                h / ny as f64
+            )
+        }
+        _ => String::new(),
+    };
     let _ = writeln!(
         s,
-        "cloth: {:?}, {} vertices, {} triangles, {} edges ({} interior); rest area {:.6} m^2, mass {:.6} kg",
+        "cloth: {:?}{grid}, {} vertices, {} triangles, {} edges ({} interior); rest area {:.6} m^2, mass {:.6} kg",
         scene.cloth.shape,
         world.mesh.vertex_count(),
         world.mesh.triangles.len(),

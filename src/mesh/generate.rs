@@ -29,15 +29,7 @@ pub fn rectangle_cells(
     short_side_segments: Option<u32>,
     pattern: DiagonalPattern,
 ) -> Result<Mesh, MeshError> {
-    let (mut nx, mut ny) = grid_counts(width, height, resolution);
-    if let Some(short) = short_side_segments {
-        let short = short.max(1) as usize;
-        if width >= height {
-            ny = short;
-        } else {
-            nx = short;
-        }
-    }
+    let (nx, ny) = cell_counts(width, height, resolution, short_side_segments);
     let mut material = Vec::with_capacity((nx + 1) * (ny + 1));
     for j in 0..=ny {
         for i in 0..=nx {
@@ -66,6 +58,25 @@ pub fn rectangle_cells(
         }
     }
     Mesh::new(material, triangles)
+}
+
+/// Cells along u and v of [`rectangle_cells`].
+pub fn cell_counts(
+    width: Scalar,
+    height: Scalar,
+    resolution: u32,
+    short_side_segments: Option<u32>,
+) -> (usize, usize) {
+    let (mut nx, mut ny) = grid_counts(width, height, resolution);
+    if let Some(short) = short_side_segments {
+        let short = short.max(1) as usize;
+        if width >= height {
+            ny = short;
+        } else {
+            nx = short;
+        }
+    }
+    (nx, ny)
 }
 
 /// Segments along u and v for a rectangle.

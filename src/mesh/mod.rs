@@ -10,7 +10,7 @@ mod obj;
 mod pairmap;
 mod topology;
 
-pub use generate::{disk, rectangle, rectangle_cells};
+pub use generate::{cell_counts, disk, rectangle, rectangle_cells};
 pub use obj::{ObjCloth, ObjError, load_obj};
 pub use pairmap::{PairHasher, PairMap, PairSet};
 pub use topology::{Edge, NO_TRIANGLE};

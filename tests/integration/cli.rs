@@ -343,6 +343,27 @@ fn check_flag_lists_wind_and_rk4() {
 }
 
 #[test]
+fn check_prints_a_rectangles_cells() {
+    let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    let out = drape(
+        &[
+            "check",
+            "cantilever.toml",
+            "--set",
+            "cloth.short_side_segments=2",
+        ],
+        &scenes,
+    );
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let text = stdout(&out);
+    // 20 segments along the 5 cm, 2 across the 2 cm.
+    assert!(
+        text.contains("cloth: Rectangle (20 x 2 cells of 0.0025 x 0.0100 m), 63 vertices"),
+        "{text}"
+    );
+}
+
+#[test]
 fn check_unknown_key_names_file_line_and_key() {
     let dir = temp_dir("unknown-key");
     let scene = write_scene(&dir, "bad.toml", "colour = \"red\"");
