@@ -96,11 +96,14 @@ pub struct Settled {
     pub residual: Scalar,
 }
 
-fn strip_mesh(overhang: Scalar, res: u32) -> Mesh {
-    mesh::rectangle(
+/// The strip's mesh: `res` cells along the overhang, `across` cells across
+/// its width (`None`: square cells).
+fn strip_mesh(overhang: Scalar, res: u32, across: Option<u32>) -> Mesh {
+    mesh::rectangle_cells(
         overhang * 9.0 / 8.0,
         overhang / 4.0,
         res * 9 / 8,
+        across,
         DiagonalPattern::Alternating,
     )
     .unwrap()
@@ -156,7 +159,7 @@ fn settle_on(m: &Mesh, x: &mut [Vector], mat: &MaterialParams, overhang: Scalar)
 
 /// The equilibrium of the strip at uniform resolution `res`.
 pub fn settle(overhang: Scalar, res: u32, mat: &MaterialParams) -> Settled {
-    let m = strip_mesh(overhang, res);
+    let m = strip_mesh(overhang, res, None);
     let mut x: Vec<Vector> = m.material.iter().map(|p| p.extend(0.0)).collect();
     settle_on(&m, &mut x, mat, overhang)
 }
@@ -165,7 +168,7 @@ pub fn settle(overhang: Scalar, res: u32, mat: &MaterialParams) -> Settled {
 /// with the settings (5 deg / 0.5 deg, max level 4), solved and adapted
 /// in turn until the mesh stops changing.
 pub fn settle_adaptive(overhang: Scalar, mat: &MaterialParams) -> Settled {
-    let m = strip_mesh(overhang, 8);
+    let m = strip_mesh(overhang, 8, None);
     let x: Vec<Vector> = m.material.iter().map(|p| p.extend(0.0)).collect();
     let mut world = World::new(m, x);
     let config = AdaptConfig {
@@ -312,17 +315,11 @@ fn cantilever_other_models() {
     }
 }
 
-/// The strip at `res` cells along the overhang and `across` cells across its
-/// width (cells up to 8 times longer across than along at `across = 1`).
+/// The equilibrium of the strip at `res` cells along the overhang and `across`
+/// cells across its width (at `res = 32` and `across = 1` the cells are 8
+/// times longer across than along).
 fn settle_across(overhang: Scalar, res: u32, across: u32, mat: &MaterialParams) -> Settled {
-    let m = mesh::rectangle_cells(
-        overhang * 9.0 / 8.0,
-        overhang / 4.0,
-        res * 9 / 8,
-        Some(across),
-        DiagonalPattern::Alternating,
-    )
-    .unwrap();
+    let m = strip_mesh(overhang, res, Some(across));
     let mut x: Vec<Vector> = m.material.iter().map(|p| p.extend(0.0)).collect();
     settle_on(&m, &mut x, mat, overhang)
 }

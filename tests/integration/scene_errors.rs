@@ -424,32 +424,23 @@ fn shape_keys_must_match_the_shape() {
         (Kind::MissingKey, Some(4), Some("cloth.radius")),
         "{e}"
     );
-    let e = load_scene_str(
-        &disk_scene.replacen("radius = 0.5", "radius = 0.5\nshort_side_segments = 2", 1),
-        "test.toml",
-        &[],
-    )
-    .expect_err("short_side_segments on disk");
-    assert_eq!(
-        (e.kind, e.line, e.key.as_deref()),
-        (
-            Kind::NotApplicable,
-            Some(7),
-            Some("cloth.short_side_segments")
-        ),
-        "{e}"
-    );
-    let e = load_scene_str(
-        &disk_scene.replacen("radius = 0.5", "radius = 0.5\nwidth = 1.0", 1),
-        "test.toml",
-        &[],
-    )
-    .expect_err("width on disk");
-    assert_eq!(
-        (e.kind, e.line, e.key.as_deref()),
-        (Kind::NotApplicable, Some(7), Some("cloth.width")),
-        "{e}"
-    );
+    // Rectangle-only keys on a disk.
+    for (line, key) in [
+        ("short_side_segments = 2", "cloth.short_side_segments"),
+        ("width = 1.0", "cloth.width"),
+    ] {
+        let e = load_scene_str(
+            &disk_scene.replacen("radius = 0.5", &format!("radius = 0.5\n{line}"), 1),
+            "test.toml",
+            &[],
+        )
+        .expect_err(line);
+        assert_eq!(
+            (e.kind, e.line, e.key.as_deref()),
+            (Kind::NotApplicable, Some(7), Some(key)),
+            "{e}"
+        );
+    }
     let obj_scene = BASE.replacen(rect, "shape = \"obj\"\n", 1);
     let e = load_scene_str(&obj_scene, "test.toml", &[]).expect_err("obj without path");
     assert_eq!(
