@@ -19,6 +19,8 @@ mod tri_list;
 pub use check::{ConsistencyError, boundary_length, check_consistency};
 pub use marks::{edge_angles, edge_angles_into};
 
+use std::collections::HashMap;
+
 use crate::math::{Scalar, Vector};
 use crate::mesh::MeshError;
 use crate::spec::{
@@ -81,6 +83,10 @@ pub struct AdaptStats {
     pub changed_passes: u64,
     /// Largest number of operations in one pass.
     pub max_ops_per_pass: u64,
+    /// Merges that the criterion split again before the next pass had run
+    /// (red-green; with the sizing criterion each one doubles that parent's
+    /// hysteresis: `sizing.rs`, "Bounces").
+    pub bounces: u64,
     /// Mean over the passes of the fraction of triangles at `max_level` or
     /// finer (closure triangles of the finest red level included).
     pub top_level_fraction_mean: Scalar,
@@ -183,6 +189,14 @@ pub struct Adapter {
     hierarchy: RedGreen,
     /// Leaf of the hierarchy that owns each triangle of the world's mesh.
     owner: Vec<u32>,
+    /// The parents the latest pass merged, sorted (a split of one of them by
+    /// the criterion before the next pass is a bounce).
+    merged_last_pass: Vec<u32>,
+    /// The parents [`Adapter::apply`] merged since the pass began.
+    pass_merges: Vec<u32>,
+    /// Per parent: how many of its merges bounced (its sizing hysteresis is
+    /// doubled that many times; dropped when the parent itself merges away).
+    bounces: HashMap<u32, u32>,
     density: Scalar,
     /// Limits of the edge method (`None` for red_green).
     edge: Option<edge::Limits>,
@@ -211,6 +225,9 @@ impl Adapter {
             events: Vec::new(),
             hierarchy,
             owner,
+            merged_last_pass: Vec::new(),
+            pass_merges: Vec::new(),
+            bounces: HashMap::new(),
             density,
             edge,
             area: m.total_rest_area(),
@@ -282,12 +299,15 @@ impl Adapter {
             }
         };
         self.stats.passes += 1;
+        self.pass_merges.clear();
         let mut ops: Vec<(RedGreenOp, Option<Scalar>)> = merges
             .iter()
             .map(|&(p, a)| (RedGreenOp::Merge(p), Some(a)))
             .collect();
         ops.extend(splits.iter().map(|&(l, a)| (RedGreenOp::Split(l), Some(a))));
         let changed = self.apply(world, &ops, step);
+        self.merged_last_pass = std::mem::take(&mut self.pass_merges);
+        self.merged_last_pass.sort_unstable();
         self.stats.note_levels(world, self.config.max_level);
         changed
     }
@@ -356,10 +376,20 @@ impl Adapter {
         }
         for a in &applied {
             match a.op {
-                RedGreenOp::Merge(_) => self.stats.merges += 1,
-                RedGreenOp::Split(_) => {
+                RedGreenOp::Merge(n) => {
+                    self.stats.merges += 1;
+                    self.pass_merges.push(n);
+                    for c in a.children {
+                        self.bounces.remove(&c);
+                    }
+                }
+                RedGreenOp::Split(l) => {
                     self.stats.splits += 1;
                     self.stats.closure_splits += a.forced as u64;
+                    if !a.forced && self.merged_last_pass.binary_search(&l).is_ok() {
+                        *self.bounces.entry(l).or_default() += 1;
+                        self.stats.bounces += 1;
+                    }
                 }
             }
         }

@@ -328,3 +328,55 @@ fn top_level_statistics_count_triangles_and_area() {
     assert!((s.top_level_area_fraction_final - by_area).abs() < 1e-12);
     assert!(by_area < 0.5 * by_count, "fine triangles are small");
 }
+
+/// Regression (the churn at rest, `src/adapt/sizing.rs`, "Bounces"): a merge
+/// judged by the children's measures was split again at the next pass, over
+/// and over, once the coarse mesh had relaxed: `hanging_sheet_rest` with base
+/// 8 and `max_level = 6` changed its mesh at every pass of its last 2 s at
+/// rest (180 splits, 180 merges). Each bounce now doubles that parent's
+/// hysteresis, so the mesh settles: over the last second of 3 s it must not
+/// change at all. The counts are printed.
+#[test]
+fn a_sheet_at_rest_stops_remeshing() {
+    use std::sync::atomic::AtomicBool;
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/hanging_sheet_rest.toml");
+    let sets: Vec<String> = [
+        "simulation.duration=3.0",
+        "cloth.resolution=8",
+        "adapt.max_level=6",
+        "adapt.refine_angle=7.0",
+        "adapt.coarsen_angle=0.7",
+        "adapt.refine_strain=0.02",
+        "adapt.rollback=false",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    let scene = drape::scene::load_scene_file(&path, &sets).expect("scene");
+    let mut previous: Option<Vec<[u32; 3]>> = None;
+    let (mut changes, mut late_changes) = (0u32, 0u32);
+    let summary = drape::run::run_observed(
+        &scene,
+        &drape::run::RunOptions::default(),
+        &AtomicBool::new(false),
+        &mut |_| {},
+        &mut |f| {
+            if previous.as_deref().is_some_and(|p| p != f.triangles) {
+                changes += 1;
+                if f.sim_time > 2.0 {
+                    late_changes += 1;
+                }
+            }
+            previous = Some(f.triangles.to_vec());
+        },
+    )
+    .expect("run");
+    let a = summary.adapt.expect("adaptive");
+    println!(
+        "frames whose mesh changed: {changes} in 3 s, {late_changes} after 2 s; {} splits, {} merges, {} bounces, {} of {} passes changed the mesh",
+        a.splits, a.merges, a.bounces, a.changed_passes, a.passes
+    );
+    assert!(a.bounces > 0, "the case bounces (else it tests nothing)");
+    assert_eq!(late_changes, 0, "the mesh still changes at rest");
+}
