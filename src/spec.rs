@@ -313,7 +313,8 @@ pub struct Adapt {
     pub criterion: AdaptCriterion,
     /// Sizing criterion only: four children merge when their parent would
     /// carry at most `refine_angle / hysteresis` at the measured curvature
-    /// (> 1; absent: [`DEFAULT_HYSTERESIS`]).
+    /// (> 1; absent: [`DEFAULT_HYSTERESIS`]; doubled for a parent once per
+    /// bounce, `src/adapt/sizing.rs`).
     #[serde(default)]
     pub hysteresis: Option<f64>,
     /// Sizing criterion with red-green only: also split a leaf where the
