@@ -87,16 +87,34 @@ impl ElementBlocks<'_> {
     /// 9.0 against 8.6 / 8.3 s). The gather reads blocks in pattern order, not
     /// triangle order, so the likely cause is that a second 432-byte row per
     /// triangle costs more cache misses than the arithmetic it saves.
+    ///
+    /// A tip slot `3 + a` moves angle `a` only (`shape.rs`, `HINGE_SLOTS`), so
+    /// its gradients by the other two angles are zero and their terms are
+    /// skipped: a block with one tip sums one outer product or one term of
+    /// `M J` instead of three, a tip-tip block one of each. Skipping exact
+    /// zeros leaves every block the same to the last bit (the summaries of the
+    /// scenes compared in `docs/performance.md`, "Shape blocks", are identical).
     fn shape_block(&self, tri: usize, k: usize, l: usize) -> Matrix3 {
         let (m, jac) = (&self.shape_triangles[tri].m, &self.shape_jacobians[tri]);
         let mut out = Matrix3::ZERO;
-        for (a, row) in m.iter().enumerate() {
+        for a in moved_angles(k) {
             // sum_b M_ab J_bl
-            let right = jac[0][l] * row[0] + jac[1][l] * row[1] + jac[2][l] * row[2];
+            let row = &m[a];
+            let right = match l {
+                0..3 => jac[0][l] * row[0] + jac[1][l] * row[1] + jac[2][l] * row[2],
+                _ => jac[l - 3][l] * row[l - 3],
+            };
             out += outer(jac[a][k], right);
         }
         out * self.h2
     }
+}
+
+/// The angles of a shape triangle that slot `k` moves: all three for one of
+/// its own vertices, angle `a` alone for the tip across edge `a` (slot `3 + a`).
+#[inline(always)]
+fn moved_angles(k: usize) -> std::ops::Range<usize> {
+    if k < 3 { 0..3 } else { k - 3..k - 2 }
 }
 
 /// A fixed 3x3-block sparsity pattern for one mesh topology (module docs).
