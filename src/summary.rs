@@ -190,8 +190,8 @@ impl Summary {
             self.solver.describe(),
             match &self.adapt {
                 Some(a) => format!(
-                    " Adaptive: {} splits ({} forced), {} merges, {} rollbacks, max level {}.",
-                    a.splits, a.closure_splits, a.merges, a.rollbacks, self.max_level
+                    " Adaptive: {} splits ({} forced), {} merges ({} bounced), {} rollbacks, max level {}.",
+                    a.splits, a.closure_splits, a.merges, a.bounces, a.rollbacks, self.max_level
                 ),
                 None => String::new(),
             },
