@@ -38,6 +38,9 @@ pub enum EventKind {
     Split,
     /// A 1-4 split forced by closure (two hanging nodes) or by 1-irregularity.
     ClosureSplit,
+    /// A split asked for by the criterion that undoes a merge of the latest
+    /// pass (a bounce: `sizing.rs`, "Bounces"); counted among the splits.
+    Bounce,
     /// Four children merged back into their parent.
     Merge,
     /// A step restored, refined and integrated again.
@@ -363,7 +366,7 @@ impl Adapter {
         if applied.is_empty() {
             return Ok(false);
         }
-        let events: Vec<AdaptEvent> = applied
+        let mut events: Vec<AdaptEvent> = applied
             .iter()
             .zip(asked)
             .map(|(a, angle)| red_green_event(world, a, angle, step))
@@ -374,7 +377,7 @@ impl Adapter {
             }
             return Err(e);
         }
-        for a in &applied {
+        for (a, event) in applied.iter().zip(events.iter_mut()) {
             match a.op {
                 RedGreenOp::Merge(n) => {
                     self.stats.merges += 1;
@@ -389,6 +392,7 @@ impl Adapter {
                     if !a.forced && self.merged_last_pass.binary_search(&l).is_ok() {
                         *self.bounces.entry(l).or_default() += 1;
                         self.stats.bounces += 1;
+                        event.kind = EventKind::Bounce;
                     }
                 }
             }

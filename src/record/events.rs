@@ -9,6 +9,7 @@ use super::{EventMark, convert};
 /// |---|---|
 /// | `split` | orange `#FF8F00` |
 /// | `closure_split` | yellow `#FFD54F` |
+/// | `bounce` | purple `#AB47BC` |
 /// | `merge`, `collapse` | blue `#42A5F5` |
 /// | `flip` | grey `#BDBDBD` |
 /// | `rollback` | red `#E53935` |
@@ -16,6 +17,7 @@ pub fn event_rgb(kind: &str) -> [u8; 3] {
     match kind {
         "split" => [0xFF, 0x8F, 0x00],
         "closure_split" => [0xFF, 0xD5, 0x4F],
+        "bounce" => [0xAB, 0x47, 0xBC],
         "merge" | "collapse" => [0x42, 0xA5, 0xF5],
         "flip" => [0xBD, 0xBD, 0xBD],
         _ => [0xE5, 0x39, 0x35],

@@ -34,7 +34,7 @@ pub struct FrameView<'a> {
 /// One remeshing event, as plain data for the recording.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EventMark {
-    /// What happened: `split`, `closure_split`, `merge`, `flip`, `collapse` or `rollback`.
+    /// What happened: `split`, `closure_split`, `bounce`, `merge`, `flip`, `collapse` or `rollback`.
     pub kind: &'static str,
     /// Where, in world coordinates (m).
     pub position: Vector,

@@ -75,7 +75,7 @@ pub(super) fn record_state(
         let count = |k: EventKind| events.iter().filter(|e| e.kind == k).count() as f64;
         scalars.push((
             "adapt/splits",
-            count(EventKind::Split) + count(EventKind::ClosureSplit),
+            count(EventKind::Split) + count(EventKind::ClosureSplit) + count(EventKind::Bounce),
         ));
         scalars.push((
             "adapt/merges",
@@ -117,6 +117,7 @@ fn event_mark(e: &AdaptEvent) -> EventMark {
     let kind = match e.kind {
         EventKind::Split => "split",
         EventKind::ClosureSplit => "closure_split",
+        EventKind::Bounce => "bounce",
         EventKind::Merge => "merge",
         EventKind::Rollback => "rollback",
         EventKind::Flip => "flip",

@@ -110,7 +110,8 @@ fn check_event_counts(ins: &Inspection, summary: &Summary) {
     let n = |k: &str| counts.get(k).copied().unwrap_or(0) as u64;
     let a = summary.adapt.expect("adaptive run");
     println!("events in the file {counts:?}; engine {a:?}");
-    assert_eq!(n("split") + n("closure_split"), a.splits);
+    assert_eq!(n("split") + n("closure_split") + n("bounce"), a.splits);
+    assert_eq!(n("bounce"), a.bounces);
     assert_eq!(n("merge") + n("collapse"), a.merges);
     assert_eq!(n("rollback"), a.rollbacks);
     assert_eq!(n("flip"), a.flips);
@@ -497,4 +498,32 @@ fn step_plot_shows_the_step_taken_not_the_target() {
         );
     }
     std::fs::remove_file(&out).ok();
+}
+
+/// Bounces (`src/adapt/sizing.rs`, "Bounces") are recorded as `bounce` events,
+/// one per bounce the summary counts, and counted among the splits: the case
+/// of `adapt_sizing::a_sheet_at_rest_stops_remeshing` over 1 s, where they
+/// happen.
+#[test]
+fn bounces_are_recorded_as_their_own_events() {
+    let out = temp_path("bounces.rrd");
+    let scene = scene_file(
+        "hanging_sheet_rest.toml",
+        &[
+            "simulation.duration=1.0",
+            "cloth.resolution=8",
+            "adapt.max_level=6",
+            "adapt.refine_angle=7.0",
+            "adapt.coarsen_angle=0.7",
+            "adapt.refine_strain=0.02",
+            "adapt.rollback=false",
+        ],
+    );
+    let summary = record(&scene, &out, RunOptions::default()).expect("run");
+    let ins = inspect(&out).expect("decodes");
+    let bounces = ins.event_counts().get("bounce").copied().unwrap_or(0);
+    println!("bounce events in the file: {bounces}");
+    assert!(bounces > 0, "the case bounces");
+    check_event_counts(&ins, &summary);
+    let _ = std::fs::remove_file(&out);
 }
