@@ -103,6 +103,10 @@
 //! in 10.7 s, 0.01 without rollback 1.19e-3 (x1.05) in 9.1 s, 0.005 1.13e-3
 //! in 47.8 s (rollbacks: 1,375 steps for 600); with `refine_angle = 8`, 0.02
 //! 1.24e-3 (x1.09) in 7.0 s against uniform 64's 24.1 s in the same run.
+//! Those figures are from before the bounce rule (below), which changes every
+//! strain rung that bounced: tight 0.02 ends at 1.45e-3 (x1.27) with it, 0.01
+//! at 1.21e-3 in 0.77 of its former time and 0.005 at 1.12e-3 in 0.43
+//! (`docs/speed-vs-error.md`, "Bounces").
 //! Not the default: it is measured on one scene.
 //!
 //! # Bounces (the churn at rest)

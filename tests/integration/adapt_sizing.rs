@@ -341,18 +341,10 @@ fn a_sheet_at_rest_stops_remeshing() {
     use std::sync::atomic::AtomicBool;
     let path =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/hanging_sheet_rest.toml");
-    let sets: Vec<String> = [
-        "simulation.duration=3.0",
-        "cloth.resolution=8",
-        "adapt.max_level=6",
-        "adapt.refine_angle=7.0",
-        "adapt.coarsen_angle=0.7",
-        "adapt.refine_strain=0.02",
-        "adapt.rollback=false",
-    ]
-    .iter()
-    .map(|s| s.to_string())
-    .collect();
+    let sets: Vec<String> = std::iter::once("simulation.duration=3.0")
+        .chain(crate::common::BOUNCING_SHEET)
+        .map(String::from)
+        .collect();
     let scene = drape::scene::load_scene_file(&path, &sets).expect("scene");
     let mut previous: Option<Vec<[u32; 3]>> = None;
     let (mut changes, mut late_changes) = (0u32, 0u32);

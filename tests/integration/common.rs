@@ -6,6 +6,19 @@ use drape::physics::{Energy, Model, SolveFailure, Stepper};
 use drape::scene::{AdaptCriterion, AdaptMethod, Pin, PinMotion};
 use drape::world::World;
 
+/// Overrides of `scenes/hanging_sheet_rest.toml` that made the sizing
+/// criterion churn at rest before bounces doubled the hysteresis
+/// (`src/adapt/sizing.rs`, "Bounces"): base 8, levels up to 6, 7 / 0.7 deg,
+/// `refine_strain = 0.02`, no rollback. Add the duration.
+pub const BOUNCING_SHEET: [&str; 6] = [
+    "cloth.resolution=8",
+    "adapt.max_level=6",
+    "adapt.refine_angle=7.0",
+    "adapt.coarsen_angle=0.7",
+    "adapt.refine_strain=0.02",
+    "adapt.rollback=false",
+];
+
 /// A fixed pin on `region` with every other key at its default.
 pub fn pin(region: &str) -> Pin {
     Pin {

@@ -507,18 +507,10 @@ fn step_plot_shows_the_step_taken_not_the_target() {
 #[test]
 fn bounces_are_recorded_as_their_own_events() {
     let out = temp_path("bounces.rrd");
-    let scene = scene_file(
-        "hanging_sheet_rest.toml",
-        &[
-            "simulation.duration=1.0",
-            "cloth.resolution=8",
-            "adapt.max_level=6",
-            "adapt.refine_angle=7.0",
-            "adapt.coarsen_angle=0.7",
-            "adapt.refine_strain=0.02",
-            "adapt.rollback=false",
-        ],
-    );
+    let sets: Vec<&str> = std::iter::once("simulation.duration=1.0")
+        .chain(crate::common::BOUNCING_SHEET)
+        .collect();
+    let scene = scene_file("hanging_sheet_rest.toml", &sets);
     let summary = record(&scene, &out, RunOptions::default()).expect("run");
     let ins = inspect(&out).expect("decodes");
     let bounces = ins.event_counts().get("bounce").copied().unwrap_or(0);
