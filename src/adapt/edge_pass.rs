@@ -3,7 +3,7 @@
 
 use std::collections::HashMap;
 
-use super::transfer::{compact, transfer};
+use super::transfer::{VertexOrder, compact, transfer};
 use super::{AdaptEvent, Adapter, EventKind, edge, edge_angles};
 use crate::math::{Scalar, Vector};
 use crate::mesh::MeshError;
@@ -177,7 +177,13 @@ impl Adapter {
         soup: &edge::Soup,
     ) -> Result<Vec<u32>, MeshError> {
         let (tris, levels) = soup.live();
-        let (map, remeshed) = compact(&soup.material, soup.first_new, &soup.created, &tris, levels);
+        let (map, remeshed) = compact(
+            &soup.material,
+            (soup.first_new, &soup.created),
+            &tris,
+            levels,
+            VertexOrder::Kept,
+        );
         transfer(world, self.density, remeshed)?;
         Ok(map)
     }

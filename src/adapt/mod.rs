@@ -28,7 +28,7 @@ use crate::spec::{
 };
 use crate::world::World;
 use red_green::{Applied, RedGreen, RedGreenOp};
-use transfer::{compact, transfer};
+use transfer::{VertexOrder, compact, transfer};
 
 /// What happened, for the recording and the counters.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -409,7 +409,13 @@ impl Adapter {
     fn rebuild_world(&mut self, world: &mut World) -> Result<(), MeshError> {
         let (tris, levels, owner) = self.hierarchy.build(self.config.alternate_diagonals);
         let (first_new, created) = self.hierarchy.created();
-        let (map, remeshed) = compact(self.hierarchy.material(), first_new, created, &tris, levels);
+        let (map, remeshed) = compact(
+            self.hierarchy.material(),
+            (first_new, created),
+            &tris,
+            levels,
+            VertexOrder::FirstUse,
+        );
         let material = remeshed.material.clone();
         transfer(world, self.density, remeshed)?;
         self.hierarchy.remap(&map, &material);

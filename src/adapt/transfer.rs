@@ -6,6 +6,31 @@
 //! `sum m v`; the difference is given back as one common velocity change of the
 //! vertices whose mass changed, so momentum is conserved to round-off and the
 //! correction stays local to the remeshed region.
+//!
+//! # Vertex order
+//! Compaction chooses the new mesh's vertex numbering (`VertexOrder`). Kept
+//! in creation order, the vertices of a refined patch are the old ones
+//! wherever they were and the midpoints appended at the end of the arrays, so
+//! a vertex's neighbours lie far apart in memory: on a 32 x 32 grid refined
+//! twice around one patch, the two ends of an edge were 0.198 of the vertex
+//! count apart in index on average (test
+//! `red_green_numbers_vertices_in_triangle_order`). Every per-vertex gather of
+//! the implicit step (the block rows of the matrix, the force sums) then
+//! reads scattered memory, and an adaptive run paid more per vertex for its
+//! assembly than a uniform one (`hanging_sheet_rest`, red-green 8 L6: 1.01 s
+//! for 1,146 vertices against uniform 64's 3.13 s for 4,225, 20 % more per
+//! vertex and step). Red-green's triangles come out of its forest depth first
+//! (roots in input order), so numbering the vertices in the order the
+//! triangle list first uses them keeps neighbours close (0.013 of the count in
+//! that test; the grid itself 0.020) at the cost of renumbering every vertex
+//! at each remesh, which the hierarchy's `remap` follows. Measured side by
+//! side in `docs/performance.md`, "Vertex order". The edge method keeps
+//! creation order: its triangle list is in slot order, which carries no
+//! locality for a numbering to follow.
+//!
+//! A renumbered midpoint may come before its parents, so positions,
+//! velocities and pins are transferred in [`Remeshed::parents_first`] order
+//! (ascending old ids), where every midpoint follows both ends of its edge.
 
 use crate::math::{Scalar, Vector, Vector2};
 use crate::mesh::{Mesh, MeshError, signed_area};
@@ -17,7 +42,8 @@ use crate::world::World;
 pub enum Origin {
     /// The old vertex with this index.
     Old(u32),
-    /// The midpoint of two vertices of the new mesh with smaller indices.
+    /// The midpoint of two vertices of the new mesh (which come before it in
+    /// [`Remeshed::parents_first`]).
     Midpoint(u32, u32),
 }
 
@@ -32,6 +58,8 @@ pub struct Remeshed {
     pub levels: Vec<u8>,
     /// Origin of each new vertex.
     pub origin: Vec<Origin>,
+    /// The new vertices in an order where a midpoint comes after its parents.
+    pub parents_first: Vec<u32>,
 }
 
 /// Lumped vertex masses `density * sum(A_t) / 3`.
@@ -51,21 +79,22 @@ pub fn transfer(world: &mut World, density: Scalar, new: Remeshed) -> Result<(),
     let old_mass = lumped_masses(&world.mesh.material, &world.mesh.triangles, density);
     let new_mass = lumped_masses(&new.material, &new.triangles, density);
     let n = new.origin.len();
-    let mut x = Vec::with_capacity(n);
-    let mut v = Vec::with_capacity(n);
+    let mut x = vec![Vector::ZERO; n];
+    let mut v = vec![Vector::ZERO; n];
     let mut kept = vec![false; world.x.len()];
     let mut old_index = vec![u32::MAX; world.x.len()];
-    for (i, o) in new.origin.iter().enumerate() {
-        match *o {
+    for &i in &new.parents_first {
+        let i = i as usize;
+        match new.origin[i] {
             Origin::Old(j) => {
-                x.push(world.x[j as usize]);
-                v.push(world.v[j as usize]);
+                x[i] = world.x[j as usize];
+                v[i] = world.v[j as usize];
                 kept[j as usize] = true;
                 old_index[j as usize] = i as u32;
             }
             Origin::Midpoint(a, b) => {
-                x.push((x[a as usize] + x[b as usize]) * 0.5);
-                v.push((v[a as usize] + v[b as usize]) * 0.5);
+                x[i] = (x[a as usize] + x[b as usize]) * 0.5;
+                v[i] = (v[a as usize] + v[b as usize]) * 0.5;
             }
         }
     }
@@ -103,7 +132,8 @@ pub fn transfer(world: &mut World, density: Scalar, new: Remeshed) -> Result<(),
             anchor_of[i as usize] = Some(Anchor { vertex: i, ..*a });
         }
     }
-    for i in 0..n {
+    for &i in &new.parents_first {
+        let i = i as usize;
         if let Origin::Midpoint(a, b) = new.origin[i]
             && let (Some(pa), Some(pb)) = (anchor_of[a as usize], anchor_of[b as usize])
             && pa.pin == pb.pin
@@ -125,29 +155,56 @@ pub fn transfer(world: &mut World, density: Scalar, new: Remeshed) -> Result<(),
     Ok(())
 }
 
-/// Keeps the vertices the triangles use, in their order: returns the map from
+/// The order of the vertices of a compacted mesh.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum VertexOrder {
+    /// The surviving ids in ascending order: old vertices first, then the new
+    /// ones in the order they were created (the edge method, whose triangle
+    /// list is in slot order and so carries no locality to follow).
+    Kept,
+    /// In the order the triangle list first uses them (red-green, whose
+    /// triangles come depth first out of its forest): module docs, "Vertex
+    /// order".
+    FirstUse,
+}
+
+/// Keeps the vertices the triangles use, in `order`: returns the map from
 /// old ids to new indices (`u32::MAX` for dropped ones) and the new topology.
 /// Ids below `first_new` are old world vertices; `created[k]` is the parent edge
 /// of vertex `first_new + k`.
 pub(super) fn compact(
     material: &[Vector2],
-    first_new: u32,
-    created: &[(u32, u32)],
+    (first_new, created): (u32, &[(u32, u32)]),
     tris: &[[u32; 3]],
     levels: Vec<u8>,
+    order: VertexOrder,
 ) -> (Vec<u32>, Remeshed) {
-    let mut used = vec![false; material.len()];
-    for t in tris {
-        for &v in t {
-            used[v as usize] = true;
-        }
-    }
     let mut map = vec![u32::MAX; material.len()];
     let mut kept = Vec::new();
-    for (v, _) in used.iter().enumerate().filter(|(_, u)| **u) {
-        map[v] = kept.len() as u32;
-        kept.push(v);
+    match order {
+        VertexOrder::Kept => {
+            let mut used = vec![false; material.len()];
+            for &v in tris.iter().flatten() {
+                used[v as usize] = true;
+            }
+            for (v, _) in used.iter().enumerate().filter(|(_, u)| **u) {
+                map[v] = kept.len() as u32;
+                kept.push(v);
+            }
+        }
+        VertexOrder::FirstUse => {
+            for &v in tris.iter().flatten() {
+                if map[v as usize] == u32::MAX {
+                    map[v as usize] = kept.len() as u32;
+                    kept.push(v as usize);
+                }
+            }
+        }
     }
+    // Ascending old ids put every midpoint after its parent edge's ends: old
+    // vertices come first and a new vertex is created after its parents.
+    let mut parents_first: Vec<u32> = (0..kept.len() as u32).collect();
+    parents_first.sort_unstable_by_key(|&i| kept[i as usize]);
     let origin = kept
         .iter()
         .map(|&v| {
@@ -164,6 +221,7 @@ pub(super) fn compact(
         triangles: tris.iter().map(|t| t.map(|v| map[v as usize])).collect(),
         levels,
         origin,
+        parents_first,
     };
     (map, remeshed)
 }
