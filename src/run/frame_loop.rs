@@ -9,7 +9,7 @@ use super::tally::{Tally, TallyEnd};
 use super::{FrameState, Progress, RunError, RunOptions};
 use crate::adapt::Adapter;
 use crate::math::{Scalar, Vector};
-use crate::physics::Model;
+use crate::physics::{Energy, Model};
 use crate::record::{RecordError, RecordTarget, Recorder, obj::write_frame_obj};
 use crate::scene::Scene;
 use crate::sim::{FrameFailed, MAX_STEP_HALVINGS, Pipeline, SimState, Simulation, StepFailure};
@@ -24,6 +24,9 @@ pub struct FrameLoop<'a> {
     model: Model,
     state: SimState,
     pipeline: Pipeline,
+    /// The energy of the state as it is, once measured (or handed over by the
+    /// pipeline) for the frame's statistics; cleared when the state advances.
+    energy_now: Option<Energy>,
     recorder: Option<Recorder>,
     record_path: Option<PathBuf>,
     obj_dir: Option<PathBuf>,
@@ -111,6 +114,7 @@ impl<'a> FrameLoop<'a> {
             recorded_frames: 0,
             last_recorded: None,
             normals: Vec::new(),
+            energy_now: None,
             interrupted: false,
             failure: None,
         })
@@ -140,10 +144,13 @@ impl<'a> FrameLoop<'a> {
     /// reports the failure.
     pub fn advance(&mut self) -> Result<bool, RunError> {
         let t0 = Instant::now();
-        match self
-            .pipeline
-            .advance_frame(&self.model, &mut self.state, self.frame_interval)
-        {
+        let start_energy = self.energy_now.take();
+        match self.pipeline.advance_frame_from(
+            &self.model,
+            &mut self.state,
+            self.frame_interval,
+            start_energy,
+        ) {
             Ok(_) => {}
             Err(FrameFailed::Steps {
                 last_dt,
@@ -175,8 +182,8 @@ impl<'a> FrameLoop<'a> {
         &mut self,
         observe: &mut (dyn FnMut(&FrameState) + Send),
     ) -> Result<(), RunError> {
+        let energy = self.energy();
         let world = &self.state.world;
-        let energy = self.pipeline.stepper().energy(&self.model, world);
         self.tally.observe(world, energy);
         observe(&FrameState {
             frame: self.frame,
@@ -195,6 +202,23 @@ impl<'a> FrameLoop<'a> {
         Ok(())
     }
 
+    /// The energy of the state as it is: measured once per state, or the one
+    /// the pipeline's last frame measured on it.
+    fn energy(&mut self) -> Energy {
+        if let Some(e) = self.energy_now {
+            return e;
+        }
+        let e = match self.pipeline.take_frame_end_energy() {
+            Some(e) => e,
+            None => self
+                .pipeline
+                .stepper()
+                .energy(&self.model, &self.state.world),
+        };
+        self.energy_now = Some(e);
+        e
+    }
+
     /// Records the current frame and exports its OBJ.
     fn record_now(&mut self) -> Result<(), RunError> {
         let t1 = Instant::now();
@@ -210,15 +234,16 @@ impl<'a> FrameLoop<'a> {
 
     /// Logs the current frame to the recording (when there is one).
     fn log_frame(&mut self) -> Result<(), RunError> {
+        if self.recorder.is_none() {
+            return Ok(());
+        }
+        let energy = self.energy();
         let Some(rec) = self.recorder.as_mut() else {
             return Ok(());
         };
         let snap = Snapshot {
             frame: self.frame,
-            energy: self
-                .pipeline
-                .stepper()
-                .energy(&self.model, &self.state.world),
+            energy,
             timing: self.timing,
             frame_interval: self.frame_interval,
         };

@@ -5,7 +5,7 @@ use super::{SimState, StepFailure};
 use crate::collide::{Collider, StepCloth};
 use crate::math::Scalar;
 use crate::mesh::MeshError;
-use crate::physics::{Model, StepStats, Stepper};
+use crate::physics::{Energy, Model, StepStats, Stepper};
 use crate::world::World;
 
 mod remesh;
@@ -71,6 +71,10 @@ pub struct Pipeline {
     angles_fresh: bool,
     /// The size of the last accepted step (for the recording's step plot).
     last_step: Option<Scalar>,
+    /// The energy of the state as the last successful frame left it, when the
+    /// frame measured it (its energy check, the adaptation after it having left
+    /// the mesh as it was); taken by [`Pipeline::take_frame_end_energy`].
+    frame_end_energy: Option<Energy>,
 }
 
 impl Pipeline {
@@ -99,7 +103,20 @@ impl Pipeline {
             angles: Vec::new(),
             last_step: None,
             angles_fresh: false,
+            frame_end_energy: None,
         }
+    }
+
+    /// The energy of the state as the last successful [`Pipeline::advance_frame`]
+    /// left it, when that frame measured it: its energy check measures the state
+    /// at the frame's end, which is the state it returns unless the adaptation
+    /// after the check changed the mesh (then `None`, as before any frame and
+    /// after a failed one). Taking it clears it, so it is never read for a later
+    /// state. Equal to the bit to [`Stepper::energy`] on that state: the frame
+    /// loop reads it instead of measuring the same state again (measuring the
+    /// energy costs about as much as a force evaluation).
+    pub fn take_frame_end_energy(&mut self) -> Option<Energy> {
+        self.frame_end_energy.take()
     }
 
     /// The stepper: force model, element tables (masses), energies.
@@ -130,6 +147,25 @@ impl Pipeline {
         state: &mut SimState,
         frame_interval: Scalar,
     ) -> Result<u64, FrameFailed> {
+        self.advance_frame_from(model, state, frame_interval, None)
+    }
+
+    /// [`Pipeline::advance_frame`] given the energy of `state` as it is, when
+    /// the caller has measured it ([`Stepper::energy`]; the frame loop does so
+    /// for its statistics): the frame then does not measure it again. The
+    /// result is the same either way.
+    pub fn advance_frame_from(
+        &mut self,
+        model: &Model,
+        state: &mut SimState,
+        frame_interval: Scalar,
+        start_energy: Option<Energy>,
+    ) -> Result<u64, FrameFailed> {
+        self.frame_end_energy = None;
+        debug_assert!(
+            start_energy.is_none_or(|e| e == self.stepper.energy(model, &state.world)),
+            "the start energy given is not the state's"
+        );
         let start = match self.frame_start.take() {
             Some(mut saved) => {
                 saved.clone_from(state);
@@ -137,7 +173,7 @@ impl Pipeline {
             }
             None => state.clone(),
         };
-        let result = self.retry_frame(model, state, &start, frame_interval);
+        let result = self.retry_frame(model, state, &start, frame_interval, start_energy);
         self.frame_start = Some(start);
         result
     }
@@ -148,17 +184,19 @@ impl Pipeline {
         state: &mut SimState,
         start: &SimState,
         frame_interval: Scalar,
+        start_energy: Option<Energy>,
     ) -> Result<u64, FrameFailed> {
         let t0 = state.world.time;
         // E - W at the frame start: without numerical error it can only fall.
-        let balance_start = self.stepper.energy(model, &state.world).total() - state.ledger.work();
+        let energy_start = start_energy.unwrap_or_else(|| self.stepper.energy(model, &state.world));
+        let balance_start = energy_start.total() - state.ledger.work();
         let mut last_gain = Scalar::INFINITY;
         for halving in 0..=MAX_STEP_HALVINGS {
             let healthy = self.steps_through(model, state, frame_interval, halving)?;
             state.world.time = t0 + frame_interval;
             if healthy {
-                let balance =
-                    self.stepper.energy(model, &state.world).total() - state.ledger.work();
+                let energy_end = self.stepper.energy(model, &state.world);
+                let balance = energy_end.total() - state.ledger.work();
                 let gain = balance - balance_start;
                 let retry = gain > ENERGY_GAIN_TOLERANCE * state.ledger.bound.scale
                     && halving < MAX_ENERGY_HALVINGS
@@ -167,7 +205,9 @@ impl Pipeline {
                     let excess = balance - state.ledger.bound.initial;
                     state.ledger.excess_max = state.ledger.excess_max.max(excess);
                     state.effort.step_halvings += halving as u64;
-                    self.adapt_at_frame_end(model, state)?;
+                    if !self.adapt_at_frame_end(model, state)? {
+                        self.frame_end_energy = Some(energy_end);
+                    }
                     return Ok(halving as u64);
                 }
                 last_gain = gain;

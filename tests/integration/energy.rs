@@ -45,3 +45,66 @@ fn an_impact_at_large_implicit_steps_does_not_gain_energy() {
     );
     assert_eq!(s.energy.external_work, 0.0, "a static sphere does no work");
 }
+
+/// The frame loop reads the energy the pipeline's frame-end check measured
+/// instead of measuring the same state again (`Pipeline::take_frame_end_energy`).
+/// Over 1 s of the adaptive `hanging_sheet` adapting once per frame (red-green,
+/// remeshing in its frame-end pass or in a rollback within the frame) the energy
+/// handed over equals a fresh measurement of the state to the bit, it is
+/// withheld only after frames that changed the mesh, and taking it clears it. Giving the next frame its start energy changes nothing: the same
+/// run without it ends in the same state.
+#[test]
+fn the_frame_end_energy_handed_over_is_the_states() {
+    use drape::sim::build;
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/hanging_sheet.toml");
+    let scene = load_scene_file(
+        std::path::Path::new(path),
+        &[
+            "simulation.duration=1.0".into(),
+            "adapt.every=\"frame\"".into(),
+        ],
+    )
+    .expect("scene");
+    let resolved = scene.resolve().expect("resolve");
+    let mut given = build(&resolved).expect("build");
+    let mut plain = build(&resolved).expect("build");
+    let (mut handed, mut withheld) = (0, 0);
+    let mut start = None;
+    for frame in 0..30 {
+        let changes = |s: &drape::sim::SimState| {
+            s.adapter
+                .as_ref()
+                .map_or(0, |a| a.stats.splits + a.stats.merges)
+        };
+        let before = changes(&given.state);
+        given
+            .pipeline
+            .advance_frame_from(&given.model, &mut given.state, 1.0 / 30.0, start)
+            .unwrap_or_else(|e| panic!("frame {frame}: {e}"));
+        plain
+            .pipeline
+            .advance_frame(&plain.model, &mut plain.state, 1.0 / 30.0)
+            .unwrap_or_else(|e| panic!("frame {frame}: {e}"));
+        let remeshed = changes(&given.state) > before;
+        let fresh = given
+            .pipeline
+            .stepper()
+            .energy(&given.model, &given.state.world);
+        match given.pipeline.take_frame_end_energy() {
+            Some(e) => {
+                assert_eq!(e, fresh, "frame {frame}");
+                handed += 1;
+            }
+            None => {
+                assert!(remeshed, "frame {frame}: withheld without a remesh");
+                withheld += 1;
+            }
+        }
+        assert_eq!(given.pipeline.take_frame_end_energy(), None, "taken twice");
+        start = Some(fresh);
+    }
+    println!("frames with the energy handed over: {handed}, withheld after a remesh: {withheld}");
+    assert!(handed > 0 && withheld > 0, "{handed} / {withheld}");
+    assert_eq!(given.state.world.x, plain.state.world.x);
+    assert_eq!(given.state.world.v, plain.state.world.v);
+}

@@ -73,30 +73,34 @@ impl Pipeline {
     pub(super) fn adapt(&mut self, model: &Model, state: &mut SimState) -> Result<(), MeshError> {
         match state.adapter.as_ref() {
             Some(ad) if ad.config.every.after_step(state.ledger.steps_done) => {
-                self.remesh(model, state)
+                self.remesh(model, state).map(|_| ())
             }
             _ => Ok(()),
         }
     }
 
     /// Adapt, with `adapt.every = "frame"`: the remeshing pass once the frame's
-    /// steps are accepted.
+    /// steps are accepted. True when it changed the mesh.
     pub(super) fn adapt_at_frame_end(
         &mut self,
         model: &Model,
         state: &mut SimState,
-    ) -> Result<(), MeshError> {
+    ) -> Result<bool, MeshError> {
         match state.adapter.as_ref() {
             Some(ad) if ad.config.every == AdaptEvery::Frame => self.remesh(model, state),
-            _ => Ok(()),
+            _ => Ok(false),
         }
     }
 
     /// The remeshing pass on the state as it is (reusing the edge angles the
-    /// rollback check measured on it, when it did).
-    pub(super) fn remesh(&mut self, model: &Model, state: &mut SimState) -> Result<(), MeshError> {
+    /// rollback check measured on it, when it did). True when it changed the mesh.
+    pub(super) fn remesh(
+        &mut self,
+        model: &Model,
+        state: &mut SimState,
+    ) -> Result<bool, MeshError> {
         let Some(ad) = state.adapter.as_mut() else {
-            return Ok(());
+            return Ok(false);
         };
         let step = state.ledger.steps_done;
         let changed = if self.angles_fresh {
@@ -108,6 +112,6 @@ impl Pipeline {
         if changed {
             self.mesh_changed(model, state);
         }
-        Ok(())
+        Ok(changed)
     }
 }
