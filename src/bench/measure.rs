@@ -45,6 +45,12 @@ pub fn measure(
     } else {
         (Scalar::NAN, Scalar::NAN)
     };
+    let final_offset = match (complete, first.frames.last(), reference.frames.last()) {
+        (true, Some(run), Some(r)) if run.frame == r.frame => {
+            sampling::frame_offset(run, r, reference.diagonal).unwrap_or(Scalar::NAN)
+        }
+        _ => Scalar::NAN,
+    };
     let status = match (&first.failure, complete) {
         (Some(f), _) => format!("failed: {f}"),
         (None, false) => "failed: frames do not match the reference's".to_owned(),
@@ -84,6 +90,7 @@ pub fn measure(
         peak_vertices: first.summary.vertices.max,
         mean_error,
         final_error,
+        final_offset,
         compare,
         error: match compare {
             Compare::Frames => mean_error,

@@ -160,6 +160,11 @@ pub struct Row {
     pub mean_error: Scalar,
     /// Error at the last frame (`NaN` if failed).
     pub final_error: Scalar,
+    /// The rigid translation part of `final_error`: the length of the mean
+    /// displacement of the samples at the last frame, relative to the diagonal
+    /// ([`metric::relative_offset`]; `NaN` if failed, and in rows read back
+    /// from a CSV, which does not hold it).
+    pub final_offset: Scalar,
     /// What `error` is: the mean over the frames or the error at rest.
     pub compare: Compare,
     /// The error the report compares: `mean_error` for [`Compare::Frames`],

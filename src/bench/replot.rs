@@ -80,6 +80,7 @@ pub fn read_csv(path: &Path) -> Result<Vec<Row>, BenchError> {
             peak_vertices: num(&f[16]),
             mean_error: num(&f[17]),
             final_error: num(&f[18]),
+            final_offset: Scalar::NAN,
             compare: if f[19] == "rest" {
                 Compare::Rest
             } else {

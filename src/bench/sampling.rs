@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
-use super::metric::{locate, relative_rms, sample_positions};
+use super::metric::{locate, relative_offset, relative_rms, sample_positions};
 use crate::math::{Scalar, Vector, Vector2};
 use crate::mesh::Mesh;
 use crate::run::{FrameState, Progress, RunError, RunOptions, run_observed};
@@ -121,6 +121,27 @@ pub fn frame_error(
         .filter_map(|(p, q)| Some((Vector::from_array((*p)?), Vector::from_array((*q)?))))
         .unzip();
     (!a.is_empty()).then(|| relative_rms(&a, &b, diagonal))
+}
+
+/// The offset of one frame against the reference's frame
+/// ([`super::metric::relative_offset`] over the samples found in both), with the
+/// same conditions as [`frame_error`].
+pub fn frame_offset(
+    run: &FrameSamples,
+    reference: &FrameSamples,
+    diagonal: Scalar,
+) -> Option<Scalar> {
+    let dt = (run.time - reference.time).abs();
+    if dt > 1e-9 * reference.time.abs().max(1.0) {
+        return None;
+    }
+    let (a, b): (Vec<Vector>, Vec<Vector>) = run
+        .positions
+        .iter()
+        .zip(&reference.positions)
+        .filter_map(|(p, q)| Some((Vector::from_array((*p)?), Vector::from_array((*q)?))))
+        .unzip();
+    (!a.is_empty()).then(|| relative_offset(&a, &b, diagonal))
 }
 
 /// Per-frame errors of a run against the reference (matched by frame index;

@@ -79,6 +79,7 @@ pub(crate) fn row(label: &str, adaptive: bool, res: u32, finest: u32, wall: f64,
         peak_vertices: 30.0,
         mean_error: err,
         final_error: err,
+        final_offset: f64::NAN,
         compare: Compare::Frames,
         error: err,
         errors: vec![],
@@ -271,7 +272,16 @@ fn tiny_ladder_end_to_end_with_cache_and_a_failed_rung() {
             r.errors[0].1 < 1e-12,
             "the initial states agree (to rounding)"
         );
+        // The final offset is the translation part of the final error.
+        assert!(
+            r.final_offset.is_finite() && r.final_offset <= r.final_error * (1.0 + 1e-12),
+            "{}: offset {} of {}",
+            r.label,
+            r.final_offset,
+            r.final_error
+        );
     }
+    assert!(first.rows[3].final_offset.is_nan(), "a failed run has none");
     assert!(first.rows[2].adaptive && !first.rows[0].adaptive);
     assert!(
         first.rows[3].status.starts_with("failed"),
@@ -285,6 +295,8 @@ fn tiny_ladder_end_to_end_with_cache_and_a_failed_rung() {
     let text = std::fs::read_to_string(dir.join("out/tiny.csv")).expect("csv");
     assert_eq!(text.lines().count(), 5);
     assert!(text.contains(",failed: numerical failure"));
+    let md = std::fs::read_to_string(dir.join("out/tiny.md")).expect("md");
+    assert!(md.contains("| final offset % |"), "{md}");
     let svg = std::fs::read_to_string(dir.join("out/tiny.svg")).expect("svg");
     assert!(svg.starts_with("<svg") && svg.contains("Pareto front") && svg.contains("uniform 6"));
 

@@ -1,9 +1,12 @@
 //! The error metric: identical meshes give 0, a rigid offset gives exactly that
-//! offset, and samples are the same cloth points on a uniform and an adapted mesh.
+//! offset (all of it reported as offset, and a zero-mean deformation none), and
+//! samples are the same cloth points on a uniform and an adapted mesh.
 
 use drape::adapt::Adapter;
 use drape::adapt::red_green::RedGreenOp;
-use drape::bench::metric::{diagonal, grid_samples, locate, relative_rms, sample_positions};
+use drape::bench::metric::{
+    diagonal, grid_samples, locate, relative_offset, relative_rms, sample_positions,
+};
 use drape::math::{Scalar, Vector};
 use drape::mesh;
 use drape::scene::{AdaptMethod, DiagonalPattern};
@@ -56,6 +59,62 @@ fn a_rigid_offset_gives_exactly_that_offset() {
         "{err} vs {}",
         0.05 / diag
     );
+    // All of it is offset: nothing is left once the translation is taken out.
+    let offset = relative_offset(&b, &a, diag);
+    println!("rigid 5 cm shift: error {err:.6e}, offset {offset:.6e}");
+    assert!((offset - err).abs() < 1e-14, "{offset} vs {err}");
+}
+
+/// The offset is the translation part of the error only: a deformation whose
+/// displacements average to zero (the wave made twice as deep, which moves the
+/// samples up and down symmetrically) has no offset, and adding a rigid shift to
+/// it gives an offset of exactly that shift and an error whose square is the sum
+/// of the two parts' squares.
+#[test]
+fn the_offset_is_the_translation_part_of_the_error() {
+    let w = wavy(16);
+    let samples = grid_samples(&w.mesh, 20);
+    let located: Vec<_> = locate(&w.mesh, &samples)
+        .into_iter()
+        .map(Option::unwrap)
+        .collect();
+    let diag = diagonal(&w.mesh);
+    let a = sample_positions(&w.mesh, &w.x, &located);
+    let deeper: Vec<Vector> =
+        w.x.iter()
+            .map(|p| Vector::new(p.x, p.y, 2.0 * p.z))
+            .collect();
+    let b = sample_positions(&w.mesh, &deeper, &located);
+    let shape = relative_rms(&b, &a, diag);
+    let mean_z = b.iter().zip(&a).map(|(p, q)| p.z - q.z).sum::<Scalar>() / a.len() as Scalar;
+    let offset = relative_offset(&b, &a, diag);
+    println!("deeper wave: error {shape:.6e}, offset {offset:.3e} (mean z {mean_z:.3e} m)");
+    assert!(shape > 1e-3, "the wave changed: {shape}");
+    assert!((offset - mean_z.abs() / diag).abs() < 1e-15);
+    assert!(offset < 1e-3 * shape, "{offset} vs {shape}");
+    let shift = Vector::new(0.0, 0.0, 0.02);
+    let c: Vec<Vector> = b.iter().map(|p| *p + shift).collect();
+    let total = relative_rms(&c, &a, diag);
+    let moved = relative_offset(&c, &a, diag);
+    let expected = (mean_z + 0.02).abs() / diag;
+    println!("deeper wave raised 2 cm: error {total:.6e}, offset {moved:.6e}");
+    assert!((moved - expected).abs() < 1e-14, "{moved} vs {expected}");
+    let rest = (total * total - moved * moved).sqrt();
+    assert!(
+        (rest - shape_without_mean(&b, &a, diag)).abs() < 1e-12,
+        "{rest}"
+    );
+}
+
+/// The RMS of the displacements less their mean, relative to `diag`.
+fn shape_without_mean(b: &[Vector], a: &[Vector], diag: Scalar) -> Scalar {
+    let mean = b.iter().zip(a).map(|(p, q)| *p - *q).sum::<Vector>() / a.len() as Scalar;
+    let sum: Scalar = b
+        .iter()
+        .zip(a)
+        .map(|(p, q)| (*p - *q - mean).length_squared())
+        .sum();
+    (sum / a.len() as Scalar).sqrt() / diag
 }
 
 #[test]
