@@ -140,3 +140,129 @@ fn second_level_transitions_bend_within_ten_percent_of_the_continuum() {
         }
     }
 }
+
+/// The membrane is not exact on graded meshes (the mass-spring patch test):
+/// a 1 m sheet at resolution 16 or 32 with a round patch refined two red
+/// levels, stretched by a uniform 1 % strain (every vertex moved by the same
+/// affine map, no relaxation), against the same sheet unrefined (which the
+/// grid four times finer matches to 1e-5). Measured: equal biaxial stretch
+/// is exact (the consistent spring rule is built for it); a stretch along x
+/// stores 0.73 % less energy at 16 and 0.39 % less at 32, shear 3.84 % and
+/// 1.88 % more. The differences halve with the green closure triangles'
+/// area (0.080 and 0.038 of the sheet), so they sit in the greens: 9 to 10 %
+/// softer along an axis and 48 to 50 % stiffer in shear there. Nothing is tuned
+/// away here; this pins what a red-green mesh gives up
+/// (`docs/speed-vs-error.md`, "Strain thresholds": a graded sheet hangs
+/// lower than the grid's would).
+#[test]
+fn green_closures_stretch_unlike_the_grid() {
+    let material = MaterialParams {
+        density: 0.15,
+        stretch: 200.0,
+        bending: 0.0,
+        damping: 0.0,
+        bending_model: BendingModel::ShapeOperator,
+        stiffness_rule: StiffnessRule::Consistent,
+    };
+    let e = 0.01;
+    let cases: [(&str, [[Scalar; 2]; 2]); 4] = [
+        ("along x", [[1.0 + e, 0.0], [0.0, 1.0]]),
+        ("along y", [[1.0, 0.0], [0.0, 1.0 + e]]),
+        ("biaxial", [[1.0 + e, 0.0], [0.0, 1.0 + e]]),
+        ("shear", [[1.0, e], [e, 1.0]]),
+    ];
+    let energy = |m: &Mesh, f: [[Scalar; 2]; 2]| {
+        let el = Elements::build(m, &material);
+        let x: Vec<Vector> = m
+            .material
+            .iter()
+            .map(|p| {
+                Vector::new(
+                    f[0][0] * p.x + f[0][1] * p.y,
+                    f[1][0] * p.x + f[1][1] * p.y,
+                    0.0,
+                )
+            })
+            .collect();
+        let v = vec![Vector::ZERO; x.len()];
+        let ext = drape::physics::ExternalForces {
+            gravity: None,
+            drag: None,
+            air_velocity: Vector::ZERO,
+            wind: None,
+        };
+        drape::physics::forces::energy(&el, &ext, &x, &v).elastic
+    };
+    let mut deficits = Vec::new();
+    for res in [16u32, 32] {
+        let grid = mesh::rectangle(1.0, 1.0, res, DiagonalPattern::Alternating).unwrap();
+        let x0: Vec<Vector> = grid.material.iter().map(|p| p.extend(0.0)).collect();
+        let mut world = World::new(grid.clone(), x0);
+        let config = AdaptConfig {
+            max_level: 6,
+            ..crate::common::angle_config(AdaptMethod::RedGreen)
+        };
+        let mut adapter = Adapter::new(config, &world, 0.15);
+        for round in 0..2 {
+            let ops: Vec<_> = adapter
+                .hierarchy()
+                .leaves()
+                .into_iter()
+                .filter(|&l| {
+                    let c = adapter
+                        .hierarchy()
+                        .vertices(l)
+                        .iter()
+                        .map(|&v| world.mesh.material[v as usize])
+                        .sum::<Vector2>()
+                        / 3.0;
+                    (c - Vector2::new(0.1, -0.05)).length() < 0.25
+                })
+                .map(|l| (drape::adapt::red_green::RedGreenOp::Split(l), None))
+                .collect();
+            adapter.apply(&mut world, &ops, round).unwrap();
+        }
+        let green: Scalar = world
+            .mesh
+            .triangles
+            .iter()
+            .zip(&world.mesh.levels)
+            .filter(|(_, l)| **l % 2 == 1)
+            .map(|(t, _)| mesh::signed_area(&world.mesh.material, t))
+            .sum();
+        let fine = mesh::rectangle(1.0, 1.0, 4 * res, DiagonalPattern::Alternating).unwrap();
+        let mut ratios = Vec::new();
+        for (name, f) in cases {
+            let (g, u, r) = (energy(&world.mesh, f), energy(&grid, f), energy(&fine, f));
+            println!(
+                "resolution {res}, {name}: graded / grid {:.5}, grid {res} x 4 / grid {:.6} (green area {green:.4})",
+                g / u,
+                r / u
+            );
+            assert!(
+                (r / u - 1.0).abs() < 1e-5,
+                "the grid's energy depends on its resolution"
+            );
+            ratios.push(g / u);
+        }
+        assert!((ratios[2] - 1.0).abs() < 1e-12, "biaxial: {}", ratios[2]);
+        assert!(
+            ratios[0] < 1.0 && ratios[1] < 1.0 && ratios[3] > 1.0,
+            "{ratios:?}"
+        );
+        assert!(
+            ratios[3] - 1.0 < 0.05 && 1.0 - ratios[0] < 0.01,
+            "{ratios:?}"
+        );
+        deficits.push(((1.0 - ratios[0]) / green, (ratios[3] - 1.0) / green));
+    }
+    println!("per green area (along x, shear): {deficits:?}");
+    // The same per green area at both resolutions: the error is the greens'.
+    for k in 0..2 {
+        let (a, b) = (
+            [deficits[0].0, deficits[0].1][k],
+            [deficits[1].0, deficits[1].1][k],
+        );
+        assert!((a / b - 1.0).abs() < 0.25, "{a} against {b}");
+    }
+}
