@@ -102,14 +102,9 @@ pub fn sample_frame(f: &FrameState, points: &[Vector2]) -> FrameSamples {
     }
 }
 
-/// The error of one frame against the reference's frame: the relative RMS
-/// distance over the samples found in both, or `None` when the frames' times
-/// differ or no sample is found in both.
-pub fn frame_error(
-    run: &FrameSamples,
-    reference: &FrameSamples,
-    diagonal: Scalar,
-) -> Option<Scalar> {
+/// The samples found in both frames, as `(run, reference)` positions, or
+/// `None` when the frames' times differ or no sample is found in both.
+fn matched(run: &FrameSamples, reference: &FrameSamples) -> Option<(Vec<Vector>, Vec<Vector>)> {
     let dt = (run.time - reference.time).abs();
     if dt > 1e-9 * reference.time.abs().max(1.0) {
         return None;
@@ -120,7 +115,18 @@ pub fn frame_error(
         .zip(&reference.positions)
         .filter_map(|(p, q)| Some((Vector::from_array((*p)?), Vector::from_array((*q)?))))
         .unzip();
-    (!a.is_empty()).then(|| relative_rms(&a, &b, diagonal))
+    (!a.is_empty()).then_some((a, b))
+}
+
+/// The error of one frame against the reference's frame: the relative RMS
+/// distance over the samples found in both, or `None` when the frames' times
+/// differ or no sample is found in both.
+pub fn frame_error(
+    run: &FrameSamples,
+    reference: &FrameSamples,
+    diagonal: Scalar,
+) -> Option<Scalar> {
+    matched(run, reference).map(|(a, b)| relative_rms(&a, &b, diagonal))
 }
 
 /// The offset of one frame against the reference's frame
@@ -131,17 +137,7 @@ pub fn frame_offset(
     reference: &FrameSamples,
     diagonal: Scalar,
 ) -> Option<Scalar> {
-    let dt = (run.time - reference.time).abs();
-    if dt > 1e-9 * reference.time.abs().max(1.0) {
-        return None;
-    }
-    let (a, b): (Vec<Vector>, Vec<Vector>) = run
-        .positions
-        .iter()
-        .zip(&reference.positions)
-        .filter_map(|(p, q)| Some((Vector::from_array((*p)?), Vector::from_array((*q)?))))
-        .unzip();
-    (!a.is_empty()).then(|| relative_offset(&a, &b, diagonal))
+    matched(run, reference).map(|(a, b)| relative_offset(&a, &b, diagonal))
 }
 
 /// Per-frame errors of a run against the reference (matched by frame index;

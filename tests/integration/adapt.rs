@@ -165,28 +165,7 @@ fn refining_then_coarsening_a_flat_sheet_restores_the_original_mesh() {
         let original = w.mesh.clone();
         let mut ad = Adapter::new(config(), &w, DENSITY);
         // Refine around the centre twice (the second round splits children).
-        for round in 0..2 {
-            let centre: Vec<u32> = ad
-                .hierarchy()
-                .leaves()
-                .into_iter()
-                .filter(|&l| {
-                    let c = ad
-                        .hierarchy()
-                        .vertices(l)
-                        .iter()
-                        .map(|&v| w.mesh.material[v as usize])
-                        .sum::<drape::math::Vector2>()
-                        / 3.0;
-                    c.length() < 0.25
-                })
-                .collect();
-            let ops: Vec<_> = centre
-                .iter()
-                .map(|&l| (RedGreenOp::Split(l), None))
-                .collect();
-            ad.apply(&mut w, &ops, round).unwrap();
-        }
+        crate::common::refine_around(&mut ad, &mut w, (drape::math::Vector2::ZERO, 0.25), 2);
         let refined = w.mesh.vertex_count();
         assert!(
             refined > original.vertex_count() + 20,
@@ -274,25 +253,8 @@ fn red_green_numbers_vertices_in_triangle_order() {
     let mut w = world(32, DiagonalPattern::Alternating);
     let base = mean_edge_index_spread(&w.mesh);
     let mut ad = Adapter::new(config(), &w, DENSITY);
-    for round in 0..2 {
-        let ops: Vec<_> = ad
-            .hierarchy()
-            .leaves()
-            .into_iter()
-            .filter(|&l| {
-                let c = ad
-                    .hierarchy()
-                    .vertices(l)
-                    .iter()
-                    .map(|&v| w.mesh.material[v as usize])
-                    .sum::<drape::math::Vector2>()
-                    / 3.0;
-                (c - drape::math::Vector2::new(0.2, -0.1)).length() < 0.2
-            })
-            .map(|l| (RedGreenOp::Split(l), None))
-            .collect();
-        ad.apply(&mut w, &ops, round).unwrap();
-    }
+    let centre = drape::math::Vector2::new(0.2, -0.1);
+    crate::common::refine_around(&mut ad, &mut w, (centre, 0.2), 2);
     let spread = mean_edge_index_spread(&w.mesh);
     println!(
         "mean edge index spread: {spread:.4} of {} vertices (grid: {base:.4})",

@@ -55,6 +55,37 @@ pub fn angle_config(method: AdaptMethod) -> AdaptConfig {
     }
 }
 
+/// Splits, `rounds` times over, every leaf of `adapter`'s red-green hierarchy
+/// whose centre (material space) lies within `radius` of `centre`, and moves
+/// `world` onto the result (the second round splits the first's children).
+pub fn refine_around(
+    adapter: &mut drape::adapt::Adapter,
+    world: &mut World,
+    (centre, radius): (drape::math::Vector2, Scalar),
+    rounds: u64,
+) {
+    use drape::adapt::red_green::RedGreenOp;
+    for round in 0..rounds {
+        let ops: Vec<_> = adapter
+            .hierarchy()
+            .leaves()
+            .into_iter()
+            .filter(|&l| {
+                let c = adapter
+                    .hierarchy()
+                    .vertices(l)
+                    .iter()
+                    .map(|&v| world.mesh.material[v as usize])
+                    .sum::<drape::math::Vector2>()
+                    / 3.0;
+                (c - centre).length() < radius
+            })
+            .map(|l| (RedGreenOp::Split(l), None))
+            .collect();
+        adapter.apply(world, &ops, round).expect("refinement");
+    }
+}
+
 /// A stepper driven without the pipeline (the physics tests step a bare world):
 /// it keeps the model and the implicit warm start that [`drape::sim::Pipeline`]
 /// would otherwise pass to [`Stepper`] from the run and its state.

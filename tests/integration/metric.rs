@@ -23,6 +23,15 @@ fn wavy(res: u32) -> World {
     World::new(m, x)
 }
 
+/// The 20 x 20 grid of samples located in `w`'s mesh (all inside it).
+fn located_grid(w: &World) -> Vec<drape::bench::metric::Located> {
+    let samples = grid_samples(&w.mesh, 20);
+    locate(&w.mesh, &samples)
+        .into_iter()
+        .map(|l| l.expect("a grid sample inside the rectangle"))
+        .collect()
+}
+
 #[test]
 fn identical_meshes_have_zero_error() {
     let w = wavy(16);
@@ -43,11 +52,7 @@ fn identical_meshes_have_zero_error() {
 #[test]
 fn a_rigid_offset_gives_exactly_that_offset() {
     let w = wavy(16);
-    let samples = grid_samples(&w.mesh, 20);
-    let located: Vec<_> = locate(&w.mesh, &samples)
-        .into_iter()
-        .map(Option::unwrap)
-        .collect();
+    let located = located_grid(&w);
     let a = sample_positions(&w.mesh, &w.x, &located);
     let shift = Vector::new(0.03, -0.04, 0.0); // 5 cm
     let moved: Vec<Vector> = w.x.iter().map(|p| *p + shift).collect();
@@ -73,11 +78,7 @@ fn a_rigid_offset_gives_exactly_that_offset() {
 #[test]
 fn the_offset_is_the_translation_part_of_the_error() {
     let w = wavy(16);
-    let samples = grid_samples(&w.mesh, 20);
-    let located: Vec<_> = locate(&w.mesh, &samples)
-        .into_iter()
-        .map(Option::unwrap)
-        .collect();
+    let located = located_grid(&w);
     let diag = diagonal(&w.mesh);
     let a = sample_positions(&w.mesh, &w.x, &located);
     let deeper: Vec<Vector> =

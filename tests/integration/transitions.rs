@@ -203,25 +203,8 @@ fn green_closures_stretch_unlike_the_grid() {
             ..crate::common::angle_config(AdaptMethod::RedGreen)
         };
         let mut adapter = Adapter::new(config, &world, 0.15);
-        for round in 0..2 {
-            let ops: Vec<_> = adapter
-                .hierarchy()
-                .leaves()
-                .into_iter()
-                .filter(|&l| {
-                    let c = adapter
-                        .hierarchy()
-                        .vertices(l)
-                        .iter()
-                        .map(|&v| world.mesh.material[v as usize])
-                        .sum::<Vector2>()
-                        / 3.0;
-                    (c - Vector2::new(0.1, -0.05)).length() < 0.25
-                })
-                .map(|l| (drape::adapt::red_green::RedGreenOp::Split(l), None))
-                .collect();
-            adapter.apply(&mut world, &ops, round).unwrap();
-        }
+        let centre = Vector2::new(0.1, -0.05);
+        crate::common::refine_around(&mut adapter, &mut world, (centre, 0.25), 2);
         let green: Scalar = world
             .mesh
             .triangles
