@@ -16,8 +16,8 @@ use std::sync::atomic::AtomicBool;
 
 use anyhow::{Context, bail};
 use drape::bench::Reference;
-use drape::bench::sampling::{frame_error, sampled_run};
-use drape::math::Vector;
+use drape::bench::metric::{mean_displacement, relative_rms};
+use drape::bench::sampling::{matched, sampled_run};
 
 fn main() -> anyhow::Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -45,14 +45,9 @@ fn main() -> anyhow::Result<()> {
             r.frame
         );
     }
-    let error = frame_error(last, r, reference.diagonal).context("no common samples")?;
-    let pairs: Vec<(Vector, Vector)> = last
-        .positions
-        .iter()
-        .zip(&r.positions)
-        .filter_map(|(p, q)| Some((Vector::from_array((*p)?), Vector::from_array((*q)?))))
-        .collect();
-    let mean = pairs.iter().map(|(p, q)| *p - *q).sum::<Vector>() / pairs.len() as f64;
+    let (a, b) = matched(last, r).context("no common samples")?;
+    let error = relative_rms(&a, &b, reference.diagonal);
+    let mean = mean_displacement(&a, &b);
     println!(
         "error {:.4e} of the diagonal, mean displacement ({:.3}, {:.3}, {:.3}) mm, {:.0} mean vertices: {}",
         error,

@@ -126,11 +126,15 @@ pub fn relative_rms(a: &[Vector], b: &[Vector], scale: Scalar) -> Scalar {
 /// whose error is mostly a shift of the whole cloth can be told from one whose
 /// shape is off.
 pub fn relative_offset(a: &[Vector], b: &[Vector], scale: Scalar) -> Scalar {
+    mean_displacement(a, b).length() / scale
+}
+
+/// The mean of `a[i] - b[i]`, m (zero for no points).
+pub fn mean_displacement(a: &[Vector], b: &[Vector]) -> Vector {
     if a.is_empty() {
-        return 0.0;
+        return Vector::ZERO;
     }
-    let sum: Vector = a.iter().zip(b).map(|(p, q)| *p - *q).sum();
-    (sum / a.len() as Scalar).length() / scale
+    a.iter().zip(b).map(|(p, q)| *p - *q).sum::<Vector>() / a.len() as Scalar
 }
 
 /// The cloth's diagonal in material space, m.

@@ -104,7 +104,7 @@ pub fn sample_frame(f: &FrameState, points: &[Vector2]) -> FrameSamples {
 
 /// The samples found in both frames, as `(run, reference)` positions, or
 /// `None` when the frames' times differ or no sample is found in both.
-fn matched(run: &FrameSamples, reference: &FrameSamples) -> Option<(Vec<Vector>, Vec<Vector>)> {
+pub fn matched(run: &FrameSamples, reference: &FrameSamples) -> Option<(Vec<Vector>, Vec<Vector>)> {
     let dt = (run.time - reference.time).abs();
     if dt > 1e-9 * reference.time.abs().max(1.0) {
         return None;

@@ -234,9 +234,8 @@ impl<'a> FrameLoop<'a> {
 
     /// Logs the current frame to the recording (when there is one).
     fn log_frame(&mut self) -> Result<(), RunError> {
-        if self.recorder.is_none() {
-            return Ok(());
-        }
+        // `record` has measured this state already (after a failed frame,
+        // `finish` comes here with the restored state and measures it once).
         let energy = self.energy();
         let Some(rec) = self.recorder.as_mut() else {
             return Ok(());
