@@ -293,7 +293,7 @@ fn creased(mesh: &drape::mesh::Mesh) -> drape::mesh::Mesh {
         refine_strain: None,
         alternate_diagonals: true,
     };
-    let mut adapter = Adapter::new(config, &world, 0.15);
+    let mut adapter = Adapter::new(config, &world, 0.15).expect("the adapter starts");
     adapter.pass(&mut world, 0).expect("a crease refines");
     world.mesh
 }

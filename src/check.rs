@@ -204,6 +204,8 @@ fn describe_adapt(s: &mut String, scene: &Scene, a: &AdaptConfig) {
         match a.method {
             AdaptMethod::Edge =>
                 "edge (paper B: longest-edge splits, Delaunay flips, guarded collapses)",
+            AdaptMethod::Tensor =>
+                "tensor (whole grid lines of the rectangle inserted and removed: anisotropic)",
             _ if a.alternate_diagonals => "red_green (paper A; red splits' diagonals alternating)",
             _ => "red_green (paper A; red splits' diagonals as split)",
         },

@@ -66,6 +66,9 @@ pub enum RunError {
     /// The scene's obstacles could not be built.
     #[error("{0}")]
     Collide(#[from] crate::collide::CollideError),
+    /// The adaptive method cannot work on the cloth's mesh.
+    #[error("{0}")]
+    Adapt(#[from] crate::adapt::tensor::NotAGrid),
     /// Remeshing produced an invalid mesh (a bug: please report it).
     #[error("adaptive remeshing: {0}")]
     Remesh(#[from] crate::mesh::MeshError),
@@ -122,6 +125,7 @@ impl From<SimBuildError> for RunError {
         match e {
             SimBuildError::Build(e) => RunError::Build(e),
             SimBuildError::Collide(e) => RunError::Collide(e),
+            SimBuildError::Adapt(e) => RunError::Adapt(e),
         }
     }
 }

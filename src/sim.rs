@@ -76,6 +76,9 @@ pub enum SimBuildError {
     /// The obstacles could not be built.
     #[error("{0}")]
     Collide(#[from] CollideError),
+    /// The adaptive method cannot work on this mesh.
+    #[error("{0}")]
+    Adapt(#[from] crate::adapt::tensor::NotAGrid),
 }
 
 /// A simulation ready to run: the model it integrates, its initial state and the
@@ -93,7 +96,10 @@ pub struct Simulation {
 /// bad OBJ file or a pin that selects nothing is found, before any output is opened.
 pub fn build(spec: &SimSpec) -> Result<Simulation, SimBuildError> {
     let world = World::from_spec(&spec.cloth, &spec.pins)?;
-    let adapter = spec.adapt.map(|c| Adapter::new(c, &world, spec.density));
+    let adapter = spec
+        .adapt
+        .map(|c| Adapter::new(c, &world, spec.density))
+        .transpose()?;
     let collider = Collider::new(&spec.obstacles, spec.self_collision.as_ref())?;
     let model = spec.model.clone();
     let pipeline = Pipeline::new(&model, &world, collider, spec.fixed_dt, spec.multirate);

@@ -371,6 +371,9 @@ pub enum AdaptMethod {
     RedGreen,
     /// Paper B: edge splits with local re-triangulation, coarsening by edge collapse.
     Edge,
+    /// Whole grid lines of a rectangle inserted and removed (anisotropic,
+    /// axis-aligned: `src/adapt/tensor.rs`), for sheets bent about an axis.
+    Tensor,
     /// No adaptation (the same as leaving `[adapt]` out).
     None,
 }

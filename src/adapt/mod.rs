@@ -13,6 +13,8 @@ mod marks;
 pub mod red_green;
 pub mod sizing;
 pub mod soup;
+pub mod tensor;
+mod tensor_pass;
 pub mod transfer;
 mod tri_list;
 
@@ -201,8 +203,10 @@ pub struct Adapter {
     /// doubled that many times; dropped when the parent itself merges away).
     bounces: HashMap<u32, u32>,
     density: Scalar,
-    /// Limits of the edge method (`None` for red_green).
+    /// Limits of the edge method (`None` for the others).
     edge: Option<edge::Limits>,
+    /// The tensor method's grid (`None` for the others).
+    tensor: Option<tensor::TensorGrid>,
     /// Rest area and boundary length of the cloth, for [`Adapter::check`].
     area: Scalar,
     boundary: Scalar,
@@ -210,7 +214,13 @@ pub struct Adapter {
 
 impl Adapter {
     /// Starts adapting `world`'s mesh (its current triangles become level 0).
-    pub fn new(config: AdaptConfig, world: &World, density: Scalar) -> Adapter {
+    /// Fails only for the tensor method on a mesh that is not a rectangle's
+    /// grid (scene validation refuses that combination first).
+    pub fn new(
+        config: AdaptConfig,
+        world: &World,
+        density: Scalar,
+    ) -> Result<Adapter, tensor::NotAGrid> {
         let hierarchy = RedGreen::new(&world.mesh.triangles, &world.mesh.material);
         let owner = (0..world.mesh.triangles.len() as u32).collect();
         let m = &world.mesh;
@@ -222,7 +232,11 @@ impl Adapter {
                 config.min_edge_length,
             )
         });
-        Adapter {
+        let tensor = match config.method {
+            AdaptMethod::Tensor => Some(tensor::TensorGrid::from_mesh(m)?),
+            _ => None,
+        };
+        Ok(Adapter {
             config,
             stats: AdaptStats::default(),
             events: Vec::new(),
@@ -233,9 +247,10 @@ impl Adapter {
             bounces: HashMap::new(),
             density,
             edge,
+            tensor,
             area: m.total_rest_area(),
             boundary: boundary_length(m),
-        }
+        })
     }
 
     /// Checks the adapted world (manifold, conforming, positive rest areas,
@@ -271,6 +286,9 @@ impl Adapter {
     /// One adaptation pass on `world` after step `step`: merges, then splits,
     /// then closure; returns true when the mesh changed.
     pub fn pass(&mut self, world: &mut World, step: u64) -> Result<bool, MeshError> {
+        if self.tensor.is_some() {
+            return self.tensor_pass(world, step);
+        }
         if let Some(limits) = self.edge {
             return self.edge_pass(world, step, limits);
         }
@@ -286,6 +304,9 @@ impl Adapter {
         step: u64,
         angles: &[Scalar],
     ) -> Result<bool, MeshError> {
+        if self.tensor.is_some() {
+            return self.tensor_pass(world, step);
+        }
         if let Some(limits) = self.edge {
             return self.edge_pass(world, step, limits);
         }

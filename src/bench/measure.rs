@@ -68,6 +68,7 @@ pub fn measure(
             .map_or("none", |a| match a.method {
                 AdaptMethod::RedGreen => "red_green",
                 AdaptMethod::Edge => "edge",
+                AdaptMethod::Tensor => "tensor",
                 AdaptMethod::None => "none",
             })
             .to_owned(),

@@ -80,7 +80,7 @@ pub(crate) fn allowed(path: &str) -> Option<&'static str> {
         "self_collision.culling" => "true or false",
         "self_collision.patch_size" => "a finite number > 0 (m, material space)",
         "adapt" => "a table [adapt]",
-        "adapt.method" => "\"red_green\", \"edge\" or \"none\"",
+        "adapt.method" => "\"red_green\", \"edge\", \"tensor\" (rectangles only) or \"none\"",
         "adapt.refine_angle" => "a finite number of degrees in (coarsen_angle, 180)",
         "adapt.coarsen_angle" => "a finite number of degrees in (0, refine_angle)",
         "adapt.max_level" => "an integer >= 1 (at most 254)",

@@ -3,10 +3,10 @@
 
 use super::error::{Issue, SceneErrorKind as Kind, keys, num};
 use super::validate::{finite, non_negative, out_of_range, positive};
-use super::{Adapt, AdaptCriterion, AdaptEvery, AdaptMethod, Integrator};
+use super::{Adapt, AdaptCriterion, AdaptEvery, AdaptMethod, ClothShape, Integrator};
 
 /// The `[adapt]` table's ranges and the keys that do not apply to its settings.
-pub(super) fn adapt(a: &Adapt, integrator: Integrator) -> Result<(), Issue> {
+pub(super) fn adapt(a: &Adapt, integrator: Integrator, shape: ClothShape) -> Result<(), Issue> {
     let angle = |key: &str, x: f64| -> Result<(), Issue> {
         positive(keys(&["adapt", key]), x)?;
         if x >= 180.0 {
@@ -49,12 +49,35 @@ pub(super) fn adapt(a: &Adapt, integrator: Integrator) -> Result<(), Issue> {
             "rollback is paper A's and works with method = \"red_green\" only",
         ));
     }
+    if a.method == AdaptMethod::Tensor {
+        tensor(a, shape)?;
+    }
     if a.multirate && integrator == Integrator::Implicit {
         let path = keys(&["adapt", "multirate"]);
         let why = "multirate stepping is for the explicit integrators (symplectic_euler, rk4)";
         return Err(Issue::new(path, Kind::Unsupported, why));
     }
     criterion(a)
+}
+
+/// The tensor method works on a rectangle's grid, without paper A's rollback
+/// and multirate stepping (built for red-green's levels).
+fn tensor(a: &Adapt, shape: ClothShape) -> Result<(), Issue> {
+    if shape != ClothShape::Rectangle {
+        let path = keys(&["adapt", "method"]);
+        let why = "method = \"tensor\" refines the grid of a rectangle and needs cloth.shape = \"rectangle\"";
+        return Err(Issue::new(path, Kind::NotApplicable, why));
+    }
+    for (key, on) in [("rollback", a.rollback), ("multirate", a.multirate)] {
+        if on {
+            let path = keys(&["adapt", key]);
+            let why = format!(
+                "{key} is paper A's and works with method = \"red_green\" (and multirate also \"edge\"), not \"tensor\""
+            );
+            return Err(Issue::new(path, Kind::NotApplicable, why));
+        }
+    }
+    Ok(())
 }
 
 /// The sizing criterion's own keys: `hysteresis` > 1, and only with `criterion =

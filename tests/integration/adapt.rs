@@ -103,7 +103,8 @@ proptest! {
         let pattern = if alternating { DiagonalPattern::Alternating } else { DiagonalPattern::Regular };
         let mut w = world(4, pattern);
         let (area, bound) = (w.mesh.total_rest_area(), boundary(&w));
-        let mut ad = Adapter::new(config(), &w, DENSITY);
+        let mut ad = Adapter::new(config(), &w, DENSITY)
+        .expect("the adapter starts");
         let (p0, scale) = momentum(&w);
         for (step, (refine, pick)) in ops.into_iter().enumerate() {
             let h = ad.hierarchy();
@@ -137,7 +138,8 @@ proptest! {
     ) {
         let mut w = world(6, DiagonalPattern::Regular);
         let (area, bound) = (w.mesh.total_rest_area(), boundary(&w));
-        let mut ad = Adapter::new(edge_config(), &w, DENSITY);
+        let mut ad = Adapter::new(edge_config(), &w, DENSITY)
+        .expect("the adapter starts");
         let stated = ad.min_angle().unwrap();
         let (p0, scale) = momentum(&w);
         let mut refined = false;
@@ -163,7 +165,7 @@ fn refining_then_coarsening_a_flat_sheet_restores_the_original_mesh() {
     for pattern in [DiagonalPattern::Regular, DiagonalPattern::Alternating] {
         let mut w = world(6, pattern);
         let original = w.mesh.clone();
-        let mut ad = Adapter::new(config(), &w, DENSITY);
+        let mut ad = Adapter::new(config(), &w, DENSITY).expect("the adapter starts");
         // Refine around the centre twice (the second round splits children).
         crate::common::refine_around(&mut ad, &mut w, (drape::math::Vector2::ZERO, 0.25), 2);
         let refined = w.mesh.vertex_count();
@@ -252,7 +254,7 @@ fn mean_edge_index_spread(m: &drape::mesh::Mesh) -> Scalar {
 fn red_green_numbers_vertices_in_triangle_order() {
     let mut w = world(32, DiagonalPattern::Alternating);
     let base = mean_edge_index_spread(&w.mesh);
-    let mut ad = Adapter::new(config(), &w, DENSITY);
+    let mut ad = Adapter::new(config(), &w, DENSITY).expect("the adapter starts");
     let centre = drape::math::Vector2::new(0.2, -0.1);
     crate::common::refine_around(&mut ad, &mut w, (centre, 0.2), 2);
     let spread = mean_edge_index_spread(&w.mesh);
@@ -275,7 +277,7 @@ fn paper_a_level_rules_on_hand_built_cases() {
     // A 2 x 2 grid with regular diagonals: 8 triangles. Triangle 1-5-4 (in the
     // lower-right square, touching the centre vertex 4) has three interior edges.
     let mut w = world(2, DiagonalPattern::Regular);
-    let mut ad = Adapter::new(config(), &w, DENSITY);
+    let mut ad = Adapter::new(config(), &w, DENSITY).expect("the adapter starts");
     let t = ad
         .hierarchy()
         .leaves()
@@ -343,7 +345,7 @@ fn paper_a_level_rules_on_hand_built_cases() {
 #[test]
 fn a_split_first_splits_a_coarser_neighbour_to_keep_levels_within_one_split() {
     let mut w = world(2, DiagonalPattern::Regular);
-    let mut ad = Adapter::new(config(), &w, DENSITY);
+    let mut ad = Adapter::new(config(), &w, DENSITY).expect("the adapter starts");
     let t = ad.hierarchy().leaves()[3];
     ad.apply(&mut w, &[(RedGreenOp::Split(t), None)], 0)
         .unwrap();
@@ -381,7 +383,7 @@ fn pins_survive_refinement_and_coarsening() {
         m
     };
     let before = pinned_material(&w);
-    let mut ad = Adapter::new(config(), &w, DENSITY);
+    let mut ad = Adapter::new(config(), &w, DENSITY).expect("the adapter starts");
     let all: Vec<_> = ad
         .hierarchy()
         .leaves()
@@ -435,7 +437,7 @@ fn close_thresholds_do_not_thrash() {
             max_level: 4,
             ..config()
         };
-        let mut ad = Adapter::new(cfg, &w, DENSITY);
+        let mut ad = Adapter::new(cfg, &w, DENSITY).expect("the adapter starts");
         let steps = 150;
         for step in 0..steps {
             st.step(&mut w, 0.01).expect("the step is solved");
@@ -570,7 +572,7 @@ fn edge_method_never_goes_below_its_minimum_angle_and_keeps_the_invariants() {
     .unwrap();
     let (area, bound) = (w.mesh.total_rest_area(), boundary(&w));
     let mut st = swinging_stepper(&w, Integrator::Implicit, 0.001);
-    let mut ad = Adapter::new(edge_config(), &w, DENSITY);
+    let mut ad = Adapter::new(edge_config(), &w, DENSITY).expect("the adapter starts");
     let stated = ad.min_angle().expect("edge method");
     let mut worst: Scalar = 180.0;
     for step in 0..150 {
@@ -602,7 +604,7 @@ fn edge_method_refine_then_flatten_returns_near_the_original_vertex_count() {
     let mut w = world(8, DiagonalPattern::Alternating);
     let original = w.mesh.vertex_count();
     let (area, bound) = (w.mesh.total_rest_area(), boundary(&w));
-    let mut ad = Adapter::new(edge_config(), &w, DENSITY);
+    let mut ad = Adapter::new(edge_config(), &w, DENSITY).expect("the adapter starts");
     // Bend the sheet sharply along a line so that edges there exceed 15 degrees.
     let bend = |w: &mut World| {
         for (x, m) in w.x.iter_mut().zip(&w.mesh.material) {
@@ -671,7 +673,8 @@ fn swinging_explicit(
         },
         &w,
         DENSITY,
-    );
+    )
+    .expect("the adapter starts");
     let started = std::time::Instant::now();
     let mut steps = 0;
     while w.time < duration - 1e-12 {

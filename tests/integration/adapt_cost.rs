@@ -66,7 +66,7 @@ fn cost(method: AdaptMethod) {
         bending_model: BendingModel::ShapeOperator,
         stiffness_rule: StiffnessRule::Consistent,
     };
-    let mut ad = Adapter::new(config, &w, 0.15);
+    let mut ad = Adapter::new(config, &w, 0.15).unwrap();
     let (mut pass_s, mut rebuild_s, mut times) = (0.0, 0.0, Vec::new());
     let mut vertices = 0;
     for k in 0..60 {

@@ -58,7 +58,7 @@ fn sizing_on_a_flat_sheet_refines_nothing() {
     for pattern in [DiagonalPattern::Regular, DiagonalPattern::Alternating] {
         let mut w = flat_world(8, pattern);
         let before = w.mesh.triangles.clone();
-        let mut ad = Adapter::new(sizing(15.0, 4), &w, DENSITY);
+        let mut ad = Adapter::new(sizing(15.0, 4), &w, DENSITY).expect("the adapter starts");
         let passes = settle(&mut w, &mut ad, |p| p.extend(0.0));
         assert_eq!((passes, ad.stats.splits), (0, 0), "{pattern:?}");
         assert_eq!(w.mesh.triangles, before);
@@ -96,7 +96,8 @@ fn sizing_on_a_cylinder_refines_to_the_predicted_level() {
         for (r, predicted) in [(1.15, 2u8), (2.3, 4u8)] {
             let radius = d0 / (r * budget_deg.to_radians());
             let mut w = flat_world(res, pattern);
-            let mut ad = Adapter::new(sizing(budget_deg, 6), &w, DENSITY);
+            let mut ad =
+                Adapter::new(sizing(budget_deg, 6), &w, DENSITY).expect("the adapter starts");
             let passes = settle(&mut w, &mut ad, cylinder(radius));
             // Away from the u boundary (where a triangle's one vertical leg
             // is a boundary edge and measures nothing) every triangle is at
@@ -174,7 +175,8 @@ fn sweep(criterion: AdaptCriterion) -> Sweep {
         },
         &w,
         DENSITY,
-    );
+    )
+    .expect("the adapter starts");
     let (mut peak, mut after_left, mut after_centre) = (0u8, None, None);
     let (mut since_left, mut since_centre) = (0u32, 0u32);
     for k in 0..=60u64 {
@@ -307,7 +309,7 @@ fn strain_jumps_refine_the_mesh_at_point_pins() {
 #[test]
 fn top_level_statistics_count_triangles_and_area() {
     let mut w = flat_world(16, DiagonalPattern::Alternating);
-    let mut ad = Adapter::new(sizing(15.0, 4), &w, DENSITY);
+    let mut ad = Adapter::new(sizing(15.0, 4), &w, DENSITY).expect("the adapter starts");
     settle(&mut w, &mut ad, fold(0.0, 0.08, 0.05));
     let m = &w.mesh;
     let top: Vec<usize> = (0..m.triangles.len())

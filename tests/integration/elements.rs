@@ -56,7 +56,8 @@ proptest! {
             alternate_diagonals: alternate,
             ..crate::common::angle_config(method)
         };
-        let mut ad = Adapter::new(config, &w, 0.15);
+        let mut ad = Adapter::new(config, &w, 0.15)
+        .expect("the adapter starts");
         let clamped = |mesh: &Mesh| if clamp { clamp_left(mesh) } else { Vec::new() };
         let mut el = Elements::build_clamped(&w.mesh, &mat, &clamped(&w.mesh));
         let mut kept = 0;

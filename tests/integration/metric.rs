@@ -132,7 +132,7 @@ fn samples_are_the_same_cloth_points_on_an_adapted_mesh() {
         .collect();
     let before = sample_positions(&w.mesh, &w.x, &before_loc);
     let cfg = crate::common::angle_config(AdaptMethod::RedGreen);
-    let mut ad = Adapter::new(cfg, &w, 0.15);
+    let mut ad = Adapter::new(cfg, &w, 0.15).expect("the adapter starts");
     let leaves: Vec<_> = ad
         .hierarchy()
         .leaves()

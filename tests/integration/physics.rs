@@ -542,7 +542,7 @@ fn partly_refined_sheet_bends_like_the_continuum_in(alternate: bool, region: &st
         alternate_diagonals: alternate,
         ..crate::common::angle_config(drape::scene::AdaptMethod::RedGreen)
     };
-    let mut adapter = Adapter::new(config, &world, 0.15);
+    let mut adapter = Adapter::new(config, &world, 0.15).unwrap();
     let h = adapter.hierarchy();
     let marks: Vec<(u32, Scalar)> = h
         .leaves()

@@ -264,7 +264,7 @@ fn incremental_tables_equal_a_rebuild_over_draping_passes() {
             max_rollbacks: 3,
             ..crate::common::angle_config(method)
         };
-        let mut ad = Adapter::new(config, &w, 0.15);
+        let mut ad = Adapter::new(config, &w, 0.15).expect("the adapter starts");
         let mut changed = 0;
         for k in 0..30 {
             for (x, p) in w.x.iter_mut().zip(&w.mesh.material) {
@@ -345,7 +345,8 @@ proptest! {
             alternate_diagonals: alternate,
             ..crate::common::angle_config(method)
         };
-        let mut ad = Adapter::new(config, &w, 0.15);
+        let mut ad = Adapter::new(config, &w, 0.15)
+        .expect("the adapter starts");
         for (j, &k) in shapes.iter().enumerate() {
             for (x, p) in w.x.iter_mut().zip(&w.mesh.material) {
                 *x = crate::adapt_cost::drape(*p, k);

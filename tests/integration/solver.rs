@@ -310,7 +310,8 @@ fn ordering_by_vertex_fills_no_more_than_scalar_amd() {
         crate::common::angle_config(AdaptMethod::RedGreen),
         &world,
         0.15,
-    );
+    )
+    .expect("the adapter starts");
     adapter.pass(&mut world, 0).expect("the crease refines");
     assert!(world.mesh.vertex_count() > grid.vertex_count());
     let material = MaterialParams {

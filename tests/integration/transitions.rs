@@ -26,7 +26,7 @@ fn two_levels(
         alternate_diagonals: alternate,
         ..crate::common::angle_config(AdaptMethod::RedGreen)
     };
-    let mut adapter = Adapter::new(config, &world, 0.15);
+    let mut adapter = Adapter::new(config, &world, 0.15).unwrap();
     for inside in [&first as &dyn Fn(Vector2) -> bool, &second] {
         let h = adapter.hierarchy();
         let marks: Vec<(u32, Scalar)> = h
@@ -202,7 +202,7 @@ fn green_closures_stretch_unlike_the_grid() {
             max_level: 6,
             ..crate::common::angle_config(AdaptMethod::RedGreen)
         };
-        let mut adapter = Adapter::new(config, &world, 0.15);
+        let mut adapter = Adapter::new(config, &world, 0.15).unwrap();
         let centre = Vector2::new(0.1, -0.05);
         crate::common::refine_around(&mut adapter, &mut world, (centre, 0.25), 2);
         let green: Scalar = world

@@ -1,0 +1,442 @@
+//! Tensor-product refinement (`method = "tensor"`): anisotropic refinement of
+//! a rectangle's grid by whole grid lines, so that a sheet bent along one
+//! axis only is halved along that axis only.
+//!
+//! Why. A strip bent along its length (the cantilever) needs short cells
+//! along the bend and none across it: one cell across the strip gives the
+//! square cells' rest error within 1 % at 1/25 of the wall time
+//! (`docs/speed-vs-error.md`, "Anisotropic cells"), but red-green's 1-4
+//! splits halve a cell both ways, so from a base one cell across it carries
+//! 169 vertices at level 4 where 82 do. Anisotropic bisection in a metric
+//! (tried on the edge method, same section) made oblique thin triangles on
+//! which drape's bending is wrong; every structured mesh of stretched right
+//! triangles bends exactly. This method keeps the mesh such a structured
+//! mesh: the cloth is a tensor grid, its u-lines and v-lines each kept in a
+//! one-dimensional binary hierarchy, and a pass inserts a line halving a
+//! column (or row) or removes one that halved its parent. The mesh is
+//! always conforming (a line crosses the whole sheet), every cell is a
+//! rectangle split into two right triangles, and every new vertex is the
+//! midpoint of an edge of the old mesh, so `transfer.rs` carries the state.
+//!
+//! What it costs. A line crosses the whole sheet: a fold that is not along
+//! an axis, or a bend that is needed in one corner only, refines the whole
+//! row or column through it. It suits strips and sheets bent about an axis,
+//! not a falling tablecloth. Cells of different sizes meet only across grid
+//! lines (there are no hanging nodes).
+//!
+//! The measure along u at a vertex is the turn of its grid line there: the
+//! angle `phi` between the two segments of the row through it (the same
+//! along v with the column). With the angle criterion a column splits where
+//! `phi` at one of its two bounding lines exceeds `refine_angle` and a line
+//! goes where `phi` at it and at its two neighbours is below `coarsen_angle`
+//! (and half `refine_angle`), as the papers' criterion on dihedral angles.
+//! With the sizing criterion (`sizing.rs`) the curvature is `kappa = phi /
+//! hbar` (`hbar` the mean of the two segments' material lengths), a column of
+//! width `h` splits where `kappa h > refine_angle`, and a line goes where its
+//! parent column `H = 2 h` would carry `kappa H <= refine_angle / hysteresis`,
+//! `kappa` the largest at the three lines. A row or column is judged by its
+//! largest value over the whole sheet. Adjacent columns (rows) differ by at
+//! most one halving (a split forces the split of a coarser neighbour, and a
+//! removal that would break it is refused), so neighbouring cells differ in
+//! width by a factor of two at most. Levels follow paper A's count: a halving
+//! adds 2, and `max_level` allows `max_level / 2` halvings either way; a
+//! triangle's level is that of its finer direction.
+//!
+//! A sheet with one cell across a direction has no interior line there to
+//! measure, so it is never refined that way (the cantilever with
+//! `cloth.short_side_segments = 1`: exactly what it needs).
+
+use crate::math::{Scalar, Vector, Vector2};
+use crate::mesh::Mesh;
+
+use super::transfer::{Origin, Remeshed};
+
+/// The mesh given to [`TensorGrid::from_mesh`] is not a rectangle's grid.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error(
+    "adapt.method = \"tensor\" needs the grid of a generated rectangle (shape = \"rectangle\"): {0}"
+)]
+pub struct NotAGrid(pub String);
+
+/// A grid line: its material coordinate and how many halvings made it (0 for
+/// the base grid's lines).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Line {
+    at: Scalar,
+    level: u8,
+}
+
+/// Where a line of the grid after a pass comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Source {
+    /// Line `i` of the grid before the pass.
+    Old(usize),
+    /// Inserted between the old lines `i` and `i + 1`.
+    Between(usize),
+}
+
+/// The lines of one axis, in increasing order.
+#[derive(Debug, Clone, PartialEq)]
+struct Axis {
+    lines: Vec<Line>,
+}
+
+/// What a pass does on one axis.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub(super) struct AxisOps {
+    /// Columns (between line `c` and `c + 1`) to halve, with the measure that
+    /// asked for it (radians for the angle criterion, `kappa h` for the
+    /// sizing one) or `None` for a split forced by the one-halving rule.
+    pub(super) splits: Vec<(usize, Option<Scalar>)>,
+    /// Lines to remove.
+    pub(super) merges: Vec<usize>,
+}
+
+/// The thresholds of a pass, in radians.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct Thresholds {
+    /// Sizing (`kappa h` against `refine`) or angle (`phi` against both).
+    pub(super) sizing: bool,
+    /// Upper threshold.
+    pub(super) refine: Scalar,
+    /// Lower threshold (angle criterion) or `refine / hysteresis` (sizing).
+    pub(super) coarsen: Scalar,
+    /// Halvings allowed.
+    pub(super) max_halvings: u8,
+    /// Shortest cell side a split may make, m (0: no limit).
+    pub(super) min_edge: Scalar,
+}
+
+impl Axis {
+    fn n(&self) -> usize {
+        self.lines.len()
+    }
+
+    /// Level of the column between lines `c` and `c + 1`.
+    fn column_level(&self, c: usize) -> u8 {
+        self.lines[c].level.max(self.lines[c + 1].level)
+    }
+
+    fn width(&self, c: usize) -> Scalar {
+        self.lines[c + 1].at - self.lines[c].at
+    }
+
+    /// Whether line `m` halved its parent column (both neighbours coarser).
+    fn removable(&self, m: usize) -> bool {
+        m > 0
+            && m + 1 < self.n()
+            && self.lines[m].level > self.lines[m - 1].level
+            && self.lines[m].level > self.lines[m + 1].level
+    }
+
+    /// The operations of a pass given the largest measure at each line (`phi`
+    /// or `kappa`; zero at the two boundary lines, which have none).
+    fn marks(&self, at_line: &[Scalar], th: &Thresholds) -> AxisOps {
+        let cols = self.n() - 1;
+        let mut level: Vec<u8> = (0..cols).map(|c| self.column_level(c)).collect();
+        let mut split: Vec<Option<Option<Scalar>>> = vec![None; cols];
+        for c in 0..cols {
+            let demand = at_line[c].max(at_line[c + 1]);
+            let measure = if th.sizing {
+                demand * self.width(c)
+            } else {
+                demand
+            };
+            if measure > th.refine && self.can_split(c, th) {
+                split[c] = Some(Some(measure));
+                level[c] += 1;
+            }
+        }
+        // One halving between neighbours: split the coarser one.
+        loop {
+            let mut changed = false;
+            for c in 0..cols {
+                for n in [c.wrapping_sub(1), c + 1] {
+                    if n < cols && level[c] > level[n] + 1 && split[n].is_none() {
+                        split[n] = Some(None);
+                        level[n] += 1;
+                        changed = true;
+                    }
+                }
+            }
+            if !changed {
+                break;
+            }
+        }
+        let mut ops = AxisOps {
+            splits: (0..cols).filter_map(|c| split[c].map(|m| (c, m))).collect(),
+            merges: Vec::new(),
+        };
+        for m in (1..self.n() - 1).filter(|&m| self.removable(m)) {
+            if split[m - 1].is_some() || split[m].is_some() {
+                continue;
+            }
+            let demand = at_line[m - 1].max(at_line[m]).max(at_line[m + 1]);
+            let parent = self.lines[m - 1].level.max(self.lines[m + 1].level);
+            let measure = if th.sizing {
+                demand * (self.lines[m + 1].at - self.lines[m - 1].at)
+            } else {
+                demand
+            };
+            let flat = if th.sizing {
+                measure <= th.coarsen
+            } else {
+                measure < th.coarsen && measure < 0.5 * th.refine
+            };
+            // The columns beyond the parent (after this pass's splits) may be
+            // at most one halving finer than it.
+            let balanced = (m < 2 || level[m - 2] <= parent + 1)
+                && (m + 1 >= cols || level[m + 1] <= parent + 1);
+            if flat && balanced {
+                ops.merges.push(m);
+            }
+        }
+        // No two removals are neighbours (a removable line's neighbours are
+        // coarser than it, so not removable), so each parent is judged against
+        // columns no removal of this pass changes, except to coarsen them.
+        ops
+    }
+
+    fn can_split(&self, c: usize, th: &Thresholds) -> bool {
+        self.column_level(c) < th.max_halvings
+            && (th.min_edge <= 0.0 || 0.5 * self.width(c) >= th.min_edge)
+    }
+
+    /// Applies `ops`: the new lines and where each comes from.
+    fn apply(&mut self, ops: &AxisOps) -> Vec<Source> {
+        let mut split = vec![false; self.n()];
+        for &(c, _) in &ops.splits {
+            split[c] = true;
+        }
+        let mut merged = vec![false; self.n()];
+        for &m in &ops.merges {
+            merged[m] = true;
+        }
+        let mut lines = Vec::with_capacity(self.n() + ops.splits.len());
+        let mut source = Vec::with_capacity(lines.capacity());
+        for i in 0..self.n() {
+            if !merged[i] {
+                lines.push(self.lines[i]);
+                source.push(Source::Old(i));
+            }
+            if i + 1 < self.n() && split[i] {
+                lines.push(Line {
+                    at: 0.5 * (self.lines[i].at + self.lines[i + 1].at),
+                    level: self.column_level(i) + 1,
+                });
+                source.push(Source::Between(i));
+            }
+        }
+        self.lines = lines;
+        source
+    }
+}
+
+/// A rectangle's grid as two axes of lines; vertex `j * nu + i` of the world's
+/// mesh sits at u-line `i` and v-line `j`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TensorGrid {
+    u: Axis,
+    v: Axis,
+    alternating: bool,
+}
+
+impl TensorGrid {
+    /// The grid of a mesh made by `mesh::rectangle_cells` (vertices row by row
+    /// along u, each cell split by one diagonal, all the same way or
+    /// alternating); anything else is refused.
+    pub fn from_mesh(mesh: &Mesh) -> Result<TensorGrid, NotAGrid> {
+        let coords = |f: fn(&Vector2) -> Scalar| {
+            let mut c: Vec<Scalar> = mesh.material.iter().map(f).collect();
+            c.sort_by(Scalar::total_cmp);
+            c.dedup();
+            c
+        };
+        let (us, vs) = (coords(|p| p.x), coords(|p| p.y));
+        let base = |c: Vec<Scalar>| Axis {
+            lines: c.into_iter().map(|at| Line { at, level: 0 }).collect(),
+        };
+        let (u, v) = (base(us), base(vs));
+        if u.n() < 2 || v.n() < 2 || u.n() * v.n() != mesh.vertex_count() {
+            return Err(NotAGrid(format!(
+                "{} vertices on {} distinct u and {} distinct v coordinates",
+                mesh.vertex_count(),
+                u.n(),
+                v.n()
+            )));
+        }
+        for (k, p) in mesh.material.iter().enumerate() {
+            let (i, j) = (k % u.n(), k / u.n());
+            if p.x != u.lines[i].at || p.y != v.lines[j].at {
+                return Err(NotAGrid(format!(
+                    "vertex {k} is not the grid's node ({i}, {j}) in row order"
+                )));
+            }
+        }
+        for alternating in [true, false] {
+            let grid = TensorGrid {
+                u: u.clone(),
+                v: v.clone(),
+                alternating,
+            };
+            let (tris, _) = grid.triangles();
+            if tris == mesh.triangles {
+                return Ok(grid);
+            }
+        }
+        Err(NotAGrid(
+            "its triangles are not the grid's cells split by regular or alternating diagonals"
+                .to_owned(),
+        ))
+    }
+
+    /// Vertices along u and v.
+    pub fn counts(&self) -> (usize, usize) {
+        (self.u.n(), self.v.n())
+    }
+
+    /// The lines' material coordinates along u and v (for tests and
+    /// inspection).
+    pub fn lines(&self) -> (Vec<Scalar>, Vec<Scalar>) {
+        let at = |a: &Axis| a.lines.iter().map(|l| l.at).collect();
+        (at(&self.u), at(&self.v))
+    }
+
+    /// The level (halvings) of every column along u and every row along v.
+    pub(super) fn column_levels(&self) -> (Vec<u8>, Vec<u8>) {
+        let levels = |a: &Axis| (0..a.n() - 1).map(|c| a.column_level(c)).collect();
+        (levels(&self.u), levels(&self.v))
+    }
+
+    /// Whether the cell at columns `i`, rows `j` is split along its diagonal
+    /// from (i, j) to (i + 1, j + 1). Alternating grids alternate among cells
+    /// of the same size: the parity is that of the cell's index among cells of
+    /// its width and height, so a cell keeps its diagonal when lines are
+    /// inserted elsewhere.
+    fn along_ac(&self, i: usize, j: usize) -> bool {
+        if !self.alternating {
+            return true;
+        }
+        let index =
+            |a: &Axis, c: usize| ((a.lines[c].at - a.lines[0].at) / a.width(c)).round() as i64;
+        (index(&self.u, i) + index(&self.v, j)) % 2 == 0
+    }
+
+    /// The grid's triangles (row order of vertices) and their levels.
+    pub fn triangles(&self) -> (Vec<[u32; 3]>, Vec<u8>) {
+        let nu = self.u.n();
+        let id = |i: usize, j: usize| (j * nu + i) as u32;
+        let mut tris = Vec::with_capacity(2 * (nu - 1) * (self.v.n() - 1));
+        let mut levels = Vec::with_capacity(tris.capacity());
+        for j in 0..self.v.n() - 1 {
+            for i in 0..nu - 1 {
+                let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+                if self.along_ac(i, j) {
+                    tris.extend([[a, b, c], [a, c, d]]);
+                } else {
+                    tris.extend([[a, b, d], [b, c, d]]);
+                }
+                let level = self.u.column_level(i).max(self.v.column_level(j));
+                let level = level.saturating_mul(2);
+                levels.extend([level, level]);
+            }
+        }
+        (tris, levels)
+    }
+
+    /// The largest measure at each line of both axes, from the world's
+    /// positions `x` (row order): the turn `phi` of the grid lines through
+    /// it, or with `sizing` the curvature `phi / hbar`.
+    pub(super) fn measures(&self, x: &[Vector], sizing: bool) -> (Vec<Scalar>, Vec<Scalar>) {
+        let (nu, nv) = (self.u.n(), self.v.n());
+        let mut at_u = vec![0.0; nu];
+        let mut at_v = vec![0.0; nv];
+        let turn = |p: Vector, q: Vector, r: Vector| {
+            let (a, b) = (q - p, r - q);
+            a.cross(b).length().atan2(a.dot(b))
+        };
+        for (i, slot) in at_u.iter_mut().enumerate().take(nu - 1).skip(1) {
+            let hbar = 0.5 * (self.u.lines[i + 1].at - self.u.lines[i - 1].at);
+            for j in 0..nv {
+                let k = j * nu + i;
+                let m = turn(x[k - 1], x[k], x[k + 1]);
+                *slot = Scalar::max(*slot, if sizing { m / hbar } else { m });
+            }
+        }
+        for (j, slot) in at_v.iter_mut().enumerate().take(nv - 1).skip(1) {
+            let hbar = 0.5 * (self.v.lines[j + 1].at - self.v.lines[j - 1].at);
+            for i in 0..nu {
+                let k = j * nu + i;
+                let m = turn(x[k - nu], x[k], x[k + nu]);
+                *slot = Scalar::max(*slot, if sizing { m / hbar } else { m });
+            }
+        }
+        (at_u, at_v)
+    }
+
+    /// The operations of a pass on both axes.
+    pub(super) fn marks(
+        &self,
+        measures: &(Vec<Scalar>, Vec<Scalar>),
+        th: &Thresholds,
+    ) -> (AxisOps, AxisOps) {
+        (self.u.marks(&measures.0, th), self.v.marks(&measures.1, th))
+    }
+
+    /// Applies the operations and returns the new topology (vertices in row
+    /// order; every new vertex the midpoint of an edge of the old mesh).
+    pub(super) fn apply(&mut self, ops: &(AxisOps, AxisOps)) -> Remeshed {
+        let old = self.clone();
+        let su = self.u.apply(&ops.0);
+        let sv = self.v.apply(&ops.1);
+        let (nu, nv) = (self.u.n(), self.v.n());
+        let old_nu = old.u.n();
+        // New index of each surviving old line.
+        let new_of = |s: &[Source], n_old: usize| {
+            let mut m = vec![usize::MAX; n_old];
+            for (k, src) in s.iter().enumerate() {
+                if let Source::Old(i) = src {
+                    m[*i] = k;
+                }
+            }
+            m
+        };
+        let (nu_of, nv_of) = (new_of(&su, old_nu), new_of(&sv, old.v.n()));
+        let id = |i: usize, j: usize| (j * nu + i) as u32;
+        let mut material = Vec::with_capacity(nu * nv);
+        let mut origin = Vec::with_capacity(nu * nv);
+        for (j, sj) in sv.iter().enumerate() {
+            for (i, si) in su.iter().enumerate() {
+                material.push(Vector2::new(self.u.lines[i].at, self.v.lines[j].at));
+                origin.push(match (*si, *sj) {
+                    (Source::Old(a), Source::Old(b)) => Origin::Old((b * old_nu + a) as u32),
+                    (Source::Between(a), Source::Old(_)) => {
+                        Origin::Midpoint(id(nu_of[a], j), id(nu_of[a + 1], j))
+                    }
+                    (Source::Old(_), Source::Between(b)) => {
+                        Origin::Midpoint(id(i, nv_of[b]), id(i, nv_of[b + 1]))
+                    }
+                    (Source::Between(a), Source::Between(b)) => {
+                        // The centre of old cell (a, b): the midpoint of its diagonal.
+                        let (l, r, lo, hi) = (nu_of[a], nu_of[a + 1], nv_of[b], nv_of[b + 1]);
+                        if old.along_ac(a, b) {
+                            Origin::Midpoint(id(l, lo), id(r, hi))
+                        } else {
+                            Origin::Midpoint(id(r, lo), id(l, hi))
+                        }
+                    }
+                });
+            }
+        }
+        let mut parents_first: Vec<u32> = (0..origin.len() as u32).collect();
+        parents_first.sort_by_key(|&k| matches!(origin[k as usize], Origin::Midpoint(..)));
+        let (triangles, levels) = self.triangles();
+        Remeshed {
+            material,
+            triangles,
+            levels,
+            origin,
+            parents_first,
+        }
+    }
+}
