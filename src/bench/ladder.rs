@@ -173,19 +173,21 @@ fn rung(label: String, set: &[String]) -> Rung {
 
 /// The default ladder for `scene`: uniform meshes of 16 to 64 segments, and
 /// adaptive runs whose finest edges match 32 or 64 segments, with the scene's
-/// remeshing method (red-green if it has none), the other method, tighter and
-/// looser thresholds, and, for explicit integrators under [`StepPolicy::Own`],
-/// multirate stepping (under a common fixed step it would only subdivide
+/// remeshing method (red-green if it has none), the other method (edge for
+/// red-green, red-green for the edge and tensor methods), tighter and looser
+/// thresholds, and, for explicit integrators under [`StepPolicy::Own`] and
+/// other methods than tensor, multirate stepping (under a common fixed step it would only subdivide
 /// that step further: it is a choice of step, not of mesh).
 pub fn default_ladder(scene: &Scene, step: StepPolicy) -> Ladder {
     let method = match scene.adapt.as_ref().map(|a| a.method) {
         Some(AdaptMethod::Edge) => "edge",
+        Some(AdaptMethod::Tensor) => "tensor",
         _ => "red_green",
     };
-    let other = if method == "edge" {
-        "red_green"
-    } else {
+    let other = if method == "red_green" {
         "edge"
+    } else {
+        "red_green"
     };
     let mut rungs = Vec::new();
     for res in [16, 32, 48, 64] {
@@ -203,7 +205,7 @@ pub fn default_ladder(scene: &Scene, step: StepPolicy) -> Ladder {
             format!("cloth.resolution={res}"),
             format!("adapt.max_level={level}"),
         ];
-        if m == "edge" {
+        if m != "red_green" {
             // Rollback is paper A's (red-green only).
             set.push("adapt.rollback=false".into());
         }
@@ -233,7 +235,11 @@ pub fn default_ladder(scene: &Scene, step: StepPolicy) -> Ladder {
         &adaptive(method, 16, 4, &loose),
     ));
     rungs.push(rung(format!("{other} 16 L4"), &adaptive(other, 16, 4, &[])));
-    if scene.simulation.integrator != Integrator::Implicit && step == StepPolicy::Own {
+    // Multirate stepping is paper A's, on red-green's and the edge method's levels.
+    if scene.simulation.integrator != Integrator::Implicit
+        && step == StepPolicy::Own
+        && method != "tensor"
+    {
         rungs.push(rung(
             format!("{method} 16 L4 multirate"),
             &adaptive(method, 16, 4, &["adapt.multirate=true"]),

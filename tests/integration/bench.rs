@@ -336,6 +336,28 @@ fn bench_cli_lists_the_default_ladder_and_rejects_unknown_rungs() {
     assert!(out.status.success());
     assert!(text.contains("uniform 64: adapt.method=none cloth.resolution=64"));
     assert!(text.contains("red_green 16 L4: "));
+    // A tensor scene's ladder runs the tensor method without rollback, and
+    // red-green as the other method.
+    let out = Command::new(env!("CARGO_BIN_EXE_drape"))
+        .args(["bench", scene.to_str().expect("utf-8"), "--list"])
+        .args([
+            "--set",
+            "adapt.method=tensor",
+            "--set",
+            "adapt.rollback=false",
+        ])
+        .output()
+        .expect("run drape");
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(text.contains(
+        "tensor 16 L4: adapt.method=tensor cloth.resolution=16 adapt.max_level=4 adapt.rollback=false\n"
+    ));
+    assert!(text.contains("red_green 16 L4: "));
     let out = Command::new(env!("CARGO_BIN_EXE_drape"))
         .args(["bench", scene.to_str().expect("utf-8"), "--rungs", "nope"])
         .output()
