@@ -34,7 +34,9 @@ pub struct Convergence {
     pub points: Vec<(String, Scalar, Scalar)>,
     /// The least-squares slope of log(error) against log(h).
     pub order: Scalar,
-    /// The slope between each pair of neighbouring points.
+    /// The slope between each pair of neighbouring distinct h (where several
+    /// runs share an h, such as a ladder's square and stretched cells, the
+    /// first of them in ladder order).
     pub local: Vec<Scalar>,
 }
 
@@ -64,7 +66,10 @@ fn series(
     points.sort_by(|a, b| b.1.total_cmp(&a.1));
     let xy: Vec<(Scalar, Scalar)> = points.iter().map(|p| (p.1, p.2)).collect();
     let order = loglog_slope(&xy)?;
-    let local = xy
+    // The sort is stable: the first point at each h is the ladder's first.
+    let mut distinct = xy.clone();
+    distinct.dedup_by(|b, a| a.0 == b.0);
+    let local = distinct
         .windows(2)
         .map(|w| loglog_slope(w).unwrap_or(Scalar::NAN))
         .collect();

@@ -74,6 +74,19 @@ fn convergence_series_use_the_uniform_runs_only() {
     assert_eq!(s.local.len(), 2);
     assert_eq!(s.points[0].0, "uniform 8", "coarse first");
     assert_eq!(temporal(&rows), None, "no two runs on one mesh");
+    // Two runs at one h (square and stretched cells, as in the tensor
+    // ladder): the local orders are between distinct h only, from the first
+    // run at each (they used to include a 0 / 0 slope, printed as NaN).
+    let mut shared = rows[..3].to_vec();
+    shared.insert(2, row("uniform 16 across 1", false, 16, 16, 0.1, 1.1e-2));
+    let s = spatial(&shared).expect("three resolutions");
+    println!("local orders with a shared h: {:?}", s.local);
+    assert_eq!(s.local.len(), 2);
+    assert!(
+        s.local.iter().all(|&p| (p - 2.0).abs() < 1e-12),
+        "{:?}",
+        s.local
+    );
     // A time-step ladder: one mesh, three steps, first order.
     let steps: Vec<Row> = [("0.01", 0.04), ("0.005", 0.02), ("0.0025", 0.01)]
         .iter()
