@@ -255,10 +255,14 @@ impl Adapter {
 
     /// Checks the adapted world (manifold, conforming, positive rest areas,
     /// exact mass: [`check_consistency`] against the cloth this adapter
-    /// started from) and the red-green tables against a rebuild. Runs after
+    /// started from), the tensor method's grid against the world's mesh, and
+    /// the red-green tables against a rebuild. Runs after
     /// every remesh in debug builds; tests call it in release builds too.
     pub fn check(&self, world: &World) -> Result<(), ConsistencyError> {
         check_consistency(world, self.density, self.area, self.boundary)?;
+        if let Some(grid) = &self.tensor {
+            grid.check(&world.mesh).map_err(ConsistencyError::Tables)?;
+        }
         self.hierarchy
             .check_tables()
             .map_err(ConsistencyError::Tables)

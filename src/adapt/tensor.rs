@@ -290,6 +290,49 @@ impl TensorGrid {
         ))
     }
 
+    /// Checks that `mesh` is this grid: its vertices the grid's nodes in row
+    /// order and its triangles the grid's cells with their diagonals, and
+    /// that every line that is not a base line halves its parent column
+    /// (the one-halving rule between neighbouring columns included).
+    pub fn check(&self, mesh: &Mesh) -> Result<(), String> {
+        let nu = self.u.n();
+        if mesh.vertex_count() != nu * self.v.n() {
+            return Err(format!(
+                "tensor grid of {} x {} nodes, mesh of {} vertices",
+                nu,
+                self.v.n(),
+                mesh.vertex_count()
+            ));
+        }
+        for (k, p) in mesh.material.iter().enumerate() {
+            let (u, v) = (self.u.lines[k % nu].at, self.v.lines[k / nu].at);
+            if p.x != u || p.y != v {
+                return Err(format!("vertex {k} at {p:?}, its grid node at ({u}, {v})"));
+            }
+        }
+        if self.triangles().0 != mesh.triangles {
+            return Err("the mesh's triangles are not the grid's cells".to_owned());
+        }
+        for (name, axis) in [("u", &self.u), ("v", &self.v)] {
+            for c in 0..axis.n() - 1 {
+                if axis.width(c) <= 0.0 {
+                    return Err(format!("{name}-lines {c} and {} out of order", c + 1));
+                }
+            }
+            for c in 1..axis.n().saturating_sub(1) {
+                let (a, b) = (axis.column_level(c - 1), axis.column_level(c));
+                if a.abs_diff(b) > 1 {
+                    return Err(format!(
+                        "{name}-columns {} and {c} differ by {} halvings",
+                        c - 1,
+                        a.abs_diff(b)
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// Vertices along u and v.
     pub fn counts(&self) -> (usize, usize) {
         (self.u.n(), self.v.n())

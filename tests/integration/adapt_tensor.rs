@@ -168,6 +168,7 @@ fn a_flattened_sheet_returns_to_the_base_grid() {
         w.x = w.mesh.material.iter().map(|p| p.extend(0.0)).collect();
         let mut passes = 0;
         while ad.pass(&mut w, 10 + passes).unwrap() {
+            ad.check(&w).expect("consistent after the pass");
             passes += 1;
             assert!(
                 passes <= 3,
@@ -201,6 +202,7 @@ fn neighbouring_columns_differ_by_one_halving() {
         let at = if step < 2 { 0.0 } else { 0.0625 };
         w.x = w.mesh.material.iter().map(|&p| crease(at)(p)).collect();
         ad.pass(&mut w, step).unwrap();
+        ad.check(&w).expect("consistent after the pass");
         let (u, _) = ad.tensor_grid().unwrap().lines();
         let widths: Vec<Scalar> = u.windows(2).map(|p| p[1] - p[0]).collect();
         println!("pass {step}, crease at {at}: column widths {widths:?}");
@@ -266,4 +268,33 @@ method = "tensor"
         e.to_string()
             .contains("needs the grid of a generated rectangle")
     );
+}
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(24))]
+    /// Random sequences of creases (where, which way, how sharp) and flat
+    /// passes: after every pass the world's mesh is the grid of the kept
+    /// lines (vertices, triangles, diagonals), neighbouring columns differ by
+    /// one halving at most, and the mesh passes the consistency checks.
+    #[test]
+    fn random_passes_keep_the_mesh_the_grid(
+        creases in proptest::collection::vec((-0.45f64..0.45, proptest::bool::ANY, 0.0f64..1.2), 1..8),
+        alternating in proptest::bool::ANY,
+    ) {
+        let pattern = if alternating { DiagonalPattern::Alternating } else { DiagonalPattern::Regular };
+        let mut w = sheet(6, 3, pattern, |p: Vector2| p.extend(0.0));
+        let mut ad = Adapter::new(tensor_config(5.0, 6), &w, DENSITY).expect("a grid");
+        for (step, &(at, along_u, angle)) in creases.iter().enumerate() {
+            let fold = |p: Vector2| {
+                let (s, t) = if along_u { (p.x, p.y) } else { (p.y, p.x) };
+                let d = (s - at).max(0.0);
+                let (bent_s, z) = (s.min(at) + d * angle.cos(), d * angle.sin());
+                if along_u { Vector::new(bent_s, t, z) } else { Vector::new(t, bent_s, z) }
+            };
+            w.x = w.mesh.material.iter().map(|&p| fold(p)).collect();
+            ad.pass(&mut w, step as u64).unwrap();
+            let checked = ad.check(&w);
+            proptest::prop_assert!(checked.is_ok(), "pass {}: {:?}", step, checked);
+        }
+    }
 }
