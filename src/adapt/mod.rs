@@ -72,11 +72,13 @@ pub struct AdaptEvent {
 /// Counters over a run.
 #[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
 pub struct AdaptStats {
-    /// 1-4 splits (asked for and forced).
+    /// 1-4 splits (asked for and forced); with the tensor method, grid lines
+    /// inserted.
     pub splits: u64,
     /// Of those, forced by closure or 1-irregularity.
     pub closure_splits: u64,
-    /// Merges (red_green) or edge collapses (edge).
+    /// Merges (red_green), edge collapses (edge) or grid lines removed
+    /// (tensor).
     pub merges: u64,
     /// Edge flips (edge method).
     pub flips: u64,
@@ -131,7 +133,7 @@ impl AdaptStats {
 /// Adaptivity settings (the scene's `[adapt]`, resolved).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AdaptConfig {
-    /// The remeshing method (`red_green` or `edge`).
+    /// The remeshing method (`red_green`, `edge` or `tensor`).
     pub method: AdaptMethod,
     /// Upper threshold, degrees.
     pub refine_angle: Scalar,
@@ -372,13 +374,18 @@ impl Adapter {
     /// mesh and moves the world onto it. Atomic: if the world cannot take the
     /// new mesh, the hierarchy's operations are undone (newest first, see
     /// [`RedGreen::undo`]) and the world, the counters and the events stay as
-    /// they were.
+    /// they were. Red-green only: panics on an adapter of the tensor method,
+    /// whose grid the operations would leave out of step with the world.
     pub fn apply(
         &mut self,
         world: &mut World,
         ops: &[(RedGreenOp, Option<Scalar>)],
         step: u64,
     ) -> Result<bool, MeshError> {
+        assert!(
+            self.tensor.is_none(),
+            "red-green operations on an adapter of the tensor method"
+        );
         let mut applied: Vec<Applied> = Vec::new();
         let plain: Vec<RedGreenOp> = ops.iter().map(|o| o.0).collect();
         self.hierarchy.apply(&plain, &mut applied);

@@ -24,32 +24,41 @@
 //! not a falling tablecloth. Cells of different sizes meet only across grid
 //! lines (there are no hanging nodes).
 //!
-//! The measure along u at a vertex is the turn of its grid line there: the
-//! angle `phi` between the two segments of the row through it (the same
-//! along v with the column). With the angle criterion a column splits where
-//! `phi` at one of its two bounding lines exceeds `refine_angle` and a line
-//! goes where `phi` at it and at its two neighbours is below `coarsen_angle`
-//! (and half `refine_angle`), as the papers' criterion on dihedral angles.
-//! With the sizing criterion (`sizing.rs`) the curvature is `kappa = phi /
-//! hbar` (`hbar` the mean of the two segments' material lengths), a column of
-//! width `h` splits where `kappa h > refine_angle`, and a line goes where its
-//! parent column `H = 2 h` would carry `kappa H <= refine_angle / hysteresis`,
-//! `kappa` the largest at the three lines. A row or column is judged by its
-//! largest value over the whole sheet. Adjacent columns (rows) differ by at
-//! most one halving (a split forces the split of a coarser neighbour, and a
-//! removal that would break it is refused), so neighbouring cells differ in
-//! width by a factor of two at most. Levels follow paper A's count: a halving
-//! adds 2, and `max_level` allows `max_level / 2` halvings either way; a
+//! The measure along u at a vertex is the bend of its grid line there: the
+//! angle `phi` between the two segments of the row through it, counting only
+//! the part of the turn about an axis in the surface (the surface normal at
+//! the vertex is the cross product of the row's and the column's chords), so
+//! that a line curving within the surface under shear or uneven stretch is
+//! not a bend (along v the same with the column). With the angle criterion
+//! a column splits where `phi` at one of its two bounding lines exceeds
+//! `refine_angle` and a line goes where `phi` at it and at its two
+//! neighbours is below `coarsen_angle` (and half `refine_angle`), as the
+//! papers' criterion does with dihedral angles. With the sizing criterion
+//! (`sizing.rs`) the curvature is `kappa = phi / hbar` (`hbar` the mean of
+//! the two segments' material lengths), a column of width `h` splits where
+//! `kappa h > refine_angle`, and a line goes where its parent column `H = 2
+//! h` would carry `kappa H <= refine_angle / hysteresis`, `kappa` the
+//! largest at the three lines. A row or column is judged by its largest
+//! value over the whole sheet. Adjacent columns (rows) differ by at most one
+//! halving: a split that would leave a neighbour two halvings coarser splits
+//! that neighbour too (a forced split), and a removal that would leave one
+//! two halvings finer is refused. So neighbouring cells differ in width by a
+//! factor of two at most. Levels follow paper A's count: a halving adds 2,
+//! and `max_level` (even) allows `max_level / 2` halvings either way; a
 //! triangle's level is that of its finer direction.
 //!
 //! A sheet with one cell across a direction has no interior line there to
 //! measure, so it is never refined that way (the cantilever with
 //! `cloth.short_side_segments = 1`: exactly what it needs).
 
+mod axis;
+
 use crate::math::{Scalar, Vector, Vector2};
 use crate::mesh::Mesh;
 
 use super::transfer::{Origin, Remeshed};
+use axis::{Axis, Line, Source};
+pub(super) use axis::{AxisOps, Thresholds};
 
 /// The mesh given to [`TensorGrid::from_mesh`] is not a rectangle's grid.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -57,180 +66,6 @@ use super::transfer::{Origin, Remeshed};
     "adapt.method = \"tensor\" needs the grid of a generated rectangle (shape = \"rectangle\"): {0}"
 )]
 pub struct NotAGrid(pub String);
-
-/// A grid line: its material coordinate and how many halvings made it (0 for
-/// the base grid's lines).
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct Line {
-    at: Scalar,
-    level: u8,
-}
-
-/// Where a line of the grid after a pass comes from.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Source {
-    /// Line `i` of the grid before the pass.
-    Old(usize),
-    /// Inserted between the old lines `i` and `i + 1`.
-    Between(usize),
-}
-
-/// The lines of one axis, in increasing order.
-#[derive(Debug, Clone, PartialEq)]
-struct Axis {
-    lines: Vec<Line>,
-}
-
-/// What a pass does on one axis.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub(super) struct AxisOps {
-    /// Columns (between line `c` and `c + 1`) to halve, with the measure that
-    /// asked for it (radians for the angle criterion, `kappa h` for the
-    /// sizing one) or `None` for a split forced by the one-halving rule.
-    pub(super) splits: Vec<(usize, Option<Scalar>)>,
-    /// Lines to remove.
-    pub(super) merges: Vec<usize>,
-}
-
-/// The thresholds of a pass, in radians.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(super) struct Thresholds {
-    /// Sizing (`kappa h` against `refine`) or angle (`phi` against both).
-    pub(super) sizing: bool,
-    /// Upper threshold.
-    pub(super) refine: Scalar,
-    /// Lower threshold (angle criterion) or `refine / hysteresis` (sizing).
-    pub(super) coarsen: Scalar,
-    /// Halvings allowed.
-    pub(super) max_halvings: u8,
-    /// Shortest cell side a split may make, m (0: no limit).
-    pub(super) min_edge: Scalar,
-}
-
-impl Axis {
-    fn n(&self) -> usize {
-        self.lines.len()
-    }
-
-    /// Level of the column between lines `c` and `c + 1`.
-    fn column_level(&self, c: usize) -> u8 {
-        self.lines[c].level.max(self.lines[c + 1].level)
-    }
-
-    fn width(&self, c: usize) -> Scalar {
-        self.lines[c + 1].at - self.lines[c].at
-    }
-
-    /// Whether line `m` halved its parent column (both neighbours coarser).
-    fn removable(&self, m: usize) -> bool {
-        m > 0
-            && m + 1 < self.n()
-            && self.lines[m].level > self.lines[m - 1].level
-            && self.lines[m].level > self.lines[m + 1].level
-    }
-
-    /// The operations of a pass given the largest measure at each line (`phi`
-    /// or `kappa`; zero at the two boundary lines, which have none).
-    fn marks(&self, at_line: &[Scalar], th: &Thresholds) -> AxisOps {
-        let cols = self.n() - 1;
-        let mut level: Vec<u8> = (0..cols).map(|c| self.column_level(c)).collect();
-        let mut split: Vec<Option<Option<Scalar>>> = vec![None; cols];
-        for c in 0..cols {
-            let demand = at_line[c].max(at_line[c + 1]);
-            let measure = if th.sizing {
-                demand * self.width(c)
-            } else {
-                demand
-            };
-            if measure > th.refine && self.can_split(c, th) {
-                split[c] = Some(Some(measure));
-                level[c] += 1;
-            }
-        }
-        // One halving between neighbours: split the coarser one.
-        loop {
-            let mut changed = false;
-            for c in 0..cols {
-                for n in [c.wrapping_sub(1), c + 1] {
-                    if n < cols && level[c] > level[n] + 1 && split[n].is_none() {
-                        split[n] = Some(None);
-                        level[n] += 1;
-                        changed = true;
-                    }
-                }
-            }
-            if !changed {
-                break;
-            }
-        }
-        let mut ops = AxisOps {
-            splits: (0..cols).filter_map(|c| split[c].map(|m| (c, m))).collect(),
-            merges: Vec::new(),
-        };
-        for m in (1..self.n() - 1).filter(|&m| self.removable(m)) {
-            if split[m - 1].is_some() || split[m].is_some() {
-                continue;
-            }
-            let demand = at_line[m - 1].max(at_line[m]).max(at_line[m + 1]);
-            let parent = self.lines[m - 1].level.max(self.lines[m + 1].level);
-            let measure = if th.sizing {
-                demand * (self.lines[m + 1].at - self.lines[m - 1].at)
-            } else {
-                demand
-            };
-            let flat = if th.sizing {
-                measure <= th.coarsen
-            } else {
-                measure < th.coarsen && measure < 0.5 * th.refine
-            };
-            // The columns beyond the parent (after this pass's splits) may be
-            // at most one halving finer than it.
-            let balanced = (m < 2 || level[m - 2] <= parent + 1)
-                && (m + 1 >= cols || level[m + 1] <= parent + 1);
-            if flat && balanced {
-                ops.merges.push(m);
-            }
-        }
-        // No two removals are neighbours (a removable line's neighbours are
-        // coarser than it, so not removable), so each parent is judged against
-        // columns no removal of this pass changes, except to coarsen them.
-        ops
-    }
-
-    fn can_split(&self, c: usize, th: &Thresholds) -> bool {
-        self.column_level(c) < th.max_halvings
-            && (th.min_edge <= 0.0 || 0.5 * self.width(c) >= th.min_edge)
-    }
-
-    /// Applies `ops`: the new lines and where each comes from.
-    fn apply(&mut self, ops: &AxisOps) -> Vec<Source> {
-        let mut split = vec![false; self.n()];
-        for &(c, _) in &ops.splits {
-            split[c] = true;
-        }
-        let mut merged = vec![false; self.n()];
-        for &m in &ops.merges {
-            merged[m] = true;
-        }
-        let mut lines = Vec::with_capacity(self.n() + ops.splits.len());
-        let mut source = Vec::with_capacity(lines.capacity());
-        for i in 0..self.n() {
-            if !merged[i] {
-                lines.push(self.lines[i]);
-                source.push(Source::Old(i));
-            }
-            if i + 1 < self.n() && split[i] {
-                lines.push(Line {
-                    at: 0.5 * (self.lines[i].at + self.lines[i + 1].at),
-                    level: self.column_level(i) + 1,
-                });
-                source.push(Source::Between(i));
-            }
-        }
-        self.lines = lines;
-        source
-    }
-}
 
 /// A rectangle's grid as two axes of lines; vertex `j * nu + i` of the world's
 /// mesh sits at u-line `i` and v-line `j`.
@@ -244,7 +79,8 @@ pub struct TensorGrid {
 impl TensorGrid {
     /// The grid of a mesh made by `mesh::rectangle_cells` (vertices row by row
     /// along u, each cell split by one diagonal, all the same way or
-    /// alternating); anything else is refused.
+    /// alternating); anything else is refused. The pattern is read from the
+    /// triangles; a single cell matches both and is taken as alternating.
     pub fn from_mesh(mesh: &Mesh) -> Result<TensorGrid, NotAGrid> {
         let coords = |f: fn(&Vector2) -> Scalar| {
             let mut c: Vec<Scalar> = mesh.material.iter().map(f).collect();
@@ -290,10 +126,11 @@ impl TensorGrid {
         ))
     }
 
-    /// Checks that `mesh` is this grid: its vertices the grid's nodes in row
-    /// order and its triangles the grid's cells with their diagonals, and
-    /// that every line that is not a base line halves its parent column
-    /// (the one-halving rule between neighbouring columns included).
+    /// Checks that `mesh` is this grid (its vertices the grid's nodes in row
+    /// order, its triangles the grid's cells with their diagonals), that every
+    /// line that is not a base line sits at the middle of its parent column
+    /// (between the nearest coarser lines) one level finer than it, and that
+    /// neighbouring columns differ by one halving at most.
     pub fn check(&self, mesh: &Mesh) -> Result<(), String> {
         let nu = self.u.n();
         if mesh.vertex_count() != nu * self.v.n() {
@@ -317,6 +154,25 @@ impl TensorGrid {
             for c in 0..axis.n() - 1 {
                 if axis.width(c) <= 0.0 {
                     return Err(format!("{name}-lines {c} and {} out of order", c + 1));
+                }
+            }
+            // A line of level L halves the column between the nearest lines
+            // of lower level on either side, whose level is L - 1.
+            for (m, line) in axis.lines.iter().enumerate().filter(|(_, l)| l.level > 0) {
+                let coarser = |k: &usize| axis.lines[*k].level < line.level;
+                let (l, r) = ((0..m).rev().find(coarser), (m + 1..axis.n()).find(coarser));
+                let (Some(l), Some(r)) = (l, r) else {
+                    return Err(format!(
+                        "{name}-line {m} (level {}) has no parent column",
+                        line.level
+                    ));
+                };
+                let (a, b) = (axis.lines[l], axis.lines[r]);
+                if line.at != 0.5 * (a.at + b.at) || line.level != a.level.max(b.level) + 1 {
+                    return Err(format!(
+                        "{name}-line {m} at {} (level {}) does not halve lines {l} and {r} at {} and {} (levels {}, {})",
+                        line.at, line.level, a.at, b.at, a.level, b.level
+                    ));
                 }
             }
             for c in 1..axis.n().saturating_sub(1) {
@@ -388,21 +244,33 @@ impl TensorGrid {
     }
 
     /// The largest measure at each line of both axes, from the world's
-    /// positions `x` (row order): the turn `phi` of the grid lines through
-    /// it, or with `sizing` the curvature `phi / hbar`.
+    /// positions `x` (row order): the angle by which the grid lines through
+    /// it bend out of the surface there, or with `sizing` that angle over the
+    /// mean length of the two segments (a curvature). The surface normal at a
+    /// vertex is the cross product of the two lines' chords through it (one
+    /// sided at the boundary), and only the part of the turn about an axis in
+    /// the surface counts: a line curving within the surface (shear, uneven
+    /// stretch) is not a bend.
     pub(super) fn measures(&self, x: &[Vector], sizing: bool) -> (Vec<Scalar>, Vec<Scalar>) {
         let (nu, nv) = (self.u.n(), self.v.n());
+        let normal = |i: usize, j: usize| {
+            let at = |i: usize, j: usize| x[j * nu + i];
+            let du = at((i + 1).min(nu - 1), j) - at(i.saturating_sub(1), j);
+            let dv = at(i, (j + 1).min(nv - 1)) - at(i, j.saturating_sub(1));
+            du.cross(dv).normalize_or_zero()
+        };
+        let bend = |p: Vector, q: Vector, r: Vector, n: Vector| {
+            let (a, b) = (q - p, r - q);
+            let c = a.cross(b);
+            (c - n * c.dot(n)).length().atan2(a.dot(b))
+        };
         let mut at_u = vec![0.0; nu];
         let mut at_v = vec![0.0; nv];
-        let turn = |p: Vector, q: Vector, r: Vector| {
-            let (a, b) = (q - p, r - q);
-            a.cross(b).length().atan2(a.dot(b))
-        };
         for (i, slot) in at_u.iter_mut().enumerate().take(nu - 1).skip(1) {
             let hbar = 0.5 * (self.u.lines[i + 1].at - self.u.lines[i - 1].at);
             for j in 0..nv {
                 let k = j * nu + i;
-                let m = turn(x[k - 1], x[k], x[k + 1]);
+                let m = bend(x[k - 1], x[k], x[k + 1], normal(i, j));
                 *slot = Scalar::max(*slot, if sizing { m / hbar } else { m });
             }
         }
@@ -410,7 +278,7 @@ impl TensorGrid {
             let hbar = 0.5 * (self.v.lines[j + 1].at - self.v.lines[j - 1].at);
             for i in 0..nu {
                 let k = j * nu + i;
-                let m = turn(x[k - nu], x[k], x[k + nu]);
+                let m = bend(x[k - nu], x[k], x[k + nu], normal(i, j));
                 *slot = Scalar::max(*slot, if sizing { m / hbar } else { m });
             }
         }

@@ -13,10 +13,11 @@ use crate::world::World;
 impl Adapter {
     /// One pass of the tensor method on `world` after step `step`; true when
     /// the mesh changed. Atomic: if the world refuses the new mesh, the grid,
-    /// the world, the counters and the events stay as they were.
+    /// the world, the events and the counters other than `passes` stay as
+    /// they were.
     pub(super) fn tensor_pass(&mut self, world: &mut World, step: u64) -> Result<bool, MeshError> {
         let Some(grid) = self.tensor.as_mut() else {
-            return Ok(false);
+            unreachable!("the tensor pass runs on an adapter with a tensor grid");
         };
         let c = &self.config;
         let sizing = c.criterion == AdaptCriterion::Sizing;
@@ -33,7 +34,7 @@ impl Adapter {
             min_edge: c.min_edge_length,
         };
         self.stats.passes += 1;
-        debug_assert_eq!(
+        assert_eq!(
             grid.counts().0 * grid.counts().1,
             world.x.len(),
             "tensor grid out of step with the world"
@@ -42,8 +43,10 @@ impl Adapter {
         let ops = grid.marks(&measures, &th);
         let count =
             ops.0.splits.len() + ops.0.merges.len() + ops.1.splits.len() + ops.1.merges.len();
+        // The finest level a triangle can reach (levels are even here).
+        let top = 2 * (c.max_level / 2);
         if count == 0 {
-            self.stats.note_levels(world, c.max_level);
+            self.stats.note_levels(world, top);
             return Ok(false);
         }
         let events = line_events(world, grid.counts().0, &ops, grid, step);
@@ -66,7 +69,7 @@ impl Adapter {
         self.events.extend(events);
         self.stats.changed_passes += 1;
         self.stats.max_ops_per_pass = self.stats.max_ops_per_pass.max(count as u64);
-        self.stats.note_levels(world, self.config.max_level);
+        self.stats.note_levels(world, top);
         self.debug_check(world);
         Ok(true)
     }

@@ -83,7 +83,7 @@ pub(crate) fn allowed(path: &str) -> Option<&'static str> {
         "adapt.method" => "\"red_green\", \"edge\", \"tensor\" (rectangles only) or \"none\"",
         "adapt.refine_angle" => "a finite number of degrees in (coarsen_angle, 180)",
         "adapt.coarsen_angle" => "a finite number of degrees in (0, refine_angle)",
-        "adapt.max_level" => "an integer >= 1 (at most 254)",
+        "adapt.max_level" => "an integer >= 1 (at most 254; even with method = \"tensor\")",
         "adapt.min_edge_length" => "a finite number >= 0 (m, material space; 0: no limit)",
         "adapt.every" => "an integer >= 1 (steps) or \"frame\"",
         "adapt.rollback" => "true or false",

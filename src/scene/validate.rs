@@ -40,7 +40,12 @@ pub(crate) fn validate(scene: &Scene, doc: &Table) -> Result<(), Issue> {
         super::validate_collide::self_collision(s)?;
     }
     if let Some(a) = &scene.adapt {
-        super::validate_adapt::adapt(a, scene.simulation.integrator, scene.cloth.shape)?;
+        super::validate_adapt::adapt(
+            a,
+            scene.simulation.integrator,
+            scene.cloth.shape,
+            scene.material.stiffness_rule,
+        )?;
     }
     Ok(())
 }

@@ -3,10 +3,17 @@
 
 use super::error::{Issue, SceneErrorKind as Kind, keys, num};
 use super::validate::{finite, non_negative, out_of_range, positive};
-use super::{Adapt, AdaptCriterion, AdaptEvery, AdaptMethod, ClothShape, Integrator};
+use super::{
+    Adapt, AdaptCriterion, AdaptEvery, AdaptMethod, ClothShape, Integrator, StiffnessRule,
+};
 
 /// The `[adapt]` table's ranges and the keys that do not apply to its settings.
-pub(super) fn adapt(a: &Adapt, integrator: Integrator, shape: ClothShape) -> Result<(), Issue> {
+pub(super) fn adapt(
+    a: &Adapt,
+    integrator: Integrator,
+    shape: ClothShape,
+    stiffness: StiffnessRule,
+) -> Result<(), Issue> {
     let angle = |key: &str, x: f64| -> Result<(), Issue> {
         positive(keys(&["adapt", key]), x)?;
         if x >= 180.0 {
@@ -50,7 +57,7 @@ pub(super) fn adapt(a: &Adapt, integrator: Integrator, shape: ClothShape) -> Res
         ));
     }
     if a.method == AdaptMethod::Tensor {
-        tensor(a, shape)?;
+        tensor(a, shape, stiffness)?;
     }
     if a.multirate && integrator == Integrator::Implicit {
         let path = keys(&["adapt", "multirate"]);
@@ -60,22 +67,39 @@ pub(super) fn adapt(a: &Adapt, integrator: Integrator, shape: ClothShape) -> Res
     criterion(a)
 }
 
-/// The tensor method works on a rectangle's grid, without paper A's rollback
-/// and multirate stepping (built for red-green's levels).
-fn tensor(a: &Adapt, shape: ClothShape) -> Result<(), Issue> {
+/// The tensor method works on a rectangle's grid, with an even `max_level`
+/// (a halving adds 2), without paper A's rollback, multirate stepping and
+/// level-scaled stiffness (built for red-green's levels, where a level is
+/// the same along both axes; a tensor cell may be halved one way only).
+fn tensor(a: &Adapt, shape: ClothShape, stiffness: StiffnessRule) -> Result<(), Issue> {
     if shape != ClothShape::Rectangle {
         let path = keys(&["adapt", "method"]);
         let why = "method = \"tensor\" refines the grid of a rectangle and needs cloth.shape = \"rectangle\"";
         return Err(Issue::new(path, Kind::NotApplicable, why));
     }
-    for (key, on) in [("rollback", a.rollback), ("multirate", a.multirate)] {
-        if on {
-            let path = keys(&["adapt", key]);
-            let why = format!(
-                "{key} is paper A's and works with method = \"red_green\" (and multirate also \"edge\"), not \"tensor\""
-            );
-            return Err(Issue::new(path, Kind::NotApplicable, why));
-        }
+    if !a.max_level.is_multiple_of(2) {
+        return Err(out_of_range(
+            keys(&["adapt", "max_level"]),
+            format!(
+                "{} is odd: with method = \"tensor\" each halving of a column or row adds 2, so max_level must be even (2 for one halving)",
+                a.max_level
+            ),
+        ));
+    }
+    if a.rollback {
+        let path = keys(&["adapt", "rollback"]);
+        let why = "rollback is paper A's and works with method = \"red_green\" only";
+        return Err(Issue::new(path, Kind::NotApplicable, why));
+    }
+    if a.multirate {
+        let path = keys(&["adapt", "multirate"]);
+        let why = "multirate stepping works on the levels of method = \"red_green\" or \"edge\", not \"tensor\"";
+        return Err(Issue::new(path, Kind::NotApplicable, why));
+    }
+    if stiffness == StiffnessRule::PaperA {
+        let path = keys(&["material", "stiffness_rule"]);
+        let why = "stiffness_rule = \"paper_a\" scales springs by red-green's levels; with method = \"tensor\" a cell halved along one axis only would stiffen its other edges too (use \"consistent\")";
+        return Err(Issue::new(path, Kind::NotApplicable, why));
     }
     Ok(())
 }
@@ -85,7 +109,7 @@ fn tensor(a: &Adapt, shape: ClothShape) -> Result<(), Issue> {
 fn criterion(a: &Adapt) -> Result<(), Issue> {
     if a.diagonals.is_some() && a.method != AdaptMethod::RedGreen {
         let path = keys(&["adapt", "diagonals"]);
-        let why = "diagonals belongs to method = \"red_green\" (the edge method splits edges one at a time)";
+        let why = "diagonals belongs to method = \"red_green\" (the edge method splits edges one at a time; the tensor method keeps the cloth's own `diagonals`)";
         return Err(Issue::new(path, Kind::NotApplicable, why));
     }
     if let Some(s) = a.refine_strain {

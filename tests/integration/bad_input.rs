@@ -361,6 +361,41 @@ fn refine_strain_needs_the_sizing_rule_on_red_green_and_a_positive_value() {
     );
 }
 
+/// The tensor method (`src/adapt/tensor.rs`) refines a rectangle's grid,
+/// with an even `max_level`, and without rollback, multirate stepping or
+/// level-scaled stiffness.
+#[test]
+fn the_tensor_method_refuses_what_it_cannot_do() {
+    accepted_sets("tensor", &["adapt.method=\"tensor\""]);
+    for (set, why) in [
+        (
+            "adapt.rollback=true",
+            "rollback is paper A's and works with method = \"red_green\" only",
+        ),
+        (
+            "adapt.multirate=true",
+            "multirate stepping works on the levels of method = \"red_green\" or \"edge\", not \"tensor\"",
+        ),
+        (
+            "adapt.max_level=5",
+            "5 is odd: with method = \"tensor\" each halving of a column or row adds 2",
+        ),
+        (
+            "material.stiffness_rule=\"paper_a\"",
+            "stiffness_rule = \"paper_a\" scales springs by red-green's levels",
+        ),
+    ] {
+        refused_with("tensor", set, "adapt.method=\"tensor\"", why);
+    }
+    refused_file(
+        b"name = \"t\"\n[simulation]\nduration = 0.1\n[cloth]\nshape = \"disk\"\nradius = 0.5\nresolution = 8\n[material]\ndensity = 0.15\nstretch = 200.0\n[adapt]\nmethod = \"tensor\"\n",
+        &[
+            "bad.toml:12: key `adapt.method`",
+            "needs cloth.shape = \"rectangle\"",
+        ],
+    );
+}
+
 #[test]
 fn red_green_diagonals_are_named_and_belong_to_red_green() {
     accepted_sets(
