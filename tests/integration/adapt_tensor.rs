@@ -407,7 +407,7 @@ fn pins_min_edge_and_events() {
     let (u, _) = ad.tensor_grid().unwrap().lines();
     let narrowest = u.windows(2).map(|p| p[1] - p[0]).fold(1.0, Scalar::min);
     println!("{} u-lines, narrowest column {narrowest} m", u.len());
-    assert!(narrowest >= 0.05 - 1e-12 && narrowest < 0.1, "{narrowest}");
+    assert!((0.05 - 1e-12..0.1).contains(&narrowest), "{narrowest}");
     let events = ad.take_events();
     let asked: Vec<_> = events
         .iter()
