@@ -40,6 +40,11 @@ fn bent_along_u(r: Scalar) -> impl Fn(Vector2) -> Vector {
     }
 }
 
+/// Puts every vertex of `w` at `shape` of its material point.
+fn shape_world(w: &mut World, shape: impl Fn(Vector2) -> Vector) {
+    w.x = w.mesh.material.iter().map(|&p| shape(p)).collect();
+}
+
 /// Each world position's height interpolated linearly on `old` at material
 /// point `p`: the old mesh's surface there (`None` if no triangle holds it).
 fn on_surface(old: &Mesh, x: &[Vector], p: Vector2) -> Option<Vector> {
@@ -132,7 +137,7 @@ fn refined_everywhere_it_is_the_uniform_grid() {
         let mut w = sheet(4, 2, pattern, bowl);
         let mut ad = Adapter::new(tensor_config(0.5, 4), &w, DENSITY).expect("a grid");
         for step in 0..4 {
-            w.x = w.mesh.material.iter().map(|&p| bowl(p)).collect();
+            shape_world(&mut w, bowl);
             ad.pass(&mut w, step).unwrap();
         }
         let uniform = mesh::rectangle_cells(1.0, 0.5, 16, Some(8), pattern).unwrap();
@@ -156,12 +161,7 @@ fn a_flattened_sheet_returns_to_the_base_grid() {
         let base = w.mesh.clone();
         let mut ad = Adapter::new(config, &w, DENSITY).expect("a grid");
         for step in 0..3 {
-            w.x = w
-                .mesh
-                .material
-                .iter()
-                .map(|&p| bent_along_u(0.2)(p))
-                .collect();
+            shape_world(&mut w, bent_along_u(0.2));
             ad.pass(&mut w, step).unwrap();
         }
         let refined = w.mesh.vertex_count();
@@ -200,7 +200,7 @@ fn neighbouring_columns_differ_by_one_halving() {
     let mut ad = Adapter::new(tensor_config(1.0, 8), &w, DENSITY).expect("a grid");
     for step in 0..6 {
         let at = if step < 2 { 0.0 } else { 0.0625 };
-        w.x = w.mesh.material.iter().map(|&p| crease(at)(p)).collect();
+        shape_world(&mut w, crease(at));
         ad.pass(&mut w, step).unwrap();
         ad.check(&w).expect("consistent after the pass");
         let (u, _) = ad.tensor_grid().unwrap().lines();
@@ -323,7 +323,7 @@ proptest::proptest! {
                 let (bent_s, z) = (s.min(at) + d * angle.cos(), d * angle.sin());
                 if along_u { Vector::new(bent_s, t, z) } else { Vector::new(t, bent_s, z) }
             };
-            w.x = w.mesh.material.iter().map(|&p| fold(p)).collect();
+            shape_world(&mut w, fold);
             let (old, old_x) = (w.mesh.clone(), w.x.clone());
             ad.pass(&mut w, step as u64).unwrap();
             for (i, p) in w.mesh.material.iter().enumerate() {
@@ -356,7 +356,7 @@ fn a_flat_sheet_distorted_in_its_plane_does_not_refine() {
         let q = swirl(p);
         Vector::new(q.x, 0.3 * q.y.sin(), 0.3 * (1.0 - q.y.cos()))
     };
-    w.x = w.mesh.material.iter().map(|&p| rolled(p)).collect();
+    shape_world(&mut w, rolled);
     assert!(ad.pass(&mut w, 1).unwrap());
 }
 
@@ -391,12 +391,7 @@ fn pins_min_edge_and_events() {
         .collect();
     let mut ad = Adapter::new(config, &w, DENSITY).expect("a grid");
     for step in 0..4 {
-        w.x = w
-            .mesh
-            .material
-            .iter()
-            .map(|&p| bent_along_u(0.2)(p))
-            .collect();
+        shape_world(&mut w, bent_along_u(0.2));
         ad.pass(&mut w, step).unwrap();
         assert_eq!(
             pinned_top(&w),

@@ -377,6 +377,21 @@ fn settle_across(overhang: Scalar, res: u32, across: u32, mat: &MaterialParams) 
     settle_on(&m, &mut x, mat, overhang)
 }
 
+/// The large-deflection strip of the shape operator with consistent
+/// stiffness: its bending length `c` (the overhang is `2 c`), its material,
+/// and the exact elastica's chord angle, degrees.
+fn large_strip() -> (Scalar, MaterialParams, Scalar) {
+    let bending = 1e-5;
+    let c = (bending / (RHO * G)).cbrt();
+    let mat = strip_material(
+        bending,
+        BendingModel::ShapeOperator,
+        StiffnessRule::Consistent,
+    );
+    let (drop, reach) = heavy_elastica(8.0);
+    (c, mat, drop.atan2(reach).to_degrees())
+}
+
 /// `cloth.short_side_segments`: a strip that bends along its length needs no
 /// cells across it. Measured (shape operator, consistent stiffness, 32 cells
 /// along the overhang): square cells (8 across, 333 vertices) 41.5173 deg, 2
@@ -387,15 +402,7 @@ fn settle_across(overhang: Scalar, res: u32, across: u32, mat: &MaterialParams) 
 /// wrong way round).
 #[test]
 fn a_strip_one_cell_wide_bends_like_one_with_square_cells() {
-    let bending = 1e-5;
-    let c = (bending / (RHO * G)).cbrt();
-    let mat = strip_material(
-        bending,
-        BendingModel::ShapeOperator,
-        StiffnessRule::Consistent,
-    );
-    let (drop, reach) = heavy_elastica(8.0);
-    let exact = drop.atan2(reach).to_degrees();
+    let (c, mat, exact) = large_strip();
     let square = settle(2.0 * c, 32, &mat);
     println!(
         "square cells: chord angle {:.4} deg ({} vertices), elastica {exact:.4} deg",
@@ -430,15 +437,7 @@ fn a_strip_one_cell_wide_bends_like_one_with_square_cells() {
 /// graded cells bent differently from uniform ones.
 #[test]
 fn a_tensor_refined_strip_bends_like_the_uniform_one() {
-    let bending = 1e-5;
-    let c = (bending / (RHO * G)).cbrt();
-    let mat = strip_material(
-        bending,
-        BendingModel::ShapeOperator,
-        StiffnessRule::Consistent,
-    );
-    let (drop, reach) = heavy_elastica(8.0);
-    let exact = drop.atan2(reach).to_degrees();
+    let (c, mat, exact) = large_strip();
     let uniform = settle_across(2.0 * c, 32, 1, &mat);
     let base = settle_across(2.0 * c, 8, 1, &mat);
     let tensor = settle_tensor(2.0 * c, 8, 1.0, &mat);
