@@ -49,7 +49,7 @@ impl Adapter {
             self.stats.note_levels(world, top);
             return Ok(false);
         }
-        let events = line_events(world, grid.counts().0, &ops, grid, step);
+        let events = line_events(world, &ops, grid, step);
         let before = grid.clone();
         let remeshed = grid.apply(&ops);
         if let Err(e) = transfer(world, self.density, remeshed) {
@@ -86,12 +86,11 @@ impl Adapter {
 /// the angle criterion and as `kappa h` in degrees for the sizing one.
 fn line_events(
     world: &World,
-    nu: usize,
     ops: &(AxisOps, AxisOps),
     grid: &super::tensor::TensorGrid,
     step: u64,
 ) -> Vec<AdaptEvent> {
-    let nv = world.x.len() / nu;
+    let (nu, nv) = grid.counts();
     let mean_u = |lines: &[usize]| {
         let s: Vector = (0..nv)
             .flat_map(|j| lines.iter().map(move |&i| world.x[j * nu + i]))
