@@ -219,7 +219,12 @@ fn describe_adapt(s: &mut String, scene: &Scene, a: &AdaptConfig) {
                 a.refine_angle,
                 a.refine_strain
                     .map(|j| format!(" or the strain jumps by more than {j} at an edge"))
-                    .unwrap_or_default(),
+                    .unwrap_or_default()
+                    + &a.refine_obstacle
+                        .map(|r| format!(
+                            " or an edge leans towards an obstacle by more than {r} of its height"
+                        ))
+                        .unwrap_or_default(),
                 a.refine_angle / a.hysteresis,
                 a.hysteresis
             ),

@@ -323,6 +323,12 @@ pub struct Adapt {
     /// "Strain jumps".
     #[serde(default)]
     pub refine_strain: Option<f64>,
+    /// Sizing criterion with red-green only: also split a leaf where one of its
+    /// edges leans towards the nearest obstacle by more than this fraction of
+    /// its height above it (dimensionless); absent: no obstacle term. See
+    /// `src/adapt/proximity.rs`.
+    #[serde(default)]
+    pub refine_obstacle: Option<f64>,
     /// Red-green only: how the children of red splits are triangulated
     /// (absent: [`RedDiagonals::Alternating`]). See `src/adapt/red_green/mesh.rs`,
     /// "Alternating diagonals".

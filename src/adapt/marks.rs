@@ -98,7 +98,7 @@ impl Adapter {
             return Vec::new(); // rollback is paper A's, with red_green only
         }
         if self.config.criterion == AdaptCriterion::Sizing {
-            return self.sizing_refinement_marks(&self.leaf_curvatures(world, angles));
+            return self.sizing_refinement_marks(&self.leaf_curvatures(world, angles, &[]));
         }
         let mut marks: Vec<(u32, Scalar)> = Vec::new();
         for (e, edge) in world.mesh.edges.iter().enumerate() {

@@ -10,6 +10,7 @@ mod check;
 pub mod edge;
 mod edge_pass;
 mod marks;
+pub mod proximity;
 pub mod red_green;
 pub mod sizing;
 pub mod soup;
@@ -157,6 +158,10 @@ pub struct AdaptConfig {
     /// Sizing criterion: also split where the strain jumps across an edge by
     /// more than this (`None`: curvature alone; see `sizing.rs`).
     pub refine_strain: Option<Scalar>,
+    /// Sizing criterion: also split where an edge leans towards the nearest
+    /// obstacle by more than this fraction of its height (`None`: no obstacle
+    /// term; see `proximity.rs`).
+    pub refine_obstacle: Option<Scalar>,
     /// Red-green: flip the corner squares of red splits so that refined grids
     /// alternate their diagonals (`red_green/mesh.rs`, "Alternating diagonals").
     pub alternate_diagonals: bool,
@@ -178,6 +183,7 @@ impl AdaptConfig {
             criterion: a.criterion,
             hysteresis: a.hysteresis.unwrap_or(DEFAULT_HYSTERESIS),
             refine_strain: a.refine_strain,
+            refine_obstacle: a.refine_obstacle,
             alternate_diagonals: a.diagonals.unwrap_or_default() == RedDiagonals::Alternating,
         })
     }
@@ -292,14 +298,7 @@ impl Adapter {
     /// One adaptation pass on `world` after step `step`: merges, then splits,
     /// then closure; returns true when the mesh changed.
     pub fn pass(&mut self, world: &mut World, step: u64) -> Result<bool, MeshError> {
-        if self.tensor.is_some() {
-            return self.tensor_pass(world, step);
-        }
-        if let Some(limits) = self.edge {
-            return self.edge_pass(world, step, limits);
-        }
-        let angles = edge_angles(world);
-        self.pass_measured(world, step, &angles)
+        self.pass_near(world, step, None, &[])
     }
 
     /// [`Adapter::pass`] given the world's current [`edge_angles`] (the rollback
@@ -310,12 +309,35 @@ impl Adapter {
         step: u64,
         angles: &[Scalar],
     ) -> Result<bool, MeshError> {
+        self.pass_near(world, step, Some(angles), &[])
+    }
+
+    /// [`Adapter::pass`] with the world's current [`edge_angles`] when they are
+    /// known, and the tangent planes of the obstacle points nearest to its
+    /// vertices (one per vertex, from `Collider::nearest_planes`; empty: no
+    /// obstacles), which the sizing criterion's obstacle term measures
+    /// (`proximity.rs`; unused without `refine_obstacle`).
+    pub fn pass_near(
+        &mut self,
+        world: &mut World,
+        step: u64,
+        angles: Option<&[Scalar]>,
+        planes: &[proximity::ObstaclePlane],
+    ) -> Result<bool, MeshError> {
         if self.tensor.is_some() {
             return self.tensor_pass(world, step);
         }
         if let Some(limits) = self.edge {
             return self.edge_pass(world, step, limits);
         }
+        let measured;
+        let angles = match angles {
+            Some(a) => a,
+            None => {
+                measured = edge_angles(world);
+                &measured
+            }
+        };
         debug_assert_eq!(angles.len(), world.mesh.edges.len(), "stale edge angles");
         let (merges, splits) = match self.config.criterion {
             AdaptCriterion::Angle => (
@@ -323,7 +345,7 @@ impl Adapter {
                 self.refinement_marks(world, angles),
             ),
             AdaptCriterion::Sizing => {
-                let curv = self.leaf_curvatures(world, angles);
+                let curv = self.leaf_curvatures(world, angles, planes);
                 let merges = self.sizing_merge_marks(&curv);
                 (merges, self.sizing_refinement_marks(&curv))
             }

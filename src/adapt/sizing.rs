@@ -163,6 +163,7 @@
 use std::collections::HashMap;
 
 use super::Adapter;
+use super::proximity::{ObstaclePlane, edge_obstacle_lean};
 use crate::math::{Scalar, Vector2};
 use crate::mesh::{Edge, NO_TRIANGLE};
 use crate::world::World;
@@ -257,6 +258,9 @@ pub(super) struct LeafMeasure {
     pub angle: Scalar,
     /// The largest strain jump (0 unless `refine_strain` is set).
     pub jump: Scalar,
+    /// The largest lean towards an obstacle (0 unless `refine_obstacle` is
+    /// set and the pass was given the obstacles' planes; `proximity.rs`).
+    pub lean: Scalar,
 }
 
 impl LeafMeasure {
@@ -265,6 +269,7 @@ impl LeafMeasure {
             kappa: self.kappa.max(o.kappa),
             angle: self.angle.max(o.angle),
             jump: self.jump.max(o.jump),
+            lean: self.lean.max(o.lean),
         }
     }
 }
@@ -284,10 +289,23 @@ impl LeafCurvature {
 
 impl Adapter {
     /// The curvature of every leaf from the edge angles of the world's mesh
-    /// (and the strain jumps, when `refine_strain` is set).
-    pub(super) fn leaf_curvatures(&self, world: &World, angles: &[Scalar]) -> LeafCurvature {
+    /// (and the strain jumps, when `refine_strain` is set, and the leans towards
+    /// the obstacles whose `planes` are given, one per vertex, when
+    /// `refine_obstacle` is set).
+    pub(super) fn leaf_curvatures(
+        &self,
+        world: &World,
+        angles: &[Scalar],
+        planes: &[ObstaclePlane],
+    ) -> LeafCurvature {
         let kappa = edge_curvatures(world, angles);
         let strain = self.config.refine_strain.is_some();
+        let planes = if self.config.refine_obstacle.is_some() {
+            debug_assert!(planes.is_empty() || planes.len() == world.x.len());
+            planes
+        } else {
+            &[]
+        };
         let mut by_leaf: HashMap<u32, LeafMeasure> = HashMap::new();
         for (e, edge) in world.mesh.edges.iter().enumerate() {
             let here = LeafMeasure {
@@ -298,6 +316,7 @@ impl Adapter {
                 } else {
                     0.0
                 },
+                lean: edge_obstacle_lean(&world.x, planes, edge),
             };
             for &t in edge.triangles.iter().filter(|&&t| t != NO_TRIANGLE) {
                 let m = by_leaf.entry(self.owner[t as usize]).or_default();
@@ -320,7 +339,10 @@ impl Adapter {
         let mut marks: Vec<(u32, Scalar)> = curv
             .by_leaf
             .iter()
-            .filter(|&(&l, m)| self.sizing_wants_split(l, m.kappa, m.jump) && self.may_split(l))
+            .filter(|&(&l, m)| {
+                (self.sizing_wants_split(l, m.kappa, m.jump) || self.obstacle_wants_split(m.lean))
+                    && self.may_split(l)
+            })
             .map(|(&l, m)| (l, m.angle))
             .collect();
         marks.sort_by_key(|m| m.0);
@@ -334,6 +356,12 @@ impl Adapter {
         // The strain test first: it needs no spacing.
         self.config.refine_strain.is_some_and(|s| jump > s)
             || kappa * self.node_spacing(l) > self.config.refine_angle.to_radians()
+    }
+
+    /// True when a leaf whose edges lean towards an obstacle by `lean` at most
+    /// (`proximity.rs`) is too coarse there: `lean > refine_obstacle`.
+    fn obstacle_wants_split(&self, lean: Scalar) -> bool {
+        self.config.refine_obstacle.is_some_and(|r| lean > r)
     }
 
     /// Parents whose four leaf children would, merged, still be finer than
@@ -358,7 +386,11 @@ impl Adapter {
                 .config
                 .refine_strain
                 .is_none_or(|s| 2.0 * m.jump <= s / h);
-            if m.kappa * self.node_spacing(p) <= limit && strain_ok {
+            let obstacle_ok = self
+                .config
+                .refine_obstacle
+                .is_none_or(|r| 2.0 * m.lean <= r / h);
+            if m.kappa * self.node_spacing(p) <= limit && strain_ok && obstacle_ok {
                 out.push((p, m.angle));
             }
         }

@@ -40,6 +40,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 use serde::Serialize;
 
+use crate::adapt::proximity::ObstaclePlane;
 use crate::math::{Scalar, Vector};
 use crate::physics::Contact;
 use crate::spec::{ClothMesh, ClothSpec, Obstacle, ObstacleShape, SelfCollision};
@@ -244,6 +245,25 @@ impl Collider {
                 }
             })
             .collect()
+    }
+
+    /// Per vertex of `x`, the tangent plane of the nearest obstacle surface
+    /// point at time `t` (over every obstacle), into `out`; `out` is left empty
+    /// when there are no obstacles. For the sizing criterion's obstacle term
+    /// (`crate::adapt::proximity`).
+    pub fn nearest_planes(&self, x: &[Vector], t: Scalar, out: &mut Vec<ObstaclePlane>) {
+        out.clear();
+        if self.bodies.is_empty() {
+            return;
+        }
+        out.extend(x.iter().map(|&p| {
+            self.bodies
+                .iter()
+                .map(|b| b.nearest_plane(t, p))
+                .min_by(|a, b| a.0.total_cmp(&b.0))
+                .map(|(_, plane)| plane)
+                .expect("at least one obstacle")
+        }));
     }
 
     /// True when some obstacle moves.

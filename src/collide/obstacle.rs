@@ -11,6 +11,7 @@ use parry3d_f64::shape::{
 };
 
 use super::CollideError;
+use crate::adapt::proximity::ObstaclePlane;
 use crate::math::{Scalar, Vector, rotation_from_euler_deg};
 use crate::spec::{Obstacle, ObstacleShape};
 
@@ -164,6 +165,25 @@ impl Body {
             signed: if proj.is_inside { -dist } else { dist },
             normal,
         }
+    }
+
+    /// The obstacle surface point nearest to world point `x` at time `t`: its
+    /// distance from `x` (m, unsigned) and the tangent plane there, in world
+    /// coordinates (for the sizing criterion's obstacle term,
+    /// `crate::adapt::proximity`).
+    pub fn nearest_plane(&self, t: Scalar, x: Vector) -> (Scalar, ObstaclePlane) {
+        let pose = self.pose(t);
+        let q = pose.inverse_transform_point(x);
+        let probe = self.probe(q);
+        let local_point = q - probe.normal * probe.signed;
+        (
+            probe.signed.abs(),
+            ObstaclePlane {
+                point: pose.transform_point(local_point),
+                normal: pose.rotation * probe.normal,
+                thickness: self.thickness,
+            },
+        )
     }
 
     /// Where the local segment `a` -> `b` first enters the solid from outside:

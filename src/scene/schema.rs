@@ -95,6 +95,9 @@ pub(crate) fn allowed(path: &str) -> Option<&'static str> {
         "adapt.refine_strain" => {
             "a finite number > 0 (criterion = \"sizing\" with method = \"red_green\" only)"
         }
+        "adapt.refine_obstacle" => {
+            "a finite number > 0 (criterion = \"sizing\" with method = \"red_green\" only)"
+        }
         _ => return None,
     })
 }

@@ -105,7 +105,8 @@ fn tensor(a: &Adapt, shape: ClothShape, stiffness: StiffnessRule) -> Result<(), 
 }
 
 /// The sizing criterion's own keys: `hysteresis` > 1, and only with `criterion =
-/// "sizing"`; `refine_strain` > 0, and only with the sizing criterion on red-green.
+/// "sizing"`; `refine_strain` and `refine_obstacle` > 0, and only with the sizing
+/// criterion on red-green.
 fn criterion(a: &Adapt) -> Result<(), Issue> {
     if a.diagonals.is_some() && a.method != AdaptMethod::RedGreen {
         let path = keys(&["adapt", "diagonals"]);
@@ -119,6 +120,15 @@ fn criterion(a: &Adapt) -> Result<(), Issue> {
             return Err(Issue::new(path, Kind::NotApplicable, why));
         }
         positive(path, s)?;
+    }
+    if let Some(r) = a.refine_obstacle {
+        let path = keys(&["adapt", "refine_obstacle"]);
+        if a.criterion != AdaptCriterion::Sizing || a.method != AdaptMethod::RedGreen {
+            let why =
+                "refine_obstacle belongs to criterion = \"sizing\" with method = \"red_green\"";
+            return Err(Issue::new(path, Kind::NotApplicable, why));
+        }
+        positive(path, r)?;
     }
     let Some(h) = a.hysteresis else {
         return Ok(());

@@ -69,6 +69,9 @@ pub struct Pipeline {
     /// True while `angles` are those of the state's current positions and mesh
     /// (the adaptation pass after an accepted step then reuses them).
     angles_fresh: bool,
+    /// Per vertex, the tangent plane of the nearest obstacle point, measured for
+    /// the adaptation pass's obstacle term (buffer reused pass to pass).
+    obstacle_planes: Vec<crate::adapt::proximity::ObstaclePlane>,
     /// The size of the last accepted step (for the recording's step plot).
     last_step: Option<Scalar>,
     /// The energy of the state as the last successful frame left it, when the
@@ -103,6 +106,7 @@ impl Pipeline {
             angles: Vec::new(),
             last_step: None,
             angles_fresh: false,
+            obstacle_planes: Vec::new(),
             frame_end_energy: None,
         }
     }

@@ -361,6 +361,29 @@ fn refine_strain_needs_the_sizing_rule_on_red_green_and_a_positive_value() {
     );
 }
 
+/// `refine_obstacle` (`src/adapt/proximity.rs`) is the sizing rule's obstacle
+/// term on red-green, and a positive fraction.
+#[test]
+fn refine_obstacle_needs_the_sizing_rule_on_red_green_and_a_positive_value() {
+    accepted_sets("obstacle", &["adapt.refine_obstacle=1.0"]);
+    for other in ["adapt.criterion=\"angle\"", "adapt.method=\"edge\""] {
+        refused_with(
+            "obstacle",
+            "adapt.refine_obstacle=1.0",
+            other,
+            "refine_obstacle belongs to criterion = \"sizing\" with method = \"red_green\"",
+        );
+    }
+    refused_sets(
+        "obstacle-range",
+        &[
+            ("adapt.refine_obstacle", "0"),
+            ("adapt.refine_obstacle", "-1"),
+        ],
+        "must be > 0",
+    );
+}
+
 /// The tensor method (`src/adapt/tensor.rs`) refines a rectangle's grid,
 /// with an even `max_level`, and without rollback, multirate stepping or
 /// level-scaled stiffness.

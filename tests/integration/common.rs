@@ -51,6 +51,7 @@ pub fn angle_config(method: AdaptMethod) -> AdaptConfig {
         criterion: AdaptCriterion::Angle,
         hysteresis: 2.0,
         refine_strain: None,
+        refine_obstacle: None,
         alternate_diagonals: true,
     }
 }

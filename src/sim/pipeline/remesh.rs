@@ -103,11 +103,15 @@ impl Pipeline {
             return Ok(false);
         };
         let step = state.ledger.steps_done;
-        let changed = if self.angles_fresh {
-            ad.pass_measured(&mut state.world, step, &self.angles)?
-        } else {
-            ad.pass(&mut state.world, step)?
-        };
+        self.obstacle_planes.clear();
+        if ad.config.refine_obstacle.is_some()
+            && let Some(c) = &self.collider
+        {
+            let w = &state.world;
+            c.nearest_planes(&w.x, w.time, &mut self.obstacle_planes);
+        }
+        let angles = self.angles_fresh.then_some(self.angles.as_slice());
+        let changed = ad.pass_near(&mut state.world, step, angles, &self.obstacle_planes)?;
         self.angles_fresh = false;
         if changed {
             self.mesh_changed(model, state);

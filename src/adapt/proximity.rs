@@ -1,0 +1,74 @@
+//! The obstacle term of the sizing criterion (`refine_obstacle`, off by
+//! default): refine the cloth where it comes near an obstacle at an angle, so
+//! that the mesh is fine where it will fold over the obstacle before the fold
+//! forms, instead of after.
+//!
+//! Why. Compared frame by frame on `tablecloth` (`docs/speed-vs-error.md`),
+//! the adaptive runs are already far behind uniform 64 in the first frame
+//! after the cloth lands on the table (t = 0.33 s: edge 16 L4 0.677 % of the
+//! diagonal, red_green 16 L4 0.698 %, uniform 64 0.232 %, uniform 32 0.731 %):
+//! the sheet falls flat, so the curvature rule leaves it at the base mesh
+//! until it hits the table's edges, and the crease over each edge forms on
+//! the coarse mesh. Refining afterwards cannot undo where the crease formed.
+//!
+//! The measure is the obstacle metric of Narain, Pfaff and O'Brien (2013,
+//! "Folding and crumpling adaptive sheets", the obstacle term of ARCSim's
+//! sizing field), taken edge by edge. Each vertex `v` gets the tangent plane
+//! of the nearest obstacle surface point (outward normal `n_v`, surface point
+//! `s_v`). The heights of an edge's two ends above the plane of one end,
+//! `h_a = n_a . (x_a - s_a)` and `h_b = n_a . (x_b - s_a)`, differ by
+//! `|h_b - h_a|`: how far the edge leans towards the obstacle over its length.
+//! An edge leaning by more than a fraction of its height would reach the
+//! surface before it could bend to follow it, so it is too long there; the
+//! measure of the edge is the larger over its two ends of
+//!
+//! ```text
+//! r = |h_b - h_a| / max(h_a, thickness)
+//! ```
+//!
+//! (the obstacle's contact thickness, the height the cloth rests at, is the
+//! floor: a vertex in contact is at about that height, and the floor keeps a
+//! vertex pushed slightly inside from dividing by nothing). A leaf splits
+//! where `r > refine_obstacle` at one of its edges; `r` halves with the
+//! edge's length, as the curvature measure `kappa * D` does, so four children
+//! merge when twice their largest `r` is at most `refine_obstacle / H` (the
+//! same hysteresis). A sheet lying flat on a flat surface has `r = 0`, and so
+//! has a sheet falling parallel to it; a sheet over a ball is refined ahead of
+//! the contact where it is not parallel to the ball's surface, and one draped
+//! over a table's edge along the edge (the nearest point there is on the
+//! edge, whose normal leans at 45 degrees to both faces).
+//!
+//! Red-green with the sizing criterion only. The rollback check does not see
+//! it (it is measured in the adaptation pass, where the obstacles are known).
+
+use crate::math::{Scalar, Vector};
+use crate::mesh::Edge;
+
+/// The tangent plane of the obstacle surface point nearest to one cloth vertex.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ObstaclePlane {
+    /// The nearest surface point, world coordinates, m.
+    pub point: Vector,
+    /// The outward unit normal there.
+    pub normal: Vector,
+    /// The obstacle's contact thickness, m: the smallest height the measure
+    /// divides by.
+    pub thickness: Scalar,
+}
+
+/// How far edge `e` leans towards the obstacle nearest to its ends, relative
+/// to its height above it (module docs): the larger over both ends of
+/// `|h_b - h_a| / max(h_a, thickness)`. 0 when `planes` is empty.
+pub fn edge_obstacle_lean(x: &[Vector], planes: &[ObstaclePlane], e: &Edge) -> Scalar {
+    if planes.is_empty() {
+        return 0.0;
+    }
+    let [a, b] = e.vertices.map(|v| v as usize);
+    let lean = |own: usize, other: usize| {
+        let p = &planes[own];
+        let h_own = p.normal.dot(x[own] - p.point);
+        let h_other = p.normal.dot(x[other] - p.point);
+        (h_other - h_own).abs() / h_own.max(p.thickness)
+    };
+    lean(a, b).max(lean(b, a))
+}
