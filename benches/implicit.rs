@@ -291,6 +291,7 @@ fn creased(mesh: &drape::mesh::Mesh) -> drape::mesh::Mesh {
         criterion: AdaptCriterion::Angle,
         hysteresis: 2.0,
         refine_strain: None,
+        refine_obstacle: None,
         alternate_diagonals: true,
     };
     let mut adapter = Adapter::new(config, &world, 0.15).expect("the adapter starts");

@@ -407,7 +407,7 @@ fn an_edge_leaning_towards_an_obstacle_refines_near_it_only() {
     config.refine_obstacle = Some(1.0);
 
     let mut w = flat_world(8, DiagonalPattern::Alternating);
-    let mut ad = Adapter::new(config.clone(), &w, DENSITY).expect("the adapter starts");
+    let mut ad = Adapter::new(config, &w, DENSITY).expect("the adapter starts");
     settle(&mut w, &mut ad, &leaning(0.0));
     let (near, far) = (max_level_in(&w, -0.5, -0.45), max_level_in(&w, -0.25, 0.5));
     println!(
