@@ -113,6 +113,11 @@ struct BenchArgs {
     /// Recompute the reference even if DIR/cache/ holds it (the new one is not cached).
     #[arg(long)]
     no_cache: bool,
+    /// Skip the sensitivity floor: by default the reference is run a second time with
+    /// the cloth started 1 micrometre higher, and the report says how far that run ends
+    /// from the reference (errors closer than that are not told apart).
+    #[arg(long)]
+    no_floor: bool,
     /// Segments of the reference's uniform mesh (default: 1.5 times the finest rung's, rounded up to even).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(2..))]
     reference_resolution: Option<u32>,
@@ -316,6 +321,7 @@ fn cmd_bench(args: BenchArgs) -> Result<ExitCode> {
         cache: !args.no_cache,
         reference_resolution: args.reference_resolution,
         grid: args.samples as usize,
+        floor: !args.no_floor,
     };
     if args.list {
         use std::io::Write;

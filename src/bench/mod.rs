@@ -115,6 +115,36 @@ pub struct BenchOptions {
     pub reference_resolution: Option<u32>,
     /// Sample points per side of the material-space grid.
     pub grid: usize,
+    /// Also run the reference with the cloth started [`FLOOR_LIFT`] higher
+    /// (against gravity) and report how far it ends from the reference: the
+    /// metric's sensitivity floor ([`Floor`]).
+    pub floor: bool,
+}
+
+/// How far the sensitivity floor's run starts from the reference's, m: the
+/// cloth lifted 1 micrometre against gravity, a change no mesh or step setting
+/// resolves.
+pub const FLOOR_LIFT: Scalar = 1e-6;
+
+/// The metric's sensitivity floor: the reference run again with the cloth
+/// started [`FLOOR_LIFT`] higher, compared with the reference like a rung.
+/// A smooth problem answers with about the lift itself (relative to the
+/// diagonal); a chaotic one (a sheet falling onto an obstacle and folding)
+/// amplifies the lift, and errors of runs that differ by less than the floor
+/// are not told apart by this comparison.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Floor {
+    /// The lift, m.
+    pub lift: Scalar,
+    /// `(time, error)` at every recorded frame, relative to the diagonal.
+    pub errors: Vec<(Scalar, Scalar)>,
+    /// The error compared like the rungs': the mean over the frames, or the
+    /// last frame's at rest.
+    pub error: Scalar,
+    /// Wall time of the lifted run, s.
+    pub wall_s: Scalar,
+    /// True when the lifted run came from the cache.
+    pub cache_hit: bool,
 }
 
 /// One rung's result: its settings and measurements.
@@ -204,6 +234,9 @@ pub struct BenchResult {
     /// How far the reference's samples moved over its last frame, relative to
     /// the diagonal (a check that a scene compared at rest has settled).
     pub reference_last_motion: Option<Scalar>,
+    /// The sensitivity floor (`None` unless asked for, or for the time-step
+    /// ladder).
+    pub floor: Option<Floor>,
 }
 
 fn load(path: &Path, overrides: &[String], context: &str) -> Result<Scene, BenchError> {
@@ -222,6 +255,10 @@ struct Plan {
     ref_own: Vec<String>,
     ref_set: Vec<String>,
     ref_scene: Scene,
+    /// The reference's overrides and scene with the cloth lifted by
+    /// [`FLOOR_LIFT`].
+    floor_set: Vec<String>,
+    floor_scene: Scene,
     compare: Compare,
     step: StepPolicy,
     common_dt: Option<(Scalar, String)>,
@@ -301,9 +338,14 @@ fn plan(opts: &BenchOptions) -> Result<Plan, BenchError> {
             "reference",
         )?;
     }
+    let ref_set = chain(&base_set, &step_set, &ref_own);
+    let floor_set = chain(&ref_set, &[lifted_position(&ref_scene)], &[]);
+    let floor_scene = load(&opts.scene, &floor_set, "reference, lifted")?;
     Ok(Plan {
         base,
-        ref_set: chain(&base_set, &step_set, &ref_own),
+        ref_set,
+        floor_set,
+        floor_scene,
         ladder,
         scenes,
         ref_own,
@@ -314,40 +356,45 @@ fn plan(opts: &BenchOptions) -> Result<Plan, BenchError> {
     })
 }
 
-/// The reference: from the cache when allowed and present, else computed.
+/// The `cloth.position` override that starts `scene`'s cloth [`FLOOR_LIFT`]
+/// higher: against gravity, or along +z without gravity.
+fn lifted_position(scene: &Scene) -> String {
+    let g = crate::math::Vector::from(scene.simulation.gravity);
+    let up = (-g).try_normalize().unwrap_or(crate::math::Vector::Z);
+    let p = crate::math::Vector::from(scene.cloth.position) + up * FLOOR_LIFT;
+    format!("cloth.position=[{:e}, {:e}, {:e}]", p.x, p.y, p.z)
+}
+
+/// The reference (or, with `lifted`, the floor's run): from the cache when
+/// allowed and present, else computed.
 fn obtain_reference(
     plan: &Plan,
     opts: &BenchOptions,
-    run_opts: &RunOptions,
-    interrupt: &AtomicBool,
+    lifted: bool,
+    (run_opts, interrupt): (&RunOptions, &AtomicBool),
     log: &mut dyn FnMut(&str),
 ) -> Result<(Reference, bool), BenchError> {
     let scene_text = std::fs::read_to_string(&opts.scene).map_err(|source| BenchError::Io {
         path: opts.scene.clone(),
         source,
     })?;
-    let key = reference::cache_key(&scene_text, &plan.ref_set, opts.grid);
+    let (what, set, scene) = if lifted {
+        ("reference lifted 1 um", &plan.floor_set, &plan.floor_scene)
+    } else {
+        ("reference", &plan.ref_set, &plan.ref_scene)
+    };
+    let key = reference::cache_key(&scene_text, set, opts.grid);
     let cache_file = reference::cache_path(&opts.out_dir, &plan.base.name, &key);
     if opts.cache
         && let Some(r) = reference::load_cached(&cache_file, &key)
     {
-        log(&format!("reference: cached {}", cache_file.display()));
+        log(&format!("{what}: cached {}", cache_file.display()));
         return Ok((r, true));
     }
+    log(&format!("{what}: computing ({})", plan.ref_own.join(" ")));
+    let r = reference::compute(scene, set.clone(), key, opts.grid, run_opts, interrupt)?;
     log(&format!(
-        "reference: computing ({})",
-        plan.ref_own.join(" ")
-    ));
-    let r = reference::compute(
-        &plan.ref_scene,
-        plan.ref_set.clone(),
-        key,
-        opts.grid,
-        run_opts,
-        interrupt,
-    )?;
-    log(&format!(
-        "reference: {} vertices, {} steps, {:.1} s",
+        "{what}: {} vertices, {} steps, {:.1} s",
         r.vertices, r.steps, r.wall_s
     ));
     if opts.cache {
@@ -372,7 +419,30 @@ pub fn bench(
         threads: opts.threads,
         ..RunOptions::default()
     };
-    let (reference, cache_hit) = obtain_reference(&plan, opts, &run_opts, interrupt, log)?;
+    let (reference, cache_hit) = obtain_reference(&plan, opts, false, (&run_opts, interrupt), log)?;
+    let floor = if opts.floor && !opts.time_ladder {
+        let (lifted, hit) = obtain_reference(&plan, opts, true, (&run_opts, interrupt), log)?;
+        let errors = sampling::run_errors(&lifted.frames, &reference.frames, reference.diagonal);
+        let error = match plan.compare {
+            Compare::Frames => {
+                errors.iter().map(|e| e.1).sum::<Scalar>() / errors.len().max(1) as Scalar
+            }
+            Compare::Rest => errors.last().map_or(Scalar::NAN, |e| e.1),
+        };
+        log(&format!(
+            "sensitivity floor ({}): {error:.3e} of the diagonal",
+            plan.compare.name()
+        ));
+        Some(Floor {
+            lift: FLOOR_LIFT,
+            errors,
+            error,
+            wall_s: lifted.wall_s,
+            cache_hit: hit,
+        })
+    } else {
+        None
+    };
     let points = reference.sample_points();
     let mut rows = Vec::new();
     let n = plan.scenes.len();
@@ -416,6 +486,7 @@ pub fn bench(
         step: plan.step,
         common_dt: plan.common_dt,
         reference_last_motion,
+        floor,
     };
     result.files = report::write_all(&opts.out_dir, &result, &opts.scene)?;
     Ok(result)

@@ -232,6 +232,7 @@ fn tiny_ladder_end_to_end_with_cache_and_a_failed_rung() {
         cache: true,
         reference_resolution: None,
         grid: 8,
+        floor: false,
     };
     let stop = AtomicBool::new(false);
     let mut lines = Vec::new();
@@ -401,4 +402,84 @@ fn bench_cli_lists_the_default_ladder_and_rejects_unknown_rungs() {
         .expect("run drape");
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("expected `frames` or `rest`"));
+}
+
+/// The sensitivity floor (`drape::bench::Floor`): the reference run again with
+/// the cloth started 1 micrometre higher. A sheet falling freely through air
+/// (no pin, no obstacle) is translation invariant, so the lifted run is the
+/// reference moved by the lift at every frame: its error is the lift over the
+/// diagonal, which the test prints per frame. The report and the per-frame CSV
+/// carry it.
+#[test]
+fn the_sensitivity_floor_of_a_free_fall_is_the_lift_itself() {
+    let dir = temp_dir("floor");
+    let scene = tiny_scene(&dir);
+    let text = std::fs::read_to_string(&scene).expect("scene");
+    std::fs::write(
+        &scene,
+        text.replace("[[pin]]\nregion = \"corner:top_left\"\n", ""),
+    )
+    .expect("write scene");
+    let opts = BenchOptions {
+        scene: scene.clone(),
+        overrides: vec![],
+        ladder: Some(Ladder {
+            reference: None,
+            compare: None,
+            step: None,
+            rung: vec![rung(
+                "uniform 4",
+                &["adapt.method=none", "cloth.resolution=4"],
+            )],
+        }),
+        time_ladder: false,
+        rungs: vec![],
+        compare: None,
+        step: None,
+        reps: 1,
+        duration: Some(0.15),
+        threads: Some(1),
+        out_dir: dir.join("out"),
+        cache: true,
+        reference_resolution: None,
+        grid: 8,
+        floor: true,
+    };
+    let stop = AtomicBool::new(false);
+    let mut lines = Vec::new();
+    let res = bench(&opts, &stop, &mut |l| lines.push(l.to_owned())).expect("bench");
+    let floor = res.floor.expect("the floor was asked for");
+    let lift = drape::bench::FLOOR_LIFT / res.reference.diagonal;
+    println!(
+        "lift / diagonal {lift:.6e}; floor per frame {:?}",
+        floor.errors
+    );
+    assert_eq!(floor.errors.len(), res.reference.frames.len());
+    for (t, e) in &floor.errors {
+        assert!(
+            (e / lift - 1.0).abs() < 1e-3,
+            "t = {t}: floor {e:e} against the lift {lift:e}"
+        );
+    }
+    assert!((floor.error / lift - 1.0).abs() < 1e-3);
+    assert!(
+        lines.iter().any(|l| l.starts_with("sensitivity floor")),
+        "{lines:?}"
+    );
+    let md = std::fs::read_to_string(dir.join("out/tiny.md")).expect("md");
+    assert!(
+        md.contains("Sensitivity floor: the reference run again"),
+        "{md}"
+    );
+    let frames = std::fs::read_to_string(dir.join("out/tiny-frames.csv")).expect("csv");
+    assert_eq!(
+        frames
+            .lines()
+            .filter(|l| l.starts_with("reference lifted 1 um,"))
+            .count(),
+        floor.errors.len()
+    );
+    // Cached the second time, like the reference.
+    let again = bench(&opts, &stop, &mut |_| {}).expect("bench");
+    assert!(again.floor.is_some_and(|f| f.cache_hit));
 }

@@ -159,6 +159,7 @@ fn time_ladder_end_to_end_error_falls_with_the_step() {
         cache: false,
         reference_resolution: None,
         grid: 8,
+        floor: false,
     };
     let res = bench(&opts, &AtomicBool::new(false), &mut |_| {}).expect("bench");
     assert!(res.time_ladder && res.common_dt.is_none());
@@ -245,6 +246,7 @@ fn uniform_error_at_rest_falls_with_resolution() {
         cache: false,
         reference_resolution: None,
         grid: 24,
+        floor: false,
     };
     let res = bench(&opts, &AtomicBool::new(false), &mut |l| eprintln!("{l}")).expect("bench");
     let e: Vec<f64> = res.rows.iter().map(|r| r.error).collect();
