@@ -127,16 +127,21 @@ pub struct BenchOptions {
 pub const FLOOR_LIFT: Scalar = 1e-6;
 
 /// The metric's sensitivity floor: the reference run again with the cloth
-/// started [`FLOOR_LIFT`] higher, compared with the reference like a rung.
-/// A smooth problem answers with about the lift itself (relative to the
-/// diagonal); a chaotic one (a sheet falling onto an obstacle and folding)
-/// amplifies the lift, and errors of runs that differ by less than the floor
-/// are not told apart by this comparison.
+/// started [`FLOOR_LIFT`] higher, moved back down by the lift and compared
+/// with the reference like a rung. A smooth problem (translation invariant up
+/// to its obstacles) answers with about nothing; a chaotic one (a sheet
+/// falling onto an obstacle and folding) amplifies the lift, and errors of
+/// runs that differ by less than the floor are not told apart by this
+/// comparison.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Floor {
     /// The lift, m.
     pub lift: Scalar,
-    /// `(time, error)` at every recorded frame, relative to the diagonal.
+    /// The lifted run's first frame against the reference's, as it started
+    /// (the lift not taken out), relative to the diagonal: the lift itself.
+    pub start: Scalar,
+    /// `(time, error)` at every recorded frame, relative to the diagonal, the
+    /// lift taken out.
     pub errors: Vec<(Scalar, Scalar)>,
     /// The error compared like the rungs': the mean over the frames, or the
     /// last frame's at rest.
@@ -259,6 +264,7 @@ struct Plan {
     /// [`FLOOR_LIFT`].
     floor_set: Vec<String>,
     floor_scene: Scene,
+    floor_lift: crate::math::Vector,
     compare: Compare,
     step: StepPolicy,
     common_dt: Option<(Scalar, String)>,
@@ -339,13 +345,15 @@ fn plan(opts: &BenchOptions) -> Result<Plan, BenchError> {
         )?;
     }
     let ref_set = chain(&base_set, &step_set, &ref_own);
-    let floor_set = chain(&ref_set, &[lifted_position(&ref_scene)], &[]);
+    let floor_lift = lift(&ref_scene);
+    let floor_set = chain(&ref_set, &[lifted_position(&ref_scene, floor_lift)], &[]);
     let floor_scene = load(&opts.scene, &floor_set, "reference, lifted")?;
     Ok(Plan {
         base,
         ref_set,
         floor_set,
         floor_scene,
+        floor_lift,
         ladder,
         scenes,
         ref_own,
@@ -356,13 +364,60 @@ fn plan(opts: &BenchOptions) -> Result<Plan, BenchError> {
     })
 }
 
-/// The `cloth.position` override that starts `scene`'s cloth [`FLOOR_LIFT`]
-/// higher: against gravity, or along +z without gravity.
-fn lifted_position(scene: &Scene) -> String {
+/// The sensitivity floor's lift for `scene`: [`FLOOR_LIFT`] against gravity,
+/// or along +z without gravity.
+fn lift(scene: &Scene) -> crate::math::Vector {
     let g = crate::math::Vector::from(scene.simulation.gravity);
-    let up = (-g).try_normalize().unwrap_or(crate::math::Vector::Z);
-    let p = crate::math::Vector::from(scene.cloth.position) + up * FLOOR_LIFT;
+    (-g).try_normalize().unwrap_or(crate::math::Vector::Z) * FLOOR_LIFT
+}
+
+/// The `cloth.position` override that starts `scene`'s cloth `lift` away.
+fn lifted_position(scene: &Scene, lift: crate::math::Vector) -> String {
+    let p = crate::math::Vector::from(scene.cloth.position) + lift;
     format!("cloth.position=[{:e}, {:e}, {:e}]", p.x, p.y, p.z)
+}
+
+/// The sensitivity floor from the lifted run's samples (`lifted`) and the
+/// reference's, compared as `compare` says.
+fn floor_of(
+    lifted: &Reference,
+    reference: &Reference,
+    lift: crate::math::Vector,
+    compare: Compare,
+) -> Floor {
+    let start = match (lifted.frames.first(), reference.frames.first()) {
+        (Some(a), Some(b)) => {
+            sampling::frame_error(a, b, reference.diagonal).unwrap_or(Scalar::NAN)
+        }
+        _ => Scalar::NAN,
+    };
+    let lowered: Vec<sampling::FrameSamples> = lifted
+        .frames
+        .iter()
+        .map(|f| sampling::FrameSamples {
+            positions: f
+                .positions
+                .iter()
+                .map(|p| p.map(|q| (crate::math::Vector::from_array(q) - lift).to_array()))
+                .collect(),
+            ..f.clone()
+        })
+        .collect();
+    let errors = sampling::run_errors(&lowered, &reference.frames, reference.diagonal);
+    let error = match compare {
+        Compare::Frames => {
+            errors.iter().map(|e| e.1).sum::<Scalar>() / errors.len().max(1) as Scalar
+        }
+        Compare::Rest => errors.last().map_or(Scalar::NAN, |e| e.1),
+    };
+    Floor {
+        lift: lift.length(),
+        start,
+        errors,
+        error,
+        wall_s: lifted.wall_s,
+        cache_hit: false,
+    }
 }
 
 /// The reference (or, with `lifted`, the floor's run): from the cache when
@@ -422,24 +477,16 @@ pub fn bench(
     let (reference, cache_hit) = obtain_reference(&plan, opts, false, (&run_opts, interrupt), log)?;
     let floor = if opts.floor && !opts.time_ladder {
         let (lifted, hit) = obtain_reference(&plan, opts, true, (&run_opts, interrupt), log)?;
-        let errors = sampling::run_errors(&lifted.frames, &reference.frames, reference.diagonal);
-        let error = match plan.compare {
-            Compare::Frames => {
-                errors.iter().map(|e| e.1).sum::<Scalar>() / errors.len().max(1) as Scalar
-            }
-            Compare::Rest => errors.last().map_or(Scalar::NAN, |e| e.1),
+        let floor = Floor {
+            cache_hit: hit,
+            ..floor_of(&lifted, &reference, plan.floor_lift, plan.compare)
         };
         log(&format!(
-            "sensitivity floor ({}): {error:.3e} of the diagonal",
-            plan.compare.name()
+            "sensitivity floor ({}): {:.3e} of the diagonal",
+            plan.compare.name(),
+            floor.error
         ));
-        Some(Floor {
-            lift: FLOOR_LIFT,
-            errors,
-            error,
-            wall_s: lifted.wall_s,
-            cache_hit: hit,
-        })
+        Some(floor)
     } else {
         None
     };

@@ -216,7 +216,7 @@ fn preamble(res: &BenchResult, scene_path: &Path) -> String {
     if let Some(f) = &res.floor {
         let _ = writeln!(
             out,
-            "Sensitivity floor: the reference run again with the cloth started {:.0e} m higher{} is {} % of the diagonal from the reference ({}; {} % at the last frame, against the {:.2e} % that the lift itself accounts for). Differences between runs' errors smaller than that are not resolved by this comparison: the target table marks a check as decided only where the floor is below a tenth of the uniform run's error.\n",
+            "Sensitivity floor: the reference run again with the cloth started {:.0e} m higher{}, moved back down by that lift, is {} % of the diagonal from the reference ({}; {} % at the last frame; as it started, {} %, the lift itself). Differences between runs' errors smaller than that are not resolved by this comparison: the target table marks a check as decided only where the floor is below a tenth of the uniform run's error.\n",
             f.lift,
             if f.cache_hit { " (cached)" } else { "" },
             pct(f.error),
@@ -225,7 +225,7 @@ fn preamble(res: &BenchResult, scene_path: &Path) -> String {
                 super::Compare::Rest => "at rest",
             },
             pct(f.errors.last().map_or(Scalar::NAN, |e| e.1)),
-            100.0 * f.lift / r.diagonal,
+            pct(f.start),
         );
     }
     out.push_str("Final offset: the length of the mean displacement of the samples from the reference's at the last frame (the rigid translation part of the final error; what is left once it is taken out is `sqrt(final^2 - offset^2)`).\n\n");
