@@ -7,6 +7,19 @@
 //! vertices whose mass changed, so momentum is conserved to round-off and the
 //! correction stays local to the remeshed region.
 //!
+//! Tried and dropped (2026-11-24): placing a new vertex on the curved surface
+//! instead of the chord, `(a + b) / 2 - (((b - a) . n_a) n_a + ((a - b) . n_b) n_b) / 8`
+//! with the area-weighted vertex normals (the PN-triangle edge midpoint,
+//! exact to second order on a circle: it adds the sagitta `L^2 / 8R`), so
+//! that a split does not flatten a bend. Frame by frame against the bench's
+//! references (build `a511d06` with the change): `drape_sphere` over 2.5 s
+//! red_green 16 L4 0.671 -> 0.571 %, loose 0.575 -> 0.629 %, edge 16 L4
+//! 0.644 -> 0.773 %; `tablecloth` over its landing (0.6 s) red_green 16 L4
+//! 0.449 -> 0.450 %, edge 16 L4 0.442 -> 0.461 %. No consistent gain (the
+//! falling sheet's sensitivity floor is 0.038 %, so the changes are real, in
+//! both directions), and the midpoint leaves the old surface, which the
+//! tensor method's checks rely on.
+//!
 //! # Vertex order
 //! Compaction chooses the new mesh's vertex numbering (`VertexOrder`). Kept
 //! in creation order, the vertices of a refined patch are the old ones
