@@ -2,7 +2,9 @@
 //! error against wall time on log-log axes, uniform runs as blue circles,
 //! adaptive runs as orange squares, the Pareto front as a dashed staircase
 //! through ringed points; points are numbered, with the key of numbers to
-//! labels on the right.
+//! labels on the right. The sensitivity floor, when measured and within two
+//! decades of the smallest error, is a dotted grey line: errors closer together than it are not told
+//! apart by the comparison.
 
 use plotters::coord::Shift;
 use plotters::coord::combinators::WithKeyPoints;
@@ -68,12 +70,13 @@ fn drawable(r: &Row) -> bool {
 }
 
 /// The chart of `rows` (wall time against the compared error in percent) as
-/// SVG text, titled `title`.
-pub fn svg(title: &str, rows: &[Row]) -> Result<String, BenchError> {
+/// SVG text, titled `title`, with the sensitivity floor `floor` (relative to
+/// the diagonal, compared like the rows' errors) when there is one.
+pub fn svg(title: &str, rows: &[Row], floor: Option<f64>) -> Result<String, BenchError> {
     let mut out = String::new();
     {
         let root = SVGBackend::with_string(&mut out, (W, H)).into_drawing_area();
-        draw(&root, title, rows).map_err(|e| BenchError::Chart(e.to_string()))?;
+        draw(&root, title, rows, floor).map_err(|e| BenchError::Chart(e.to_string()))?;
         root.present()
             .map_err(|e| BenchError::Chart(e.to_string()))?;
     }
@@ -91,13 +94,27 @@ fn log_axis(lo: f64, hi: f64) -> WithKeyPoints<LogCoord<f64>> {
 
 type DrawResult = Result<(), DrawingAreaErrorKind<std::io::Error>>;
 
-fn draw(root: &DrawingArea<SVGBackend<'_>, Shift>, title: &str, rows: &[Row]) -> DrawResult {
+fn draw(
+    root: &DrawingArea<SVGBackend<'_>, Shift>,
+    title: &str,
+    rows: &[Row],
+    floor: Option<f64>,
+) -> DrawResult {
     root.fill(&WHITE)?;
     let (plot, key) = root.split_horizontally(W - KEY_W);
     let point = |r: &Row| (r.wall_s, 100.0 * r.error);
     let ok: Vec<&Row> = rows.iter().filter(|r| drawable(r)).collect();
     let (x0, x1) = decades(ok.iter().map(|r| r.wall_s));
-    let (y0, y1) = decades(ok.iter().map(|r| 100.0 * r.error));
+    // The floor widens the error axis when it is within two decades of the
+    // smallest error (a rounding-level floor, at rest, is left out).
+    let smallest = ok
+        .iter()
+        .map(|r| 100.0 * r.error)
+        .fold(f64::INFINITY, f64::min);
+    let floor = floor
+        .map(|f| 100.0 * f)
+        .filter(|f| f.is_finite() && *f > 0.0 && *f >= 1e-2 * smallest);
+    let (y0, y1) = decades(ok.iter().map(|r| 100.0 * r.error).chain(floor));
     let mut chart = ChartBuilder::on(&plot)
         .caption(
             format!("{title}: error against wall time"),
@@ -120,6 +137,19 @@ fn draw(root: &DrawingArea<SVGBackend<'_>, Shift>, title: &str, rows: &[Row]) ->
         .light_line_style(RGBColor(0xee, 0xee, 0xee))
         .bold_line_style(RGBColor(0xcc, 0xcc, 0xcc))
         .draw()?;
+    // The sensitivity floor, where the axes show it.
+    if let Some(f) = floor {
+        let grey = RGBColor(0x88, 0x88, 0x88);
+        chart
+            .draw_series(DashedLineSeries::new(
+                [(x0, f), (x1, f)],
+                2,
+                4,
+                grey.stroke_width(2),
+            ))?
+            .label("sensitivity floor")
+            .legend(move |(x, y)| PathElement::new([(x - 8, y), (x + 8, y)], grey.stroke_width(2)));
+    }
     // The Pareto front: a staircase through its points in order of cost.
     let mut front: Vec<&Row> = ok.iter().copied().filter(|r| r.pareto).collect();
     front.sort_by(|a, b| a.wall_s.total_cmp(&b.wall_s));

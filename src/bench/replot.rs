@@ -99,14 +99,39 @@ pub fn read_csv(path: &Path) -> Result<Vec<Row>, BenchError> {
     Ok(rows)
 }
 
-/// Redraws `dir/stem.svg` from `dir/stem.csv` (`drape bench --replot`);
+/// The sensitivity floor from `dir/stem-frames.csv` (its rows labelled
+/// [`super::report::FLOOR_LABEL`]), compared as `compare` says: `None` when the
+/// file or the rows are missing.
+fn floor_from_frames(dir: &Path, stem: &str, compare: super::Compare) -> Option<f64> {
+    let text = std::fs::read_to_string(dir.join(format!("{stem}-frames.csv"))).ok()?;
+    let errors: Vec<f64> = text
+        .lines()
+        .skip(1)
+        .map(split_csv_line)
+        .filter(|f| f.len() == 3 && f[0] == super::report::FLOOR_LABEL)
+        .filter_map(|f| f[2].parse().ok())
+        .collect();
+    let last = *errors.last()?;
+    Some(match compare {
+        super::Compare::Frames => errors.iter().sum::<f64>() / errors.len() as f64,
+        super::Compare::Rest => last,
+    })
+}
+
+/// Redraws `dir/stem.svg` from `dir/stem.csv` (`drape bench --replot`), with
+/// the sensitivity floor from `dir/stem-frames.csv` when it holds one;
 /// returns the chart's path.
 pub fn replot(dir: &Path, stem: &str) -> Result<std::path::PathBuf, BenchError> {
     let rows = read_csv(&dir.join(format!("{stem}.csv")))?;
     let svg = dir.join(format!("{stem}.svg"));
-    std::fs::write(&svg, super::chart::svg(stem, &rows)?).map_err(|source| BenchError::Io {
-        path: svg.clone(),
-        source,
+    let floor = rows
+        .first()
+        .and_then(|r| floor_from_frames(dir, stem, r.compare));
+    std::fs::write(&svg, super::chart::svg(stem, &rows, floor)?).map_err(|source| {
+        BenchError::Io {
+            path: svg.clone(),
+            source,
+        }
     })?;
     Ok(svg)
 }

@@ -372,7 +372,10 @@ pub fn write_all(
             frames_csv(&res.rows, res.floor.as_ref()),
         ),
         (format!("{stem}.md"), markdown(res, scene_path)),
-        (format!("{stem}.svg"), super::chart::svg(stem, &res.rows)?),
+        (
+            format!("{stem}.svg"),
+            super::chart::svg(stem, &res.rows, res.floor.as_ref().map(|f| f.error))?,
+        ),
     ];
     let mut paths = Vec::new();
     for (name, text) in files {

@@ -488,3 +488,20 @@ fn the_sensitivity_floor_of_a_free_fall_is_nothing_but_the_lift() {
     let again = bench(&opts, &stop, &mut |_| {}).expect("bench");
     assert!(again.floor.is_some_and(|f| f.cache_hit));
 }
+
+/// The chart draws the sensitivity floor as a line when it is within two
+/// decades of the smallest error (a falling sheet's), and leaves a
+/// rounding-level floor (a scene at rest) out.
+#[test]
+fn the_chart_draws_a_floor_near_the_errors_only() {
+    let rows = vec![
+        row("uniform 4", false, 4, 4, 0.1, 0.02),
+        row("adaptive 4 L2", true, 4, 8, 0.2, 0.01),
+    ];
+    let with = drape::bench::chart::svg("t", &rows, Some(0.001)).expect("chart");
+    let rounding = drape::bench::chart::svg("t", &rows, Some(1e-15)).expect("chart");
+    let without = drape::bench::chart::svg("t", &rows, None).expect("chart");
+    assert!(with.contains("sensitivity floor"));
+    assert!(!rounding.contains("sensitivity floor"));
+    assert_eq!(rounding, without);
+}
