@@ -49,6 +49,28 @@ region = "corner:top_left"
     path
 }
 
+/// Options for `ladder` on the tiny scene: 0.15 s, one thread, one
+/// repetition, an 8 x 8 sample grid, the cache on, no sensitivity floor.
+fn tiny_options(scene: &Path, out_dir: PathBuf, ladder: Ladder) -> BenchOptions {
+    BenchOptions {
+        scene: scene.to_path_buf(),
+        overrides: vec![],
+        ladder: Some(ladder),
+        time_ladder: false,
+        rungs: vec![],
+        compare: None,
+        step: None,
+        reps: 1,
+        duration: Some(0.15),
+        threads: Some(1),
+        out_dir,
+        cache: true,
+        reference_resolution: None,
+        grid: 8,
+        floor: false,
+    }
+}
+
 fn rung(label: &str, set: &[&str]) -> Rung {
     Rung {
         label: label.into(),
@@ -218,21 +240,8 @@ fn tiny_ladder_end_to_end_with_cache_and_a_failed_rung() {
         ],
     };
     let opts = BenchOptions {
-        scene: scene.clone(),
-        overrides: vec![],
-        ladder: Some(ladder),
-        time_ladder: false,
-        rungs: vec![],
-        compare: None,
-        step: None,
         reps: 2,
-        duration: Some(0.15),
-        threads: Some(1),
-        out_dir: dir.join("out"),
-        cache: true,
-        reference_resolution: None,
-        grid: 8,
-        floor: false,
+        ..tiny_options(&scene, dir.join("out"), ladder)
     };
     let stop = AtomicBool::new(false);
     let mut lines = Vec::new();
@@ -421,30 +430,18 @@ fn the_sensitivity_floor_of_a_free_fall_is_nothing_but_the_lift() {
         text.replace("[[pin]]\nregion = \"corner:top_left\"\n", ""),
     )
     .expect("write scene");
-    let opts = BenchOptions {
-        scene: scene.clone(),
-        overrides: vec![],
-        ladder: Some(Ladder {
-            reference: None,
-            compare: None,
-            step: None,
-            rung: vec![rung(
-                "uniform 4",
-                &["adapt.method=none", "cloth.resolution=4"],
-            )],
-        }),
-        time_ladder: false,
-        rungs: vec![],
+    let ladder = Ladder {
+        reference: None,
         compare: None,
         step: None,
-        reps: 1,
-        duration: Some(0.15),
-        threads: Some(1),
-        out_dir: dir.join("out"),
-        cache: true,
-        reference_resolution: None,
-        grid: 8,
+        rung: vec![rung(
+            "uniform 4",
+            &["adapt.method=none", "cloth.resolution=4"],
+        )],
+    };
+    let opts = BenchOptions {
         floor: true,
+        ..tiny_options(&scene, dir.join("out"), ladder)
     };
     let stop = AtomicBool::new(false);
     let mut lines = Vec::new();
