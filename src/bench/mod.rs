@@ -240,8 +240,10 @@ pub struct BenchResult {
     /// the diagonal (a check that a scene compared at rest has settled).
     pub reference_last_motion: Option<Scalar>,
     /// The sensitivity floor (`None` unless asked for, or for the time-step
-    /// ladder).
+    /// ladder, or when its run failed).
     pub floor: Option<Floor>,
+    /// Why the sensitivity floor's run failed numerically, when it did.
+    pub floor_failure: Option<String>,
 }
 
 fn load(path: &Path, overrides: &[String], context: &str) -> Result<Scene, BenchError> {
@@ -475,18 +477,30 @@ pub fn bench(
         ..RunOptions::default()
     };
     let (reference, cache_hit) = obtain_reference(&plan, opts, false, (&run_opts, interrupt), log)?;
+    let mut floor_failure = None;
     let floor = if opts.floor && !opts.time_ladder {
-        let (lifted, hit) = obtain_reference(&plan, opts, true, (&run_opts, interrupt), log)?;
-        let floor = Floor {
-            cache_hit: hit,
-            ..floor_of(&lifted, &reference, plan.floor_lift, plan.compare)
-        };
-        log(&format!(
-            "sensitivity floor ({}): {:.3e} of the diagonal",
-            plan.compare.name(),
-            floor.error
-        ));
-        Some(floor)
+        match obtain_reference(&plan, opts, true, (&run_opts, interrupt), log) {
+            Ok((lifted, hit)) => {
+                let floor = Floor {
+                    cache_hit: hit,
+                    ..floor_of(&lifted, &reference, plan.floor_lift, plan.compare)
+                };
+                log(&format!(
+                    "sensitivity floor ({}): {:.3e} of the diagonal",
+                    plan.compare.name(),
+                    floor.error
+                ));
+                Some(floor)
+            }
+            // The lifted run failed numerically where the reference did not: the
+            // floor is reported as missing, and the rungs are still measured.
+            Err(BenchError::Reference(why)) => {
+                log(&format!("sensitivity floor: the lifted run failed ({why})"));
+                floor_failure = Some(why);
+                None
+            }
+            Err(e) => return Err(e),
+        }
     } else {
         None
     };
@@ -534,6 +548,7 @@ pub fn bench(
         common_dt: plan.common_dt,
         reference_last_motion,
         floor,
+        floor_failure,
     };
     result.files = report::write_all(&opts.out_dir, &result, &opts.scene)?;
     Ok(result)

@@ -228,6 +228,12 @@ fn preamble(res: &BenchResult, scene_path: &Path) -> String {
             pct(f.start),
         );
     }
+    if let Some(why) = &res.floor_failure {
+        let _ = writeln!(
+            out,
+            "Sensitivity floor: not measured: the reference run started 1 micrometre higher failed ({why}).\n"
+        );
+    }
     out.push_str("Final offset: the length of the mean displacement of the samples from the reference's at the last frame (the rigid translation part of the final error; what is left once it is taken out is `sqrt(final^2 - offset^2)`).\n\n");
     out
 }
