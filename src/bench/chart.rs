@@ -3,8 +3,8 @@
 //! adaptive runs as orange squares, the Pareto front as a dashed staircase
 //! through ringed points; points are numbered, with the key of numbers to
 //! labels on the right. The sensitivity floor, when measured and within two
-//! decades of the smallest error, is a dotted grey line: errors closer together than it are not told
-//! apart by the comparison.
+//! decades of the smallest error, is a dotted grey line: errors closer
+//! together than it are not told apart by the comparison.
 
 use plotters::coord::Shift;
 use plotters::coord::combinators::WithKeyPoints;

@@ -22,6 +22,7 @@ use std::path::Path;
 use serde::Deserialize;
 
 use super::BenchError;
+use crate::math::Scalar;
 use crate::scene::{AdaptMethod, Integrator, Scene};
 
 /// What the error compares.
@@ -42,6 +43,18 @@ impl Compare {
         match self {
             Compare::Frames => "frames",
             Compare::Rest => "rest",
+        }
+    }
+
+    /// The compared error of per-frame `errors` (in frame order): their mean,
+    /// or the last one at rest; `NaN` when there are none.
+    pub fn of(self, errors: impl ExactSizeIterator<Item = Scalar>) -> Scalar {
+        let n = errors.len();
+        let (sum, last) = errors.fold((0.0, Scalar::NAN), |(s, _), e| (s + e, e));
+        match self {
+            _ if n == 0 => Scalar::NAN,
+            Compare::Frames => sum / n as Scalar,
+            Compare::Rest => last,
         }
     }
 }

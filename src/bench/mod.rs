@@ -146,8 +146,6 @@ pub struct Floor {
     /// The error compared like the rungs': the mean over the frames, or the
     /// last frame's at rest.
     pub error: Scalar,
-    /// Wall time of the lifted run, s.
-    pub wall_s: Scalar,
     /// True when the lifted run came from the cache.
     pub cache_hit: bool,
 }
@@ -406,18 +404,12 @@ fn floor_of(
         })
         .collect();
     let errors = sampling::run_errors(&lowered, &reference.frames, reference.diagonal);
-    let error = match compare {
-        Compare::Frames => {
-            errors.iter().map(|e| e.1).sum::<Scalar>() / errors.len().max(1) as Scalar
-        }
-        Compare::Rest => errors.last().map_or(Scalar::NAN, |e| e.1),
-    };
+    let error = compare.of(errors.iter().map(|e| e.1));
     Floor {
         lift: lift.length(),
         start,
         errors,
         error,
-        wall_s: lifted.wall_s,
         cache_hit: false,
     }
 }

@@ -111,11 +111,7 @@ fn floor_from_frames(dir: &Path, stem: &str, compare: super::Compare) -> Option<
         .filter(|f| f.len() == 3 && f[0] == super::report::FLOOR_LABEL)
         .filter_map(|f| f[2].parse().ok())
         .collect();
-    let last = *errors.last()?;
-    Some(match compare {
-        super::Compare::Frames => errors.iter().sum::<f64>() / errors.len() as f64,
-        super::Compare::Rest => last,
-    })
+    (!errors.is_empty()).then(|| compare.of(errors.into_iter()))
 }
 
 /// Redraws `dir/stem.svg` from `dir/stem.csv` (`drape bench --replot`), with
