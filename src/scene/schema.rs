@@ -96,7 +96,7 @@ pub(crate) fn allowed(path: &str) -> Option<&'static str> {
             "a finite number > 0 (criterion = \"sizing\" with method = \"red_green\" only)"
         }
         "adapt.refine_obstacle" => {
-            "a finite number > 0 (criterion = \"sizing\" with method = \"red_green\" only)"
+            "a finite number > 0 (criterion = \"sizing\" with method = \"red_green\" only, in a scene with an [[obstacle]])"
         }
         _ => return None,
     })

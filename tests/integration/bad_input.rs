@@ -384,6 +384,29 @@ fn refine_obstacle_needs_the_sizing_rule_on_red_green_and_a_positive_value() {
     );
 }
 
+/// Regression: `refine_obstacle` on a scene without obstacles was accepted
+/// and did nothing (the sizing rule had no plane to lean towards).
+#[test]
+fn refine_obstacle_without_an_obstacle_is_refused() {
+    let dir = temp_dir("obstacle-none");
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/hanging_sheet.toml");
+    let scene = scene.to_str().expect("a UTF-8 path");
+    let out = drape(
+        &dir,
+        &["check", scene, "--set", "adapt.refine_obstacle=1.0"],
+    );
+    refused(
+        &out,
+        1,
+        &[
+            "hanging_sheet.toml",
+            "key `adapt.refine_obstacle`",
+            "this scene has no [[obstacle]]",
+        ],
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 /// The tensor method (`src/adapt/tensor.rs`) refines a rectangle's grid,
 /// with an even `max_level`, and without rollback, multirate stepping or
 /// level-scaled stiffness.
