@@ -183,6 +183,17 @@
 //!   free edge from the other two folds (a red one, cylinder about x, 1.000 ->
 //!   0.965), against the zero-moment condition below.
 //!
+//! * Irregular triangulations (an OBJ cloth, bisection in a metric) are not
+//!   exact: a triangle whose folds do not cancel inside it carries a residue
+//!   for a constant curvature, so by Jensen the sheet is too stiff, by a
+//!   factor that does not fall with the cell size. Measured on the
+//!   cantilever with free vertices moved up to a quarter cell: 1.1 to 1.2 deg
+//!   stiff of the elastica, 1.7 to 1.8 deg at 0.3 cell and 64 cells along;
+//!   `P` on every interior triangle overshoots to 0.6 deg soft (3.5 to 5.1
+//!   deg on thin cells). The test
+//!   `elastica::an_irregular_strip_bends_stiffer_than_the_elastica` and
+//!   `docs/speed-vs-error.md`, "Bending on irregular triangles".
+//!
 //! Boundary edges have no angle, so an imposed curvature across a free edge loses
 //! the outer half row of triangles' share (the `1 - 1/n` of the cylinder test).
 //! At a free edge the plate's natural boundary condition is zero moment, so a
