@@ -81,7 +81,7 @@ struct BenchArgs {
     #[arg(long, value_name = "FILE.toml")]
     ladder: Option<PathBuf>,
     /// Run the time-step ladder instead: one uniform mesh at the scene's step, 1/2 and 1/4 of it, against 1/32 of it (files SCENE-time.*).
-    #[arg(long, conflicts_with_all = ["ladder", "reference_resolution", "step"])]
+    #[arg(long, conflicts_with_all = ["ladder", "reference_resolution", "step", "mesh_floor"])]
     time_ladder: bool,
     /// What the error compares: `frames` (every recorded frame, mean; dynamic scenes) or `rest` (the last frame; quasi-static scenes). Default: the ladder's `compare`, else `frames`.
     #[arg(long, value_name = "HOW")]
@@ -116,8 +116,15 @@ struct BenchArgs {
     /// Skip the sensitivity floor: by default the reference is run a second time with
     /// the cloth started 1 micrometre higher, and the report says how far that run ends
     /// from the reference (errors closer than that are not told apart).
-    #[arg(long)]
+    #[arg(long, conflicts_with = "mesh_floor")]
     no_floor: bool,
+    /// Also run the reference's settings on a uniform mesh of N segments and report
+    /// how far it ends from the reference: the mesh floor (errors closer than the
+    /// larger floor are not told apart). Choose N near the reference's resolution
+    /// with the pins, clamps and the sheet's centre on the same grid lines (e.g. two
+    /// more on a sheet whose features lie on even lines); see README.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(2..))]
+    mesh_floor: Option<u32>,
     /// Segments of the reference's uniform mesh (default: 1.5 times the finest rung's, rounded up to even).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(2..))]
     reference_resolution: Option<u32>,
@@ -322,6 +329,7 @@ fn cmd_bench(args: BenchArgs) -> Result<ExitCode> {
         reference_resolution: args.reference_resolution,
         grid: args.samples as usize,
         floor: !args.no_floor,
+        mesh_floor: args.mesh_floor,
     };
     if args.list {
         use std::io::Write;

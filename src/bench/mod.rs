@@ -14,6 +14,7 @@
 //! mesh and varies the step (SPEC section 8).
 
 pub mod chart;
+pub mod floor;
 pub mod ladder;
 pub mod measure;
 pub mod metric;
@@ -31,6 +32,7 @@ use std::sync::atomic::AtomicBool;
 use crate::math::Scalar;
 use crate::run::{RunError, RunOptions};
 use crate::scene::{Scene, SceneError, load_scene_file};
+pub use floor::{FLOOR_LIFT, Floor, FloorChange};
 pub use ladder::{Compare, Ladder, Rung, StepPolicy};
 pub use measure::{integrator_name, median};
 pub use reference::Reference;
@@ -82,6 +84,9 @@ pub enum BenchError {
     /// The chart could not be drawn.
     #[error("drawing the chart: {0}")]
     Chart(String),
+    /// `--mesh-floor` does not apply.
+    #[error("--mesh-floor: {0}")]
+    MeshFloor(String),
 }
 
 /// What to benchmark and how.
@@ -117,37 +122,12 @@ pub struct BenchOptions {
     pub grid: usize,
     /// Also run the reference with the cloth started [`FLOOR_LIFT`] higher
     /// (against gravity) and report how far it ends from the reference: the
-    /// metric's sensitivity floor ([`Floor`]).
+    /// comparison's lift floor ([`floor`]).
     pub floor: bool,
-}
-
-/// How far the sensitivity floor's run starts from the reference's, m: the
-/// cloth lifted 1 micrometre against gravity, a change no mesh or step setting
-/// resolves.
-pub const FLOOR_LIFT: Scalar = 1e-6;
-
-/// The metric's sensitivity floor: the reference run again with the cloth
-/// started [`FLOOR_LIFT`] higher, moved back down by the lift and compared
-/// with the reference like a rung. A smooth problem (translation invariant up
-/// to its obstacles) answers with about nothing; a chaotic one (a sheet
-/// falling onto an obstacle and folding) amplifies the lift, and errors of
-/// runs that differ by less than the floor are not told apart by this
-/// comparison.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Floor {
-    /// The lift, m.
-    pub lift: Scalar,
-    /// The lifted run's first frame against the reference's, as it started
-    /// (the lift not taken out), relative to the diagonal: the lift itself.
-    pub start: Scalar,
-    /// `(time, error)` at every recorded frame, relative to the diagonal, the
-    /// lift taken out.
-    pub errors: Vec<(Scalar, Scalar)>,
-    /// The error compared like the rungs': the mean over the frames, or the
-    /// last frame's at rest.
-    pub error: Scalar,
-    /// True when the lifted run came from the cache.
-    pub cache_hit: bool,
+    /// Also run the reference's settings on a uniform mesh of this many
+    /// segments and report how far it ends from the reference: the mesh
+    /// floor ([`floor`]; not with the time-step ladder or an OBJ cloth).
+    pub mesh_floor: Option<u32>,
 }
 
 /// One rung's result: its settings and measurements.
@@ -237,11 +217,22 @@ pub struct BenchResult {
     /// How far the reference's samples moved over its last frame, relative to
     /// the diagonal (a check that a scene compared at rest has settled).
     pub reference_last_motion: Option<Scalar>,
-    /// The sensitivity floor (`None` unless asked for, or for the time-step
-    /// ladder, or when its run failed).
+    /// The lift floor (`None` unless asked for, or for the time-step ladder,
+    /// or when its run failed).
     pub floor: Option<Floor>,
-    /// Why the sensitivity floor's run failed numerically, when it did.
+    /// Why the lift floor's run failed numerically, when it did.
     pub floor_failure: Option<String>,
+    /// The mesh floor (`None` unless asked for, or when its run failed).
+    pub mesh_floor: Option<Floor>,
+    /// Why the mesh floor's run failed numerically, when it did.
+    pub mesh_floor_failure: Option<String>,
+}
+
+impl BenchResult {
+    /// The floors measured: the lift's, then the mesh's.
+    pub fn floors(&self) -> impl Iterator<Item = &Floor> {
+        self.floor.iter().chain(&self.mesh_floor)
+    }
 }
 
 fn load(path: &Path, overrides: &[String], context: &str) -> Result<Scene, BenchError> {
@@ -265,6 +256,9 @@ struct Plan {
     floor_set: Vec<String>,
     floor_scene: Scene,
     floor_lift: crate::math::Vector,
+    /// The reference's overrides and scene on the mesh floor's mesh, with its
+    /// resolution (`None` unless asked for).
+    mesh: Option<(Vec<String>, Scene, u32)>,
     compare: Compare,
     step: StepPolicy,
     common_dt: Option<(Scalar, String)>,
@@ -345,10 +339,25 @@ fn plan(opts: &BenchOptions) -> Result<Plan, BenchError> {
         )?;
     }
     let ref_set = chain(&base_set, &step_set, &ref_own);
-    let floor_lift = lift(&ref_scene);
-    let floor_set = chain(&ref_set, &[lifted_position(&ref_scene, floor_lift)], &[]);
+    let floor_lift = floor::lift(&ref_scene);
+    let floor_set = chain(
+        &ref_set,
+        &[floor::lifted_position(&ref_scene, floor_lift)],
+        &[],
+    );
     let floor_scene = load(&opts.scene, &floor_set, "reference, lifted")?;
+    let mesh = match opts.mesh_floor {
+        Some(n) => {
+            let set = floor::mesh_override(&ref_scene, n, opts.time_ladder)
+                .map_err(BenchError::MeshFloor)?;
+            let set = chain(&ref_set, &[set], &[]);
+            let scene = load(&opts.scene, &set, "reference, mesh floor")?;
+            Some((set, scene, n))
+        }
+        None => None,
+    };
     Ok(Plan {
+        mesh,
         base,
         ref_set,
         floor_set,
@@ -364,62 +373,23 @@ fn plan(opts: &BenchOptions) -> Result<Plan, BenchError> {
     })
 }
 
-/// The sensitivity floor's lift for `scene`: [`FLOOR_LIFT`] against gravity,
-/// or along +z without gravity.
-fn lift(scene: &Scene) -> crate::math::Vector {
-    let g = crate::math::Vector::from(scene.simulation.gravity);
-    (-g).try_normalize().unwrap_or(crate::math::Vector::Z) * FLOOR_LIFT
+/// Which run [`obtain_reference`] gives.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Which {
+    /// The reference.
+    Reference,
+    /// The lift floor's run.
+    Lifted,
+    /// The mesh floor's run.
+    Finer,
 }
 
-/// The `cloth.position` override that starts `scene`'s cloth `lift` away.
-fn lifted_position(scene: &Scene, lift: crate::math::Vector) -> String {
-    let p = crate::math::Vector::from(scene.cloth.position) + lift;
-    format!("cloth.position=[{:e}, {:e}, {:e}]", p.x, p.y, p.z)
-}
-
-/// The sensitivity floor from the lifted run's samples (`lifted`) and the
-/// reference's, compared as `compare` says.
-fn floor_of(
-    lifted: &Reference,
-    reference: &Reference,
-    lift: crate::math::Vector,
-    compare: Compare,
-) -> Floor {
-    let start = match (lifted.frames.first(), reference.frames.first()) {
-        (Some(a), Some(b)) => {
-            sampling::frame_error(a, b, reference.diagonal).unwrap_or(Scalar::NAN)
-        }
-        _ => Scalar::NAN,
-    };
-    let lowered: Vec<sampling::FrameSamples> = lifted
-        .frames
-        .iter()
-        .map(|f| sampling::FrameSamples {
-            positions: f
-                .positions
-                .iter()
-                .map(|p| p.map(|q| (crate::math::Vector::from_array(q) - lift).to_array()))
-                .collect(),
-            ..f.clone()
-        })
-        .collect();
-    let errors = sampling::run_errors(&lowered, &reference.frames, reference.diagonal);
-    let error = compare.of(errors.iter().map(|e| e.1));
-    Floor {
-        lift: lift.length(),
-        start,
-        errors,
-        error,
-        cache_hit: false,
-    }
-}
-
-/// The reference (or, with `lifted`, the floor's run): from the cache when
-/// allowed and present, else computed.
+/// The reference or a floor's run: from the cache when allowed and present,
+/// else computed.
 fn obtain_reference(
     plan: &Plan,
     opts: &BenchOptions,
-    lifted: bool,
+    which: Which,
     (run_opts, interrupt): (&RunOptions, &AtomicBool),
     log: &mut dyn FnMut(&str),
 ) -> Result<(Reference, bool), BenchError> {
@@ -427,10 +397,15 @@ fn obtain_reference(
         path: opts.scene.clone(),
         source,
     })?;
-    let (what, set, scene) = if lifted {
-        ("reference lifted 1 um", &plan.floor_set, &plan.floor_scene)
-    } else {
-        ("reference", &plan.ref_set, &plan.ref_scene)
+    let (what, set, scene) = match (which, &plan.mesh) {
+        (Which::Reference, _) => ("reference".to_owned(), &plan.ref_set, &plan.ref_scene),
+        (Which::Lifted, _) => (
+            floor::FLOOR_LABEL.to_owned(),
+            &plan.floor_set,
+            &plan.floor_scene,
+        ),
+        (Which::Finer, Some((set, scene, n))) => (floor::mesh_label(*n), set, scene),
+        (Which::Finer, None) => unreachable!("the mesh floor's run is only asked for when planned"),
     };
     let key = reference::cache_key(&scene_text, set, opts.grid);
     let cache_file = reference::cache_path(&opts.out_dir, &plan.base.name, &key);
@@ -440,7 +415,14 @@ fn obtain_reference(
         log(&format!("{what}: cached {}", cache_file.display()));
         return Ok((r, true));
     }
-    log(&format!("{what}: computing ({})", plan.ref_own.join(" ")));
+    let change = match which {
+        Which::Reference => String::new(),
+        _ => format!(", then {}", set.last().map_or("", String::as_str)),
+    };
+    log(&format!(
+        "{what}: computing ({}{change})",
+        plan.ref_own.join(" ")
+    ));
     let r = reference::compute(scene, set.clone(), key, opts.grid, run_opts, interrupt)?;
     log(&format!(
         "{what}: {} vertices, {} steps, {:.1} s",
@@ -450,6 +432,50 @@ fn obtain_reference(
         reference::store(&cache_file, &r)?;
     }
     Ok((r, false))
+}
+
+/// A floor's run and its comparison with `reference` (module [`floor`]):
+/// `Ok(None)` when the floor was not asked for, `Err(why)` when its run
+/// failed numerically (the rungs are still measured).
+fn measure_floor(
+    plan: &Plan,
+    opts: &BenchOptions,
+    which: Which,
+    reference: &Reference,
+    run: (&RunOptions, &AtomicBool),
+    log: &mut dyn FnMut(&str),
+) -> Result<Result<Option<Floor>, String>, BenchError> {
+    let (change, lift) = match (which, &plan.mesh) {
+        (Which::Finer, None) => return Ok(Ok(None)),
+        (Which::Finer, Some((_, _, n))) => (FloorChange::Resolution(*n), crate::math::Vector::ZERO),
+        _ if !opts.floor || opts.time_ladder => return Ok(Ok(None)),
+        _ => (FloorChange::Lift(plan.floor_lift.length()), plan.floor_lift),
+    };
+    let name = match change {
+        FloorChange::Lift(_) => "sensitivity floor",
+        FloorChange::Resolution(_) => "mesh floor",
+    };
+    match obtain_reference(plan, opts, which, run, log) {
+        Ok((r, hit)) => {
+            let f = Floor {
+                cache_hit: hit,
+                ..floor::floor_of(&r, reference, change, lift, plan.compare)
+            };
+            log(&format!(
+                "{name} ({}): {:.3e} of the diagonal",
+                plan.compare.name(),
+                f.error
+            ));
+            Ok(Ok(Some(f)))
+        }
+        // The floor's run failed numerically where the reference did not: the
+        // floor is reported as missing, and the rungs are still measured.
+        Err(BenchError::Reference(why)) => {
+            log(&format!("{name}: its run failed ({why})"));
+            Ok(Err(why))
+        }
+        Err(e) => Err(e),
+    }
 }
 
 /// Runs the benchmark, reporting progress lines through `log`.
@@ -468,34 +494,18 @@ pub fn bench(
         threads: opts.threads,
         ..RunOptions::default()
     };
-    let (reference, cache_hit) = obtain_reference(&plan, opts, false, (&run_opts, interrupt), log)?;
-    let mut floor_failure = None;
-    let floor = if opts.floor && !opts.time_ladder {
-        match obtain_reference(&plan, opts, true, (&run_opts, interrupt), log) {
-            Ok((lifted, hit)) => {
-                let floor = Floor {
-                    cache_hit: hit,
-                    ..floor_of(&lifted, &reference, plan.floor_lift, plan.compare)
-                };
-                log(&format!(
-                    "sensitivity floor ({}): {:.3e} of the diagonal",
-                    plan.compare.name(),
-                    floor.error
-                ));
-                Some(floor)
-            }
-            // The lifted run failed numerically where the reference did not: the
-            // floor is reported as missing, and the rungs are still measured.
-            Err(BenchError::Reference(why)) => {
-                log(&format!("sensitivity floor: the lifted run failed ({why})"));
-                floor_failure = Some(why);
-                None
-            }
-            Err(e) => return Err(e),
-        }
-    } else {
-        None
-    };
+    let run = (&run_opts, interrupt);
+    let (reference, cache_hit) = obtain_reference(&plan, opts, Which::Reference, run, log)?;
+    let (floor, floor_failure) =
+        match measure_floor(&plan, opts, Which::Lifted, &reference, run, log)? {
+            Ok(f) => (f, None),
+            Err(why) => (None, Some(why)),
+        };
+    let (mesh_floor, mesh_floor_failure) =
+        match measure_floor(&plan, opts, Which::Finer, &reference, run, log)? {
+            Ok(f) => (f, None),
+            Err(why) => (None, Some(why)),
+        };
     let points = reference.sample_points();
     let mut rows = Vec::new();
     let n = plan.scenes.len();
@@ -541,6 +551,8 @@ pub fn bench(
         reference_last_motion,
         floor,
         floor_failure,
+        mesh_floor,
+        mesh_floor_failure,
     };
     result.files = report::write_all(&opts.out_dir, &result, &opts.scene)?;
     Ok(result)

@@ -99,19 +99,27 @@ pub fn read_csv(path: &Path) -> Result<Vec<Row>, BenchError> {
     Ok(rows)
 }
 
-/// The sensitivity floor from `dir/stem-frames.csv` (its rows labelled
-/// [`super::report::FLOOR_LABEL`]), compared as `compare` says: `None` when the
-/// file or the rows are missing.
-fn floor_from_frames(dir: &Path, stem: &str, compare: super::Compare) -> Option<f64> {
+/// The larger sensitivity floor from `dir/stem-frames.csv` (its rows
+/// labelled as [`super::floor::is_floor_label`] says), each compared as
+/// `compare` says: `None` when the file or the rows are missing.
+pub fn floor_from_frames(dir: &Path, stem: &str, compare: super::Compare) -> Option<f64> {
     let text = std::fs::read_to_string(dir.join(format!("{stem}-frames.csv"))).ok()?;
-    let errors: Vec<f64> = text
-        .lines()
-        .skip(1)
-        .map(split_csv_line)
-        .filter(|f| f.len() == 3 && f[0] == super::report::FLOOR_LABEL)
-        .filter_map(|f| f[2].parse().ok())
-        .collect();
-    (!errors.is_empty()).then(|| compare.of(errors.into_iter()))
+    let mut by_label: Vec<(String, Vec<f64>)> = Vec::new();
+    for f in text.lines().skip(1).map(split_csv_line) {
+        if f.len() != 3 || !super::floor::is_floor_label(&f[0]) {
+            continue;
+        }
+        let Ok(e) = f[2].parse() else { continue };
+        match by_label.iter_mut().find(|(l, _)| *l == f[0]) {
+            Some((_, v)) => v.push(e),
+            None => by_label.push((f[0].clone(), vec![e])),
+        }
+    }
+    by_label
+        .into_iter()
+        .map(|(_, v)| compare.of(v.into_iter()))
+        .filter(|e| !e.is_nan())
+        .reduce(f64::max)
 }
 
 /// Redraws `dir/stem.svg` from `dir/stem.csv` (`drape bench --replot`), with

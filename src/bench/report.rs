@@ -76,20 +76,22 @@ pub fn kind(r: &Row) -> &'static str {
     if r.adaptive { "adaptive" } else { "uniform" }
 }
 
-/// The label of the sensitivity floor's rows in `SCENE-frames.csv`.
-pub const FLOOR_LABEL: &str = "reference lifted 1 um";
+pub use super::floor::FLOOR_LABEL;
 
-/// The per-frame errors: `label,time,error`, then the sensitivity floor's
-/// (label [`FLOOR_LABEL`]) when it was measured.
-pub fn frames_csv(rows: &[Row], floor: Option<&Floor>) -> String {
+/// The per-frame errors: `label,time,error`, then the floors' (labelled by
+/// [`super::FloorChange::label`]) when they were measured.
+pub fn frames_csv<'a>(rows: &[Row], floors: impl IntoIterator<Item = &'a Floor>) -> String {
     let mut out = String::from("label,time,error\n");
     for r in rows {
         for (t, e) in &r.errors {
             let _ = writeln!(out, "{},{t},{e}", field(&r.label));
         }
     }
-    for (t, e) in floor.map_or(&[][..], |f| &f.errors) {
-        let _ = writeln!(out, "{},{t},{e}", field(FLOOR_LABEL));
+    for f in floors {
+        let label = f.change.label();
+        for (t, e) in &f.errors {
+            let _ = writeln!(out, "{},{t},{e}", field(&label));
+        }
     }
     out
 }
@@ -213,18 +215,22 @@ fn preamble(res: &BenchResult, scene_path: &Path) -> String {
         r.points.len(),
         r.diagonal,
     );
+    let how = match res.compare {
+        super::Compare::Frames => "mean over the frames",
+        super::Compare::Rest => "at rest",
+    };
+    let last = |f: &Floor| pct(f.errors.last().map_or(Scalar::NAN, |e| e.1));
     if let Some(f) = &res.floor {
+        let lift = match f.change {
+            super::FloorChange::Lift(m) => m,
+            super::FloorChange::Resolution(_) => Scalar::NAN,
+        };
         let _ = writeln!(
             out,
-            "Sensitivity floor: the reference run again with the cloth started {:.0e} m higher{}, moved back down by that lift, is {} % of the diagonal from the reference ({}; {} % at the last frame; as it started, {} %, the lift itself). Differences between runs' errors smaller than that are not resolved by this comparison: the target table marks a check as decided only where the floor is below a tenth of the uniform run's error.\n",
-            f.lift,
+            "Sensitivity floor: the reference run again with the cloth started {lift:.0e} m higher{}, moved back down by that lift, is {} % of the diagonal from the reference ({how}; {} % at the last frame; as it started, {} %, the lift itself).\n",
             if f.cache_hit { " (cached)" } else { "" },
             pct(f.error),
-            match res.compare {
-                super::Compare::Frames => "mean over the frames",
-                super::Compare::Rest => "at rest",
-            },
-            pct(f.errors.last().map_or(Scalar::NAN, |e| e.1)),
+            last(f),
             pct(f.start),
         );
     }
@@ -232,6 +238,29 @@ fn preamble(res: &BenchResult, scene_path: &Path) -> String {
         let _ = writeln!(
             out,
             "Sensitivity floor: not measured: the reference run started 1 micrometre higher failed ({why}).\n"
+        );
+    }
+    if let Some(f) = &res.mesh_floor {
+        let n = match f.change {
+            super::FloorChange::Resolution(n) => n.to_string(),
+            super::FloorChange::Lift(_) => "?".into(),
+        };
+        let _ = writeln!(
+            out,
+            "Mesh floor: the reference run again on a uniform mesh of {n} segments{}, two more than its own, is {} % of the diagonal from the reference ({how}; {} % at the last frame). Where the mesh decides where folds form, this is as large as the distance between any two fine meshes.\n",
+            if f.cache_hit { " (cached)" } else { "" },
+            pct(f.error),
+            last(f),
+        );
+    }
+    if let Some(why) = &res.mesh_floor_failure {
+        let _ = writeln!(out, "Mesh floor: not measured ({why}).\n");
+    }
+    if let Some(f) = super::floor::largest(res.floors()) {
+        let _ = writeln!(
+            out,
+            "Differences between runs' errors smaller than the larger floor ({} %) are not resolved by this comparison: the target table marks a check as decided only where it is below a tenth of the uniform run's error.\n",
+            pct(f)
         );
     }
     out.push_str("Final offset: the length of the mean displacement of the samples from the reference's at the last frame (the rigid translation part of the final error; what is left once it is taken out is `sqrt(final^2 - offset^2)`).\n\n");
@@ -302,9 +331,9 @@ pub fn convergence_text(c: &Convergence) -> String {
 }
 
 /// The target paragraph: every adaptive run against its uniform counterpart,
-/// and, with the sensitivity floor measured, whether the metric decides the
-/// 10 % (the floor below a tenth of the uniform run's error).
-fn targets(rows: &[Row], floor: Option<&Floor>) -> String {
+/// and, with the floors measured, whether the metric decides the 10 % (the
+/// larger floor, `floor`, below a tenth of the uniform run's error).
+fn targets(rows: &[Row], floor: Option<Scalar>) -> String {
     let checks = target_checks(rows);
     if checks.is_empty() {
         return String::new();
@@ -320,7 +349,7 @@ fn targets(rows: &[Row], floor: Option<&Floor>) -> String {
             .map_or(Scalar::NAN, |r| r.error);
         let (ratio, decided) = match floor {
             Some(f) => {
-                let ratio = f.error / uniform_error;
+                let ratio = f / uniform_error;
                 (format!("{ratio:.2}"), yes(ratio < 0.1))
             }
             None => ("-".into(), "-"),
@@ -356,7 +385,7 @@ pub fn markdown(res: &BenchResult, scene_path: &Path) -> String {
     for c in &series {
         out.push_str(&convergence_text(c));
     }
-    out.push_str(&targets(&res.rows, res.floor.as_ref()));
+    out.push_str(&targets(&res.rows, super::floor::largest(res.floors())));
     out
 }
 
@@ -375,12 +404,12 @@ pub fn write_all(
         (format!("{stem}.csv"), csv(&res.rows)),
         (
             format!("{stem}-frames.csv"),
-            frames_csv(&res.rows, res.floor.as_ref()),
+            frames_csv(&res.rows, res.floors()),
         ),
         (format!("{stem}.md"), markdown(res, scene_path)),
         (
             format!("{stem}.svg"),
-            super::chart::svg(stem, &res.rows, res.floor.as_ref().map(|f| f.error))?,
+            super::chart::svg(stem, &res.rows, super::floor::largest(res.floors()))?,
         ),
     ];
     let mut paths = Vec::new();

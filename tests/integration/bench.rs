@@ -9,7 +9,9 @@ use drape::bench::pareto::pareto_front;
 use drape::bench::replot::read_csv;
 use drape::bench::report::{CSV_HEADER, csv, target_checks};
 use drape::bench::sampling::{FrameSamples, frame_error};
-use drape::bench::{BenchOptions, Compare, Ladder, Row, Rung, StepPolicy, bench, median};
+use drape::bench::{
+    BenchOptions, Compare, FloorChange, Ladder, Row, Rung, StepPolicy, bench, median,
+};
 
 /// A fresh empty directory in the temp dir, unique per process and name.
 pub(crate) fn temp_dir(name: &str) -> PathBuf {
@@ -66,6 +68,7 @@ fn tiny_options(scene: &Path, out_dir: PathBuf, ladder: Ladder) -> BenchOptions 
         out_dir,
         cache: true,
         reference_resolution: None,
+        mesh_floor: None,
         grid: 8,
         floor: false,
     }
@@ -419,7 +422,9 @@ fn bench_cli_lists_the_default_ladder_and_rejects_unknown_rungs() {
 /// so the lifted run is the reference moved by the lift at every frame: it
 /// starts the lift away (over the diagonal) and, the lift taken out, is the
 /// reference to rounding at every frame (printed). The report and the
-/// per-frame CSV carry it.
+/// per-frame CSV carry it. The mesh floor (`--mesh-floor 8` against the
+/// reference's 6 segments) of a free fall is rounding too: every mesh falls
+/// alike.
 #[test]
 fn the_sensitivity_floor_of_a_free_fall_is_nothing_but_the_lift() {
     let dir = temp_dir("floor");
@@ -441,6 +446,7 @@ fn the_sensitivity_floor_of_a_free_fall_is_nothing_but_the_lift() {
     };
     let opts = BenchOptions {
         floor: true,
+        mesh_floor: Some(8),
         ..tiny_options(&scene, dir.join("out"), ladder)
     };
     let stop = AtomicBool::new(false);
@@ -481,9 +487,69 @@ fn the_sensitivity_floor_of_a_free_fall_is_nothing_but_the_lift() {
             .count(),
         floor.errors.len()
     );
+    // The mesh floor: the reference's 6 segments and 7 fall alike.
+    let mesh = res.mesh_floor.expect("the mesh floor was asked for");
+    println!("mesh floor per frame {:?}", mesh.errors);
+    assert_eq!(mesh.change, FloorChange::Resolution(8));
+    assert_eq!(mesh.errors.len(), res.reference.frames.len());
+    assert!(mesh.error < 1e-3 * lift, "{:e}", mesh.error);
+    assert!(md.contains("Mesh floor: the reference run again on a uniform mesh of 8 segments"));
+    assert_eq!(
+        frames
+            .lines()
+            .filter(|l| l.starts_with("reference at 8 segments,"))
+            .count(),
+        mesh.errors.len()
+    );
     // Cached the second time, like the reference.
     let again = bench(&opts, &stop, &mut |_| {}).expect("bench");
     assert!(again.floor.is_some_and(|f| f.cache_hit));
+    assert!(again.mesh_floor.is_some_and(|f| f.cache_hit));
+}
+
+/// The mesh floor (`drape::bench::floor`) of a problem that converges with
+/// the mesh is far below the rungs' errors: the tiny sheet hanging from a
+/// corner, uniform 4 against a reference of 16 segments, and 18 segments
+/// against 16 (printed). With the lift floor it decides the target table's
+/// comparison, and the replot reads the larger of the two back from the
+/// per-frame CSV.
+#[test]
+fn the_mesh_floor_of_a_converging_sheet_is_below_the_rungs_errors() {
+    let dir = temp_dir("mesh-floor");
+    let scene = tiny_scene(&dir);
+    let ladder = Ladder {
+        reference: None,
+        compare: None,
+        step: None,
+        rung: vec![rung(
+            "uniform 4",
+            &["adapt.method=none", "cloth.resolution=4"],
+        )],
+    };
+    let opts = BenchOptions {
+        floor: true,
+        reference_resolution: Some(16),
+        mesh_floor: Some(18),
+        ..tiny_options(&scene, dir.join("out"), ladder)
+    };
+    let stop = AtomicBool::new(false);
+    let res = bench(&opts, &stop, &mut |_| {}).expect("bench");
+    let lift = res.floor.as_ref().expect("lift floor").error;
+    let mesh = res.mesh_floor.as_ref().expect("mesh floor").error;
+    let uniform = res.rows[0].error;
+    println!(
+        "uniform 4 {uniform:.4e}, mesh floor (18 against 16) {mesh:.4e}, lift floor {lift:.4e}"
+    );
+    assert!(mesh > 0.0, "a finer mesh hangs differently");
+    assert!(mesh < 0.1 * uniform, "{mesh:e} against {uniform:e}");
+    let md = std::fs::read_to_string(dir.join("out/tiny.md")).expect("md");
+    assert!(md.contains("smaller than the larger floor"), "{md}");
+    let floor = drape::bench::replot::floor_from_frames(&dir.join("out"), "tiny", res.compare);
+    let larger = lift.max(mesh);
+    assert!(
+        floor.is_some_and(|f| (f - larger).abs() <= 1e-12 * larger),
+        "{floor:?} against {larger:e}"
+    );
 }
 
 /// The chart draws the sensitivity floor as a line when it is within two
@@ -501,4 +567,44 @@ fn the_chart_draws_a_floor_near_the_errors_only() {
     assert!(with.contains("sensitivity floor"));
     assert!(!rounding.contains("sensitivity floor"));
     assert_eq!(rounding, without);
+}
+
+/// `--mesh-floor` is refused where it does not apply: the reference's own
+/// resolution (exit 1, before any run), with `--no-floor` or the time-step
+/// ladder (usage errors, exit 2).
+#[test]
+fn the_mesh_floor_is_refused_where_it_does_not_apply() {
+    let dir = temp_dir("mesh-floor-refused");
+    let scene = tiny_scene(&dir);
+    let scene = scene.to_str().expect("utf-8");
+    let out_dir = dir.join("out");
+    let out_dir = out_dir.to_str().expect("utf-8");
+    for (args, code, needle) in [
+        (
+            vec!["--reference-resolution", "6", "--mesh-floor", "6"],
+            1,
+            "--mesh-floor: 6 segments is the reference's own mesh",
+        ),
+        (
+            vec!["--mesh-floor", "8", "--no-floor"],
+            2,
+            "cannot be used with",
+        ),
+        (
+            vec!["--mesh-floor", "8", "--time-ladder"],
+            2,
+            "cannot be used with",
+        ),
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_drape"))
+            .args(["bench", scene, "--out-dir", out_dir])
+            .args(&args)
+            .output()
+            .expect("run drape");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(code), "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{err}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
 }

@@ -158,6 +158,7 @@ fn time_ladder_end_to_end_error_falls_with_the_step() {
         out_dir: dir.join("out"),
         cache: false,
         reference_resolution: None,
+        mesh_floor: None,
         grid: 8,
         floor: false,
     };
@@ -245,6 +246,7 @@ fn uniform_error_at_rest_falls_with_resolution() {
         out_dir: dir.join("out"),
         cache: false,
         reference_resolution: None,
+        mesh_floor: None,
         grid: 24,
         floor: false,
     };

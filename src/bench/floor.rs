@@ -1,0 +1,180 @@
+//! The comparison's sensitivity floors: the reference run again with a change
+//! that no rung's setting resolves, compared with the reference like a rung.
+//!
+//! * **The lift**: the cloth started [`FLOOR_LIFT`] higher (against gravity),
+//!   moved back down by the lift before comparing. A smooth problem answers
+//!   with about nothing; a chaotic one (a sheet falling onto an obstacle and
+//!   folding) amplifies the lift.
+//! * **The mesh** (`--mesh-floor N`, off by default): the reference's
+//!   settings on a uniform mesh of `N` segments, near the reference's own. On
+//!   a problem that converges with the mesh this is the difference between
+//!   two nearly equal resolutions, a small part of the reference's own error;
+//!   where the mesh decides where folds form, it is as large as the distance
+//!   between any two fine meshes, and the rungs' errors against the reference
+//!   are that distance, not their own error. `N` is the user's: a resolution
+//!   that moves a pin's box edge, a clamp line or the sheet's centre off the
+//!   grid lines they sit on changes the problem, not only the mesh (an odd
+//!   count puts the centre in a cell's middle and turns the corners'
+//!   diagonals; the cantilever's clamp edge is on a line only at multiples of
+//!   5 segments). Measured (`docs/speed-vs-error.md`, "The mesh floor"):
+//!   against uniform 96 on `drape_sphere` (2.5 s), uniform 94 and 98 are
+//!   0.765 % and 0.762 % of the diagonal from it, 95 and 97 0.686 % and 0.698
+//!   %, where uniform 64 is 0.602 % and the lift gives 0.038 %; on
+//!   `tablecloth` (2 s) 98 is 0.548 %, uniform 64 0.606 %. On the cantilever
+//!   122 against 120 (the clamp edge off its line) gave 0.326 %, thirteen
+//!   times uniform 40's error.
+
+//! Errors of runs closer than the larger floor are not told apart by the
+//! comparison; the target table marks a check as decided only where the
+//! larger floor is below a tenth of the uniform run's error.
+
+use super::reference::Reference;
+use super::sampling;
+use super::{Compare, Scene};
+use crate::math::{Scalar, Vector};
+use crate::scene::ClothShape;
+
+/// How far the lift floor's run starts from the reference's, m: the cloth
+/// lifted 1 micrometre against gravity, a change no mesh or step setting
+/// resolves.
+pub const FLOOR_LIFT: Scalar = 1e-6;
+
+/// The label of the lift floor's rows in `SCENE-frames.csv`.
+pub const FLOOR_LABEL: &str = "reference lifted 1 um";
+
+/// What a floor's run changes from the reference.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum FloorChange {
+    /// The cloth started this much higher, m (taken out before comparing).
+    Lift(Scalar),
+    /// The reference's uniform mesh with this many segments (one more).
+    Resolution(u32),
+}
+
+impl FloorChange {
+    /// The label of the floor's rows in `SCENE-frames.csv`.
+    pub fn label(&self) -> String {
+        match self {
+            FloorChange::Lift(_) => FLOOR_LABEL.to_owned(),
+            FloorChange::Resolution(n) => mesh_label(*n),
+        }
+    }
+}
+
+/// The label of the mesh floor's rows in `SCENE-frames.csv`: `reference at N
+/// segments`.
+pub fn mesh_label(resolution: u32) -> String {
+    format!("reference at {resolution} segments")
+}
+
+/// True for a label [`FloorChange::label`] gives (a floor's rows, not a rung's).
+pub fn is_floor_label(label: &str) -> bool {
+    label == FLOOR_LABEL
+        || label
+            .strip_prefix("reference at ")
+            .and_then(|s| s.strip_suffix(" segments"))
+            .is_some_and(|n| n.parse::<u32>().is_ok())
+}
+
+/// A sensitivity floor: the reference run again with one change, compared
+/// with the reference like a rung (module docs).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Floor {
+    /// What the run changes.
+    pub change: FloorChange,
+    /// The run's first frame against the reference's, as it started (a lift
+    /// not taken out), relative to the diagonal: the lift itself, or zero for
+    /// the mesh (a flat start is sampled exactly on any mesh).
+    pub start: Scalar,
+    /// `(time, error)` at every recorded frame, relative to the diagonal (a
+    /// lift taken out).
+    pub errors: Vec<(Scalar, Scalar)>,
+    /// The error compared like the rungs': the mean over the frames, or the
+    /// last frame's at rest.
+    pub error: Scalar,
+    /// True when the run came from the cache.
+    pub cache_hit: bool,
+}
+
+/// The lift for `scene`: [`FLOOR_LIFT`] against gravity, or along +z without
+/// gravity.
+pub(super) fn lift(scene: &Scene) -> Vector {
+    let g = Vector::from(scene.simulation.gravity);
+    (-g).try_normalize().unwrap_or(Vector::Z) * FLOOR_LIFT
+}
+
+/// The `cloth.position` override that starts `scene`'s cloth `lift` away.
+pub(super) fn lifted_position(scene: &Scene, lift: Vector) -> String {
+    let p = Vector::from(scene.cloth.position) + lift;
+    format!("cloth.position=[{:e}, {:e}, {:e}]", p.x, p.y, p.z)
+}
+
+/// The `cloth.resolution` override of the mesh floor's run at `resolution`
+/// segments for the reference `scene`; `Err` says why it does not apply.
+pub(super) fn mesh_override(
+    scene: &Scene,
+    resolution: u32,
+    time_ladder: bool,
+) -> Result<String, String> {
+    if time_ladder {
+        return Err(
+            "the time-step ladder keeps one mesh; the mesh floor is for the spatial ladder".into(),
+        );
+    }
+    if scene.cloth.shape == ClothShape::Obj {
+        return Err("an OBJ cloth has no resolution to change".into());
+    }
+    if scene.cloth.resolution == Some(resolution) {
+        return Err(format!(
+            "{resolution} segments is the reference's own mesh; give another resolution"
+        ));
+    }
+    Ok(format!("cloth.resolution={resolution}"))
+}
+
+/// The floor from its run's samples (`run`) and the reference's, compared as
+/// `compare` says; a lift is taken out first.
+pub(super) fn floor_of(
+    run: &Reference,
+    reference: &Reference,
+    change: FloorChange,
+    lift: Vector,
+    compare: Compare,
+) -> Floor {
+    let start = match (run.frames.first(), reference.frames.first()) {
+        (Some(a), Some(b)) => {
+            sampling::frame_error(a, b, reference.diagonal).unwrap_or(Scalar::NAN)
+        }
+        _ => Scalar::NAN,
+    };
+    let lowered: Vec<sampling::FrameSamples> = run
+        .frames
+        .iter()
+        .map(|f| sampling::FrameSamples {
+            positions: f
+                .positions
+                .iter()
+                .map(|p| p.map(|q| (Vector::from_array(q) - lift).to_array()))
+                .collect(),
+            ..f.clone()
+        })
+        .collect();
+    let errors = sampling::run_errors(&lowered, &reference.frames, reference.diagonal);
+    let error = compare.of(errors.iter().map(|e| e.1));
+    Floor {
+        change,
+        start,
+        errors,
+        error,
+        cache_hit: false,
+    }
+}
+
+/// The larger of the floors' errors (`None` without any; NaN ones ignored).
+pub fn largest<'a>(floors: impl IntoIterator<Item = &'a Floor>) -> Option<Scalar> {
+    floors
+        .into_iter()
+        .map(|f| f.error)
+        .filter(|e| !e.is_nan())
+        .reduce(Scalar::max)
+}
