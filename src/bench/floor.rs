@@ -18,12 +18,12 @@
 //!   diagonals; the cantilever's clamp edge is on a line only at multiples of
 //!   5 segments). Measured (`docs/speed-vs-error.md`, "The mesh floor"):
 //!   against uniform 96 on `drape_sphere` (2.5 s), uniform 94 and 98 are
-//!   0.765 % and 0.762 % of the diagonal from it, 95 and 97 0.686 % and 0.698
-//!   %, where uniform 64 is 0.602 % and the lift gives 0.038 %; on
+//!   0.765 % and 0.762 % of the diagonal from it, 95 and 97 0.686 % and
+//!   0.698 %, where uniform 64 is 0.602 % and the lift gives 0.038 %; on
 //!   `tablecloth` (2 s) 98 is 0.548 %, uniform 64 0.606 %. On the cantilever
 //!   122 against 120 (the clamp edge off its line) gave 0.326 %, thirteen
 //!   times uniform 40's error.
-
+//!
 //! Errors of runs closer than the larger floor are not told apart by the
 //! comparison; the target table marks a check as decided only where the
 //! larger floor is below a tenth of the uniform run's error.

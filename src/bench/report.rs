@@ -247,7 +247,7 @@ fn preamble(res: &BenchResult, scene_path: &Path) -> String {
         };
         let _ = writeln!(
             out,
-            "Mesh floor: the reference run again on a uniform mesh of {n} segments{}, two more than its own, is {} % of the diagonal from the reference ({how}; {} % at the last frame). Where the mesh decides where folds form, this is as large as the distance between any two fine meshes.\n",
+            "Mesh floor: the reference's settings on a uniform mesh of {n} segments instead of its own{}, is {} % of the diagonal from the reference ({how}; {} % at the last frame). Where the mesh decides where folds form, this is as large as the distance between any two fine meshes.\n",
             if f.cache_hit { " (cached)" } else { "" },
             pct(f.error),
             last(f),

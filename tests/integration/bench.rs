@@ -493,7 +493,7 @@ fn the_sensitivity_floor_of_a_free_fall_is_nothing_but_the_lift() {
     assert_eq!(mesh.change, FloorChange::Resolution(8));
     assert_eq!(mesh.errors.len(), res.reference.frames.len());
     assert!(mesh.error < 1e-3 * lift, "{:e}", mesh.error);
-    assert!(md.contains("Mesh floor: the reference run again on a uniform mesh of 8 segments"));
+    assert!(md.contains("Mesh floor: the reference's settings on a uniform mesh of 8 segments"));
     assert_eq!(
         frames
             .lines()
