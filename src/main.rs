@@ -113,12 +113,13 @@ struct BenchArgs {
     /// Recompute the reference even if DIR/cache/ holds it (the new one is not cached).
     #[arg(long)]
     no_cache: bool,
-    /// Skip the sensitivity floor: by default the reference is run a second time with
-    /// the cloth started 1 micrometre higher, and the report says how far that run ends
-    /// from the reference (errors closer than that are not told apart).
-    #[arg(long, conflicts_with = "mesh_floor")]
+    /// Skip the lift floor: by default the reference is run a second time with the
+    /// cloth started 1 micrometre higher, and the report says how far that run ends
+    /// from the reference (errors closer than that are not told apart). A mesh floor
+    /// asked for with --mesh-floor is still measured.
+    #[arg(long)]
     no_floor: bool,
-    /// Also run the reference's settings on a uniform mesh of N segments and report
+    /// Also run the reference's settings with `cloth.resolution = N` (a rectangle) and report
     /// how far it ends from the reference: the mesh floor (errors closer than the
     /// larger floor are not told apart). Choose N near the reference's resolution
     /// with the pins, clamps and the sheet's centre on the same grid lines (e.g. two

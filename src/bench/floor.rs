@@ -5,8 +5,8 @@
 //!   moved back down by the lift before comparing. A smooth problem answers
 //!   with about nothing; a chaotic one (a sheet falling onto an obstacle and
 //!   folding) amplifies the lift.
-//! * **The mesh** (`--mesh-floor N`, off by default): the reference's
-//!   settings on a uniform mesh of `N` segments, near the reference's own. On
+//! * **The mesh** (`--mesh-floor N`, off by default; rectangles only): the
+//!   reference's settings with `cloth.resolution = N`, near its own. On
 //!   a problem that converges with the mesh this is the difference between
 //!   two nearly equal resolutions, a small part of the reference's own error;
 //!   where the mesh decides where folds form, it is as large as the distance
@@ -47,7 +47,7 @@ pub const FLOOR_LABEL: &str = "reference lifted 1 um";
 pub enum FloorChange {
     /// The cloth started this much higher, m (taken out before comparing).
     Lift(Scalar),
-    /// The reference's uniform mesh with this many segments (one more).
+    /// The reference's settings at this many segments (`--mesh-floor`).
     Resolution(u32),
 }
 
@@ -121,8 +121,12 @@ pub(super) fn mesh_override(
             "the time-step ladder keeps one mesh; the mesh floor is for the spatial ladder".into(),
         );
     }
-    if scene.cloth.shape == ClothShape::Obj {
-        return Err("an OBJ cloth has no resolution to change".into());
+    match scene.cloth.shape {
+        ClothShape::Rectangle => {}
+        ClothShape::Obj => return Err("an OBJ cloth has no resolution to change".into()),
+        ClothShape::Disk => {
+            return Err("a disk's outline, and so the sample points, change with its resolution; the mesh floor needs a rectangle".into());
+        }
     }
     if scene.cloth.resolution == Some(resolution) {
         return Err(format!(
@@ -170,11 +174,15 @@ pub(super) fn floor_of(
     }
 }
 
-/// The larger of the floors' errors (`None` without any; NaN ones ignored).
+/// The larger of the floors' errors: `None` without any, or when one is NaN
+/// (a floor that could not be compared is not taken as no floor).
 pub fn largest<'a>(floors: impl IntoIterator<Item = &'a Floor>) -> Option<Scalar> {
-    floors
-        .into_iter()
-        .map(|f| f.error)
-        .filter(|e| !e.is_nan())
-        .reduce(Scalar::max)
+    let mut largest: Option<Scalar> = None;
+    for f in floors {
+        if f.error.is_nan() {
+            return None;
+        }
+        largest = Some(largest.map_or(f.error, |m| m.max(f.error)));
+    }
+    largest
 }

@@ -233,6 +233,17 @@ impl BenchResult {
     pub fn floors(&self) -> impl Iterator<Item = &Floor> {
         self.floor.iter().chain(&self.mesh_floor)
     }
+
+    /// The floor that decides the target check: the larger of those measured,
+    /// or `None` when none was, or when one that was asked for is missing (its
+    /// run failed) or could not be compared: a check is then not called
+    /// decided on the other floor alone.
+    pub fn deciding_floor(&self) -> Option<Scalar> {
+        if self.floor_failure.is_some() || self.mesh_floor_failure.is_some() {
+            return None;
+        }
+        floor::largest(self.floors())
+    }
 }
 
 fn load(path: &Path, overrides: &[String], context: &str) -> Result<Scene, BenchError> {
@@ -373,23 +384,12 @@ fn plan(opts: &BenchOptions) -> Result<Plan, BenchError> {
     })
 }
 
-/// Which run [`obtain_reference`] gives.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Which {
-    /// The reference.
-    Reference,
-    /// The lift floor's run.
-    Lifted,
-    /// The mesh floor's run.
-    Finer,
-}
-
-/// The reference or a floor's run: from the cache when allowed and present,
-/// else computed.
+/// The reference or a floor's run (`what`, for the log; `set` and `scene`
+/// from the plan): from the cache when allowed and present, else computed.
 fn obtain_reference(
     plan: &Plan,
     opts: &BenchOptions,
-    which: Which,
+    (what, set, scene): (&str, &[String], &Scene),
     (run_opts, interrupt): (&RunOptions, &AtomicBool),
     log: &mut dyn FnMut(&str),
 ) -> Result<(Reference, bool), BenchError> {
@@ -397,16 +397,6 @@ fn obtain_reference(
         path: opts.scene.clone(),
         source,
     })?;
-    let (what, set, scene) = match (which, &plan.mesh) {
-        (Which::Reference, _) => ("reference".to_owned(), &plan.ref_set, &plan.ref_scene),
-        (Which::Lifted, _) => (
-            floor::FLOOR_LABEL.to_owned(),
-            &plan.floor_set,
-            &plan.floor_scene,
-        ),
-        (Which::Finer, Some((set, scene, n))) => (floor::mesh_label(*n), set, scene),
-        (Which::Finer, None) => unreachable!("the mesh floor's run is only asked for when planned"),
-    };
     let key = reference::cache_key(&scene_text, set, opts.grid);
     let cache_file = reference::cache_path(&opts.out_dir, &plan.base.name, &key);
     if opts.cache
@@ -415,15 +405,16 @@ fn obtain_reference(
         log(&format!("{what}: cached {}", cache_file.display()));
         return Ok((r, true));
     }
-    let change = match which {
-        Which::Reference => String::new(),
-        _ => format!(", then {}", set.last().map_or("", String::as_str)),
+    // A floor's run is the reference's overrides and one more.
+    let change = match set.len() > plan.ref_set.len() {
+        true => format!(", then {}", set.last().map_or("", String::as_str)),
+        false => String::new(),
     };
     log(&format!(
         "{what}: computing ({}{change})",
         plan.ref_own.join(" ")
     ));
-    let r = reference::compute(scene, set.clone(), key, opts.grid, run_opts, interrupt)?;
+    let r = reference::compute(scene, set.to_vec(), key, opts.grid, run_opts, interrupt)?;
     log(&format!(
         "{what}: {} vertices, {} steps, {:.1} s",
         r.vertices, r.steps, r.wall_s
@@ -434,28 +425,48 @@ fn obtain_reference(
     Ok((r, false))
 }
 
+/// Which floor [`measure_floor`] measures.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum FloorKind {
+    /// The cloth started [`FLOOR_LIFT`] higher.
+    Lift,
+    /// The reference's settings at `--mesh-floor`'s resolution.
+    Mesh,
+}
+
 /// A floor's run and its comparison with `reference` (module [`floor`]):
 /// `Ok(None)` when the floor was not asked for, `Err(why)` when its run
 /// failed numerically (the rungs are still measured).
 fn measure_floor(
     plan: &Plan,
     opts: &BenchOptions,
-    which: Which,
+    kind: FloorKind,
     reference: &Reference,
     run: (&RunOptions, &AtomicBool),
     log: &mut dyn FnMut(&str),
 ) -> Result<Result<Option<Floor>, String>, BenchError> {
-    let (change, lift) = match (which, &plan.mesh) {
-        (Which::Finer, None) => return Ok(Ok(None)),
-        (Which::Finer, Some((_, _, n))) => (FloorChange::Resolution(*n), crate::math::Vector::ZERO),
-        _ if !opts.floor || opts.time_ladder => return Ok(Ok(None)),
-        _ => (FloorChange::Lift(plan.floor_lift.length()), plan.floor_lift),
+    let label;
+    let (name, change, lift, set, scene) = match (kind, &plan.mesh) {
+        (FloorKind::Mesh, None) => return Ok(Ok(None)),
+        (FloorKind::Mesh, Some((set, scene, n))) => {
+            label = floor::mesh_label(*n);
+            let zero = crate::math::Vector::ZERO;
+            ("mesh floor", FloorChange::Resolution(*n), zero, set, scene)
+        }
+        (FloorKind::Lift, _) if !opts.floor || opts.time_ladder => return Ok(Ok(None)),
+        (FloorKind::Lift, _) => {
+            label = floor::FLOOR_LABEL.to_owned();
+            let change = FloorChange::Lift(plan.floor_lift.length());
+            let (set, scene) = (&plan.floor_set, &plan.floor_scene);
+            ("sensitivity floor", change, plan.floor_lift, set, scene)
+        }
     };
-    let name = match change {
-        FloorChange::Lift(_) => "sensitivity floor",
-        FloorChange::Resolution(_) => "mesh floor",
-    };
-    match obtain_reference(plan, opts, which, run, log) {
+    match obtain_reference(plan, opts, (&label, set, scene), run, log) {
+        // The floor compares the same material points as the rungs; a cloth
+        // whose outline changes with the mesh cannot be compared this way.
+        Ok((r, _)) if r.points != reference.points => Err(BenchError::MeshFloor(
+            "its sample points differ from the reference's (the cloth's outline changes with the mesh)".into(),
+        )),
         Ok((r, hit)) => {
             let f = Floor {
                 cache_hit: hit,
@@ -495,14 +506,15 @@ pub fn bench(
         ..RunOptions::default()
     };
     let run = (&run_opts, interrupt);
-    let (reference, cache_hit) = obtain_reference(&plan, opts, Which::Reference, run, log)?;
+    let ref_run = ("reference", &plan.ref_set[..], &plan.ref_scene);
+    let (reference, cache_hit) = obtain_reference(&plan, opts, ref_run, run, log)?;
     let (floor, floor_failure) =
-        match measure_floor(&plan, opts, Which::Lifted, &reference, run, log)? {
+        match measure_floor(&plan, opts, FloorKind::Lift, &reference, run, log)? {
             Ok(f) => (f, None),
             Err(why) => (None, Some(why)),
         };
     let (mesh_floor, mesh_floor_failure) =
-        match measure_floor(&plan, opts, Which::Finer, &reference, run, log)? {
+        match measure_floor(&plan, opts, FloorKind::Mesh, &reference, run, log)? {
             Ok(f) => (f, None),
             Err(why) => (None, Some(why)),
         };

@@ -256,12 +256,26 @@ fn preamble(res: &BenchResult, scene_path: &Path) -> String {
     if let Some(why) = &res.mesh_floor_failure {
         let _ = writeln!(out, "Mesh floor: not measured ({why}).\n");
     }
-    if let Some(f) = super::floor::largest(res.floors()) {
-        let _ = writeln!(
-            out,
-            "Differences between runs' errors smaller than the larger floor ({} %) are not resolved by this comparison: the target table marks a check as decided only where it is below a tenth of the uniform run's error.\n",
-            pct(f)
-        );
+    let measured = res.floors().count();
+    match res.deciding_floor() {
+        Some(f) if measured > 1 => {
+            let _ = writeln!(
+                out,
+                "Differences between runs' errors smaller than the larger floor ({} %) are not resolved by this comparison: the target table marks a check as decided only where it is below a tenth of the uniform run's error.\n",
+                pct(f)
+            );
+        }
+        Some(f) => {
+            let _ = writeln!(
+                out,
+                "Differences between runs' errors smaller than the floor ({} %) are not resolved by this comparison: the target table marks a check as decided only where it is below a tenth of the uniform run's error.\n",
+                pct(f)
+            );
+        }
+        None if measured > 0 => {
+            out.push_str("A floor that was asked for is missing: the target table decides no check on the other alone.\n\n");
+        }
+        None => {}
     }
     out.push_str("Final offset: the length of the mean displacement of the samples from the reference's at the last frame (the rigid translation part of the final error; what is left once it is taken out is `sqrt(final^2 - offset^2)`).\n\n");
     out
@@ -385,7 +399,7 @@ pub fn markdown(res: &BenchResult, scene_path: &Path) -> String {
     for c in &series {
         out.push_str(&convergence_text(c));
     }
-    out.push_str(&targets(&res.rows, super::floor::largest(res.floors())));
+    out.push_str(&targets(&res.rows, res.deciding_floor()));
     out
 }
 
@@ -409,7 +423,7 @@ pub fn write_all(
         (format!("{stem}.md"), markdown(res, scene_path)),
         (
             format!("{stem}.svg"),
-            super::chart::svg(stem, &res.rows, super::floor::largest(res.floors()))?,
+            super::chart::svg(stem, &res.rows, res.deciding_floor())?,
         ),
     ];
     let mut paths = Vec::new();

@@ -189,8 +189,8 @@
 //!   factor that does not fall with the cell size. Measured on the
 //!   cantilever with free vertices moved up to a quarter cell: 1.1 to 1.2 deg
 //!   stiff of the elastica, 1.7 to 1.8 deg at 0.3 cell and 64 cells along;
-//!   `P` on every interior triangle overshoots to 0.6 deg soft (3.5 to 5.1
-//!   deg on thin cells). The test
+//!   `P` on every interior triangle overshoots to 0.3 to 0.9 deg soft (3.5
+//!   to 5.1 deg on thin cells). The test
 //!   `elastica::an_irregular_strip_bends_stiffer_than_the_elastica` and
 //!   `docs/speed-vs-error.md`, "Bending on irregular triangles".
 //!

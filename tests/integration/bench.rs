@@ -487,7 +487,7 @@ fn the_sensitivity_floor_of_a_free_fall_is_nothing_but_the_lift() {
             .count(),
         floor.errors.len()
     );
-    // The mesh floor: the reference's 6 segments and 7 fall alike.
+    // The mesh floor: the reference's 6 segments and 8 fall alike.
     let mesh = res.mesh_floor.expect("the mesh floor was asked for");
     println!("mesh floor per frame {:?}", mesh.errors);
     assert_eq!(mesh.change, FloorChange::Resolution(8));
@@ -570,8 +570,8 @@ fn the_chart_draws_a_floor_near_the_errors_only() {
 }
 
 /// `--mesh-floor` is refused where it does not apply: the reference's own
-/// resolution (exit 1, before any run), with `--no-floor` or the time-step
-/// ladder (usage errors, exit 2).
+/// resolution (exit 1, before any run), or with the time-step ladder (a
+/// usage error, exit 2).
 #[test]
 fn the_mesh_floor_is_refused_where_it_does_not_apply() {
     let dir = temp_dir("mesh-floor-refused");
@@ -584,11 +584,6 @@ fn the_mesh_floor_is_refused_where_it_does_not_apply() {
             vec!["--reference-resolution", "6", "--mesh-floor", "6"],
             1,
             "--mesh-floor: 6 segments is the reference's own mesh",
-        ),
-        (
-            vec!["--mesh-floor", "8", "--no-floor"],
-            2,
-            "cannot be used with",
         ),
         (
             vec!["--mesh-floor", "8", "--time-ladder"],
@@ -606,5 +601,37 @@ fn the_mesh_floor_is_refused_where_it_does_not_apply() {
         assert!(err.contains(needle), "{args:?}: {err}");
         assert!(!err.contains("panicked"), "{err}");
     }
+    // A disk's outline, and so its sample points, change with its rings.
+    let disk = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cusick.toml");
+    let out = Command::new(env!("CARGO_BIN_EXE_drape"))
+        .args(["bench", disk.to_str().expect("utf-8"), "--out-dir", out_dir])
+        .args(["--mesh-floor", "98"])
+        .output()
+        .expect("run drape");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("the mesh floor needs a rectangle"), "{err}");
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The deciding floor is the larger one, and a floor that could not be
+/// compared (NaN) is not taken as no floor: nothing is then decided on the
+/// other alone.
+#[test]
+fn the_larger_floor_decides_and_a_nan_floor_decides_nothing() {
+    let floor = |change, error| drape::bench::Floor {
+        change,
+        start: 0.0,
+        errors: vec![],
+        error,
+        cache_hit: false,
+    };
+    let lift = floor(FloorChange::Lift(1e-6), 1e-4);
+    let mesh = floor(FloorChange::Resolution(98), 3e-3);
+    let nan = floor(FloorChange::Resolution(98), f64::NAN);
+    use drape::bench::floor::largest;
+    assert_eq!(largest([&lift, &mesh]), Some(3e-3));
+    assert_eq!(largest([&lift]), Some(1e-4));
+    assert_eq!(largest([&lift, &nan]), None);
+    assert_eq!(largest(std::iter::empty()), None);
 }
