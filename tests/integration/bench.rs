@@ -51,6 +51,19 @@ region = "corner:top_left"
     path
 }
 
+/// A ladder of one rung, uniform 4, for the floors' tests.
+fn uniform_4() -> Ladder {
+    Ladder {
+        reference: None,
+        compare: None,
+        step: None,
+        rung: vec![rung(
+            "uniform 4",
+            &["adapt.method=none", "cloth.resolution=4"],
+        )],
+    }
+}
+
 /// Options for `ladder` on the tiny scene: 0.15 s, one thread, one
 /// repetition, an 8 x 8 sample grid, the cache on, no sensitivity floor.
 fn tiny_options(scene: &Path, out_dir: PathBuf, ladder: Ladder) -> BenchOptions {
@@ -435,15 +448,7 @@ fn the_sensitivity_floor_of_a_free_fall_is_nothing_but_the_lift() {
         text.replace("[[pin]]\nregion = \"corner:top_left\"\n", ""),
     )
     .expect("write scene");
-    let ladder = Ladder {
-        reference: None,
-        compare: None,
-        step: None,
-        rung: vec![rung(
-            "uniform 4",
-            &["adapt.method=none", "cloth.resolution=4"],
-        )],
-    };
+    let ladder = uniform_4();
     let opts = BenchOptions {
         floor: true,
         mesh_floor: Some(8),
@@ -517,15 +522,7 @@ fn the_sensitivity_floor_of_a_free_fall_is_nothing_but_the_lift() {
 fn the_mesh_floor_of_a_converging_sheet_is_below_the_rungs_errors() {
     let dir = temp_dir("mesh-floor");
     let scene = tiny_scene(&dir);
-    let ladder = Ladder {
-        reference: None,
-        compare: None,
-        step: None,
-        rung: vec![rung(
-            "uniform 4",
-            &["adapt.method=none", "cloth.resolution=4"],
-        )],
-    };
+    let ladder = uniform_4();
     let opts = BenchOptions {
         floor: true,
         reference_resolution: Some(16),
