@@ -92,6 +92,9 @@ pub struct Floor {
     /// The error compared like the rungs': the mean over the frames, or the
     /// last frame's at rest.
     pub error: Scalar,
+    /// The shadow's relative difference from the reference's
+    /// ([`super::shadow`]), compared like `error` (`NaN` where there is none).
+    pub shadow_error: Scalar,
     /// True when the run came from the cache.
     pub cache_hit: bool,
 }
@@ -165,11 +168,18 @@ pub(super) fn floor_of(
         .collect();
     let errors = sampling::run_errors(&lowered, &reference.frames, reference.diagonal);
     let error = compare.of(errors.iter().map(|e| e.1));
+    let cell = reference.diagonal / super::shadow::CELLS_PER_DIAGONAL;
+    let shadows = super::shadow::shadow_errors(&lowered, &reference.frames, cell);
+    let shadow_error = match shadows.len() == errors.len() && !errors.is_empty() {
+        true => compare.of(shadows.iter().map(|e| e.1)),
+        false => Scalar::NAN,
+    };
     Floor {
         change,
         start,
         errors,
         error,
+        shadow_error,
         cache_hit: false,
     }
 }

@@ -4,8 +4,8 @@
 use std::sync::atomic::AtomicBool;
 
 use super::ladder::{self, Compare, Rung};
-use super::sampling;
 use super::{BenchError, Reference, Row};
+use super::{sampling, shadow};
 use crate::math::{Scalar, Vector2};
 use crate::run::{RunOptions, run};
 use crate::scene::{AdaptMethod, Integrator, Scene, TimeStep};
@@ -44,6 +44,13 @@ pub fn measure(
         (mean, errors.last().map_or(Scalar::NAN, |e| e.1))
     } else {
         (Scalar::NAN, Scalar::NAN)
+    };
+    let cell = reference.diagonal / shadow::CELLS_PER_DIAGONAL;
+    let shadows = shadow::shadow_errors(&first.frames, &reference.frames, cell);
+    let shadow_error = if complete && shadows.len() == errors.len() {
+        compare.of(shadows.iter().map(|e| e.1))
+    } else {
+        Scalar::NAN
     };
     let final_offset = match (complete, first.frames.last(), reference.frames.last()) {
         (true, Some(run), Some(r)) if run.frame == r.frame => {
@@ -98,6 +105,7 @@ pub fn measure(
             Compare::Rest => final_error,
         },
         errors,
+        shadow_error,
         pareto: false,
     })
 }

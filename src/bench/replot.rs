@@ -94,6 +94,7 @@ pub fn read_csv(path: &Path) -> Result<Vec<Row>, BenchError> {
                 .map(str::to_owned)
                 .collect(),
             errors: Vec::new(),
+            shadow_error: f64::NAN,
         });
     }
     Ok(rows)

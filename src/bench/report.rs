@@ -400,6 +400,42 @@ pub fn markdown(res: &BenchResult, scene_path: &Path) -> String {
         out.push_str(&convergence_text(c));
     }
     out.push_str(&targets(&res.rows, res.deciding_floor()));
+    out.push_str(&shadows(res));
+    out
+}
+
+/// The shadow paragraph (module [`super::shadow`]): every run's shadow
+/// against the reference's, with the floors' in the same measure; empty where
+/// no run has one.
+fn shadows(res: &BenchResult) -> String {
+    if !res.rows.iter().any(|r| r.shadow_error.is_finite()) {
+        return String::new();
+    }
+    let how = match res.compare {
+        super::Compare::Frames => "mean over the frames",
+        super::Compare::Rest => "at rest",
+    };
+    let mut out = format!(
+        "\nShadow (the area of the cloth's projection on the ground plane, from the sample grid, as in the textile drape test; `src/bench/shadow.rs`): its difference from the reference's, relative to the reference's, {how}. It does not depend on where each fold lies.\n\n| run | wall s | mean verts | shadow error % |\n|---|---:|---:|---:|\n"
+    );
+    for r in &res.rows {
+        let _ = writeln!(
+            out,
+            "| {} | {:.3} | {:.0} | {} |",
+            r.label,
+            r.wall_s,
+            r.mean_vertices,
+            pct(r.shadow_error)
+        );
+    }
+    for f in res.floors() {
+        let _ = writeln!(
+            out,
+            "| floor: {} | | | {} |",
+            f.change.label(),
+            pct(f.shadow_error)
+        );
+    }
     out
 }
 

@@ -121,6 +121,7 @@ pub(crate) fn row(label: &str, adaptive: bool, res: u32, finest: u32, wall: f64,
         compare: Compare::Frames,
         error: err,
         errors: vec![],
+        shadow_error: f64::NAN,
         pareto: false,
     }
 }
@@ -621,6 +622,7 @@ fn the_larger_floor_decides_and_a_nan_floor_decides_nothing() {
         start: 0.0,
         errors: vec![],
         error,
+        shadow_error: f64::NAN,
         cache_hit: false,
     };
     let lift = floor(FloorChange::Lift(1e-6), 1e-4);
@@ -631,4 +633,70 @@ fn the_larger_floor_decides_and_a_nan_floor_decides_nothing() {
     assert_eq!(largest([&lift]), Some(1e-4));
     assert_eq!(largest([&lift, &nan]), None);
     assert_eq!(largest(std::iter::empty()), None);
+}
+
+/// The shadow (`drape::bench::shadow`): a flat square sampled on an 8 x 8
+/// grid of cell centres covers the grid's 7 x 7 cells' area (printed against
+/// the exact value), the same square tilted 60 degrees about x half of it,
+/// and a frame against itself nothing. A frame with a sample missing has no
+/// shadow.
+#[test]
+fn the_shadow_of_a_flat_and_a_tilted_square() {
+    use drape::bench::shadow::{shadow_area, shadow_errors};
+    let n = 8;
+    let frame = |tilt: f64| FrameSamples {
+        frame: 0,
+        time: 0.0,
+        positions: (0..n * n)
+            .map(|k| {
+                let (i, j) = ((k % n) as f64, (k / n) as f64);
+                let (u, v) = ((i + 0.5) / n as f64 - 0.5, (j + 0.5) / n as f64 - 0.5);
+                Some([u + 0.3, v * tilt.cos() - 0.2, v * tilt.sin() + 1.0])
+            })
+            .collect(),
+    };
+    let cell = 1e-3;
+    let exact = (7.0 / 8.0) * (7.0 / 8.0);
+    let flat = shadow_area(&frame(0.0), cell).expect("a shadow");
+    let tilted = shadow_area(&frame(60f64.to_radians()), cell).expect("a shadow");
+    println!(
+        "flat {flat:.6} m^2 (exact {exact:.6}), tilted 60 deg {tilted:.6} (exact {:.6})",
+        exact / 2.0
+    );
+    assert!((flat / exact - 1.0).abs() < 5e-3, "{flat}");
+    assert!((tilted / (exact / 2.0) - 1.0).abs() < 5e-3, "{tilted}");
+    let same = shadow_errors(&[frame(0.3)], &[frame(0.3)], cell);
+    assert_eq!(same, vec![(0.0, 0.0)]);
+    let mut holed = frame(0.0);
+    holed.positions[5] = None;
+    assert_eq!(shadow_area(&holed, cell), None);
+}
+
+/// Regression: the mesh floor refused every real scene ("its sample points
+/// differ from the reference's") because the sample grid is laid over each
+/// mesh's material bounds, and a 1.6 m sheet's bounds at 96 and 98 segments
+/// differ in the last bits (2.2e-16 m). Points equal to rounding are the
+/// same points.
+#[test]
+fn a_mesh_floor_whose_sample_grid_differs_in_the_last_bits_is_measured() {
+    let dir = temp_dir("mesh-floor-bits");
+    let scene = tiny_scene(&dir);
+    let text = std::fs::read_to_string(&scene).expect("scene");
+    let text = text
+        .replace("width = 0.5", "width = 1.6")
+        .replace("height = 0.5", "height = 1.6")
+        .replace("duration = 0.2", "duration = 0.05");
+    std::fs::write(&scene, text).expect("write scene");
+    let opts = BenchOptions {
+        floor: false,
+        reference_resolution: Some(96),
+        mesh_floor: Some(98),
+        cache: false,
+        ..tiny_options(&scene, dir.join("out"), uniform_4())
+    };
+    let stop = AtomicBool::new(false);
+    let res = bench(&opts, &stop, &mut |_| {}).expect("bench");
+    let mesh = res.mesh_floor.expect("the mesh floor was measured");
+    println!("mesh floor (98 against 96) {:.3e}", mesh.error);
+    assert!(mesh.error.is_finite());
 }
