@@ -148,7 +148,14 @@ fn draw(
                 grey.stroke_width(2),
             ))?
             .label("sensitivity floor")
-            .legend(move |(x, y)| PathElement::new([(x - 8, y), (x + 8, y)], grey.stroke_width(2)));
+            .legend(move |(x, y)| {
+                plotters::element::DashedPathElement::new(
+                    [(x - 8, y), (x + 8, y)],
+                    2,
+                    4,
+                    grey.stroke_width(2),
+                )
+            });
     }
     // The Pareto front: a staircase through its points in order of cost.
     let mut front: Vec<&Row> = ok.iter().copied().filter(|r| r.pareto).collect();
