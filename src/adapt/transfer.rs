@@ -15,10 +15,11 @@
 //! references (build `a511d06` with the change): `drape_sphere` over 2.5 s
 //! red_green 16 L4 0.671 -> 0.571 %, loose 0.575 -> 0.629 %, edge 16 L4
 //! 0.644 -> 0.773 %; `tablecloth` over its landing (0.6 s) red_green 16 L4
-//! 0.449 -> 0.450 %, edge 16 L4 0.442 -> 0.461 %. No consistent gain (the
-//! falling sheet's sensitivity floor is 0.038 %, so the changes are real, in
-//! both directions), and the midpoint leaves the old surface, which the
-//! tensor method's checks rely on.
+//! 0.449 -> 0.450 %, edge 16 L4 0.442 -> 0.461 %. No consistent gain, and
+//! none resolved: every change is smaller than the mesh floor, how far a
+//! uniform mesh two segments finer ends from the reference (0.762 % and
+//! 0.251 %; `docs/speed-vs-error.md`, "Ninth sitting"); the midpoint also
+//! leaves the old surface, which the tensor method's checks rely on.
 //!
 //! # Vertex order
 //! Compaction chooses the new mesh's vertex numbering (`VertexOrder`). Kept

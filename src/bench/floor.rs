@@ -187,12 +187,17 @@ pub(super) fn floor_of(
 /// The larger of the floors' errors: `None` without any, or when one is NaN
 /// (a floor that could not be compared is not taken as no floor).
 pub fn largest<'a>(floors: impl IntoIterator<Item = &'a Floor>) -> Option<Scalar> {
+    largest_error(floors.into_iter().map(|f| f.error))
+}
+
+/// [`largest`] of bare floor errors (as `--replot` reads them back).
+pub fn largest_error(errors: impl IntoIterator<Item = Scalar>) -> Option<Scalar> {
     let mut largest: Option<Scalar> = None;
-    for f in floors {
-        if f.error.is_nan() {
+    for e in errors {
+        if e.is_nan() {
             return None;
         }
-        largest = Some(largest.map_or(f.error, |m| m.max(f.error)));
+        largest = Some(largest.map_or(e, |m| m.max(e)));
     }
     largest
 }

@@ -125,9 +125,10 @@ pub struct BenchOptions {
     /// (against gravity) and report how far it ends from the reference: the
     /// comparison's lift floor ([`floor`]).
     pub floor: bool,
-    /// Also run the reference's settings on a uniform mesh of this many
+    /// Also run the reference's settings with `cloth.resolution` this many
     /// segments and report how far it ends from the reference: the mesh
-    /// floor ([`floor`]; not with the time-step ladder or an OBJ cloth).
+    /// floor ([`floor`]; rectangle cloths only, not with the time-step
+    /// ladder).
     pub mesh_floor: Option<u32>,
 }
 

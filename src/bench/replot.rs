@@ -102,7 +102,8 @@ pub fn read_csv(path: &Path) -> Result<Vec<Row>, BenchError> {
 
 /// The larger sensitivity floor from `dir/stem-frames.csv` (its rows
 /// labelled as [`super::floor::is_floor_label`] says), each compared as
-/// `compare` says: `None` when the file or the rows are missing.
+/// `compare` says: `None` when the file or the rows are missing, or a floor
+/// has no number ([`super::floor::largest_error`]).
 pub fn floor_from_frames(dir: &Path, stem: &str, compare: super::Compare) -> Option<f64> {
     let text = std::fs::read_to_string(dir.join(format!("{stem}-frames.csv"))).ok()?;
     let mut by_label: Vec<(String, Vec<f64>)> = Vec::new();
@@ -116,11 +117,7 @@ pub fn floor_from_frames(dir: &Path, stem: &str, compare: super::Compare) -> Opt
             None => by_label.push((f[0].clone(), vec![e])),
         }
     }
-    by_label
-        .into_iter()
-        .map(|(_, v)| compare.of(v.into_iter()))
-        .filter(|e| !e.is_nan())
-        .reduce(f64::max)
+    super::floor::largest_error(by_label.into_iter().map(|(_, v)| compare.of(v.into_iter())))
 }
 
 /// Redraws `dir/stem.svg` from `dir/stem.csv` (`drape bench --replot`), with

@@ -76,8 +76,6 @@ pub fn kind(r: &Row) -> &'static str {
     if r.adaptive { "adaptive" } else { "uniform" }
 }
 
-pub use super::floor::FLOOR_LABEL;
-
 /// The per-frame errors: `label,time,error`, then the floors' (labelled by
 /// [`super::FloorChange::label`]) when they were measured.
 pub fn frames_csv<'a>(rows: &[Row], floors: impl IntoIterator<Item = &'a Floor>) -> String {
@@ -215,15 +213,11 @@ fn preamble(res: &BenchResult, scene_path: &Path) -> String {
         r.points.len(),
         r.diagonal,
     );
-    let how = match res.compare {
-        super::Compare::Frames => "mean over the frames",
-        super::Compare::Rest => "at rest",
-    };
+    let how = compared(res.compare);
     let last = |f: &Floor| pct(f.errors.last().map_or(Scalar::NAN, |e| e.1));
     if let Some(f) = &res.floor {
-        let lift = match f.change {
-            super::FloorChange::Lift(m) => m,
-            super::FloorChange::Resolution(_) => Scalar::NAN,
+        let super::FloorChange::Lift(lift) = f.change else {
+            unreachable!("the lift floor changes the start")
         };
         let _ = writeln!(
             out,
@@ -241,9 +235,8 @@ fn preamble(res: &BenchResult, scene_path: &Path) -> String {
         );
     }
     if let Some(f) = &res.mesh_floor {
-        let n = match f.change {
-            super::FloorChange::Resolution(n) => n.to_string(),
-            super::FloorChange::Lift(_) => "?".into(),
+        let super::FloorChange::Resolution(n) = f.change else {
+            unreachable!("the mesh floor changes the resolution")
         };
         let _ = writeln!(
             out,
@@ -258,17 +251,15 @@ fn preamble(res: &BenchResult, scene_path: &Path) -> String {
     }
     let measured = res.floors().count();
     match res.deciding_floor() {
-        Some(f) if measured > 1 => {
-            let _ = writeln!(
-                out,
-                "Differences between runs' errors smaller than the larger floor ({} %) are not resolved by this comparison: the target table marks a check as decided only where it is below a tenth of the uniform run's error.\n",
-                pct(f)
-            );
-        }
         Some(f) => {
+            let which = if measured > 1 {
+                "the larger floor"
+            } else {
+                "the floor"
+            };
             let _ = writeln!(
                 out,
-                "Differences between runs' errors smaller than the floor ({} %) are not resolved by this comparison: the target table marks a check as decided only where it is below a tenth of the uniform run's error.\n",
+                "Differences between runs' errors smaller than {which} ({} %) are not resolved by this comparison: the target table marks a check as decided only where it is below a tenth of the uniform run's error.\n",
                 pct(f)
             );
         }
@@ -404,6 +395,14 @@ pub fn markdown(res: &BenchResult, scene_path: &Path) -> String {
     out
 }
 
+/// How an error is compared, in words.
+fn compared(c: super::Compare) -> &'static str {
+    match c {
+        super::Compare::Frames => "mean over the frames",
+        super::Compare::Rest => "at rest",
+    }
+}
+
 /// The shadow paragraph (module [`super::shadow`]): every run's shadow
 /// against the reference's, with the floors' in the same measure; empty where
 /// no run has one.
@@ -411,12 +410,9 @@ fn shadows(res: &BenchResult) -> String {
     if !res.rows.iter().any(|r| r.shadow_error.is_finite()) {
         return String::new();
     }
-    let how = match res.compare {
-        super::Compare::Frames => "mean over the frames",
-        super::Compare::Rest => "at rest",
-    };
+    let how = compared(res.compare);
     let mut out = format!(
-        "\nShadow (the area of the cloth's projection on the ground plane, from the sample grid, as in the textile drape test; `src/bench/shadow.rs`): its difference from the reference's, relative to the reference's, {how}. It does not depend on where each fold lies.\n\n| run | wall s | mean verts | shadow error % |\n|---|---:|---:|---:|\n"
+        "\nShadow (the area of the cloth's projection on the ground plane, from the sample grid, as in the textile drape test; `src/bench/shadow.rs`): its difference from the reference's, relative to the reference's, {how}. It does not compare where each fold lies, only how far the cloth spreads.\n\n| run | wall s | mean verts | shadow error % |\n|---|---:|---:|---:|\n"
     );
     for r in &res.rows {
         let _ = writeln!(
