@@ -122,8 +122,9 @@ struct BenchArgs {
     /// Also run the reference's settings with `cloth.resolution = N` (a rectangle) and report
     /// how far it ends from the reference: the mesh floor (errors closer than the
     /// larger floor are not told apart). Choose N near the reference's resolution
-    /// with the pins, clamps and the sheet's centre on the same grid lines (e.g. two
-    /// more on a sheet whose features lie on even lines); see README.
+    /// with the pins, clamps, the sheet's centre and the lines under obstacles' edges on
+    /// the same grid lines (e.g. 98 for 96 where they lie on even lines; 112 on the
+    /// tablecloth, whose table edges lie on lines at multiples of 16); see README.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(2..))]
     mesh_floor: Option<u32>,
     /// Segments of the reference's uniform mesh (default: 1.5 times the finest rung's, rounded up to even).

@@ -12,17 +12,19 @@
 //!   where the mesh decides where folds form, it is as large as the distance
 //!   between any two fine meshes, and the rungs' errors against the reference
 //!   are that distance, not their own error. `N` is the user's: a resolution
-//!   that moves a pin's box edge, a clamp line or the sheet's centre off the
-//!   grid lines they sit on changes the problem, not only the mesh (an odd
-//!   count puts the centre in a cell's middle and turns the corners'
-//!   diagonals; the cantilever's clamp edge is on a line only at multiples of
-//!   5 segments). Measured (`docs/speed-vs-error.md`, "The mesh floor"):
-//!   against uniform 96 on `drape_sphere` (2.5 s), uniform 94 and 98 are
-//!   0.765 % and 0.762 % of the diagonal from it, 95 and 97 0.686 % and
-//!   0.698 %, where uniform 64 is 0.602 % and the lift gives 0.038 %; on
-//!   `tablecloth` (2 s) 98 is 0.548 %, uniform 64 0.606 %. On the cantilever
-//!   122 against 120 (the clamp edge off its line) gave 0.326 %, thirteen
-//!   times uniform 40's error.
+//!   that moves a pin's box edge, a clamp line, the sheet's centre or the
+//!   line under an obstacle's edge off the grid lines they sit on changes the
+//!   problem, not only the mesh (an odd count puts the centre in a cell's
+//!   middle and turns the corners' diagonals; the cantilever's clamp edge is
+//!   on a line only at multiples of 5 segments, the tablecloth's table edges
+//!   only at multiples of 16). Measured (`docs/speed-vs-error.md`, "The mesh
+//!   floor" and "Tenth sitting"): against uniform 96 on `drape_sphere` (2.5
+//!   s), uniform 94 and 98 are 0.765 % and 0.762 % of the diagonal from it,
+//!   95 and 97 0.686 % and 0.698 %, where uniform 64 is 0.602 % and the lift
+//!   gives 0.038 %; on `tablecloth` (2 s) 112 is 0.200 %, uniform 64 0.606 %
+//!   (98, which moves the table's edges into cells, 0.548 %). On the
+//!   cantilever 122 against 120 (the clamp edge off its line) gave 0.326 %,
+//!   thirteen times uniform 40's error.
 //!
 //! Errors of runs closer than the larger floor are not told apart by the
 //! comparison; the target table marks a check as decided only where the
