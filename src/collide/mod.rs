@@ -16,8 +16,11 @@
 //!    its velocity relative to the obstacle loses its approaching normal part `dvn`
 //!    (inelastic), and Coulomb friction acts on the tangential part `vt` (paper A; Bridson
 //!    et al. 2002): it stops when `|vt| <= mu_s dvn`, else shrinks by `mu_k dvn`. The
-//!    tangential displacement of the step is corrected to match, so static friction holds
-//!    the cloth in place and a moving obstacle carries it along.
+//!    tangential displacement of the part of the step after the vertex reached the surface
+//!    is corrected to match (all of it for a vertex that began the step there), so static
+//!    friction holds the cloth in place and a moving obstacle carries it along; correcting
+//!    the whole step for a vertex that landed within it created energy at every landing
+//!    (`response.rs`).
 //!
 //! Then self-collision runs if the scene turns it on ([`selfcol`], with Volino culling,
 //! [`volino`]), followed by a last proximity pass against the obstacles. Finally the
