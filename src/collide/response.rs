@@ -35,7 +35,9 @@ pub(super) fn respond(
     let thick = b.thickness;
     // The contact plane: outward normal and its offset n . s at the surface point s.
     let mut plane = None;
-    if b.probe(q0).signed >= 0.0
+    // Signed distance of the start of the step from the surface.
+    let start = b.probe(q0).signed;
+    if start >= 0.0
         && let Some((toi, n)) = b.first_entry(q0, q1)
     {
         plane = Some((n, n.dot(q0 + (q1 - q0) * toi)));
@@ -75,7 +77,7 @@ pub(super) fn respond(
         // `energy::friction_moving_a_landing_vertex_back_created_energy`).
         // Within the contact margin counts as on it (resting cloth sits
         // exactly a thickness out, to rounding).
-        let gap0 = b.probe(q0).signed - thick * CONTACT_MARGIN;
+        let gap0 = start - thick * CONTACT_MARGIN;
         let gap1 = n.dot(q1) - offset - thick;
         let before = if gap0 > 0.0 && gap0 > gap1 {
             (gap0 / (gap0 - gap1)).min(1.0)

@@ -18,9 +18,9 @@ fn simulate(scene: &Scene) -> Summary {
 }
 
 /// The energy-gain step control: `tablecloth` at 32 segments with 1/60 s
-/// implicit steps gains energy in a frame as it lands on the table's edges
-/// (measured: 2 frame attempts retried with halved steps over 1 s); the run retries
-/// it with halved steps and keeps the energy within its bound.
+/// implicit steps gains energy in its landing (measured: 2 frame attempts
+/// retried with halved steps over 1 s); the run retries such frames with
+/// halved steps and keeps the energy within its bound.
 #[test]
 fn an_impact_at_large_implicit_steps_does_not_gain_energy() {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/tablecloth.toml");
@@ -57,8 +57,8 @@ fn an_impact_at_large_implicit_steps_does_not_gain_energy() {
 /// it stretched and the landing created energy that grew with the resolution
 /// (`drape_sphere` at its 1/120 s steps, measured without the energy retries:
 /// 0.44 J at 64 segments and 0.96 J at 96, of 3.77 J). The retries hid it by
-/// halving the steps of the landing frames (1 frame at 64 segments by 0.4 s, 2
-/// at 96). Now only the part of the step after the vertex reached the surface
+/// halving the steps of the landing frames (by 0.5 s, 1 frame at 64 segments
+/// and 2 at 96). Now only the part of the step after the vertex reached the surface
 /// is corrected; the landing needs no halved step (measured without retries:
 /// no gain at 32, 64 and 96 segments).
 #[test]
