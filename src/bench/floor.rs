@@ -97,6 +97,9 @@ pub struct Floor {
     /// The shadow's relative difference from the reference's
     /// ([`super::shadow`]), compared like `error` (`NaN` where there is none).
     pub shadow_error: Scalar,
+    /// Each sample point's error ([`sampling::sample_errors`], compared like
+    /// `error`).
+    pub sample_errors: Vec<Scalar>,
     /// True when the run came from the cache.
     pub cache_hit: bool,
 }
@@ -176,12 +179,16 @@ pub(super) fn floor_of(
         true => compare.of(shadows.iter().map(|e| e.1)),
         false => Scalar::NAN,
     };
+    let at_rest = compare == Compare::Rest;
+    let sample_errors =
+        sampling::sample_errors(&lowered, &reference.frames, reference.diagonal, at_rest);
     Floor {
         change,
         start,
         errors,
         error,
         shadow_error,
+        sample_errors,
         cache_hit: false,
     }
 }

@@ -106,6 +106,17 @@ pub fn measure(
         },
         errors,
         shadow_error,
+        sample_errors: if complete {
+            let at_rest = compare == Compare::Rest;
+            sampling::sample_errors(
+                &first.frames,
+                &reference.frames,
+                reference.diagonal,
+                at_rest,
+            )
+        } else {
+            Vec::new()
+        },
         pareto: false,
     })
 }

@@ -191,6 +191,10 @@ pub struct Row {
     /// ([`shadow`]), compared like `error`: `NaN` where the samples are not
     /// a complete grid, the run failed, and in rows read back from a CSV.
     pub shadow_error: Scalar,
+    /// Each sample point's error, in the order of the reference's points
+    /// ([`sampling::sample_errors`], compared like `error`; empty in rows
+    /// read back from a CSV).
+    pub sample_errors: Vec<Scalar>,
     /// On the Pareto front of (wall time, error).
     pub pareto: bool,
 }

@@ -95,6 +95,7 @@ pub fn read_csv(path: &Path) -> Result<Vec<Row>, BenchError> {
                 .collect(),
             errors: Vec::new(),
             shadow_error: f64::NAN,
+            sample_errors: Vec::new(),
         });
     }
     Ok(rows)

@@ -1,5 +1,6 @@
 //! The benchmark's files: `SCENE.csv` (one row per run), `SCENE-frames.csv`
-//! (the error at every recorded frame of every run), `SCENE.md` (a Markdown
+//! (the error at every recorded frame of every run), `SCENE-samples.csv`
+//! (each run's error at every sample point: where the error is), `SCENE.md` (a Markdown
 //! table with the comparison, the step, the reference's settings, the uniform
 //! runs' observed order of convergence and the target check) and `SCENE.svg`.
 //! The time-step ladder writes the same files as `SCENE-time.*`.
@@ -90,6 +91,42 @@ pub fn frames_csv<'a>(rows: &[Row], floors: impl IntoIterator<Item = &'a Floor>)
         for (t, e) in &f.errors {
             let _ = writeln!(out, "{},{t},{e}", field(&label));
         }
+    }
+    out
+}
+
+/// Where each run's error is: `u,v` (the sample point in material
+/// coordinates, m), then one column per row and per floor (headed by its
+/// label) with that point's error relative to the diagonal
+/// ([`super::sampling::sample_errors`]: at the last frame at rest, else the
+/// RMS over the frames; empty where the point was not found or the run
+/// failed).
+pub fn samples_csv<'a>(
+    points: &[[Scalar; 2]],
+    rows: &[Row],
+    floors: impl IntoIterator<Item = &'a Floor>,
+) -> String {
+    let floors: Vec<&Floor> = floors.into_iter().collect();
+    let mut out = String::from("u,v");
+    let labels = rows
+        .iter()
+        .map(|r| r.label.clone())
+        .chain(floors.iter().map(|f| f.change.label()));
+    for label in labels {
+        let _ = write!(out, ",{}", field(&label));
+    }
+    out.push('\n');
+    let columns: Vec<&[Scalar]> = rows
+        .iter()
+        .map(|r| &r.sample_errors[..])
+        .chain(floors.iter().map(|f| &f.sample_errors[..]))
+        .collect();
+    for (i, p) in points.iter().enumerate() {
+        let _ = write!(out, "{},{}", p[0], p[1]);
+        for c in &columns {
+            let _ = write!(out, ",{}", c.get(i).map_or(String::new(), |&e| num(e)));
+        }
+        out.push('\n');
     }
     out
 }
@@ -451,6 +488,10 @@ pub fn write_all(
         (
             format!("{stem}-frames.csv"),
             frames_csv(&res.rows, res.floors()),
+        ),
+        (
+            format!("{stem}-samples.csv"),
+            samples_csv(&res.reference.points, &res.rows, res.floors()),
         ),
         (format!("{stem}.md"), markdown(res, scene_path)),
         (

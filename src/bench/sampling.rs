@@ -169,3 +169,45 @@ pub fn last_frame_motion(frames: &[FrameSamples], diagonal: Scalar) -> Option<Sc
         .unzip();
     (!p.is_empty()).then(|| relative_rms(&p, &q, diagonal))
 }
+
+/// Each sample point's error against the reference, relative to the diagonal:
+/// its distance from the reference's sample at the last frame (`at_rest`), or
+/// the RMS of that distance over the frames matched by number and time
+/// (otherwise); `NaN` for a point found in neither frame of a pair. Where the
+/// error of [`run_errors`] is, for `drape bench`'s `SCENE-samples.csv`.
+pub fn sample_errors(
+    run: &[FrameSamples],
+    reference: &[FrameSamples],
+    diagonal: Scalar,
+    at_rest: bool,
+) -> Vec<Scalar> {
+    let n = reference.first().map_or(0, |r| r.positions.len());
+    let pairs: Vec<(&FrameSamples, &FrameSamples)> = if at_rest {
+        run.last().zip(reference.last()).into_iter().collect()
+    } else {
+        run.iter()
+            .filter_map(|f| Some((f, reference.iter().find(|r| r.frame == f.frame)?)))
+            .collect()
+    };
+    let same_time = |a: &FrameSamples, b: &FrameSamples| {
+        a.frame == b.frame && (a.time - b.time).abs() <= 1e-9 * b.time.abs().max(1.0)
+    };
+    (0..n)
+        .map(|i| {
+            let (mut sum, mut count) = (0.0, 0usize);
+            for (a, b) in pairs.iter().filter(|(a, b)| same_time(a, b)) {
+                let p = a.positions.get(i).copied().flatten();
+                let q = b.positions.get(i).copied().flatten();
+                if let (Some(p), Some(q)) = (p, q) {
+                    sum += Vector::from_array(p).distance_squared(Vector::from_array(q));
+                    count += 1;
+                }
+            }
+            if count == 0 {
+                Scalar::NAN
+            } else {
+                (sum / count as Scalar).sqrt() / diagonal
+            }
+        })
+        .collect()
+}

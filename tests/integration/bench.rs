@@ -122,6 +122,7 @@ pub(crate) fn row(label: &str, adaptive: bool, res: u32, finest: u32, wall: f64,
         error: err,
         errors: vec![],
         shadow_error: f64::NAN,
+        sample_errors: Vec::new(),
         pareto: false,
     }
 }
@@ -316,8 +317,26 @@ fn tiny_ladder_end_to_end_with_cache_and_a_failed_rung() {
         first.rows[3].status
     );
     assert!(!first.rows[3].pareto);
-    for name in ["tiny.csv", "tiny-frames.csv", "tiny.md", "tiny.svg"] {
+    for name in [
+        "tiny.csv",
+        "tiny-frames.csv",
+        "tiny-samples.csv",
+        "tiny.md",
+        "tiny.svg",
+    ] {
         assert!(dir.join("out").join(name).is_file(), "{name}");
+    }
+    // Where the error is: a line per sample point, a column per run; the
+    // failed run's column is empty.
+    let samples = std::fs::read_to_string(dir.join("out/tiny-samples.csv")).expect("csv");
+    let header = samples.lines().next().expect("header");
+    assert!(header.starts_with("u,v,uniform 4,uniform 6,"), "{header}");
+    assert_eq!(samples.lines().count(), 1 + first.reference.points.len());
+    let failed_column = 2 + 3;
+    for line in samples.lines().skip(1) {
+        let cells: Vec<&str> = line.split(',').collect();
+        assert_eq!(cells[failed_column], "", "{line}");
+        assert!(cells[2].parse::<f64>().is_ok(), "{line}");
     }
     let text = std::fs::read_to_string(dir.join("out/tiny.csv")).expect("csv");
     assert_eq!(text.lines().count(), 5);
@@ -623,6 +642,7 @@ fn the_larger_floor_decides_and_a_nan_floor_decides_nothing() {
         errors: vec![],
         error,
         shadow_error: f64::NAN,
+        sample_errors: Vec::new(),
         cache_hit: false,
     };
     let lift = floor(FloorChange::Lift(1e-6), 1e-4);
@@ -699,4 +719,36 @@ fn a_mesh_floor_whose_sample_grid_differs_in_the_last_bits_is_measured() {
     let mesh = res.mesh_floor.expect("the mesh floor was measured");
     println!("mesh floor (98 against 96) {:.3e}", mesh.error);
     assert!(mesh.error.is_finite());
+}
+
+/// Where the error is (`sampling::sample_errors`): a run against itself is
+/// zero at every point, a rigid translation the translation's length over
+/// the diagonal at every point (at rest and over the frames), and a point
+/// missing from a frame has none.
+#[test]
+fn sample_errors_of_identical_and_translated_runs() {
+    use drape::bench::sampling::sample_errors;
+    let frame = |k: u64, shift: f64, missing: bool| FrameSamples {
+        frame: k,
+        time: k as f64 / 30.0,
+        positions: (0..4)
+            .map(|i| {
+                let p = [i as f64 * 0.1 + shift, 0.2 * k as f64, 1.0];
+                (!(missing && i == 3)).then_some(p)
+            })
+            .collect(),
+    };
+    let run: Vec<FrameSamples> = (0..3).map(|k| frame(k, 0.0, false)).collect();
+    let moved: Vec<FrameSamples> = (0..3).map(|k| frame(k, 0.03, k == 2)).collect();
+    for at_rest in [true, false] {
+        let same = sample_errors(&run, &run, 2.0, at_rest);
+        assert_eq!(same, vec![0.0; 4]);
+        let shifted = sample_errors(&moved, &run, 2.0, at_rest);
+        println!("at rest {at_rest}: translated by 0.03 over 2: {shifted:?}");
+        for e in &shifted[..3] {
+            assert!((e - 0.015).abs() < 1e-12, "{shifted:?}");
+        }
+        // The last point is missing from the last frame only.
+        assert_eq!(shifted[3].is_nan(), at_rest, "{shifted:?}");
+    }
 }
