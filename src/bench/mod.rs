@@ -16,6 +16,7 @@
 pub mod chart;
 pub mod floor;
 pub mod ladder;
+pub mod map;
 pub mod measure;
 pub mod metric;
 pub mod order;

@@ -1,6 +1,7 @@
 //! The benchmark's files: `SCENE.csv` (one row per run), `SCENE-frames.csv`
 //! (the error at every recorded frame of every run), `SCENE-samples.csv`
-//! (each run's error at every sample point: where the error is), `SCENE.md` (a Markdown
+//! (each run's error at every sample point: where the error is, drawn in
+//! `SCENE-map.svg`), `SCENE.md` (a Markdown
 //! table with the comparison, the step, the reference's settings, the uniform
 //! runs' observed order of convergence and the target check) and `SCENE.svg`.
 //! The time-step ladder writes the same files as `SCENE-time.*`.
@@ -499,8 +500,10 @@ pub fn write_all(
             super::chart::svg(stem, &res.rows, res.deciding_floor())?,
         ),
     ];
+    let map = super::map::svg(stem, &res.reference.points, &res.rows, res.floors())?;
+    let map = map.map(|text| (format!("{stem}-map.svg"), text));
     let mut paths = Vec::new();
-    for (name, text) in files {
+    for (name, text) in files.into_iter().chain(map) {
         let path = dir.join(name);
         std::fs::write(&path, text).map_err(|source| BenchError::Io {
             path: path.clone(),

@@ -321,6 +321,7 @@ fn tiny_ladder_end_to_end_with_cache_and_a_failed_rung() {
         "tiny.csv",
         "tiny-frames.csv",
         "tiny-samples.csv",
+        "tiny-map.svg",
         "tiny.md",
         "tiny.svg",
     ] {
@@ -338,6 +339,25 @@ fn tiny_ladder_end_to_end_with_cache_and_a_failed_rung() {
         assert_eq!(cells[failed_column], "", "{line}");
         assert!(cells[2].parse::<f64>().is_ok(), "{line}");
     }
+    // ... and drawn: a panel per run that has them (not the failed one).
+    let map = std::fs::read_to_string(dir.join("out/tiny-map.svg")).expect("map");
+    assert!(map.starts_with("<svg"), "{map}");
+    for r in &first.rows[..3] {
+        assert!(map.contains(&format!("{}: RMS", r.label)), "{}", r.label);
+    }
+    assert!(!map.contains("blows up: RMS"));
+    // Without per-point errors there is no map.
+    let bare: Vec<_> = first
+        .rows
+        .iter()
+        .cloned()
+        .map(|mut r| {
+            r.sample_errors.clear();
+            r
+        })
+        .collect();
+    let none = drape::bench::map::svg("tiny", &first.reference.points, &bare, std::iter::empty());
+    assert!(none.expect("drawn").is_none());
     let text = std::fs::read_to_string(dir.join("out/tiny.csv")).expect("csv");
     assert_eq!(text.lines().count(), 5);
     assert!(text.contains(",failed: numerical failure"));
