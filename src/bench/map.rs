@@ -4,7 +4,9 @@
 //! rest the last frame's, otherwise the RMS over the frames) on one shared
 //! scale from white (0) to dark red (the largest error of any panel), so that
 //! panels compare at a glance. Each panel's title gives its label and the
-//! RMS of its cells. The same numbers are in `SCENE-samples.csv`.
+//! RMS of its cells (at rest the run's final error; frame by frame the RMS
+//! over points and frames together, not the bench's mean of each frame's
+//! RMS). The same numbers are in `SCENE-samples.csv`.
 //!
 //! Written for the eleventh sitting's question on `hanging_sheet_rest`
 //! (docs/speed-vs-error.md): uniform 128's error was the same everywhere (a
@@ -14,7 +16,7 @@
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::{BenchError, Floor, Row};
+use super::{BenchError, Compare, Floor, Row};
 use crate::math::Scalar;
 
 /// Panels per row of the figure.
@@ -99,7 +101,8 @@ pub fn svg<'a>(
     let mut out = String::new();
     {
         let root = SVGBackend::with_string(&mut out, (w, h)).into_drawing_area();
-        draw(&root, title, points, &panels, (lines, cols))
+        let at_rest = rows.first().is_some_and(|r| r.compare == Compare::Rest);
+        draw(&root, title, points, &panels, (lines, cols), at_rest)
             .map_err(|e| BenchError::Chart(e.to_string()))?;
         root.present()
             .map_err(|e| BenchError::Chart(e.to_string()))?;
@@ -115,6 +118,7 @@ fn draw(
     points: &[[Scalar; 2]],
     panels: &[Panel],
     (lines, cols): (usize, usize),
+    at_rest: bool,
 ) -> DrawResult {
     root.fill(&WHITE)?;
     let root = root.titled(
@@ -139,11 +143,19 @@ fn draw(
             .fold(Scalar::NEG_INFINITY, Scalar::max);
         (lo - half)..(hi + half)
     };
+    // At rest the RMS over the points is the run's final error; frame by
+    // frame it is over points and frames together, which is not the bench's
+    // mean over the frames of each frame's RMS.
+    let what = if at_rest {
+        "RMS"
+    } else {
+        "RMS, points and frames"
+    };
     let areas = grid.split_evenly((lines, cols));
     for (panel, area) in panels.iter().zip(&areas) {
         let mut chart = ChartBuilder::on(area)
             .caption(
-                format!("{}: RMS {:.3} %", panel.label, 100.0 * rms(panel.errors)),
+                format!("{}: {:.3} % {what}", panel.label, 100.0 * rms(panel.errors)),
                 ("sans-serif", 12),
             )
             .margin(6)
