@@ -114,6 +114,24 @@
 //! "Strain thresholds").
 //! Not the default: it is measured on one scene.
 //!
+//! # What neither measure sees: folds the coarse mesh has not formed
+//! Both measures judge the mesh by what it shows, so they cannot refine a
+//! feature that the coarse mesh does not form. On `hanging_sheet_rest` at
+//! uniform 128's finest edges (eleventh sitting, `docs/speed-vs-error.md`,
+//! from `drape bench`'s per-point errors) the adaptive runs' remaining error
+//! is the folds of the sheet's lower half: a few millimetres deep, they have
+//! 0.24 to 0.58 of the reference's depth on a base of 16 or 32 (uniform 128
+//! 0.74 to 0.83), and there the base-16 run's dihedral angles stay below
+//! 5.7 deg, under a 6 deg budget, so nothing refines them; from a base of
+//! 64 the same settings reach uniform 128's error at 0.18 of its time, no
+//! longer a tenth. Tried and not kept: lower angles (5 and 4 deg: more
+//! vertices, no less error). Not tried, on a measurement: a compression term
+//! (ARCSim refines where the cloth is compressed, where it will buckle);
+//! here the compressed area is the same on every mesh (smallest principal
+//! strain below -0.1 % on 0.64 to 0.67 of the sheet at base 16, uniform 64
+//! and uniform 128), so it would refine two thirds of the sheet whatever
+//! the folds do.
+//!
 //! # Bounces (the churn at rest)
 //! Judging a merge by the children's measures assumes that the merged parent
 //! will measure what they predict. Where the coarse mesh is too coarse for the
