@@ -123,8 +123,8 @@
 //! 0.24 to 0.58 of the reference's depth on a base of 16 or 32 (uniform 128
 //! 0.74 to 0.83), and there the base-16 run's dihedral angles stay below
 //! 5.7 deg, under a 6 deg budget, so nothing refines them; from a base of
-//! 64 the same settings reach uniform 128's error at 0.18 of its time, no
-//! longer a tenth. Tried and not kept: lower angles (5 and 4 deg: more
+//! 64 (8 deg, `refine_strain = 0.04`) the run has 0.94 of uniform 128's
+//! error at 0.18 of its time, no longer a tenth. Tried and not kept: lower angles (5 and 4 deg: more
 //! vertices, no less error). Not tried, on a measurement: a compression term
 //! (ARCSim refines where the cloth is compressed, where it will buckle);
 //! here the compressed area is the same on every mesh (smallest principal

@@ -57,7 +57,9 @@ fn rms(values: &[Scalar]) -> Scalar {
 }
 
 /// The half width of a sample's cell: half the smallest positive gap between
-/// distinct coordinates along either axis (the sample grid's spacing).
+/// distinct coordinates along either axis (the sample grid's spacing); for
+/// samples on one point, with no gap to take, 0.5 m (a cell of 1 m around it:
+/// only the drawing's scale depends on it).
 fn half_cell(points: &[[Scalar; 2]]) -> Scalar {
     let gap = |k: usize| {
         let mut c: Vec<Scalar> = points.iter().map(|p| p[k]).collect();

@@ -173,8 +173,8 @@ pub fn last_frame_motion(frames: &[FrameSamples], diagonal: Scalar) -> Option<Sc
 /// Each sample point's error against the reference, relative to the diagonal:
 /// its distance from the reference's sample at the last frame (`at_rest`), or
 /// the RMS of that distance over the frames matched by number and time
-/// (otherwise); `NaN` for a point found in neither frame of a pair. Where the
-/// error of [`run_errors`] is, for `drape bench`'s `SCENE-samples.csv`.
+/// (otherwise); `NaN` for a point that no pair of frames holds in both. Where
+/// the error of [`run_errors`] is, for `drape bench`'s `SCENE-samples.csv`.
 pub fn sample_errors(
     run: &[FrameSamples],
     reference: &[FrameSamples],
@@ -182,6 +182,9 @@ pub fn sample_errors(
     at_rest: bool,
 ) -> Vec<Scalar> {
     let n = reference.first().map_or(0, |r| r.positions.len());
+    let same_time = |a: &FrameSamples, b: &FrameSamples| {
+        a.frame == b.frame && (a.time - b.time).abs() <= 1e-9 * b.time.abs().max(1.0)
+    };
     let pairs: Vec<(&FrameSamples, &FrameSamples)> = if at_rest {
         run.last().zip(reference.last()).into_iter().collect()
     } else {
@@ -189,13 +192,11 @@ pub fn sample_errors(
             .filter_map(|f| Some((f, reference.iter().find(|r| r.frame == f.frame)?)))
             .collect()
     };
-    let same_time = |a: &FrameSamples, b: &FrameSamples| {
-        a.frame == b.frame && (a.time - b.time).abs() <= 1e-9 * b.time.abs().max(1.0)
-    };
+    let pairs: Vec<_> = pairs.into_iter().filter(|(a, b)| same_time(a, b)).collect();
     (0..n)
         .map(|i| {
             let (mut sum, mut count) = (0.0, 0usize);
-            for (a, b) in pairs.iter().filter(|(a, b)| same_time(a, b)) {
+            for (a, b) in &pairs {
                 let p = a.positions.get(i).copied().flatten();
                 let q = b.positions.get(i).copied().flatten();
                 if let (Some(p), Some(q)) = (p, q) {
