@@ -127,7 +127,8 @@ struct BenchArgs {
     /// tablecloth, whose table edges lie on lines at multiples of 16); see README.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(2..))]
     mesh_floor: Option<u32>,
-    /// Segments of the reference's uniform mesh (default: 1.5 times the finest rung's, rounded up to even).
+    /// Segments of the reference's uniform mesh (default: 1.5 times the finest rung's, rounded up to even);
+    /// with a ladder that names its own `reference`, that reference's `cloth.resolution`.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(2..))]
     reference_resolution: Option<u32>,
     /// Sample points per side of the material-space grid of the error metric.

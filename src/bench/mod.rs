@@ -118,7 +118,9 @@ pub struct BenchOptions {
     pub out_dir: PathBuf,
     /// Use (and write) the cached reference.
     pub cache: bool,
-    /// Reference resolution (`None`: 1.5 times the finest rung's, rounded up to even).
+    /// Reference resolution (`None`: 1.5 times the finest rung's, rounded up
+    /// to even, or the resolution a ladder's own `reference` sets); with a
+    /// ladder's `reference`, it sets that reference's `cloth.resolution`.
     pub reference_resolution: Option<u32>,
     /// Sample points per side of the material-space grid.
     pub grid: usize,
@@ -342,10 +344,15 @@ fn plan(opts: &BenchOptions) -> Result<Plan, BenchError> {
     let ref_res = opts
         .reference_resolution
         .unwrap_or_else(|| (finest * 3).div_ceil(2).next_multiple_of(2));
-    let ref_own = ladder
+    let mut ref_own = ladder
         .reference
         .clone()
         .unwrap_or_else(|| ladder::reference_overrides(ref_res));
+    // A ladder's own reference takes `--reference-resolution` as its mesh
+    // (it was silently ignored there before).
+    if let (Some(_), Some(n)) = (&ladder.reference, opts.reference_resolution) {
+        ref_own.push(format!("cloth.resolution={n}"));
+    }
     let mut ref_scene = load(&opts.scene, &chain(&base_set, &ref_own, &[]), "reference")?;
     let mut step_set = Vec::new();
     let mut common_dt = None;

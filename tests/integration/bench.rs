@@ -776,3 +776,41 @@ fn sample_errors_of_identical_and_translated_runs() {
         assert_eq!(shifted[3].is_nan(), at_rest, "{shifted:?}");
     }
 }
+
+/// Regression: `--reference-resolution` was silently ignored when the ladder
+/// names its own `reference` (the twelfth sitting's ladder with a uniform 192
+/// reference, run with `--reference-resolution 256`, computed 192). The flag
+/// now sets that reference's `cloth.resolution`; the ladder's other
+/// reference overrides stay.
+#[test]
+fn reference_resolution_sets_the_mesh_of_a_ladders_own_reference() {
+    let dir = temp_dir("ladder-reference-resolution");
+    let scene = tiny_scene(&dir);
+    let mut ladder = uniform_4();
+    ladder.reference = Some(vec![
+        "adapt.method=none".into(),
+        "cloth.resolution=8".into(),
+    ]);
+    let own = BenchOptions {
+        cache: false,
+        ..tiny_options(&scene, dir.join("own"), ladder.clone())
+    };
+    let stop = AtomicBool::new(false);
+    let res = bench(&own, &stop, &mut |_| {}).expect("bench");
+    assert_eq!(res.reference.vertices, 81, "the ladder's 8 x 8 reference");
+    let flagged = BenchOptions {
+        reference_resolution: Some(10),
+        cache: false,
+        ..tiny_options(&scene, dir.join("flagged"), ladder)
+    };
+    let res = bench(&flagged, &stop, &mut |_| {}).expect("bench");
+    assert_eq!(res.reference.vertices, 121, "the flag's 10 x 10 reference");
+    assert!(
+        res.reference
+            .overrides
+            .iter()
+            .any(|o| o == "adapt.method=none"),
+        "{:?}",
+        res.reference.overrides
+    );
+}
