@@ -27,6 +27,7 @@ pub mod report;
 pub mod sampling;
 pub mod shadow;
 pub mod steps;
+pub mod window;
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;

@@ -429,7 +429,90 @@ pub fn markdown(res: &BenchResult, scene_path: &Path) -> String {
         out.push_str(&convergence_text(c));
     }
     out.push_str(&targets(&res.rows, res.deciding_floor()));
+    out.push_str(&before_parting(res));
     out.push_str(&shadows(res));
+    out
+}
+
+/// The frames the mesh decides ([`super::window`]), for a frame-by-frame
+/// comparison with the lift floor: until when the lifted reference stays
+/// within a tenth of the nearest uniform run, and every run's and floor's
+/// mean error over those frames against the uniform run with its finest
+/// edges. Empty otherwise.
+fn before_parting(res: &BenchResult) -> String {
+    match res.floor.as_ref() {
+        Some(lift) if res.compare == super::Compare::Frames && !res.time_ladder => {
+            parting_text(&res.rows, lift, res.floors())
+        }
+        _ => String::new(),
+    }
+}
+
+/// The paragraph and table of [`before_parting`] from the rows, the lift
+/// floor `lift` and every floor measured (`floors`, the lift's included);
+/// empty where [`super::window::parting`] gives no answer.
+pub fn parting_text<'a>(
+    rows: &[Row],
+    lift: &Floor,
+    floors: impl IntoIterator<Item = &'a Floor>,
+) -> String {
+    let ok = |r: &&Row| r.status == "ok";
+    let uniform: Vec<&[(Scalar, Scalar)]> = rows
+        .iter()
+        .filter(ok)
+        .filter(|r| !r.adaptive)
+        .map(|r| r.errors.as_slice())
+        .collect();
+    let Some(p) = super::window::parting(&lift.errors, &uniform) else {
+        return String::new();
+    };
+    let mut out = String::from("\nBefore the runs part: ");
+    let Some((t, l, m)) = p.parted else {
+        let _ = writeln!(
+            out,
+            "the lifted reference stays below a tenth of the nearest uniform run's error at every frame, so the lift floor decides nothing by itself here (`src/bench/window.rs`)."
+        );
+        return out;
+    };
+    if p.frames == 0 {
+        let _ = writeln!(
+            out,
+            "the lifted reference is {} % from the reference at {t:.3} s, the first frame with anything to decide, against {} % for the nearest uniform run: no frame is decided by the mesh (`src/bench/window.rs`).",
+            pct(l),
+            pct(m)
+        );
+        return out;
+    }
+    let until = p.until;
+    let _ = writeln!(
+        out,
+        "the lifted reference stays below a tenth of the nearest uniform run's error until {until:.3} s ({} of {} frames) and is {} % from the reference at {t:.3} s, against {} % for the nearest uniform run (`src/bench/window.rs`). The mean error over the frames to {until:.3} s, which the mesh decides (the wall times above are the whole run's: run again with `--duration {until}` for the cost of these frames alone):\n",
+        p.frames,
+        lift.errors.len(),
+        pct(l),
+        pct(m),
+    );
+    out.push_str(
+        "| run | mean error % to then | / uniform with its finest edges |\n|---|---:|---:|\n",
+    );
+    let mean = |r: &Row| super::window::mean_until(&r.errors, until);
+    for r in rows.iter().filter(ok) {
+        let ratio = rows
+            .iter()
+            .filter(ok)
+            .find(|u| !u.adaptive && u.resolution == r.finest_resolution && u.dt == r.dt)
+            .filter(|_| r.adaptive)
+            .map_or("".into(), |u| format!("{:.2}", mean(r) / mean(u)));
+        let _ = writeln!(out, "| {} | {} | {ratio} |", r.label, pct(mean(r)));
+    }
+    for f in floors {
+        let _ = writeln!(
+            out,
+            "| floor: {} | {} | |",
+            f.change.label(),
+            pct(super::window::mean_until(&f.errors, until))
+        );
+    }
     out
 }
 

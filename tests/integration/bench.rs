@@ -585,6 +585,11 @@ fn the_mesh_floor_of_a_converging_sheet_is_below_the_rungs_errors() {
     assert!(mesh < 0.1 * uniform, "{mesh:e} against {uniform:e}");
     let md = std::fs::read_to_string(dir.join("out/tiny.md")).expect("md");
     assert!(md.contains("smaller than the larger floor"), "{md}");
+    // The sheet does not turn chaotic: the lift floor decides no window.
+    assert!(
+        md.contains("Before the runs part: the lifted reference stays below a tenth of the nearest uniform run's error at every frame"),
+        "{md}"
+    );
     let floor = drape::bench::replot::floor_from_frames(&dir.join("out"), "tiny", res.compare);
     let larger = lift.max(mesh);
     assert!(
@@ -812,5 +817,58 @@ fn reference_resolution_sets_the_mesh_of_a_ladders_own_reference() {
             .any(|o| o == "adapt.method=none"),
         "{:?}",
         res.reference.overrides
+    );
+}
+
+/// The report's "Before the runs part" table (`drape::bench::window`): a
+/// hand-made landing where the lifted reference parts at 0.3 s. The window
+/// keeps the frames to 0.2 s; the adaptive run's mean over them is a third
+/// of its mean over all four frames and equals uniform 8's there (ratio
+/// 1.00), and each floor's mean over the window is listed.
+#[test]
+fn the_report_lists_the_errors_over_the_frames_before_the_runs_part() {
+    let frames = |e: [f64; 4]| -> Vec<(f64, f64)> {
+        e.iter()
+            .enumerate()
+            .map(|(i, &e)| (i as f64 * 0.1, e))
+            .collect()
+    };
+    let mut coarse = row("uniform 4", false, 4, 4, 1.0, 0.0);
+    coarse.errors = frames([0.0, 2e-3, 4e-3, 8e-3]);
+    let mut fine = row("uniform 8", false, 8, 8, 4.0, 0.0);
+    fine.errors = frames([0.0, 1e-3, 2e-3, 6e-3]);
+    let mut adaptive = row("red_green 4 L2", true, 4, 8, 2.0, 0.0);
+    adaptive.errors = frames([0.0, 1e-3, 2e-3, 9e-3]);
+    let floor = |change, e| drape::bench::Floor {
+        change,
+        start: 0.0,
+        errors: frames(e),
+        error: 0.0,
+        shadow_error: f64::NAN,
+        sample_errors: vec![],
+        cache_hit: false,
+    };
+    let lift = floor(FloorChange::Lift(1e-6), [0.0, 1e-9, 1e-8, 1e-3]);
+    let mesh = floor(FloorChange::Resolution(10), [0.0, 3e-4, 6e-4, 5e-3]);
+    let rows = [coarse, fine, adaptive];
+    let text = drape::bench::report::parting_text(&rows, &lift, [&lift, &mesh]);
+    println!("{text}");
+    assert!(text.contains("until 0.200 s (3 of 4 frames)"), "{text}");
+    assert!(
+        text.contains("0.100 % from the reference at 0.300 s"),
+        "{text}"
+    );
+    assert!(text.contains("| uniform 8 | 0.100 |  |"), "{text}");
+    assert!(text.contains("| red_green 4 L2 | 0.100 | 1.00 |"), "{text}");
+    assert!(
+        text.contains("| floor: reference at 10 segments | 0.030 | |"),
+        "{text}"
+    );
+    // Never parting: one sentence, no table.
+    let calm = floor(FloorChange::Lift(1e-6), [0.0, 1e-9, 1e-9, 1e-9]);
+    let text = drape::bench::report::parting_text(&rows, &calm, [&calm]);
+    assert!(
+        text.contains("at every frame") && !text.contains('|'),
+        "{text}"
     );
 }
