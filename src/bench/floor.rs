@@ -28,7 +28,8 @@
 //!
 //! Errors of runs closer than the larger floor are not told apart by the
 //! comparison; the target table marks a check as decided only where the
-//! larger floor is below a tenth of the uniform run's error.
+//! adaptive run's error and 1.1 times the uniform run's are more than 2.1
+//! times the larger floor apart (`report::floor_decides`).
 
 use super::reference::Reference;
 use super::sampling;

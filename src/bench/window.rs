@@ -13,17 +13,16 @@
 //! check over a whole chaotic run cannot be decided, while the frames before
 //! the parting can.
 //!
-//! The rule is the bench's own: a difference is decided where the floor is
-//! below a tenth of the uniform run's error. Here it is applied frame by
-//! frame with the lift floor and the smallest error of the uniform runs at
-//! that frame. A frame where even that smallest error is below a thousandth
+//! The rule: a frame is decided while the lift floor is below a tenth of the
+//! smallest error of the uniform runs at that frame, so that a 10 %
+//! difference of errors there is more than the floor. A frame where even that smallest error is below a thousandth
 //! of its largest over the run (the free fall, where every run agrees to
 //! rounding) has nothing to decide and does not end the window.
 
 use crate::math::Scalar;
 
 /// The lift floor over a tenth of the smallest uniform error ends the window
-/// (the bench's rule for a decided comparison, applied per frame).
+/// (module docs).
 pub const DECIDED_FRACTION: Scalar = 0.1;
 
 /// Frames whose smallest uniform error is below this fraction of its largest

@@ -872,3 +872,23 @@ fn the_report_lists_the_errors_over_the_frames_before_the_runs_part() {
         "{text}"
     );
 }
+
+/// `report::floor_decides`: a check is decided where the adaptive run's
+/// error and 1.1 times the uniform run's are more than 2.1 floors apart.
+/// `drape_sphere`'s contact (twelfth sitting): red_green 32 L4 at 0.236 %
+/// against uniform 128's 0.040 % with a mesh floor of 0.025 % is a decided
+/// miss, which the rule before it (floor below a tenth of the uniform
+/// error) left undecided; the tablecloth's impact, 0.069 against 0.073 %
+/// with a floor of 0.025 %, stays undecided; a floor of zero decides all.
+#[test]
+fn a_clear_miss_is_decided_and_a_run_on_the_line_is_not() {
+    use drape::bench::report::floor_decides;
+    assert!(floor_decides(0.236, 0.040, 0.025));
+    assert!(!floor_decides(0.069, 0.073, 0.025));
+    assert!(floor_decides(0.05, 0.1, 0.0));
+    // On the line: within 2.1 floors of 1.1 times the uniform error.
+    assert!(!floor_decides(0.11, 0.1, 1e-3));
+    assert!(floor_decides(0.11 + 2.2e-3, 0.1, 1e-3));
+    assert!(floor_decides(0.11 - 2.2e-3, 0.1, 1e-3));
+    assert!(!floor_decides(0.05, f64::NAN, 1e-3), "NaN decides nothing");
+}
