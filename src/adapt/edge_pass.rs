@@ -184,7 +184,7 @@ impl Adapter {
             levels,
             VertexOrder::Kept,
         );
-        transfer(world, self.density, remeshed)?;
+        self.last_origins = transfer(world, self.density, remeshed)?;
         Ok(map)
     }
 }

@@ -31,7 +31,7 @@ use crate::spec::{
 };
 use crate::world::World;
 use red_green::{Applied, RedGreen, RedGreenOp};
-use transfer::{VertexOrder, compact, transfer};
+use transfer::{VertexOrder, VertexOrigins, compact, transfer};
 
 /// What happened, for the recording and the counters.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -218,6 +218,9 @@ pub struct Adapter {
     /// Rest area and boundary length of the cloth, for [`Adapter::check`].
     area: Scalar,
     boundary: Scalar,
+    /// Where the vertices of the latest remesh came from (empty before the
+    /// first): [`Adapter::last_origins`].
+    last_origins: VertexOrigins,
 }
 
 impl Adapter {
@@ -258,7 +261,15 @@ impl Adapter {
             tensor,
             area: m.total_rest_area(),
             boundary: boundary_length(m),
+            last_origins: VertexOrigins::default(),
         })
+    }
+
+    /// Where each vertex of the world's mesh came from in the latest remesh
+    /// that changed it (for state kept outside the world, such as the resting
+    /// contacts: [`transfer::carry_contacts`]); empty before the first.
+    pub fn last_origins(&self) -> &VertexOrigins {
+        &self.last_origins
     }
 
     /// Checks the adapted world (manifold, conforming, positive rest areas,
@@ -471,7 +482,7 @@ impl Adapter {
             VertexOrder::FirstUse,
         );
         let material = remeshed.material.clone();
-        transfer(world, self.density, remeshed)?;
+        self.last_origins = transfer(world, self.density, remeshed)?;
         self.hierarchy.remap(&map, &material);
         self.owner = owner;
         Ok(())

@@ -52,9 +52,12 @@ impl Adapter {
         let events = line_events(world, &ops, grid, step);
         let before = grid.clone();
         let remeshed = grid.apply(&ops);
-        if let Err(e) = transfer(world, self.density, remeshed) {
-            *grid = before;
-            return Err(e);
+        match transfer(world, self.density, remeshed) {
+            Ok(origins) => self.last_origins = origins,
+            Err(e) => {
+                *grid = before;
+                return Err(e);
+            }
         }
         for e in &events {
             match e.kind {

@@ -1,6 +1,7 @@
 //! Moving the world's state onto a remeshed topology.
 //!
-//! New vertices take the midpoint of their parent edge's position and velocity;
+//! New vertices take the midpoint of their parent edge's position and velocity
+//! (and, through [`carry_contacts`], a resting contact where both ends rest);
 //! masses are rebuilt from material areas (so total mass is exact). Lumped masses
 //! change around the modified region, which would change the linear momentum
 //! `sum m v`; the difference is given back as one common velocity change of the
@@ -48,6 +49,7 @@
 
 use crate::math::{Scalar, Vector, Vector2};
 use crate::mesh::{Mesh, MeshError, signed_area};
+use crate::physics::Contact;
 use crate::physics::pins::Anchor;
 use crate::world::World;
 
@@ -88,8 +90,68 @@ pub fn lumped_masses(material: &[Vector2], triangles: &[[u32; 3]], density: Scal
     m
 }
 
-/// Replaces the world's mesh by `new`, carrying positions, velocities and pins.
-pub fn transfer(world: &mut World, density: Scalar, new: Remeshed) -> Result<(), MeshError> {
+/// Where each vertex of a remeshed world came from: what [`transfer`] returns,
+/// for state kept outside the world (the resting contacts,
+/// [`carry_contacts`]).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct VertexOrigins {
+    /// Origin of each new vertex.
+    pub origin: Vec<Origin>,
+    /// The new vertices in an order where a midpoint comes after its parents.
+    pub parents_first: Vec<u32>,
+}
+
+/// The resting contacts of a remeshed world from the old one's (`old`, one per
+/// old vertex): a kept vertex keeps its contact; a midpoint is in contact
+/// where both ends of its edge are, with their normals' mean direction and
+/// their normal speeds' mean. `None` when `old` does not match the old mesh
+/// (`old_vertices`). Derivation and measurement: `docs/speed-vs-error.md`,
+/// twelfth sitting, "Contacts through a remesh". Without it a remesh dropped
+/// every contact, and the implicit step after it solved the cloth as if it
+/// could sink into the obstacle (`src/physics/implicit.rs`, "Pins and
+/// contacts").
+pub fn carry_contacts(
+    old: &[Contact],
+    old_vertices: usize,
+    origins: &VertexOrigins,
+) -> Option<Vec<Contact>> {
+    if old.len() != old_vertices || old.is_empty() {
+        return None;
+    }
+    let none = Contact {
+        normal: Vector::ZERO,
+        normal_speed: 0.0,
+    };
+    let mut new = vec![none; origins.origin.len()];
+    for &i in &origins.parents_first {
+        let i = i as usize;
+        new[i] = match origins.origin[i] {
+            Origin::Old(j) => *old.get(j as usize)?,
+            Origin::Midpoint(a, b) => {
+                let (ca, cb) = (new[a as usize], new[b as usize]);
+                let normal = (ca.normal + cb.normal).normalize_or_zero();
+                if ca.normal == Vector::ZERO || cb.normal == Vector::ZERO || normal == Vector::ZERO
+                {
+                    none
+                } else {
+                    Contact {
+                        normal,
+                        normal_speed: 0.5 * (ca.normal_speed + cb.normal_speed),
+                    }
+                }
+            }
+        };
+    }
+    Some(new)
+}
+
+/// Replaces the world's mesh by `new`, carrying positions, velocities and pins;
+/// returns where each new vertex came from.
+pub fn transfer(
+    world: &mut World,
+    density: Scalar,
+    new: Remeshed,
+) -> Result<VertexOrigins, MeshError> {
     let old_mass = lumped_masses(&world.mesh.material, &world.mesh.triangles, density);
     let new_mass = lumped_masses(&new.material, &new.triangles, density);
     let n = new.origin.len();
@@ -166,7 +228,10 @@ pub fn transfer(world: &mut World, density: Scalar, new: Remeshed) -> Result<(),
     world.mesh = mesh;
     world.x = x;
     world.v = v;
-    Ok(())
+    Ok(VertexOrigins {
+        origin: new.origin,
+        parents_first: new.parents_first,
+    })
 }
 
 /// The order of the vertices of a compacted mesh.

@@ -791,3 +791,50 @@ fn recording_holds_one_event_log_line_per_engine_event() {
         Some(summary.frames as usize)
     );
 }
+
+/// Regression: a remesh dropped every resting contact, so the implicit step
+/// after it solved the cloth as if it could sink into the obstacle
+/// (`drape_sphere`'s contact, twelfth sitting: a run adapting every step was
+/// 1.8 times as far from the reference as one adapting every 4).
+/// `carry_contacts` keeps a kept vertex's contact and gives a midpoint one
+/// where both its parents rest, nested midpoints included.
+#[test]
+fn remeshing_keeps_the_resting_contacts() {
+    use drape::adapt::transfer::{Origin, VertexOrigins, carry_contacts};
+    use drape::math::Vector;
+    use drape::physics::Contact;
+    let on = |x: f64, z: f64, s: f64| Contact {
+        normal: Vector::new(x, 0.0, z).normalize(),
+        normal_speed: s,
+    };
+    let free = Contact::default();
+    let old = [on(0.0, 1.0, 0.0), on(1.0, 1.0, 0.2), free];
+    // New vertices: old 2, old 0, old 1, mid(1, 2), mid(1, 0), mid(3, 1).
+    let origins = VertexOrigins {
+        origin: vec![
+            Origin::Old(2),
+            Origin::Old(0),
+            Origin::Old(1),
+            Origin::Midpoint(1, 2),
+            Origin::Midpoint(1, 0),
+            Origin::Midpoint(3, 1),
+        ],
+        parents_first: vec![0, 1, 2, 3, 4, 5],
+    };
+    let new = carry_contacts(&old, 3, &origins).expect("contacts");
+    assert_eq!(new.len(), 6);
+    assert_eq!((new[0], new[1], new[2]), (old[2], old[0], old[1]));
+    let mid = new[3];
+    assert!((mid.normal.length() - 1.0).abs() < 1e-12);
+    let expected = (old[0].normal + old[1].normal).normalize();
+    assert!((mid.normal - expected).length() < 1e-12, "{mid:?}");
+    assert!((mid.normal_speed - 0.1).abs() < 1e-12);
+    assert_eq!(new[4], free, "one parent off the obstacle");
+    assert_ne!(
+        new[5].normal,
+        Vector::ZERO,
+        "a midpoint of resting midpoints"
+    );
+    assert_eq!(carry_contacts(&old[..2], 3, &origins), None, "stale");
+    assert_eq!(carry_contacts(&[], 0, &origins), None);
+}

@@ -4,6 +4,7 @@
 
 use super::Pipeline;
 use crate::adapt::edge_angles_into;
+use crate::adapt::transfer::carry_contacts;
 use crate::math::{Scalar, Vector};
 use crate::mesh::MeshError;
 use crate::physics::Model;
@@ -111,10 +112,18 @@ impl Pipeline {
             c.nearest_planes(&w.x, w.time, &mut self.obstacle_planes);
         }
         let angles = self.angles_fresh.then_some(self.angles.as_slice());
+        let old_vertices = state.world.x.len();
         let changed = ad.pass_near(&mut state.world, step, angles, &self.obstacle_planes)?;
         self.angles_fresh = false;
         if changed {
+            // The contacts the last step ended in, carried onto the new mesh:
+            // the next implicit step filters them as it would have (issue 14,
+            // `crate::adapt::transfer::carry_contacts`).
+            let carried = carry_contacts(&state.contacts, old_vertices, ad.last_origins());
             self.mesh_changed(model, state);
+            if let Some(contacts) = carried {
+                state.contacts = contacts;
+            }
         }
         Ok(changed)
     }
