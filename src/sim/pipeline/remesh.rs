@@ -33,7 +33,8 @@ impl Pipeline {
 
     /// Rollback (paper A): when the step bent an edge past the upper threshold and
     /// rollbacks are left, restores the step's start (positions, velocities, time,
-    /// ledger), refines the marked edges and returns true (redo the step).
+    /// ledger and resting contacts), refines the marked edges and returns true
+    /// (redo the step).
     pub(super) fn rollback(
         &mut self,
         model: &Model,
@@ -64,8 +65,19 @@ impl Pipeline {
             state.ledger = ledger;
         }
         ad.note_rollback(&state.world, state.ledger.steps_done);
-        ad.refine(&mut state.world, &marks, state.ledger.steps_done)?;
+        // The contacts the rejected step started from fit the restored start;
+        // they go through the refinement like the vertices (`remesh` below).
+        let start_contacts = std::mem::take(&mut self.stepper.contacts);
+        let old_vertices = state.world.x.len();
+        let carried = if ad.refine(&mut state.world, &marks, state.ledger.steps_done)? {
+            carry_contacts(&start_contacts, old_vertices, ad.last_origins())
+        } else {
+            Some(start_contacts).filter(|c| c.len() == old_vertices)
+        };
         self.mesh_changed(model, state);
+        if let Some(contacts) = carried {
+            state.contacts = contacts;
+        }
         *tries += 1;
         Ok(true)
     }
