@@ -797,9 +797,8 @@ fn recording_holds_one_event_log_line_per_engine_event() {
 /// (`drape_sphere`'s contact, twelfth sitting: red_green 64 L2 at 8 deg
 /// adapting every step was 2.20e-3 of the diagonal from the reference, 1.4
 /// times as far as adapting every 4 steps, and 1.33e-3 once the contacts
-/// were carried).
-/// `carry_contacts` keeps a kept vertex's contact and gives a midpoint one
-/// where both its parents rest, nested midpoints included.
+/// were carried). `carry_contacts` keeps a kept vertex's contact, in the new
+/// numbering, and gives a new vertex none.
 #[test]
 fn remeshing_keeps_the_resting_contacts() {
     use drape::adapt::transfer::{Origin, VertexOrigins, carry_contacts};
@@ -811,32 +810,27 @@ fn remeshing_keeps_the_resting_contacts() {
     };
     let free = Contact::default();
     let old = [on(0.0, 1.0, 0.0), on(1.0, 1.0, 0.2), free];
-    // New vertices: old 2, old 0, old 1, mid(1, 2), mid(1, 0), mid(3, 1).
+    // New vertices: old 2, old 0, old 1, mid(1, 2).
     let origins = VertexOrigins {
         origin: vec![
             Origin::Old(2),
             Origin::Old(0),
             Origin::Old(1),
             Origin::Midpoint(1, 2),
-            Origin::Midpoint(1, 0),
-            Origin::Midpoint(3, 1),
         ],
-        parents_first: vec![0, 1, 2, 3, 4, 5],
+        parents_first: vec![0, 1, 2, 3],
     };
     let new = carry_contacts(&old, 3, &origins).expect("contacts");
-    assert_eq!(new.len(), 6);
-    assert_eq!((new[0], new[1], new[2]), (old[2], old[0], old[1]));
-    let mid = new[3];
-    assert!((mid.normal.length() - 1.0).abs() < 1e-12);
-    let expected = (old[0].normal + old[1].normal).normalize();
-    assert!((mid.normal - expected).length() < 1e-12, "{mid:?}");
-    assert!((mid.normal_speed - 0.1).abs() < 1e-12);
-    assert_eq!(new[4], free, "one parent off the obstacle");
-    assert_ne!(
-        new[5].normal,
-        Vector::ZERO,
-        "a midpoint of resting midpoints"
-    );
+    assert_eq!(new, vec![old[2], old[0], old[1], free]);
     assert_eq!(carry_contacts(&old[..2], 3, &origins), None, "stale");
     assert_eq!(carry_contacts(&[], 0, &origins), None);
+    let bad = VertexOrigins {
+        origin: vec![Origin::Old(7)],
+        parents_first: vec![0],
+    };
+    assert_eq!(
+        carry_contacts(&old, 3, &bad),
+        None,
+        "an old index out of range"
+    );
 }
