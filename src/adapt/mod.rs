@@ -31,7 +31,7 @@ use crate::spec::{
 };
 use crate::world::World;
 use red_green::{Applied, RedGreen, RedGreenOp};
-use transfer::{VertexOrder, VertexOrigins, compact, transfer};
+use transfer::{Origin, VertexOrder, compact, transfer};
 
 /// What happened, for the recording and the counters.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -220,7 +220,7 @@ pub struct Adapter {
     boundary: Scalar,
     /// Where the vertices of the latest remesh came from (empty before the
     /// first): [`Adapter::last_origins`].
-    last_origins: VertexOrigins,
+    last_origins: Vec<Origin>,
 }
 
 impl Adapter {
@@ -261,14 +261,14 @@ impl Adapter {
             tensor,
             area: m.total_rest_area(),
             boundary: boundary_length(m),
-            last_origins: VertexOrigins::default(),
+            last_origins: Vec::new(),
         })
     }
 
     /// Where each vertex of the world's mesh came from in the latest remesh
     /// that changed it (for state kept outside the world, such as the resting
     /// contacts: [`transfer::carry_contacts`]); empty before the first.
-    pub fn last_origins(&self) -> &VertexOrigins {
+    pub fn last_origins(&self) -> &[Origin] {
         &self.last_origins
     }
 

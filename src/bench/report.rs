@@ -398,12 +398,12 @@ fn targets(rows: &[Row], floor: Option<Scalar>) -> String {
         "\nTarget (an adaptive run within 10 % of the error of the uniform run with its finest edges, at <= 1/4 of that run's wall time on every scene, <= 1/10 on two):\n\n| adaptive | uniform | error ratio | within 10 % | wall time ratio | <= 1/4 | <= 1/10 | floor / uniform error | decided |\n|---|---|---:|:-:|---:|:-:|:-:|---:|:-:|\n",
     );
     let yes = |b: bool| if b { "**yes**" } else { "no" };
+    let error_of = |label: &str| {
+        rows.iter()
+            .find(|r| r.label == label)
+            .map_or(Scalar::NAN, |r| r.error)
+    };
     for c in checks {
-        let error_of = |label: &str| {
-            rows.iter()
-                .find(|r| r.label == label)
-                .map_or(Scalar::NAN, |r| r.error)
-        };
         let (uniform_error, adaptive_error) = (error_of(&c.uniform), error_of(&c.adaptive));
         let (ratio, decided) = match floor {
             Some(f) => (

@@ -801,7 +801,7 @@ fn recording_holds_one_event_log_line_per_engine_event() {
 /// numbering, and gives a new vertex none.
 #[test]
 fn remeshing_keeps_the_resting_contacts() {
-    use drape::adapt::transfer::{Origin, VertexOrigins, carry_contacts};
+    use drape::adapt::transfer::{Origin, carry_contacts};
     use drape::math::Vector;
     use drape::physics::Contact;
     let on = |x: f64, z: f64, s: f64| Contact {
@@ -811,23 +811,17 @@ fn remeshing_keeps_the_resting_contacts() {
     let free = Contact::default();
     let old = [on(0.0, 1.0, 0.0), on(1.0, 1.0, 0.2), free];
     // New vertices: old 2, old 0, old 1, mid(1, 2).
-    let origins = VertexOrigins {
-        origin: vec![
-            Origin::Old(2),
-            Origin::Old(0),
-            Origin::Old(1),
-            Origin::Midpoint(1, 2),
-        ],
-        parents_first: vec![0, 1, 2, 3],
-    };
+    let origins = [
+        Origin::Old(2),
+        Origin::Old(0),
+        Origin::Old(1),
+        Origin::Midpoint(1, 2),
+    ];
     let new = carry_contacts(&old, 3, &origins).expect("contacts");
     assert_eq!(new, vec![old[2], old[0], old[1], free]);
     assert_eq!(carry_contacts(&old[..2], 3, &origins), None, "stale");
     assert_eq!(carry_contacts(&[], 0, &origins), None);
-    let bad = VertexOrigins {
-        origin: vec![Origin::Old(7)],
-        parents_first: vec![0],
-    };
+    let bad = [Origin::Old(7)];
     assert_eq!(
         carry_contacts(&old, 3, &bad),
         None,
