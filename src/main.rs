@@ -81,7 +81,7 @@ struct BenchArgs {
     #[arg(long, value_name = "FILE.toml")]
     ladder: Option<PathBuf>,
     /// Run the time-step ladder instead: one uniform mesh at the scene's step, 1/2 and 1/4 of it, against 1/32 of it (files SCENE-time.*).
-    #[arg(long, conflicts_with_all = ["ladder", "reference_resolution", "step", "mesh_floor"])]
+    #[arg(long, conflicts_with_all = ["ladder", "reference_resolution", "step", "mesh_floor", "pattern_floor"])]
     time_ladder: bool,
     /// What the error compares: `frames` (every recorded frame, mean; dynamic scenes) or `rest` (the last frame; quasi-static scenes). Default: the ladder's `compare`, else `frames`.
     #[arg(long, value_name = "HOW")]
@@ -127,6 +127,13 @@ struct BenchArgs {
     /// tablecloth, whose table edges lie on lines at multiples of 16); see README.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(2..))]
     mesh_floor: Option<u32>,
+    /// Also run the reference's settings with the other diagonal pattern (`cloth.diagonals`,
+    /// alternating <-> regular; a rectangle) and report how far it ends from the reference:
+    /// the pattern floor. Where the triangulation seeds where folds form (a sheet buckling
+    /// over an obstacle), it is the part of an adaptive run's error that its transitions
+    /// cause and a uniform rung, sharing the reference's pattern, does not show; see README.
+    #[arg(long)]
+    pattern_floor: bool,
     /// Segments of the reference's uniform mesh (default: 1.5 times the finest rung's, rounded up to even);
     /// with a ladder that names its own `reference`, that reference's `cloth.resolution`.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(2..))]
@@ -333,6 +340,7 @@ fn cmd_bench(args: BenchArgs) -> Result<ExitCode> {
         grid: args.samples as usize,
         floor: !args.no_floor,
         mesh_floor: args.mesh_floor,
+        pattern_floor: args.pattern_floor,
     };
     if args.list {
         use std::io::Write;

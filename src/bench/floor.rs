@@ -26,6 +26,23 @@
 //!   cantilever 122 against 120 (the clamp edge off its line) gave 0.326 %,
 //!   thirteen times uniform 40's error.
 //!
+//! * **The pattern** (`--pattern-floor`, off by default; rectangles only):
+//!   the reference's settings with the other diagonal pattern
+//!   (`cloth.diagonals`, alternating <-> regular), at the reference's own
+//!   resolution. A mass-spring sheet is not the same material on two
+//!   triangulations, and where a sheet buckles, which way each square's
+//!   diagonal runs seeds where the folds form. An adaptive mesh's transitions
+//!   and coarse cells are such a change too, while a uniform rung shares the
+//!   reference's pattern: the pattern floor says how much of the distance
+//!   between the two is that. Measured (`docs/speed-vs-error.md`, thirteenth
+//!   sitting): on `drape_sphere`'s contact (to 0.533 s) uniform 192 with
+//!   regular diagonals is 0.397 % of the diagonal from uniform 192
+//!   alternating, ten times uniform 128's 0.040 %, and uniform 64 and 128
+//!   regular are 0.412 % and 0.395 % from it; red-green refined everywhere
+//!   with its children as split (not alternating) 0.257 %, with alternating
+//!   children 0.040 %, uniform 128's own error to the digit. The lift and
+//!   the mesh floor keep the pattern and do not see this.
+//!
 //! Errors of runs closer than the larger floor are not told apart by the
 //! comparison; the target table marks a check as decided only where the
 //! adaptive run's error and 1.1 times the uniform run's are more than 2.1
@@ -35,7 +52,7 @@ use super::reference::Reference;
 use super::sampling;
 use super::{Compare, Scene};
 use crate::math::{Scalar, Vector};
-use crate::scene::ClothShape;
+use crate::scene::{ClothShape, DiagonalPattern};
 
 /// How far the lift floor's run starts from the reference's, m: the cloth
 /// lifted 1 micrometre against gravity, a change no mesh or step setting
@@ -52,6 +69,8 @@ pub enum FloorChange {
     Lift(Scalar),
     /// The reference's settings at this many segments (`--mesh-floor`).
     Resolution(u32),
+    /// The reference's settings with these diagonals (`--pattern-floor`).
+    Pattern(DiagonalPattern),
 }
 
 impl FloorChange {
@@ -60,7 +79,22 @@ impl FloorChange {
         match self {
             FloorChange::Lift(_) => FLOOR_LABEL.to_owned(),
             FloorChange::Resolution(n) => mesh_label(*n),
+            FloorChange::Pattern(p) => pattern_label(*p),
         }
+    }
+}
+
+/// The label of the pattern floor's rows in `SCENE-frames.csv`: `reference
+/// with regular diagonals` (or alternating).
+pub fn pattern_label(pattern: DiagonalPattern) -> String {
+    format!("reference with {} diagonals", pattern_name(pattern))
+}
+
+/// The scene-file name of a diagonal pattern.
+fn pattern_name(pattern: DiagonalPattern) -> &'static str {
+    match pattern {
+        DiagonalPattern::Regular => "regular",
+        DiagonalPattern::Alternating => "alternating",
     }
 }
 
@@ -73,6 +107,9 @@ pub fn mesh_label(resolution: u32) -> String {
 /// True for a label [`FloorChange::label`] gives (a floor's rows, not a rung's).
 pub fn is_floor_label(label: &str) -> bool {
     label == FLOOR_LABEL
+        || [DiagonalPattern::Regular, DiagonalPattern::Alternating]
+            .iter()
+            .any(|&p| label == pattern_label(p))
         || label
             .strip_prefix("reference at ")
             .and_then(|s| s.strip_suffix(" segments"))
@@ -143,6 +180,31 @@ pub(super) fn mesh_override(
         ));
     }
     Ok(format!("cloth.resolution={resolution}"))
+}
+
+/// The `cloth.diagonals` override of the pattern floor's run for the
+/// reference `scene` (the other pattern than its own), with that pattern;
+/// `Err` says why it does not apply.
+pub(super) fn pattern_override(
+    scene: &Scene,
+    time_ladder: bool,
+) -> Result<(String, DiagonalPattern), String> {
+    if time_ladder {
+        return Err(
+            "the time-step ladder keeps one mesh; the pattern floor is for the spatial ladder"
+                .into(),
+        );
+    }
+    if scene.cloth.shape != ClothShape::Rectangle {
+        return Err(
+            "only a rectangle's grid squares have diagonals to turn; the pattern floor needs a rectangle".into(),
+        );
+    }
+    let other = match scene.cloth.diagonals {
+        DiagonalPattern::Regular => DiagonalPattern::Alternating,
+        DiagonalPattern::Alternating => DiagonalPattern::Regular,
+    };
+    Ok((format!("cloth.diagonals={}", pattern_name(other)), other))
 }
 
 /// The floor from its run's samples (`run`) and the reference's, compared as

@@ -34,7 +34,7 @@ use std::sync::atomic::AtomicBool;
 
 use crate::math::Scalar;
 use crate::run::{RunError, RunOptions};
-use crate::scene::{Scene, SceneError, load_scene_file};
+use crate::scene::{DiagonalPattern, Scene, SceneError, load_scene_file};
 pub use floor::{FLOOR_LIFT, Floor, FloorChange};
 pub use ladder::{Compare, Ladder, Rung, StepPolicy};
 pub use measure::{integrator_name, median};
@@ -90,6 +90,9 @@ pub enum BenchError {
     /// `--mesh-floor` does not apply.
     #[error("--mesh-floor: {0}")]
     MeshFloor(String),
+    /// `--pattern-floor` does not apply.
+    #[error("--pattern-floor: {0}")]
+    PatternFloor(String),
 }
 
 /// What to benchmark and how.
@@ -134,6 +137,11 @@ pub struct BenchOptions {
     /// floor ([`floor`]; rectangle cloths only, not with the time-step
     /// ladder).
     pub mesh_floor: Option<u32>,
+    /// Also run the reference's settings with the other diagonal pattern
+    /// (`cloth.diagonals`) and report how far it ends from the reference:
+    /// the pattern floor ([`floor`]; rectangle cloths only, not with the
+    /// time-step ladder).
+    pub pattern_floor: bool,
 }
 
 /// One rung's result: its settings and measurements.
@@ -240,12 +248,19 @@ pub struct BenchResult {
     pub mesh_floor: Option<Floor>,
     /// Why the mesh floor's run failed numerically, when it did.
     pub mesh_floor_failure: Option<String>,
+    /// The pattern floor (`None` unless asked for, or when its run failed).
+    pub pattern_floor: Option<Floor>,
+    /// Why the pattern floor's run failed numerically, when it did.
+    pub pattern_floor_failure: Option<String>,
 }
 
 impl BenchResult {
-    /// The floors measured: the lift's, then the mesh's.
+    /// The floors measured: the lift's, the mesh's, then the pattern's.
     pub fn floors(&self) -> impl Iterator<Item = &Floor> {
-        self.floor.iter().chain(&self.mesh_floor)
+        self.floor
+            .iter()
+            .chain(&self.mesh_floor)
+            .chain(&self.pattern_floor)
     }
 
     /// The floor that decides the target check: the larger of those measured,
@@ -253,7 +268,10 @@ impl BenchResult {
     /// run failed) or could not be compared: a check is then not called
     /// decided on the other floor alone.
     pub fn deciding_floor(&self) -> Option<Scalar> {
-        if self.floor_failure.is_some() || self.mesh_floor_failure.is_some() {
+        if self.floor_failure.is_some()
+            || self.mesh_floor_failure.is_some()
+            || self.pattern_floor_failure.is_some()
+        {
             return None;
         }
         floor::largest(self.floors())
@@ -284,6 +302,9 @@ struct Plan {
     /// The reference's overrides and scene on the mesh floor's mesh, with its
     /// resolution (`None` unless asked for).
     mesh: Option<(Vec<String>, Scene, u32)>,
+    /// The reference's overrides and scene with the other diagonal pattern,
+    /// and that pattern (`None` unless asked for).
+    pattern: Option<(Vec<String>, Scene, DiagonalPattern)>,
     compare: Compare,
     step: StepPolicy,
     common_dt: Option<(Scalar, String)>,
@@ -386,8 +407,19 @@ fn plan(opts: &BenchOptions) -> Result<Plan, BenchError> {
         }
         None => None,
     };
+    let pattern = match opts.pattern_floor {
+        true => {
+            let (set, p) = floor::pattern_override(&ref_scene, opts.time_ladder)
+                .map_err(BenchError::PatternFloor)?;
+            let set = chain(&ref_set, &[set], &[]);
+            let scene = load(&opts.scene, &set, "reference, pattern floor")?;
+            Some((set, scene, p))
+        }
+        false => None,
+    };
     Ok(Plan {
         mesh,
+        pattern,
         base,
         ref_set,
         floor_set,
@@ -464,6 +496,8 @@ enum FloorKind {
     Lift,
     /// The reference's settings at `--mesh-floor`'s resolution.
     Mesh,
+    /// The reference's settings with the other diagonal pattern.
+    Pattern,
 }
 
 /// A floor's run and its comparison with `reference` (module [`floor`]):
@@ -478,15 +512,19 @@ fn measure_floor(
     log: &mut dyn FnMut(&str),
 ) -> Result<Result<Option<Floor>, String>, BenchError> {
     let label;
-    let (name, change, lift, set, scene) = match (kind, &plan.mesh) {
-        (FloorKind::Mesh, None) => return Ok(Ok(None)),
-        (FloorKind::Mesh, Some((set, scene, n))) => {
+    let zero = crate::math::Vector::ZERO;
+    let (name, change, lift, set, scene) = match (kind, &plan.mesh, &plan.pattern) {
+        (FloorKind::Mesh, None, _) | (FloorKind::Pattern, _, None) => return Ok(Ok(None)),
+        (FloorKind::Mesh, Some((set, scene, n)), _) => {
             label = floor::mesh_label(*n);
-            let zero = crate::math::Vector::ZERO;
             ("mesh floor", FloorChange::Resolution(*n), zero, set, scene)
         }
-        (FloorKind::Lift, _) if !opts.floor || opts.time_ladder => return Ok(Ok(None)),
-        (FloorKind::Lift, _) => {
+        (FloorKind::Pattern, _, Some((set, scene, p))) => {
+            label = floor::pattern_label(*p);
+            ("pattern floor", FloorChange::Pattern(*p), zero, set, scene)
+        }
+        (FloorKind::Lift, ..) if !opts.floor || opts.time_ladder => return Ok(Ok(None)),
+        (FloorKind::Lift, ..) => {
             label = floor::FLOOR_LABEL.to_owned();
             let change = FloorChange::Lift(plan.floor_lift.length());
             let (set, scene) = (&plan.floor_set, &plan.floor_scene);
@@ -496,9 +534,13 @@ fn measure_floor(
     match obtain_reference(plan, opts, (&label, set, scene), run, log) {
         // The floor compares the same material points as the rungs; a cloth
         // whose outline changes with the mesh cannot be compared this way.
-        Ok((r, _)) if !same_points(&r, reference) => Err(BenchError::MeshFloor(
-            "its sample points differ from the reference's (the cloth's outline changes with the mesh)".into(),
-        )),
+        Ok((r, _)) if !same_points(&r, reference) => {
+            let why = "its sample points differ from the reference's (the cloth's outline changes with the mesh)".into();
+            Err(match kind {
+                FloorKind::Pattern => BenchError::PatternFloor(why),
+                _ => BenchError::MeshFloor(why),
+            })
+        }
         Ok((r, hit)) => {
             let f = Floor {
                 cache_hit: hit,
@@ -550,6 +592,11 @@ pub fn bench(
             Ok(f) => (f, None),
             Err(why) => (None, Some(why)),
         };
+    let (pattern_floor, pattern_floor_failure) =
+        match measure_floor(&plan, opts, FloorKind::Pattern, &reference, run, log)? {
+            Ok(f) => (f, None),
+            Err(why) => (None, Some(why)),
+        };
     let points = reference.sample_points();
     let mut rows = Vec::new();
     let n = plan.scenes.len();
@@ -597,6 +644,8 @@ pub fn bench(
         floor_failure,
         mesh_floor,
         mesh_floor_failure,
+        pattern_floor,
+        pattern_floor_failure,
     };
     result.files = report::write_all(&opts.out_dir, &result, &opts.scene)?;
     Ok(result)

@@ -287,6 +287,25 @@ fn preamble(res: &BenchResult, scene_path: &Path) -> String {
     if let Some(why) = &res.mesh_floor_failure {
         let _ = writeln!(out, "Mesh floor: not measured ({why}).\n");
     }
+    if let Some(f) = &res.pattern_floor {
+        let super::FloorChange::Pattern(p) = f.change else {
+            unreachable!("the pattern floor changes the diagonals")
+        };
+        let _ = writeln!(
+            out,
+            "Pattern floor: the reference's settings with {} diagonals instead of its own{}, at its own resolution, is {} % of the diagonal from the reference ({how}; {} % at the last frame). Where the triangulation seeds where folds form, an adaptive mesh's transitions move them as far; a uniform rung shares the reference's pattern.\n",
+            match p {
+                crate::scene::DiagonalPattern::Regular => "regular",
+                crate::scene::DiagonalPattern::Alternating => "alternating",
+            },
+            if f.cache_hit { " (cached)" } else { "" },
+            pct(f.error),
+            last(f),
+        );
+    }
+    if let Some(why) = &res.pattern_floor_failure {
+        let _ = writeln!(out, "Pattern floor: not measured ({why}).\n");
+    }
     let measured = res.floors().count();
     match res.deciding_floor() {
         Some(f) => {
@@ -450,27 +469,68 @@ pub fn markdown(res: &BenchResult, scene_path: &Path) -> String {
 }
 
 /// The frames the mesh decides ([`super::window`]), for a frame-by-frame
-/// comparison with the lift floor: until when the lifted reference stays
-/// within a tenth of the nearest uniform run, and every run's and floor's
-/// mean error over those frames against the uniform run with its finest
-/// edges. Empty otherwise.
+/// comparison with the lift floor or the pattern floor: until when the
+/// lifted reference and the one with the other diagonals stay within a tenth
+/// of the nearest uniform run, and every run's and floor's mean error over
+/// those frames against the uniform run with its finest edges. Empty
+/// otherwise.
 fn before_parting(res: &BenchResult) -> String {
-    match res.floor.as_ref() {
-        Some(lift) if res.compare == super::Compare::Frames && !res.time_ladder => {
-            parting_text(&res.rows, lift, res.floors())
-        }
-        _ => String::new(),
+    let seeds: Vec<&Floor> = res.floor.iter().chain(&res.pattern_floor).collect();
+    match res.compare == super::Compare::Frames && !res.time_ladder && !seeds.is_empty() {
+        true => parting_text(&res.rows, &seeds, res.floors()),
+        false => String::new(),
     }
 }
 
-/// The paragraph and table of [`before_parting`] from the rows, the lift
-/// floor `lift` and every floor measured (`floors`, the lift's included);
-/// empty where [`super::window::parting`] gives no answer.
+/// Who a floor's run is, in the window's sentence.
+fn seed_name(f: &Floor) -> String {
+    match f.change {
+        super::FloorChange::Lift(_) => "the lifted reference".into(),
+        super::FloorChange::Resolution(n) => format!("the reference at {n} segments"),
+        super::FloorChange::Pattern(_) => format!("the {}", f.change.label()),
+    }
+}
+
+/// The paragraph and table of [`before_parting`] from the rows, the floors
+/// whose per-frame errors end the window (`seeds`: the lift's and the
+/// pattern's, the larger at each frame of the first) and every floor
+/// measured (`floors`, the seeds included); empty where
+/// [`super::window::parting`] gives no answer.
 pub fn parting_text<'a>(
     rows: &[Row],
-    lift: &Floor,
+    seeds: &[&Floor],
     floors: impl IntoIterator<Item = &'a Floor>,
 ) -> String {
+    let Some(first) = seeds.first() else {
+        return String::new();
+    };
+    // A frame one of the seeds lacks is NaN there, which ends the window.
+    let deciding: Vec<(Scalar, Scalar)> = first
+        .errors
+        .iter()
+        .map(|&(t, e)| {
+            let others = seeds[1..]
+                .iter()
+                .map(|s| super::window::error_at(&s.errors, t).unwrap_or(Scalar::NAN));
+            (
+                t,
+                others.fold(e, |m, o| if o.is_nan() { o } else { m.max(o) }),
+            )
+        })
+        .collect();
+    let who = match seeds {
+        [one] => seed_name(one),
+        _ => format!(
+            "{} (the larger at each frame)",
+            seeds
+                .iter()
+                .map(|s| seed_name(s))
+                .collect::<Vec<_>>()
+                .join(" and ")
+        ),
+    };
+    let stays = if seeds.len() > 1 { "stay" } else { "stays" };
+    let is = if seeds.len() > 1 { "are" } else { "is" };
     let ok = |r: &&Row| r.status == "ok";
     let uniform: Vec<&[(Scalar, Scalar)]> = rows
         .iter()
@@ -478,21 +538,21 @@ pub fn parting_text<'a>(
         .filter(|r| !r.adaptive)
         .map(|r| r.errors.as_slice())
         .collect();
-    let Some(p) = super::window::parting(&lift.errors, &uniform) else {
+    let Some(p) = super::window::parting(&deciding, &uniform) else {
         return String::new();
     };
     let mut out = String::from("\nBefore the runs part: ");
     let Some((t, l, m)) = p.parted else {
         let _ = writeln!(
             out,
-            "the lifted reference stays below a tenth of the nearest uniform run's error at every frame, so the lift floor decides nothing by itself here (`src/bench/window.rs`)."
+            "{who} {stays} below a tenth of the nearest uniform run's error at every frame, so the floors that seed the parting decide nothing by themselves here (`src/bench/window.rs`)."
         );
         return out;
     };
-    if p.frames == 0 {
+    if p.decided == 0 {
         let _ = writeln!(
             out,
-            "the lifted reference is {} % from the reference at {t:.3} s, the first frame with anything to decide, against {} % for the nearest uniform run: no frame is decided by the mesh (`src/bench/window.rs`).",
+            "{who} {is} {} % from the reference at {t:.3} s, the first frame with anything to decide, against {} % for the nearest uniform run: no frame is decided by the mesh (`src/bench/window.rs`).",
             pct(l),
             pct(m)
         );
@@ -501,9 +561,9 @@ pub fn parting_text<'a>(
     let until = p.until;
     let _ = writeln!(
         out,
-        "the lifted reference stays below a tenth of the nearest uniform run's error until {until:.3} s ({} of {} frames) and is {} % from the reference at {t:.3} s, against {} % for the nearest uniform run (`src/bench/window.rs`). The mean error over the frames to {until:.3} s, which the mesh decides (the wall times above are the whole run's: run again with `--duration {until}` for the cost of these frames alone):\n",
+        "{who} {stays} below a tenth of the nearest uniform run's error until {until:.3} s ({} of {} frames) and {is} {} % from the reference at {t:.3} s, against {} % for the nearest uniform run (`src/bench/window.rs`). The mean error over the frames to {until:.3} s, which the mesh decides (the wall times above are the whole run's: run again with `--duration {until}` for the cost of these frames alone):\n",
         p.frames,
-        lift.errors.len(),
+        deciding.len(),
         pct(l),
         pct(m),
     );

@@ -12,6 +12,7 @@ use drape::bench::sampling::{FrameSamples, frame_error};
 use drape::bench::{
     BenchOptions, Compare, FloorChange, Ladder, Row, Rung, StepPolicy, bench, median,
 };
+use drape::scene::DiagonalPattern;
 
 /// A fresh empty directory in the temp dir, unique per process and name.
 pub(crate) fn temp_dir(name: &str) -> PathBuf {
@@ -82,6 +83,7 @@ fn tiny_options(scene: &Path, out_dir: PathBuf, ladder: Ladder) -> BenchOptions 
         cache: true,
         reference_resolution: None,
         mesh_floor: None,
+        pattern_floor: false,
         grid: 8,
         floor: false,
     }
@@ -480,8 +482,9 @@ fn bench_cli_lists_the_default_ladder_and_rejects_unknown_rungs() {
 /// starts the lift away (over the diagonal) and, the lift taken out, is the
 /// reference to rounding at every frame (printed). The report and the
 /// per-frame CSV carry it. The mesh floor (`--mesh-floor 8` against the
-/// reference's 6 segments) of a free fall is rounding too: every mesh falls
-/// alike.
+/// reference's 6 segments) and the pattern floor (`--pattern-floor`, regular
+/// diagonals against alternating) of a free fall are rounding too: every
+/// mesh falls alike.
 #[test]
 fn the_sensitivity_floor_of_a_free_fall_is_nothing_but_the_lift() {
     let dir = temp_dir("floor");
@@ -496,6 +499,7 @@ fn the_sensitivity_floor_of_a_free_fall_is_nothing_but_the_lift() {
     let opts = BenchOptions {
         floor: true,
         mesh_floor: Some(8),
+        pattern_floor: true,
         ..tiny_options(&scene, dir.join("out"), ladder)
     };
     let stop = AtomicBool::new(false);
@@ -550,10 +554,31 @@ fn the_sensitivity_floor_of_a_free_fall_is_nothing_but_the_lift() {
             .count(),
         mesh.errors.len()
     );
+    // The pattern floor: regular diagonals fall like alternating ones.
+    let pattern = res.pattern_floor.expect("the pattern floor was asked for");
+    println!("pattern floor per frame {:?}", pattern.errors);
+    assert_eq!(
+        pattern.change,
+        FloorChange::Pattern(DiagonalPattern::Regular)
+    );
+    assert_eq!(pattern.errors.len(), res.reference.frames.len());
+    assert!(pattern.error < 1e-3 * lift, "{:e}", pattern.error);
+    assert!(
+        md.contains("Pattern floor: the reference's settings with regular diagonals"),
+        "{md}"
+    );
+    assert_eq!(
+        frames
+            .lines()
+            .filter(|l| l.starts_with("reference with regular diagonals,"))
+            .count(),
+        pattern.errors.len()
+    );
     // Cached the second time, like the reference.
     let again = bench(&opts, &stop, &mut |_| {}).expect("bench");
     assert!(again.floor.is_some_and(|f| f.cache_hit));
     assert!(again.mesh_floor.is_some_and(|f| f.cache_hit));
+    assert!(again.pattern_floor.is_some_and(|f| f.cache_hit));
 }
 
 /// The mesh floor (`drape::bench::floor`) of a problem that converges with
@@ -561,7 +586,9 @@ fn the_sensitivity_floor_of_a_free_fall_is_nothing_but_the_lift() {
 /// corner, uniform 4 against a reference of 16 segments, and 18 segments
 /// against 16 (printed). With the lift floor it decides the target table's
 /// comparison, and the replot reads the larger of the two back from the
-/// per-frame CSV.
+/// per-frame CSV. The pattern floor (regular diagonals against the
+/// reference's alternating ones) is not rounding on a hanging sheet: the two
+/// lattices are two materials (printed); the replot takes it in too.
 #[test]
 fn the_mesh_floor_of_a_converging_sheet_is_below_the_rungs_errors() {
     let dir = temp_dir("mesh-floor");
@@ -571,27 +598,32 @@ fn the_mesh_floor_of_a_converging_sheet_is_below_the_rungs_errors() {
         floor: true,
         reference_resolution: Some(16),
         mesh_floor: Some(18),
+        pattern_floor: true,
         ..tiny_options(&scene, dir.join("out"), ladder)
     };
     let stop = AtomicBool::new(false);
     let res = bench(&opts, &stop, &mut |_| {}).expect("bench");
     let lift = res.floor.as_ref().expect("lift floor").error;
     let mesh = res.mesh_floor.as_ref().expect("mesh floor").error;
+    let pattern = res.pattern_floor.as_ref().expect("pattern floor").error;
     let uniform = res.rows[0].error;
     println!(
-        "uniform 4 {uniform:.4e}, mesh floor (18 against 16) {mesh:.4e}, lift floor {lift:.4e}"
+        "uniform 4 {uniform:.4e}, mesh floor (18 against 16) {mesh:.4e}, lift floor {lift:.4e}, pattern floor (regular against alternating at 16) {pattern:.4e}"
     );
+    assert!(pattern > 1e3 * lift, "the lattices hang apart: {pattern:e}");
     assert!(mesh > 0.0, "a finer mesh hangs differently");
     assert!(mesh < 0.1 * uniform, "{mesh:e} against {uniform:e}");
     let md = std::fs::read_to_string(dir.join("out/tiny.md")).expect("md");
     assert!(md.contains("smaller than the larger floor"), "{md}");
-    // The sheet does not turn chaotic: the lift floor decides no window.
+    // The sheet does not turn chaotic, but the two lattices hang apart from
+    // the first frame: no frame is decided by the mesh.
     assert!(
-        md.contains("Before the runs part: the lifted reference stays below a tenth of the nearest uniform run's error at every frame"),
+        md.contains("Before the runs part: the lifted reference and the reference with regular diagonals (the larger at each frame) are"),
         "{md}"
     );
+    assert!(md.contains("no frame is decided by the mesh"), "{md}");
     let floor = drape::bench::replot::floor_from_frames(&dir.join("out"), "tiny", res.compare);
-    let larger = lift.max(mesh);
+    let larger = lift.max(mesh).max(pattern);
     assert!(
         floor.is_some_and(|f| (f - larger).abs() <= 1e-12 * larger),
         "{floor:?} against {larger:e}"
@@ -617,7 +649,8 @@ fn the_chart_draws_a_floor_near_the_errors_only() {
 
 /// `--mesh-floor` is refused where it does not apply: the reference's own
 /// resolution (exit 1, before any run), or with the time-step ladder (a
-/// usage error, exit 2).
+/// usage error, exit 2); so is `--pattern-floor` with the time-step ladder
+/// and on a disk (exit 1, before any run).
 #[test]
 fn the_mesh_floor_is_refused_where_it_does_not_apply() {
     let dir = temp_dir("mesh-floor-refused");
@@ -633,6 +666,11 @@ fn the_mesh_floor_is_refused_where_it_does_not_apply() {
         ),
         (
             vec!["--mesh-floor", "8", "--time-ladder"],
+            2,
+            "cannot be used with",
+        ),
+        (
+            vec!["--pattern-floor", "--time-ladder"],
             2,
             "cannot be used with",
         ),
@@ -657,6 +695,18 @@ fn the_mesh_floor_is_refused_where_it_does_not_apply() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(err.contains("the mesh floor needs a rectangle"), "{err}");
+    // A disk has no grid squares whose diagonals could turn.
+    let out = Command::new(env!("CARGO_BIN_EXE_drape"))
+        .args(["bench", disk.to_str().expect("utf-8"), "--out-dir", out_dir])
+        .arg("--pattern-floor")
+        .output()
+        .expect("run drape");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("--pattern-floor: only a rectangle's grid squares have diagonals to turn"),
+        "{err}"
+    );
     std::fs::remove_dir_all(&dir).ok();
 }
 
@@ -851,7 +901,7 @@ fn the_report_lists_the_errors_over_the_frames_before_the_runs_part() {
     let lift = floor(FloorChange::Lift(1e-6), [0.0, 1e-9, 1e-8, 1e-3]);
     let mesh = floor(FloorChange::Resolution(10), [0.0, 3e-4, 6e-4, 5e-3]);
     let rows = [coarse, fine, adaptive];
-    let text = drape::bench::report::parting_text(&rows, &lift, [&lift, &mesh]);
+    let text = drape::bench::report::parting_text(&rows, &[&lift], [&lift, &mesh]);
     println!("{text}");
     assert!(text.contains("until 0.200 s (3 of 4 frames)"), "{text}");
     assert!(
@@ -866,9 +916,25 @@ fn the_report_lists_the_errors_over_the_frames_before_the_runs_part() {
     );
     // Never parting: one sentence, no table.
     let calm = floor(FloorChange::Lift(1e-6), [0.0, 1e-9, 1e-9, 1e-9]);
-    let text = drape::bench::report::parting_text(&rows, &calm, [&calm]);
+    let text = drape::bench::report::parting_text(&rows, &[&calm], [&calm]);
     assert!(
         text.contains("at every frame") && !text.contains('|'),
+        "{text}"
+    );
+    // The pattern floor parts at 0.2 s where the lift does not: the window
+    // ends a frame earlier, at the larger of the two.
+    let pattern = floor(
+        FloorChange::Pattern(drape::scene::DiagonalPattern::Regular),
+        [0.0, 1e-5, 5e-4, 2e-3],
+    );
+    let text = drape::bench::report::parting_text(&rows, &[&calm, &pattern], [&calm, &pattern]);
+    println!("{text}");
+    assert!(
+        text.contains("the lifted reference and the reference with regular diagonals (the larger at each frame) stay below a tenth of the nearest uniform run's error until 0.100 s (2 of 4 frames) and are 0.050 % from the reference at 0.200 s"),
+        "{text}"
+    );
+    assert!(
+        text.contains("| floor: reference with regular diagonals | 5.00e-4 | |"),
         "{text}"
     );
 }

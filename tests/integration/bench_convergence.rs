@@ -159,6 +159,7 @@ fn time_ladder_end_to_end_error_falls_with_the_step() {
         cache: false,
         reference_resolution: None,
         mesh_floor: None,
+        pattern_floor: false,
         grid: 8,
         floor: false,
     };
@@ -247,6 +248,7 @@ fn uniform_error_at_rest_falls_with_resolution() {
         cache: false,
         reference_resolution: None,
         mesh_floor: None,
+        pattern_floor: false,
         grid: 24,
         floor: false,
     };
