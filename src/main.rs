@@ -127,11 +127,11 @@ struct BenchArgs {
     /// tablecloth, whose table edges lie on lines at multiples of 16); see README.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(2..))]
     mesh_floor: Option<u32>,
-    /// Also run the reference's settings with the other diagonal pattern (`cloth.diagonals`,
-    /// alternating <-> regular; a rectangle) and report how far it ends from the reference:
-    /// the pattern floor. Where the triangulation seeds where folds form (a sheet buckling
-    /// over an obstacle), it is the part of an adaptive run's error that its transitions
-    /// cause and a uniform rung, sharing the reference's pattern, does not show; see README.
+    /// Also run the reference's settings with every grid square's diagonal turned
+    /// (`cloth.diagonals = "alternating_flipped"`; a rectangle with alternating diagonals)
+    /// and report how far it ends from the reference: the pattern floor, how far the
+    /// triangulation alone moves the result (errors closer than the larger floor are not
+    /// told apart); see README.
     #[arg(long)]
     pattern_floor: bool,
     /// Segments of the reference's uniform mesh (default: 1.5 times the finest rung's, rounded up to even);

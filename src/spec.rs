@@ -101,6 +101,11 @@ pub enum DiagonalPattern {
     /// Diagonals alternate in a checkerboard, which is more isotropic.
     #[default]
     Alternating,
+    /// The same checkerboard with every square's diagonal turned (the other
+    /// parity): an equally isotropic triangulation of the same grid, whose
+    /// diagonals meet where the alternating one's do not (`drape bench
+    /// --pattern-floor` compares the two).
+    AlternatingFlipped,
 }
 
 /// The bending force model.

@@ -56,6 +56,26 @@
 //! without the term and 0.328 % with it), and `drape_sphere` stayed worse
 //! than without the term (0.834 to 0.916 % against 0.575 to 0.671 %).
 //!
+//! Tried and dropped in the thirteenth sitting (`docs/speed-vs-error.md`),
+//! over `drape_sphere`'s contact (to 0.533 s, against uniform 192): a
+//! separate arrival term that split a leaf while one of its vertices, not in
+//! contact, would reach its contact height (gap over its speed towards the
+//! surface) within `k + 1` adaptation intervals, `k` the splits the leaf
+//! still lacked, and kept its parent from merging. It refined the first
+//! contact in time (0.0019 % at 0.333 s against uniform 128's 0.0023 % and
+//! 0.028 % without it) but not the skirt that buckles around the ball after
+//! it: over the window red_green 32 L4 went from 0.220 to 0.255 % (uniform
+//! 128 0.040 %), 64 L2 8 deg from 0.150 to 0.171 %. Keeping cloth in contact
+//! at the finest level too (0.255 %), or adding the curvature of the shape
+//! extrapolated along the velocities over the same horizon (0.250 %), did
+//! not help either, nor did refining at 2 deg or with `refine_strain =
+//! 0.005` (0.249 to 0.259 %, 0.187 %). Nor is it the triangulation seeding
+//! the skirt's folds: uniform 192 with every diagonal turned is 0.025 % from
+//! the reference (the pattern floor, `crate::bench::floor`). What is known:
+//! the sheet refined everywhere before the contact is uniform 128 to the
+//! digit (0.040 %), while refining only part of it does worse than not
+//! refining at all (64 L2 8 deg 0.150 % against uniform 64's 0.139 %).
+//!
 //! Red-green with the sizing criterion only. The rollback check does not see
 //! it (it is measured in the adaptation pass, where the obstacles are known).
 

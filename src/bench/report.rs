@@ -293,10 +293,11 @@ fn preamble(res: &BenchResult, scene_path: &Path) -> String {
         };
         let _ = writeln!(
             out,
-            "Pattern floor: the reference's settings with {} diagonals instead of its own{}, at its own resolution, is {} % of the diagonal from the reference ({how}; {} % at the last frame). Where the triangulation seeds where folds form, an adaptive mesh's transitions move them as far; a uniform rung shares the reference's pattern.\n",
+            "Pattern floor: the reference's settings with {} diagonals (every grid square's diagonal turned){}, at its own resolution, is {} % of the diagonal from the reference ({how}; {} % at the last frame). Where the triangulation seeds where folds form, an adaptive mesh's transitions may move them as far; a uniform rung shares the reference's triangulation.\n",
             match p {
                 crate::scene::DiagonalPattern::Regular => "regular",
                 crate::scene::DiagonalPattern::Alternating => "alternating",
+                crate::scene::DiagonalPattern::AlternatingFlipped => "alternating_flipped",
             },
             if f.cache_hit { " (cached)" } else { "" },
             pct(f.error),

@@ -13,13 +13,10 @@
 //! check over a whole chaotic run cannot be decided, while the frames before
 //! the parting can.
 //!
-//! A change of triangulation moves a buckling sheet's folds further still:
-//! the reference with the other diagonal pattern (the pattern floor,
-//! `--pattern-floor`) parts from it as the folds form, where the lift floor
-//! may not (on `drape_sphere`'s contact it was 0.397 % of the diagonal over
-//! the window the lift floor left, ten times uniform 128's error, thirteenth
-//! sitting). Where it is measured, the window ends at the larger of the two
-//! at each frame (`report::parting_text`).
+//! A change of triangulation may move a buckling sheet's folds where a lift
+//! does not: the reference with every diagonal turned (the pattern floor,
+//! `--pattern-floor`, `floor.rs`). Where it is measured, the window ends at
+//! the larger of the two at each frame (`report::parting_text`).
 //!
 //! The rule: a frame is decided while the lift floor is below a tenth of the
 //! smallest error of the uniform runs at that frame, so that a 10 %

@@ -47,6 +47,7 @@ pub fn rectangle_cells(
             let along_ac = match pattern {
                 DiagonalPattern::Regular => true,
                 DiagonalPattern::Alternating => (i + j) % 2 == 0,
+                DiagonalPattern::AlternatingFlipped => (i + j) % 2 == 1,
             };
             if along_ac {
                 triangles.push([a, b, c]);
@@ -148,6 +149,29 @@ mod tests {
         // Euler: E = V + F - 1 for a disk-like surface.
         assert_eq!(m.edges.len(), m.vertex_count() + m.triangles.len() - 1);
         assert!(interior > 0);
+    }
+
+    /// The flipped checkerboard splits every square along the other diagonal
+    /// than the alternating one, over the same vertices.
+    #[test]
+    fn flipped_alternating_turns_every_diagonal() {
+        let a = rectangle(2.0, 1.0, 8, DiagonalPattern::Alternating).unwrap();
+        let f = rectangle(2.0, 1.0, 8, DiagonalPattern::AlternatingFlipped).unwrap();
+        assert_eq!(a.material, f.material);
+        assert_eq!(a.triangles.len(), f.triangles.len());
+        // Each square's pair of triangles shares its diagonal: the two meshes
+        // have no interior edge in common that is a diagonal.
+        let diagonal = |m: &Mesh, k: usize| {
+            let (s, t) = (m.triangles[2 * k], m.triangles[2 * k + 1]);
+            let mut shared: Vec<u32> = s.iter().copied().filter(|v| t.contains(v)).collect();
+            shared.sort_unstable();
+            shared
+        };
+        for k in 0..a.triangles.len() / 2 {
+            let (da, df) = (diagonal(&a, k), diagonal(&f, k));
+            assert_eq!((da.len(), df.len()), (2, 2));
+            assert_ne!(da, df, "square {k} keeps its diagonal");
+        }
     }
 
     #[test]

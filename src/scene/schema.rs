@@ -26,7 +26,7 @@ pub(crate) fn allowed(path: &str) -> Option<&'static str> {
         "cloth.width" | "cloth.height" | "cloth.radius" => "a finite number > 0 (m)",
         "cloth.resolution" => "an integer from 1 to 2048 (segments)",
         "cloth.short_side_segments" => "an integer from 1 to 2048 (segments; rectangle only)",
-        "cloth.diagonals" => "\"alternating\" or \"regular\"",
+        "cloth.diagonals" => "\"alternating\", \"alternating_flipped\" or \"regular\"",
         "cloth.path" => "a non-empty path to an OBJ file, relative to the scene file",
         "cloth.uv_scale" => "a finite number > 0 (m per texture-coordinate unit)",
         "cloth.position" => "an array of 3 finite numbers (m)",

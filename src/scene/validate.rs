@@ -51,6 +51,13 @@ pub(crate) fn validate(scene: &Scene, doc: &Table) -> Result<(), Issue> {
             let why = "refine_obstacle refines where the cloth leans towards an obstacle, and this scene has no [[obstacle]]";
             return Err(Issue::new(path, Kind::NotApplicable, why));
         }
+        if a.method == crate::scene::AdaptMethod::Tensor
+            && scene.cloth.diagonals == crate::scene::DiagonalPattern::AlternatingFlipped
+        {
+            let path = keys(&["cloth", "diagonals"]);
+            let why = "the tensor method keeps a regular or alternating grid as it inserts lines; \"alternating_flipped\" is for uniform and red-green runs";
+            return Err(Issue::new(path, Kind::NotApplicable, why));
+        }
     }
     Ok(())
 }

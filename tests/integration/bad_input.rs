@@ -361,6 +361,21 @@ fn refine_strain_needs_the_sizing_rule_on_red_green_and_a_positive_value() {
     );
 }
 
+/// `cloth.diagonals = "alternating_flipped"` (every square's diagonal
+/// turned, for `drape bench --pattern-floor`) is a rectangle's pattern like
+/// the others, and refused with the tensor method, which keeps a regular or
+/// alternating grid as it inserts lines.
+#[test]
+fn flipped_diagonals_are_a_pattern_but_not_for_the_tensor_method() {
+    accepted_sets("flipped", &["cloth.diagonals=\"alternating_flipped\""]);
+    refused_with(
+        "flipped-tensor",
+        "cloth.diagonals=\"alternating_flipped\"",
+        "adapt.method=\"tensor\"",
+        "the tensor method keeps a regular or alternating grid",
+    );
+}
+
 /// `refine_obstacle` (`src/adapt/proximity.rs`) is the sizing rule's obstacle
 /// term on red-green, and a positive fraction.
 #[test]
