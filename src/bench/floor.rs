@@ -94,7 +94,7 @@ pub fn pattern_label(pattern: DiagonalPattern) -> String {
 }
 
 /// The scene-file name of a diagonal pattern.
-fn pattern_name(pattern: DiagonalPattern) -> &'static str {
+pub(super) fn pattern_name(pattern: DiagonalPattern) -> &'static str {
     match pattern {
         DiagonalPattern::Regular => "regular",
         DiagonalPattern::Alternating => "alternating",

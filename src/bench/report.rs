@@ -252,19 +252,8 @@ fn preamble(res: &BenchResult, scene_path: &Path) -> String {
         r.diagonal,
     );
     let how = compared(res.compare);
-    let last = |f: &Floor| pct(f.errors.last().map_or(Scalar::NAN, |e| e.1));
     if let Some(f) = &res.floor {
-        let super::FloorChange::Lift(lift) = f.change else {
-            unreachable!("the lift floor changes the start")
-        };
-        let _ = writeln!(
-            out,
-            "Sensitivity floor: the reference run again with the cloth started {lift:.0e} m higher{}, moved back down by that lift, is {} % of the diagonal from the reference ({how}; {} % at the last frame; as it started, {} %, the lift itself).\n",
-            if f.cache_hit { " (cached)" } else { "" },
-            pct(f.error),
-            last(f),
-            pct(f.start),
-        );
+        out.push_str(&floor_text(f, how));
     }
     if let Some(why) = &res.floor_failure {
         let _ = writeln!(
@@ -273,36 +262,13 @@ fn preamble(res: &BenchResult, scene_path: &Path) -> String {
         );
     }
     if let Some(f) = &res.mesh_floor {
-        let super::FloorChange::Resolution(n) = f.change else {
-            unreachable!("the mesh floor changes the resolution")
-        };
-        let _ = writeln!(
-            out,
-            "Mesh floor: the reference's settings on a uniform mesh of {n} segments instead of its own{}, is {} % of the diagonal from the reference ({how}; {} % at the last frame). Where the mesh decides where folds form, this is as large as the distance between any two fine meshes.\n",
-            if f.cache_hit { " (cached)" } else { "" },
-            pct(f.error),
-            last(f),
-        );
+        out.push_str(&floor_text(f, how));
     }
     if let Some(why) = &res.mesh_floor_failure {
         let _ = writeln!(out, "Mesh floor: not measured ({why}).\n");
     }
     if let Some(f) = &res.pattern_floor {
-        let super::FloorChange::Pattern(p) = f.change else {
-            unreachable!("the pattern floor changes the diagonals")
-        };
-        let _ = writeln!(
-            out,
-            "Pattern floor: the reference's settings with {} diagonals (every grid square's diagonal turned){}, at its own resolution, is {} % of the diagonal from the reference ({how}; {} % at the last frame). Where the triangulation seeds where folds form, an adaptive mesh's transitions may move them as far; a uniform rung shares the reference's triangulation.\n",
-            match p {
-                crate::scene::DiagonalPattern::Regular => "regular",
-                crate::scene::DiagonalPattern::Alternating => "alternating",
-                crate::scene::DiagonalPattern::AlternatingFlipped => "alternating_flipped",
-            },
-            if f.cache_hit { " (cached)" } else { "" },
-            pct(f.error),
-            last(f),
-        );
+        out.push_str(&floor_text(f, how));
     }
     if let Some(why) = &res.pattern_floor_failure {
         let _ = writeln!(out, "Pattern floor: not measured ({why}).\n");
@@ -590,6 +556,28 @@ pub fn parting_text<'a>(
         );
     }
     out
+}
+
+/// The report's paragraph on one floor, compared `how`.
+fn floor_text(f: &Floor, how: &str) -> String {
+    let cached = if f.cache_hit { " (cached)" } else { "" };
+    let (error, last) = (
+        pct(f.error),
+        pct(f.errors.last().map_or(Scalar::NAN, |e| e.1)),
+    );
+    match f.change {
+        super::FloorChange::Lift(lift) => format!(
+            "Sensitivity floor: the reference run again with the cloth started {lift:.0e} m higher{cached}, moved back down by that lift, is {error} % of the diagonal from the reference ({how}; {last} % at the last frame; as it started, {} %, the lift itself).\n\n",
+            pct(f.start),
+        ),
+        super::FloorChange::Resolution(n) => format!(
+            "Mesh floor: the reference's settings on a uniform mesh of {n} segments instead of its own{cached}, is {error} % of the diagonal from the reference ({how}; {last} % at the last frame). Where the mesh decides where folds form, this is as large as the distance between any two fine meshes.\n\n"
+        ),
+        super::FloorChange::Pattern(p) => format!(
+            "Pattern floor: the reference's settings with {} diagonals (every grid square's diagonal turned){cached}, at its own resolution, is {error} % of the diagonal from the reference ({how}; {last} % at the last frame). Where the triangulation seeds where folds form, an adaptive mesh's transitions may move them as far; a uniform rung shares the reference's triangulation.\n\n",
+            super::floor::pattern_name(p),
+        ),
+    }
 }
 
 /// How an error is compared, in words.
