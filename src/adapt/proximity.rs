@@ -68,8 +68,9 @@
 //! 128 0.040 %), 64 L2 8 deg from 0.150 to 0.171 %. Keeping cloth in contact
 //! at the finest level too (0.255 %), or adding the curvature of the shape
 //! extrapolated along the velocities over the same horizon (0.250 %), did
-//! not help either, nor did refining at 2 deg or with `refine_strain =
-//! 0.005` (0.249 to 0.259 %, 0.187 %). Nor is it the triangulation seeding
+//! not help either, nor did refining at 2 deg (0.254 % without the term,
+//! 0.249 % with it) or with `refine_strain = 0.005` (0.187 % without the
+//! term, 0.259 % with it). Nor is it the triangulation seeding
 //! the skirt's folds: uniform 192 with every diagonal turned is 0.025 % from
 //! the reference (the pattern floor, `crate::bench::floor`). What is known:
 //! the sheet refined everywhere before the contact is uniform 128 to the
@@ -78,8 +79,9 @@
 //! scratch variant that split every leaf once any vertex arrived within the
 //! horizon (the whole sheet refined about 0.1 s before the contact) gave
 //! 0.040 %, uniform 128's error to the digit, with 0.50 to 0.65 of its mean
-//! vertices: the impact reaches the whole sheet within one adaptation
-//! interval, so all of it must be fine when the centre touches.
+//! vertices. Our reading (a calculation, `docs/speed-vs-error.md`): the
+//! impact reaches the whole sheet within one adaptation interval, so all of
+//! it must be fine when the centre touches.
 //!
 //! Red-green with the sizing criterion only. The rollback check does not see
 //! it (it is measured in the adaptation pass, where the obstacles are known).

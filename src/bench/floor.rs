@@ -191,8 +191,8 @@ pub(super) fn mesh_override(
 }
 
 /// The `cloth.diagonals` override of the pattern floor's run for the
-/// reference `scene` (the other pattern than its own), with that pattern;
-/// `Err` says why it does not apply.
+/// reference `scene` (its checkerboard with every diagonal turned), with
+/// that pattern; `Err` says why it does not apply.
 pub(super) fn pattern_override(
     scene: &Scene,
     time_ladder: bool,

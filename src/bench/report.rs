@@ -437,15 +437,23 @@ pub fn markdown(res: &BenchResult, scene_path: &Path) -> String {
 
 /// The frames the mesh decides ([`super::window`]), for a frame-by-frame
 /// comparison with the lift floor or the pattern floor: until when the
-/// lifted reference and the one with the other diagonals stay within a tenth
-/// of the nearest uniform run, and every run's and floor's mean error over
-/// those frames against the uniform run with its finest edges. Empty
-/// otherwise.
+/// lifted reference and the one with every diagonal turned stay within a
+/// tenth of the nearest uniform run, and every run's and floor's mean error
+/// over those frames against the uniform run with its finest edges. When
+/// one of the two was asked for and its run failed, no window is given on
+/// the other alone (as [`BenchResult::deciding_floor`] decides nothing
+/// then). Empty otherwise.
 fn before_parting(res: &BenchResult) -> String {
+    if res.compare != super::Compare::Frames || res.time_ladder {
+        return String::new();
+    }
+    if res.floor_failure.is_some() || res.pattern_floor_failure.is_some() {
+        return "\nBefore the runs part: not given: a floor that ends the window was asked for and its run failed, so no window is drawn from the other alone.\n".into();
+    }
     let seeds: Vec<&Floor> = res.floor.iter().chain(&res.pattern_floor).collect();
-    match res.compare == super::Compare::Frames && !res.time_ladder && !seeds.is_empty() {
-        true => parting_text(&res.rows, &seeds, res.floors()),
-        false => String::new(),
+    match seeds.is_empty() {
+        false => parting_text(&res.rows, &seeds, res.floors()),
+        true => String::new(),
     }
 }
 
@@ -471,7 +479,8 @@ pub fn parting_text<'a>(
     let Some(first) = seeds.first() else {
         return String::new();
     };
-    // A frame one of the seeds lacks is NaN there, which ends the window.
+    // A frame one of the seeds lacks, or where one is NaN, is NaN, which
+    // ends the window (`f64::max` would drop a NaN).
     let deciding: Vec<(Scalar, Scalar)> = first
         .errors
         .iter()
@@ -479,10 +488,11 @@ pub fn parting_text<'a>(
             let others = seeds[1..]
                 .iter()
                 .map(|s| super::window::error_at(&s.errors, t).unwrap_or(Scalar::NAN));
-            (
-                t,
-                others.fold(e, |m, o| if o.is_nan() { o } else { m.max(o) }),
-            )
+            let larger = |m: Scalar, o: Scalar| match m.is_nan() || o.is_nan() {
+                true => Scalar::NAN,
+                false => m.max(o),
+            };
+            (t, others.fold(e, larger))
         })
         .collect();
     let who = match seeds {

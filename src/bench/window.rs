@@ -18,7 +18,9 @@
 //! `--pattern-floor`, `floor.rs`). Where it is measured, the window ends at
 //! the larger of the two at each frame (`report::parting_text`).
 //!
-//! The rule: a frame is decided while the lift floor is below a tenth of the
+//! The rule (with "the lift floor" the larger of the lift and pattern floors
+//! at each frame where both are measured): a frame is decided while the lift
+//! floor is below a tenth of the
 //! smallest error of the uniform runs at that frame, so that a 10 %
 //! difference of errors there is more than the floor. A frame where even that smallest error is below a thousandth
 //! of its largest over the run (the free fall, where every run agrees to
@@ -37,8 +39,8 @@ pub const NOTHING_TO_DECIDE: Scalar = 1e-3;
 /// Where the runs part (module docs).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Parting {
-    /// Recorded frames before the parting (the first `frames` of the lift
-    /// floor's).
+    /// Recorded frames before the parting (the first `frames` of the floor's
+    /// given to [`parting`]).
     pub frames: usize,
     /// Of those, the frames with something to decide (the others are the
     /// free fall's, where every run agrees to rounding).

@@ -55,7 +55,7 @@ pub(crate) fn validate(scene: &Scene, doc: &Table) -> Result<(), Issue> {
             && scene.cloth.diagonals == crate::scene::DiagonalPattern::AlternatingFlipped
         {
             let path = keys(&["cloth", "diagonals"]);
-            let why = "the tensor method keeps a regular or alternating grid as it inserts lines; \"alternating_flipped\" is for uniform and red-green runs";
+            let why = "the tensor method keeps a regular or alternating grid as it inserts lines; \"alternating_flipped\" is for uniform, red-green and edge-method runs";
             return Err(Issue::new(path, Kind::NotApplicable, why));
         }
     }

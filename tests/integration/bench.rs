@@ -482,9 +482,8 @@ fn bench_cli_lists_the_default_ladder_and_rejects_unknown_rungs() {
 /// starts the lift away (over the diagonal) and, the lift taken out, is the
 /// reference to rounding at every frame (printed). The report and the
 /// per-frame CSV carry it. The mesh floor (`--mesh-floor 8` against the
-/// reference's 6 segments) and the pattern floor (`--pattern-floor`, regular
-/// diagonals against alternating) of a free fall are rounding too: every
-/// mesh falls alike.
+/// reference's 6 segments) and the pattern floor (`--pattern-floor`, every
+/// diagonal turned) of a free fall are rounding too: every mesh falls alike.
 #[test]
 fn the_sensitivity_floor_of_a_free_fall_is_nothing_but_the_lift() {
     let dir = temp_dir("floor");
@@ -654,7 +653,8 @@ fn the_chart_draws_a_floor_near_the_errors_only() {
 /// `--mesh-floor` is refused where it does not apply: the reference's own
 /// resolution (exit 1, before any run), or with the time-step ladder (a
 /// usage error, exit 2); so is `--pattern-floor` with the time-step ladder
-/// and on a disk (exit 1, before any run).
+/// (exit 2), on a disk and on a reference with regular diagonals (exit 1,
+/// before any run).
 #[test]
 fn the_mesh_floor_is_refused_where_it_does_not_apply() {
     let dir = temp_dir("mesh-floor-refused");
@@ -709,6 +709,18 @@ fn the_mesh_floor_is_refused_where_it_does_not_apply() {
     assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(
         err.contains("--pattern-floor: only a rectangle's grid squares have diagonals to turn"),
+        "{err}"
+    );
+    // Turning a regular grid's diagonals would mirror it.
+    let out = Command::new(env!("CARGO_BIN_EXE_drape"))
+        .args(["bench", scene, "--out-dir", out_dir])
+        .args(["--pattern-floor", "--set", "cloth.diagonals=regular"])
+        .output()
+        .expect("run drape");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("--pattern-floor: the reference has regular diagonals"),
         "{err}"
     );
     std::fs::remove_dir_all(&dir).ok();
@@ -941,6 +953,11 @@ fn the_report_lists_the_errors_over_the_frames_before_the_runs_part() {
         text.contains("| floor: reference with alternating_flipped diagonals | 5.00e-4 | |"),
         "{text}"
     );
+    // A NaN in the first seed ends the window however calm the other is
+    // (`f64::max` alone would drop it and keep every frame).
+    let nan_lift = floor(FloorChange::Lift(1e-6), [0.0, f64::NAN, 1e-9, 1e-9]);
+    let text = drape::bench::report::parting_text(&rows, &[&nan_lift, &calm], [&nan_lift, &calm]);
+    assert!(text.contains("no frame is decided by the mesh"), "{text}");
 }
 
 /// `report::floor_decides`: a check is decided where the adaptive run's
