@@ -689,39 +689,36 @@ fn the_mesh_floor_is_refused_where_it_does_not_apply() {
         assert!(err.contains(needle), "{args:?}: {err}");
         assert!(!err.contains("panicked"), "{err}");
     }
+    // Refused with exit 1 before any run, saying `needle`.
+    let refused_run = |scene: &str, args: &[&str], needle: &str| {
+        let out = Command::new(env!("CARGO_BIN_EXE_drape"))
+            .args(["bench", scene, "--out-dir", out_dir])
+            .args(args)
+            .output()
+            .expect("run drape");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+    };
     // A disk's outline, and so its sample points, change with its rings.
     let disk = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cusick.toml");
-    let out = Command::new(env!("CARGO_BIN_EXE_drape"))
-        .args(["bench", disk.to_str().expect("utf-8"), "--out-dir", out_dir])
-        .args(["--mesh-floor", "98"])
-        .output()
-        .expect("run drape");
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{err}");
-    assert!(err.contains("the mesh floor needs a rectangle"), "{err}");
+    let disk = disk.to_str().expect("utf-8");
+    refused_run(
+        disk,
+        &["--mesh-floor", "98"],
+        "the mesh floor needs a rectangle",
+    );
     // A disk has no grid squares whose diagonals could turn.
-    let out = Command::new(env!("CARGO_BIN_EXE_drape"))
-        .args(["bench", disk.to_str().expect("utf-8"), "--out-dir", out_dir])
-        .arg("--pattern-floor")
-        .output()
-        .expect("run drape");
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{err}");
-    assert!(
-        err.contains("--pattern-floor: only a rectangle's grid squares have diagonals to turn"),
-        "{err}"
+    refused_run(
+        disk,
+        &["--pattern-floor"],
+        "--pattern-floor: only a rectangle's grid squares have diagonals to turn",
     );
     // Turning a regular grid's diagonals would mirror it.
-    let out = Command::new(env!("CARGO_BIN_EXE_drape"))
-        .args(["bench", scene, "--out-dir", out_dir])
-        .args(["--pattern-floor", "--set", "cloth.diagonals=regular"])
-        .output()
-        .expect("run drape");
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{err}");
-    assert!(
-        err.contains("--pattern-floor: the reference has regular diagonals"),
-        "{err}"
+    refused_run(
+        scene,
+        &["--pattern-floor", "--set", "cloth.diagonals=regular"],
+        "--pattern-floor: the reference has regular diagonals",
     );
     std::fs::remove_dir_all(&dir).ok();
 }
