@@ -856,24 +856,20 @@ fn remeshing_keeps_the_resting_contacts() {
 /// The last frame of `scene` (from `scenes/`) with `sets`: every vertex's
 /// material point and world position.
 fn last_frame(scene: &str, sets: &[&str]) -> Vec<(drape::math::Vector2, Vector)> {
-    use std::sync::{Arc, Mutex};
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("scenes")
         .join(scene);
     let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
     let scene = drape::scene::load_scene_file(&path, &sets).expect("scene");
-    let last = Arc::new(Mutex::new(Vec::new()));
-    let keep = Arc::clone(&last);
+    let mut last = Vec::new();
     let stop = std::sync::atomic::AtomicBool::new(false);
     let opts = drape::run::RunOptions::default();
     drape::run::run_observed(&scene, &opts, &stop, &mut |_| {}, &mut |f| {
-        let mut l = keep.lock().expect("lock");
-        l.clear();
-        l.extend(f.material.iter().copied().zip(f.positions.iter().copied()));
+        last.clear();
+        last.extend(f.material.iter().copied().zip(f.positions.iter().copied()));
     })
     .expect("run");
-    let l = last.lock().expect("lock").clone();
-    l
+    last
 }
 
 /// Issue 14 (thirteenth sitting, `docs/speed-vs-error.md`): a red-green sheet
