@@ -167,15 +167,10 @@ pub struct TargetCheck {
 /// (a uniform run whose resolution equals its finest resolution and that
 /// takes the same step setting).
 pub fn target_checks(rows: &[Row]) -> Vec<TargetCheck> {
-    let ok = |r: &&Row| r.status == "ok";
     rows.iter()
-        .filter(ok)
-        .filter(|r| r.adaptive)
+        .filter(|r| r.status == "ok" && r.adaptive)
         .filter_map(|a| {
-            let u = rows
-                .iter()
-                .filter(ok)
-                .find(|u| !u.adaptive && u.resolution == a.finest_resolution && u.dt == a.dt)?;
+            let u = uniform_counterpart(rows, a)?;
             let error_ratio = a.error / u.error;
             let time_ratio = a.wall_s / u.wall_s;
             let within_10 = error_ratio <= 1.1;
@@ -190,6 +185,14 @@ pub fn target_checks(rows: &[Row]) -> Vec<TargetCheck> {
             })
         })
         .collect()
+}
+
+/// The uniform run (that finished) with the finest edges and the step of the
+/// adaptive run `a`, which the target check compares it with.
+fn uniform_counterpart<'a>(rows: &'a [Row], a: &Row) -> Option<&'a Row> {
+    rows.iter().find(|u| {
+        u.status == "ok" && !u.adaptive && u.resolution == a.finest_resolution && u.dt == a.dt
+    })
 }
 
 /// The lines saying what is compared, at which step, against which reference.
@@ -549,10 +552,7 @@ pub fn parting_text<'a>(
     );
     let mean = |r: &Row| super::window::mean_until(&r.errors, until);
     for r in rows.iter().filter(ok) {
-        let ratio = rows
-            .iter()
-            .filter(ok)
-            .find(|u| !u.adaptive && u.resolution == r.finest_resolution && u.dt == r.dt)
+        let ratio = uniform_counterpart(rows, r)
             .filter(|_| r.adaptive)
             .map_or("".into(), |u| format!("{:.2}", mean(r) / mean(u)));
         let _ = writeln!(out, "| {} | {} | {ratio} |", r.label, pct(mean(r)));

@@ -47,7 +47,7 @@ pub struct Parting {
     pub decided: usize,
     /// Time of the last of those frames, s.
     pub until: Scalar,
-    /// The first frame past the window: its time, the lift floor's error
+    /// The first frame past the window: its time, the floor's error there
     /// and the smallest uniform error there; `None` when the runs never part.
     pub parted: Option<(Scalar, Scalar, Scalar)>,
 }
@@ -62,15 +62,16 @@ pub fn error_at(errors: &[(Scalar, Scalar)], t: Scalar) -> Option<Scalar> {
         .map(|e| e.1)
 }
 
-/// Where the lift floor's per-frame errors (`lift`) part from the uniform
-/// runs' (`uniform`, each `(time, error)` per frame); `None` without a
-/// uniform run or a frame, or when a uniform run misses one of the floor's
-/// frames or has a non-finite error there (nothing can be said from then).
-pub fn parting(lift: &[(Scalar, Scalar)], uniform: &[&[(Scalar, Scalar)]]) -> Option<Parting> {
-    if uniform.is_empty() || lift.is_empty() {
+/// Where a floor's per-frame errors (`floor`: the lift floor's, or the
+/// larger of it and the pattern floor's) part from the uniform runs'
+/// (`uniform`, each `(time, error)` per frame); `None` without a uniform run
+/// or a frame, or when a uniform run misses one of the floor's frames or has
+/// a non-finite error there (nothing can be said from then).
+pub fn parting(floor: &[(Scalar, Scalar)], uniform: &[&[(Scalar, Scalar)]]) -> Option<Parting> {
+    if uniform.is_empty() || floor.is_empty() {
         return None;
     }
-    let smallest: Vec<Option<Scalar>> = lift
+    let smallest: Vec<Option<Scalar>> = floor
         .iter()
         .map(|&(t, _)| {
             uniform
@@ -84,9 +85,9 @@ pub fn parting(lift: &[(Scalar, Scalar)], uniform: &[&[(Scalar, Scalar)]]) -> Op
         .flatten()
         .fold(0.0, |m: Scalar, &e| m.max(e));
     let (mut until, mut decided) = (None, 0);
-    for (i, (&(t, l), m)) in lift.iter().zip(&smallest).enumerate() {
+    for (i, (&(t, l), m)) in floor.iter().zip(&smallest).enumerate() {
         let m = (*m)?;
-        // A NaN lift error ends the window too: nothing is decided past it.
+        // A NaN floor error ends the window too: nothing is decided past it.
         let below = l < DECIDED_FRACTION * m;
         let something = m >= NOTHING_TO_DECIDE * scale;
         if something && !below {
@@ -101,7 +102,7 @@ pub fn parting(lift: &[(Scalar, Scalar)], uniform: &[&[(Scalar, Scalar)]]) -> Op
         until = Some(t);
     }
     Some(Parting {
-        frames: lift.len(),
+        frames: floor.len(),
         decided,
         until: until.unwrap_or(Scalar::NAN),
         parted: None,

@@ -69,15 +69,13 @@ impl Pipeline {
         // they go through the refinement like the vertices (`remesh` below).
         let start_contacts = std::mem::take(&mut self.stepper.contacts);
         let old_vertices = state.world.x.len();
+        let had_contacts = !start_contacts.is_empty();
         let carried = if ad.refine(&mut state.world, &marks, state.ledger.steps_done)? {
             carry_contacts(&start_contacts, old_vertices, ad.last_origins())
         } else {
             Some(start_contacts).filter(|c| c.len() == old_vertices)
         };
-        self.mesh_changed(model, state);
-        if let Some(contacts) = carried {
-            state.contacts = contacts;
-        }
+        self.mesh_changed_with(model, state, carried, had_contacts);
         *tries += 1;
         Ok(true)
     }
@@ -132,11 +130,31 @@ impl Pipeline {
             // the next implicit step filters them as it would have (issue 14,
             // `crate::adapt::transfer::carry_contacts`).
             let carried = carry_contacts(&state.contacts, old_vertices, ad.last_origins());
-            self.mesh_changed(model, state);
-            if let Some(contacts) = carried {
-                state.contacts = contacts;
-            }
+            let had_contacts = !state.contacts.is_empty();
+            self.mesh_changed_with(model, state, carried, had_contacts);
         }
         Ok(changed)
+    }
+
+    /// [`Pipeline::mesh_changed`], then the resting contacts carried onto the
+    /// new mesh. Contacts that could not be carried (`None`) while there were
+    /// some (`had_contacts`) are a broken invariant: one contact per old
+    /// vertex, origins in range. Release builds then go on without them, as
+    /// every remesh did before contacts were carried.
+    fn mesh_changed_with(
+        &mut self,
+        model: &Model,
+        state: &mut SimState,
+        carried: Option<Vec<crate::physics::Contact>>,
+        had_contacts: bool,
+    ) {
+        debug_assert!(
+            carried.is_some() || !had_contacts,
+            "resting contacts that do not fit the mesh they were carried from"
+        );
+        self.mesh_changed(model, state);
+        if let Some(contacts) = carried {
+            state.contacts = contacts;
+        }
     }
 }
