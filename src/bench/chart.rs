@@ -2,9 +2,10 @@
 //! error against wall time on log-log axes, uniform runs as blue circles,
 //! adaptive runs as orange squares, the Pareto front as a dashed staircase
 //! through ringed points; points are numbered, with the key of numbers to
-//! labels on the right. The sensitivity floor, when measured and within two
-//! decades of the smallest error, is a dotted grey line: errors closer
-//! together than it are not told apart by the comparison.
+//! labels on the right. The floor (the largest of the lift, mesh and pattern
+//! floors that were measured), when within two decades of the smallest error,
+//! is a dotted grey line labelled "largest floor": errors closer together than
+//! it are not told apart by the comparison.
 
 use plotters::coord::Shift;
 use plotters::coord::combinators::WithKeyPoints;
@@ -70,8 +71,8 @@ fn drawable(r: &Row) -> bool {
 }
 
 /// The chart of `rows` (wall time against the compared error in percent) as
-/// SVG text, titled `title`, with the sensitivity floor `floor` (relative to
-/// the diagonal, compared like the rows' errors) when there is one.
+/// SVG text, titled `title`, with the largest measured floor `floor` (relative
+/// to the diagonal, compared like the rows' errors) when there is one.
 pub fn svg(title: &str, rows: &[Row], floor: Option<f64>) -> Result<String, BenchError> {
     let mut out = String::new();
     {
@@ -137,7 +138,7 @@ fn draw(
         .light_line_style(RGBColor(0xee, 0xee, 0xee))
         .bold_line_style(RGBColor(0xcc, 0xcc, 0xcc))
         .draw()?;
-    // The sensitivity floor, where the axes show it.
+    // The largest floor, where the axes show it.
     if let Some(f) = floor {
         let grey = RGBColor(0x88, 0x88, 0x88);
         chart
@@ -147,7 +148,7 @@ fn draw(
                 4,
                 grey.stroke_width(2),
             ))?
-            .label("sensitivity floor")
+            .label("largest floor")
             .legend(move |(x, y)| {
                 plotters::element::DashedPathElement::new(
                     [(x - 8, y), (x + 8, y)],

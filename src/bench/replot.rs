@@ -122,7 +122,7 @@ pub fn floor_from_frames(dir: &Path, stem: &str, compare: super::Compare) -> Opt
 }
 
 /// Redraws `dir/stem.svg` from `dir/stem.csv` (`drape bench --replot`), with
-/// the sensitivity floor from `dir/stem-frames.csv` when it holds one;
+/// the largest floor from `dir/stem-frames.csv` when it holds one;
 /// returns the chart's path.
 pub fn replot(dir: &Path, stem: &str) -> Result<std::path::PathBuf, BenchError> {
     let rows = read_csv(&dir.join(format!("{stem}.csv")))?;
