@@ -3,7 +3,7 @@
 //! prints, against a cached bench reference, the last frame's error and the
 //! mean displacement of the samples from the reference's (x, y, z in mm).
 //! `drape bench` reports the length of that mean as the final offset; this
-//! shows its sign (`docs/speed-vs-error.md`, "Strain thresholds").
+//! shows its sign (`docs/speed-vs-error-history.md`, "Strain thresholds").
 //!
 //! ```sh
 //! cargo run --release --example rest_offset -- scenes/hanging_sheet_rest.toml \

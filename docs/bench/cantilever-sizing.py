@@ -1,5 +1,5 @@
 """How much of the cantilever the sizing rule must refine (issue 14, the "why"
-behind the cantilever's missed target; docs/speed-vs-error.md).
+behind the cantilever's missed target; docs/speed-vs-error-history.md).
 
 Solves the heavy elastica of the strip in scenes/cantilever.toml (4 cm
 overhang, bending length 2 cm: lambda = (L / c)^3 = 8) by shooting with RK4,

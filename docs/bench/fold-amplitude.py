@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Where a hanging sheet's error at rest is: shape against offset, and the
-folds' amplitude row by row (docs/speed-vs-error.md, eleventh sitting).
+folds' amplitude row by row (docs/speed-vs-error-history.md, eleventh sitting).
 
 Usage: fold-amplitude.py REFERENCE.json RUN.obj
   REFERENCE.json  a `drape bench` reference cache (bench-out/.../cache/*.json)

@@ -3,7 +3,7 @@
 //! that the mesh is fine where it will fold over the obstacle before the fold
 //! forms, instead of after.
 //!
-//! Why. Compared frame by frame on `tablecloth` (`docs/speed-vs-error.md`),
+//! Why. Compared frame by frame on `tablecloth` (`docs/speed-vs-error-history.md`),
 //! the adaptive runs are already far behind uniform 64 in the first frame
 //! after the cloth lands on the table (t = 0.33 s: edge 16 L4 0.677 % of the
 //! diagonal, red_green 16 L4 0.698 %, uniform 64 0.232 %, uniform 32 0.731 %):
@@ -38,7 +38,7 @@
 //! over a table's edge along the edge (the nearest point there is on the
 //! edge, whose normal leans at 45 degrees to both faces).
 //!
-//! Measured (`docs/speed-vs-error.md`, "Eighth sitting"): over the
+//! Measured (`docs/speed-vs-error-history.md`, "Eighth sitting"): over the
 //! tablecloth's landing (0.6 s) `refine_obstacle = 0.5` brings red_green 16 L4
 //! from 1.72 to 1.26 times uniform 64's error at 0.63 instead of 0.46 of its
 //! time; over 2 s the settings scatter (1.09, 1.59, 1.35 at 1, 0.5, 0.25); on
@@ -47,7 +47,7 @@
 //! frames of the landing are resolved by the comparison (at 0.33 s 0.698 ->
 //! 0.326 % against a mesh floor of 0.249 %); over the landing and on
 //! `drape_sphere` the differences are below the mesh floor (0.251 % and
-//! 0.762 %; `docs/speed-vs-error.md`, "Ninth sitting"). Tried and dropped: counting an
+//! 0.762 %; `docs/speed-vs-error-history.md`, "Ninth sitting"). Tried and dropped: counting an
 //! end only while it approaches the surface and would reach it within two
 //! adaptation intervals (velocity against the normal, horizon 0.03 s on the
 //! tablecloth, 0.067 s on `drape_sphere`), so that cloth at rest on an
@@ -56,7 +56,7 @@
 //! without the term and 0.328 % with it), and `drape_sphere` stayed worse
 //! than without the term (0.834 to 0.916 % against 0.575 to 0.671 %).
 //!
-//! Tried and dropped in the thirteenth sitting (`docs/speed-vs-error.md`),
+//! Tried and dropped in the thirteenth sitting (`docs/speed-vs-error-history.md`),
 //! over `drape_sphere`'s contact (to 0.533 s, against uniform 192): a
 //! separate arrival term that split a leaf while one of its vertices, not in
 //! contact, would reach its contact height (gap over its speed towards the
@@ -79,7 +79,7 @@
 //! scratch variant that split every leaf once any vertex arrived within the
 //! horizon (the whole sheet refined about 0.1 s before the contact) gave
 //! 0.040 %, uniform 128's error to the digit, with 0.50 to 0.65 of its mean
-//! vertices. Our reading (a calculation, `docs/speed-vs-error.md`): the
+//! vertices. Our reading (a calculation, `docs/speed-vs-error-history.md`): the
 //! impact reaches the whole sheet within one adaptation interval, so all of
 //! it must be fine when the centre touches.
 //!

@@ -94,7 +94,7 @@
 //! diagonals run other ways), and a mass-spring membrane's stiffness depends
 //! on the triangulation: refined everywhere to 64 it is 0.226 % of the
 //! diagonal from uniform 128 and 0.290 % from itself refined to 128, where
-//! uniform 64 is 0.186 % and 0.236 % from them (`docs/speed-vs-error.md`).
+//! uniform 64 is 0.186 % and 0.236 % from them (`docs/speed-vs-error-history.md`).
 //! Those figures are with the red children as split; with the alternating
 //! diagonals that came after (`red_green/mesh.rs`, now the default) a mesh
 //! refined everywhere is the uniform grid, and the same ladder (third sitting,
@@ -106,18 +106,18 @@
 //! Those figures are from before the bounce rule (below), which changes every
 //! strain rung that bounced: tight 0.02 ends at 1.45e-3 (x1.27) with it, 0.01
 //! at 1.21e-3 in 0.77 of its former time and 0.005 at 1.12e-3 in 0.43
-//! (`docs/speed-vs-error.md`, "Bounces"). With base 8, `max_level = 6`, 8 /
+//! (`docs/speed-vs-error-history.md`, "Bounces"). With base 8, `max_level = 6`, 8 /
 //! 0.8 deg and no rollback, 0.04 is within 7 % of uniform 64's error at 0.19
 //! to 0.21 of its time and 0.05 at 0.88 of it, while 0.06 to 0.15 are 1.12 to
 //! 1.39 times it: the adaptive runs' error at rest is mostly the shape of the
-//! sheet's coarse middle, uniform 64's mostly its shift (`docs/speed-vs-error.md`,
+//! sheet's coarse middle, uniform 64's mostly its shift (`docs/speed-vs-error-history.md`,
 //! "Strain thresholds").
 //! Not the default: it is measured on one scene.
 //!
 //! # What neither measure sees: folds the coarse mesh has not formed
 //! Both measures judge the mesh by what it shows, so they cannot refine a
 //! feature that the coarse mesh does not form. On `hanging_sheet_rest` at
-//! uniform 128's finest edges (eleventh sitting, `docs/speed-vs-error.md`,
+//! uniform 128's finest edges (eleventh sitting, `docs/speed-vs-error-history.md`,
 //! from `drape bench`'s per-point errors) the adaptive runs' remaining error
 //! is the folds of the sheet's lower half: a few millimetres deep, they have
 //! 0.24 to 0.58 of the reference's depth on a base of 16 or 32 (uniform 128

@@ -5,7 +5,7 @@
 //! Why. A strip bent along its length (the cantilever) needs short cells
 //! along the bend and none across it: one cell across the strip gives the
 //! square cells' rest error within 1 % at 1/25 of the wall time
-//! (`docs/speed-vs-error.md`, "Anisotropic cells"), but red-green's 1-4
+//! (`docs/speed-vs-error-history.md`, "Anisotropic cells"), but red-green's 1-4
 //! splits halve a cell both ways, so from a base one cell across it carries
 //! 169 vertices at level 4 where 82 do. Anisotropic bisection in a metric
 //! (tried on the edge method, same section) made oblique thin triangles on
@@ -56,7 +56,7 @@
 //! refined (12 splits in the test
 //! `a_flat_sheet_distorted_in_its_plane_does_not_refine`).
 //!
-//! Measured (`docs/speed-vs-error.md`, "The tensor method"): on the
+//! Measured (`docs/speed-vs-error-history.md`, "The tensor method"): on the
 //! cantilever from its own square cells, 1.03 times uniform 40's error at
 //! rest in 0.18 of its wall time, 0.82 of the time of the uniform mesh of
 //! its own finest cells; on `hanging_sheet_rest`, `drape_sphere`,

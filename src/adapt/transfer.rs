@@ -19,7 +19,7 @@
 //! 0.449 -> 0.450 %, edge 16 L4 0.442 -> 0.461 %. No consistent gain, and
 //! none resolved: every change is smaller than the mesh floor, how far a
 //! uniform mesh two segments finer ends from the reference (0.762 % and
-//! 0.251 %; `docs/speed-vs-error.md`, "Ninth sitting"); the midpoint also
+//! 0.251 %; `docs/speed-vs-error-history.md`, "Ninth sitting"); the midpoint also
 //! leaves the old surface, which the tensor method's checks rely on. Tried
 //! again in the twelfth sitting over `drape_sphere`'s contact, where the
 //! comparison decides (uniform error falling at order 1.76, mesh floor 0.025
@@ -102,7 +102,7 @@ pub fn lumped_masses(material: &[Vector2], triangles: &[[u32; 3]], density: Scal
 /// implicit step after it solved the cloth as if it could sink into the
 /// obstacle (`src/physics/implicit.rs`, "Pins and contacts").
 ///
-/// Tried and dropped (twelfth sitting, `docs/speed-vs-error.md`): a midpoint
+/// Tried and dropped (twelfth sitting, `docs/speed-vs-error-history.md`): a midpoint
 /// resting where both ends of its edge rest, on their normals' mean
 /// direction. It gave the same errors on `drape_sphere`'s contact (within
 /// 3e-6 of the diagonal, 0.1 % of each run's error) and made the tablecloth's landing retry frames for energy

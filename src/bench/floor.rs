@@ -17,7 +17,7 @@
 //!   problem, not only the mesh (an odd count puts the centre in a cell's
 //!   middle and turns the corners' diagonals; the cantilever's clamp edge is
 //!   on a line only at multiples of 5 segments, the tablecloth's table edges
-//!   only at multiples of 16). Measured (`docs/speed-vs-error.md`, "The mesh
+//!   only at multiples of 16). Measured (`docs/speed-vs-error-history.md`, "The mesh
 //!   floor" and "Tenth sitting"): against uniform 96 on `drape_sphere` (2.5
 //!   s), uniform 94 and 98 are 0.765 % and 0.762 % of the diagonal from it,
 //!   95 and 97 0.686 % and 0.698 %, where uniform 64 is 0.602 % and the lift
@@ -33,7 +33,7 @@
 //!   an equally isotropic triangulation of the same grid. Where a sheet
 //!   buckles, the triangulation may seed where its folds form; this floor
 //!   says how much, with the material unchanged. Measured
-//!   (`docs/speed-vs-error.md`, thirteenth sitting): on `drape_sphere`'s
+//!   (`docs/speed-vs-error-history.md`, thirteenth sitting): on `drape_sphere`'s
 //!   contact (to 0.533 s) uniform 192 flipped is 0.025 % of the diagonal
 //!   from uniform 192, as far as uniform 176 (the mesh floor), and uniform
 //!   64 and 128 flipped 0.138 % and 0.038 % (unflipped 0.139 % and 0.040

@@ -9,7 +9,7 @@
 //! RMS). The same numbers are in `SCENE-samples.csv`.
 //!
 //! Written for the eleventh sitting's question on `hanging_sheet_rest`
-//! (docs/speed-vs-error.md): uniform 128's error was the same everywhere (a
+//! (docs/speed-vs-error-history.md): uniform 128's error was the same everywhere (a
 //! shift of the whole sheet), the adaptive runs' lay along the folds of the
 //! sheet's lower half.
 

@@ -3,7 +3,7 @@
 //! test (the drape coefficient is the shadow's area beyond the support over
 //! the specimen's beyond it). It depends on how far the cloth hangs and
 //! spreads, not on where each fold lies, so it can compare runs whose folds
-//! formed in different places. Measured (`docs/speed-vs-error.md`, "The
+//! formed in different places. Measured (`docs/speed-vs-error-history.md`, "The
 //! shadow"): on the falling sheets it does not converge either (a mesh two
 //! segments finer than the reference changes it by 0.8 to 2.1 %, 0.67 to 1.5
 //! times uniform 64's difference), because how far a sheet spreads depends

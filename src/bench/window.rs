@@ -6,7 +6,7 @@
 //! stays within rounding of the reference while the cloth falls and first
 //! touches, then parts from it by as much as any mesh does. Measured on
 //! `tablecloth` at uniform 128's edges (twelfth sitting,
-//! `docs/speed-vs-error.md`): the lifted reference is within 1e-4 % of the
+//! `docs/speed-vs-error-history.md`): the lifted reference is within 1e-4 % of the
 //! diagonal until 0.367 s and 0.150 % away at 0.400 s, a third of uniform
 //! 128's error at that frame; from there on every run is a few tenths of a
 //! per cent away. The mean over all the frames mixes the two, so the target

@@ -192,7 +192,7 @@
 //!   `P` on every interior triangle overshoots to 0.3 to 0.9 deg soft (3.5
 //!   to 5.1 deg on thin cells). The test
 //!   `elastica::an_irregular_strip_bends_stiffer_than_the_elastica` and
-//!   `docs/speed-vs-error.md`, "Bending on irregular triangles".
+//!   `docs/speed-vs-error-history.md`, "Bending on irregular triangles".
 //!
 //! Boundary edges have no angle, so an imposed curvature across a free edge loses
 //! the outer half row of triangles' share (the `1 - 1/n` of the cylinder test).

@@ -872,7 +872,7 @@ fn last_frame(scene: &str, sets: &[&str]) -> Vec<(drape::math::Vector2, Vector)>
     last
 }
 
-/// Issue 14 (thirteenth sitting, `docs/speed-vs-error.md`): a red-green sheet
+/// Issue 14 (thirteenth sitting, `docs/speed-vs-error-history.md`): a red-green sheet
 /// refined everywhere while it still falls flat lands on the ball exactly as
 /// the uniform grid of its finest edges does. The grid refined everywhere is
 /// that uniform grid (alternating children), and the transfer of a flat,
@@ -944,7 +944,7 @@ fn corner_cells(f: &drape::run::FrameState, corner: drape::math::Vector2) -> Vec
     cells
 }
 
-/// Issue 14 (thirteenth sitting, `docs/speed-vs-error.md`): the pattern floor
+/// Issue 14 (thirteenth sitting, `docs/speed-vs-error-history.md`): the pattern floor
 /// of `hanging_sheet_rest` (every diagonal turned) moves its rest shape by
 /// 1.87 times uniform 128's error, mostly a sag from the point pins, whose
 /// cells the turned grid changes. The adaptive run the docs compare (base 64,

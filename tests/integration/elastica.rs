@@ -544,7 +544,7 @@ fn irregular_strip(
 /// of the vertices sit on the regular outline. Using the transitions' exact
 /// operator (`P`) on every interior triangle was tried and overshoots the
 /// other way: +0.63 to +0.66 deg at a quarter cell, +0.91 / +0.92 at 64
-/// along, +3.5 / +5.1 with 2 cells across (`docs/speed-vs-error.md`,
+/// along, +3.5 / +5.1 with 2 cells across (`docs/speed-vs-error-history.md`,
 /// "Bending on irregular triangles"). The test fails if the error grows, or
 /// if a fix removes it (then the bands and the docs should say so).
 #[test]

@@ -152,7 +152,7 @@ fn second_level_transitions_bend_within_ten_percent_of_the_continuum() {
 /// area (0.080 and 0.038 of the sheet), so they sit in the greens: 9 to 10 %
 /// softer along an axis and 48 to 50 % stiffer in shear there. Nothing is tuned
 /// away here; this pins what a red-green mesh gives up
-/// (`docs/speed-vs-error.md`, "Strain thresholds": a graded sheet hangs
+/// (`docs/speed-vs-error-history.md`, "Strain thresholds": a graded sheet hangs
 /// lower than the grid's would).
 #[test]
 fn green_closures_stretch_unlike_the_grid() {

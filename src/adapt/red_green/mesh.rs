@@ -11,7 +11,7 @@
 //! one way 0.912 %, and base 16 refined everywhere to the same edges 0.163 %.
 //! Node by node the red-green family was the worse discretisation against a
 //! red-green reference too, so this was a floor under every adaptive run, not
-//! a bias of the reference (`docs/speed-vs-error.md`).
+//! a bias of the reference (`docs/speed-vs-error-history.md`).
 //!
 //! So the mesh is emitted with one flip per red split: in a split triangle
 //! with a corner of at least 90 degrees (a grid triangle's right angle), the

@@ -40,7 +40,7 @@
 //! `hanging_sheet_rest` at uniform 64, so that rule refactored at 528 of its 600
 //! steps while the sheet hung at rest; 8 was faster there (206 factorizations), but
 //! on `drape_sphere` 1 was faster than 4 or 8 (docs/performance.md,
-//! docs/speed-vs-error.md). The fixed count cannot suit both; the costs above do.
+//! docs/speed-vs-error-history.md). The fixed count cannot suit both; the costs above do.
 
 use crate::math::Scalar;
 
