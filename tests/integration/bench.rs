@@ -976,3 +976,82 @@ fn a_clear_miss_is_decided_and_a_run_on_the_line_is_not() {
     assert!(floor_decides(0.11 - 2.2e-3, 0.1, 1e-3));
     assert!(!floor_decides(0.05, f64::NAN, 1e-3), "NaN decides nothing");
 }
+
+/// The published result (docs/speed-vs-error.md, "The result") is reproduced by
+/// `docs/bench/fourteenth-sitting.sh`. Every `drape bench` line of it must still
+/// name a scene and a ladder that load, and every rung, the reference (with
+/// `--reference-resolution`) and the mesh floor's run must make a valid scene
+/// with the line's `--duration`: a renamed or tightened scene key would
+/// otherwise break the reproduction without any test noticing. Every other
+/// ladder file under `docs/bench/` must parse too.
+#[test]
+fn the_published_sittings_ladders_load_and_every_run_is_a_valid_scene() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let script = std::fs::read_to_string(root.join("docs/bench/fourteenth-sitting.sh"))
+        .expect("docs/bench/fourteenth-sitting.sh");
+    let mut lines = 0;
+    let mut runs = 0;
+    for line in script.lines().filter(|l| l.starts_with("run ")) {
+        let words: Vec<&str> = line.split_whitespace().collect();
+        let scene_path = root.join(words[2]);
+        let flag = |name: &str| {
+            words
+                .iter()
+                .position(|w| *w == name)
+                .map(|i| words[i + 1].to_owned())
+        };
+        let mut common = Vec::new();
+        if let Some(d) = flag("--duration") {
+            common.push(format!("simulation.duration={d}"));
+        }
+        let scene = drape::scene::load_scene_file(&scene_path, &common)
+            .unwrap_or_else(|e| panic!("{line}: {e}"));
+        let ladder = match flag("--ladder") {
+            Some(l) => Ladder::load(&root.join(&l)).unwrap_or_else(|e| panic!("{line}: {e}")),
+            None => drape::bench::ladder::default_ladder(&scene, StepPolicy::Common),
+        };
+        let finest = ladder
+            .rung
+            .iter()
+            .map(|r| {
+                let mut set = common.clone();
+                set.extend(r.set.iter().cloned());
+                let s = drape::scene::load_scene_file(&scene_path, &set)
+                    .unwrap_or_else(|e| panic!("{line}: rung {:?}: {e}", r.label));
+                runs += 1;
+                drape::bench::ladder::finest_resolution(&s)
+            })
+            .max()
+            .expect("rungs");
+        let mut reference = common.clone();
+        reference.extend(
+            ladder
+                .reference
+                .clone()
+                .unwrap_or_else(|| drape::bench::ladder::reference_overrides(finest * 3 / 2)),
+        );
+        if let Some(n) = flag("--reference-resolution") {
+            reference.push(format!("cloth.resolution={n}"));
+        }
+        drape::scene::load_scene_file(&scene_path, &reference)
+            .unwrap_or_else(|e| panic!("{line}: reference: {e}"));
+        if let Some(n) = flag("--mesh-floor") {
+            let mut floor = reference.clone();
+            floor.push(format!("cloth.resolution={n}"));
+            drape::scene::load_scene_file(&scene_path, &floor)
+                .unwrap_or_else(|e| panic!("{line}: mesh floor: {e}"));
+        }
+        lines += 1;
+    }
+    assert_eq!(lines, 13, "the sitting's ladders");
+    assert!(runs > 100, "{runs} runs");
+    let mut ladders = 0;
+    for entry in std::fs::read_dir(root.join("docs/bench")).expect("docs/bench") {
+        let path = entry.expect("entry").path();
+        if path.extension().is_some_and(|e| e == "toml") {
+            Ladder::load(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+            ladders += 1;
+        }
+    }
+    assert!(ladders >= 30, "{ladders} ladder files");
+}
