@@ -482,22 +482,8 @@ pub fn parting_text<'a>(
     let Some(first) = seeds.first() else {
         return String::new();
     };
-    // A frame one of the seeds lacks, or where one is NaN, is NaN, which
-    // ends the window (`f64::max` would drop a NaN).
-    let deciding: Vec<(Scalar, Scalar)> = first
-        .errors
-        .iter()
-        .map(|&(t, e)| {
-            let others = seeds[1..]
-                .iter()
-                .map(|s| super::window::error_at(&s.errors, t).unwrap_or(Scalar::NAN));
-            let larger = |m: Scalar, o: Scalar| match m.is_nan() || o.is_nan() {
-                true => Scalar::NAN,
-                false => m.max(o),
-            };
-            (t, others.fold(e, larger))
-        })
-        .collect();
+    let others: Vec<&[(Scalar, Scalar)]> = seeds[1..].iter().map(|s| s.errors.as_slice()).collect();
+    let deciding = super::window::larger_at_each_frame(&first.errors, &others);
     let who = match seeds {
         [one] => seed_name(one),
         _ => format!(

@@ -54,12 +54,33 @@ pub struct Parting {
 
 /// The error at time `t` in `errors` (`(time, error)` pairs), matched to a
 /// billionth of the time.
-pub fn error_at(errors: &[(Scalar, Scalar)], t: Scalar) -> Option<Scalar> {
+fn error_at(errors: &[(Scalar, Scalar)], t: Scalar) -> Option<Scalar> {
     let tol = 1e-9 * t.abs().max(1.0);
     errors
         .iter()
         .find(|(s, _)| (s - t).abs() <= tol)
         .map(|e| e.1)
+}
+
+/// The larger of several floors' per-frame errors at each of the first's
+/// frames (`(time, error)` pairs), the series [`parting`] is given when more
+/// than one floor ends the window. A frame another floor lacks, or where one
+/// is NaN, is NaN, which ends the window (`f64::max` would drop a NaN).
+pub fn larger_at_each_frame(
+    first: &[(Scalar, Scalar)],
+    others: &[&[(Scalar, Scalar)]],
+) -> Vec<(Scalar, Scalar)> {
+    let larger = |m: Scalar, o: Scalar| match m.is_nan() || o.is_nan() {
+        true => Scalar::NAN,
+        false => m.max(o),
+    };
+    first
+        .iter()
+        .map(|&(t, e)| {
+            let at_t = others.iter().map(|o| error_at(o, t).unwrap_or(Scalar::NAN));
+            (t, at_t.fold(e, larger))
+        })
+        .collect()
 }
 
 /// Where a floor's per-frame errors (`floor`: the lift floor's, or the
