@@ -218,6 +218,20 @@ fn main() -> ExitCode {
     }
 }
 
+/// Writes `text` to standard output. A closed pipe (`drape inspect F | head`) ends
+/// the output quietly, as `drape bench --list` does, instead of panicking in
+/// `print!` (regression test `inspect_into_a_closed_pipe_ends_quietly`); any other
+/// write error is an error.
+pub(crate) fn emit(text: &str) -> Result<()> {
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+            Err(e).context("cannot write to standard output")
+        }
+        _ => Ok(()),
+    }
+}
+
 /// The error and its causes on one line. Most of drape's errors already include their
 /// source in their own message, so a cause whose text is already there is not repeated
 /// (`{e:#}` would print each one again).
@@ -250,7 +264,7 @@ enum EdgeChoice {
 
 fn cmd_check(args: SceneArgs) -> Result<ExitCode> {
     let scene = load(&args)?;
-    print!("{}", drape::check::describe(&scene)?);
+    emit(&drape::check::describe(&scene)?)?;
     Ok(ExitCode::SUCCESS)
 }
 
@@ -297,7 +311,7 @@ fn cmd_stability(args: StabilityArgs) -> Result<ExitCode> {
         rows.push(row);
     }
     let text = table(&rows);
-    print!("{text}");
+    emit(&text)?;
     if let (Some(mut file), Some(path)) = (markdown, &args.markdown) {
         file.write_all(text.as_bytes())
             .with_context(|| format!("cannot write {}", path.display()))?;
@@ -312,8 +326,8 @@ fn cmd_stability(args: StabilityArgs) -> Result<ExitCode> {
 fn cmd_inspect(args: InspectArgs) -> Result<ExitCode> {
     let inspection = inspect(&args.file)?;
     match args.frame {
-        Some(n) => print!("{}", inspection.frame_report(n)?),
-        None => print!("{}", inspection.report()),
+        Some(n) => emit(&inspection.frame_report(n)?)?,
+        None => emit(&inspection.report())?,
     }
     Ok(ExitCode::SUCCESS)
 }
@@ -362,7 +376,7 @@ fn cmd_bench(args: BenchArgs) -> Result<ExitCode> {
             name
         };
         let svg = drape::bench::replot::replot(&args.out_dir, &stem)?;
-        println!("wrote {}", svg.display());
+        emit(&format!("wrote {}\n", svg.display()))?;
         return Ok(ExitCode::SUCCESS);
     }
     let interrupt = Arc::new(AtomicBool::new(false));
@@ -372,9 +386,10 @@ fn cmd_bench(args: BenchArgs) -> Result<ExitCode> {
             .context("installing the Ctrl-C handler")?;
     }
     let result = bench(&opts, &interrupt, &mut |line| eprintln!("{line}"))?;
-    print!("{}", drape::bench::report::markdown(&result, &args.scene));
+    let mut text = drape::bench::report::markdown(&result, &args.scene);
     for f in &result.files {
-        println!("wrote {}", f.display());
+        text.push_str(&format!("wrote {}\n", f.display()));
     }
+    emit(&text)?;
     Ok(ExitCode::SUCCESS)
 }

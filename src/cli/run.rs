@@ -79,7 +79,7 @@ fn report_outcome(
             }
         },
     };
-    println!("{}", summary.paragraph());
+    crate::emit(&format!("{}\n", summary.paragraph()))?;
     if let Some(file) = summary_file {
         write_json(file, &summary)?;
     }

@@ -135,6 +135,34 @@ fn inspect_prints_the_overview_and_a_frame() {
     std::fs::remove_file(&path).ok();
 }
 
+/// Regression: `drape inspect FILE | head` panicked in `print!` once `head` had
+/// closed the pipe ("failed printing to stdout: Broken pipe", exit code 101 and a
+/// backtrace). The reading end is closed here before drape writes anything; it
+/// must end quietly with code 0, as `drape bench --list` already did. (Checked to
+/// fail with the old `print!`.)
+#[test]
+fn inspect_into_a_closed_pipe_ends_quietly() {
+    use std::process::Stdio;
+    let path = temp_path("pipe.rrd");
+    known_recording(&path);
+    let p = path.to_str().expect("utf-8");
+    for args in [vec!["inspect", p], vec!["inspect", p, "--frame", "1"]] {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_drape"))
+            .args(&args)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("run drape");
+        drop(child.stdout.take());
+        let out = child.wait_with_output().expect("wait for drape");
+        let err = text(&out.stderr);
+        println!("{args:?}: exit {:?}, stderr {err:?}", out.status.code());
+        assert_eq!(out.status.code(), Some(0), "{err}");
+        assert!(!err.contains("panicked"), "{err}");
+    }
+    let _ = std::fs::remove_file(&path);
+}
+
 #[test]
 fn inspect_refuses_missing_and_non_rrd_files() {
     let out = drape(&["inspect", "/nonexistent-dir/x.rrd"]);
