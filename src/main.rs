@@ -66,8 +66,13 @@ struct InspectArgs {
     /// The recording to read.
     file: PathBuf,
     /// Print this frame's mesh statistics, plots and events instead of the overview.
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", conflicts_with = "frames")]
     frame: Option<i64>,
+    /// Print one line per frame instead of the overview: time, vertices, triangles,
+    /// triangles at the finest level, splits, merges, rollbacks, contacts and the
+    /// frame's stepping time, summed at the end.
+    #[arg(long)]
+    frames: bool,
 }
 
 #[derive(Args)]
@@ -327,6 +332,7 @@ fn cmd_inspect(args: InspectArgs) -> Result<ExitCode> {
     let inspection = inspect(&args.file)?;
     match args.frame {
         Some(n) => emit(&inspection.frame_report(n)?)?,
+        None if args.frames => emit(&inspection.frames_table())?,
         None => emit(&inspection.report())?,
     }
     Ok(ExitCode::SUCCESS)

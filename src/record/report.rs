@@ -152,6 +152,63 @@ impl Inspection {
         }
     }
 
+    /// One line per frame (`drape inspect --frames`): its time, the mesh's vertices
+    /// and triangles, how many triangles are at the recording's finest level, the
+    /// adaptive operations and contacts since the previous frame, and the frame's
+    /// stepping time (`timing/sim_ms`), with the stepping time summed at the end;
+    /// `-` where the recording has no value. Where an adaptive run spends its time
+    /// (which frames, at what mesh size) reads off it without one `--frame` per
+    /// frame (`docs/speed-vs-error.md`, "Fifteenth session").
+    pub fn frames_table(&self) -> String {
+        let finest = self
+            .frames
+            .values()
+            .flat_map(|f| f.levels.iter().copied())
+            .max();
+        let cell = |v: Option<f64>| v.map_or("-".to_owned(), |v| format!("{v}"));
+        let mut s = String::new();
+        let finest_head = finest.map_or("finest -".to_owned(), |l| format!("at level {l}"));
+        let _ = writeln!(
+            s,
+            "{:>6} {:>9} {:>9} {:>9} {:>11} {:>7} {:>7} {:>9} {:>8} {:>10}",
+            "frame",
+            "time s",
+            "vertices",
+            "triangles",
+            finest_head,
+            "splits",
+            "merges",
+            "rollbacks",
+            "contacts",
+            "sim ms"
+        );
+        let mut total_ms = 0.0;
+        for (n, f) in &self.frames {
+            let scalar = |name: &str| f.scalars.get(name).copied();
+            let at_finest = finest.map(|l| f.levels.iter().filter(|&&x| x == l).count());
+            let sim_ms = scalar("timing/sim_ms");
+            total_ms += sim_ms.unwrap_or(0.0);
+            let _ = writeln!(
+                s,
+                "{n:>6} {:>9} {:>9} {:>9} {:>11} {:>7} {:>7} {:>9} {:>8} {:>10}",
+                f.sim_time.map_or("-".to_owned(), |t| format!("{t:.4}")),
+                cell(f.vertices()),
+                f.triangles.map_or("-".to_owned(), |t| t.to_string()),
+                match (at_finest, f.levels.is_empty()) {
+                    (Some(c), false) => c.to_string(),
+                    _ => "-".to_owned(),
+                },
+                cell(scalar("adapt/splits")),
+                cell(scalar("adapt/merges")),
+                cell(scalar("adapt/rollbacks")),
+                cell(scalar("collision/contacts")),
+                sim_ms.map_or("-".to_owned(), |v| format!("{v:.1}")),
+            );
+        }
+        let _ = writeln!(s, "stepping time over the frames: {total_ms:.1} ms");
+        s
+    }
+
     /// One frame in detail: its time, mesh statistics (triangles, vertices, triangles per
     /// level), edges, every plot value, and its events.
     pub fn frame_report(&self, n: i64) -> Result<String, InspectError> {

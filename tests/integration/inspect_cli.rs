@@ -135,6 +135,92 @@ fn inspect_prints_the_overview_and_a_frame() {
     std::fs::remove_file(&path).ok();
 }
 
+/// `drape inspect --frames`: one line per frame with its time, mesh size, triangles
+/// at the recording's finest level, operations, contacts and stepping time, `-`
+/// where nothing was logged, and the stepping time summed; `--frame` and
+/// `--frames` together are refused.
+#[test]
+fn inspect_frames_prints_a_line_per_frame_and_the_stepping_total() {
+    let path = temp_path("frames.rrd");
+    let positions = [
+        Vector::new(0.0, 0.0, 0.0),
+        Vector::new(1.0, 0.0, 0.0),
+        Vector::new(1.0, 1.0, 0.0),
+        Vector::new(0.0, 1.0, 0.0),
+    ];
+    let target = RecordTarget::file(&path);
+    let mut rec = Recorder::open(&target, "frames", EdgeDisplay::All).expect("open");
+    for f in 0..3u64 {
+        let mut scalars = vec![("mesh/vertices", 4.0), ("timing/sim_ms", 12.5 * f as f64)];
+        if f > 0 {
+            scalars.push(("adapt/splits", 3.0 * f as f64));
+        }
+        rec.record_frame(&FrameView {
+            frame: f,
+            sim_time: f as f64 * 0.25,
+            positions: &positions,
+            vertex_normals: &[Vector::Z; 4],
+            triangles: &[[0, 1, 2], [0, 2, 3]],
+            triangle_levels: &[0, 2],
+            edges: &[[0, 1], [1, 2], [0, 2], [2, 3], [0, 3]],
+            edge_angles: &[0.0; 5],
+            pinned: &[],
+            scalars: &scalars,
+            events: &[],
+        })
+        .expect("frame");
+    }
+    rec.finish().expect("finish");
+    let p = path.to_str().expect("utf-8");
+    let out = drape(&["inspect", p, "--frames"]);
+    let s = text(&out.stdout);
+    println!("{s}{}", text(&out.stderr));
+    assert_eq!(out.status.code(), Some(0));
+    let rows: Vec<Vec<&str>> = s.lines().map(|l| l.split_whitespace().collect()).collect();
+    assert_eq!(
+        rows[0],
+        [
+            "frame",
+            "time",
+            "s",
+            "vertices",
+            "triangles",
+            "at",
+            "level",
+            "2",
+            "splits",
+            "merges",
+            "rollbacks",
+            "contacts",
+            "sim",
+            "ms"
+        ]
+    );
+    assert_eq!(
+        rows[1],
+        ["0", "0.0000", "4", "2", "1", "-", "-", "-", "-", "0.0"]
+    );
+    assert_eq!(
+        rows[2],
+        ["1", "0.2500", "4", "2", "1", "3", "-", "-", "-", "12.5"]
+    );
+    assert_eq!(
+        rows[3],
+        ["2", "0.5000", "4", "2", "1", "6", "-", "-", "-", "25.0"]
+    );
+    assert_eq!(
+        s.lines().nth(4),
+        Some("stepping time over the frames: 37.5 ms")
+    );
+    assert_eq!(s.lines().count(), 5);
+
+    let out = drape(&["inspect", p, "--frames", "--frame", "1"]);
+    let err = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("cannot be used with"), "{err}");
+    std::fs::remove_file(&path).ok();
+}
+
 /// Regression: `drape inspect FILE | head` panicked in `print!` once `head` had
 /// closed the pipe ("failed printing to stdout: Broken pipe", exit code 101 and a
 /// backtrace). The reading end is closed here before drape writes anything; it
