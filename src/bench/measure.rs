@@ -10,31 +10,80 @@ use crate::math::{Scalar, Vector2};
 use crate::run::{RunOptions, run};
 use crate::scene::{AdaptMethod, Integrator, Scene, TimeStep};
 
-/// Runs `rung` (`scene` holds its overrides) once sampled and `reps - 1` more
-/// times timed, and measures its error against `reference` as `compare` says.
+/// A rung measured by its sampled run, waiting for its timed repetitions.
+///
+/// The bench runs every rung's sampled run first and then the timed
+/// repetitions round by round, one of each rung per round
+/// ([`super::bench`]), so that a slow spell of the machine (these machines
+/// are shared) falls on one repetition of several rungs rather than on every
+/// repetition of one: the median then drops it. Before the fifteenth session
+/// each rung's repetitions ran back to back (`docs/speed-vs-error.md`,
+/// "Fifteenth session", measured why this matters).
+#[derive(Debug)]
+pub struct Sampled {
+    /// The rung's row; `wall_s` and `reps` are set by [`Sampled::finish`].
+    pub row: Row,
+    /// Wall times so far: the sampled run's stepping time, then each timed run's.
+    walls: Vec<Scalar>,
+    /// False when the sampled run failed: a failed rung is not timed again.
+    timeable: bool,
+}
+
+impl Sampled {
+    /// True when the rung is timed again (its sampled run did not fail).
+    pub fn timeable(&self) -> bool {
+        self.timeable
+    }
+
+    /// The sampled run's stepping time, s (its sampling excluded).
+    pub fn first_wall(&self) -> Scalar {
+        self.walls.first().copied().unwrap_or(Scalar::NAN)
+    }
+
+    /// Records one more timed run's wall time, s.
+    pub fn add_wall(&mut self, wall_s: Scalar) {
+        self.walls.push(wall_s);
+    }
+
+    /// The row, with the median of the wall times and their number.
+    pub fn finish(mut self) -> Row {
+        self.row.reps = self.walls.len();
+        self.row.wall_s = median(&mut self.walls);
+        self.row
+    }
+}
+
+/// Runs `scene` once more, timed only (one repetition of a rung); its wall time, s.
+pub fn time_once(
+    scene: &Scene,
+    run_opts: &RunOptions,
+    interrupt: &AtomicBool,
+) -> Result<Scalar, BenchError> {
+    let s = run(scene, run_opts, interrupt, &mut |_| {})?;
+    if s.interrupted {
+        return Err(BenchError::Interrupted);
+    }
+    Ok(s.wall_time_s)
+}
+
+/// Runs `rung` (`scene` holds its overrides) once, sampled, and measures its
+/// error against `reference` as `compare` says; its timed repetitions follow
+/// ([`Sampled`]).
 pub fn measure(
     rung: &Rung,
     scene: &Scene,
     reference: &Reference,
     points: &[Vector2],
-    (reps, compare): (usize, Compare),
+    compare: Compare,
     run_opts: &RunOptions,
     interrupt: &AtomicBool,
-) -> Result<Row, BenchError> {
+) -> Result<Sampled, BenchError> {
     let first = sampling::sampled_run(scene, run_opts, points, interrupt)?;
     if first.summary.interrupted {
         return Err(BenchError::Interrupted);
     }
-    let mut walls = vec![first.summary.wall_time_s - first.sampling_s];
-    if first.failure.is_none() {
-        for _ in 1..reps.max(1) {
-            let s = run(scene, run_opts, interrupt, &mut |_| {})?;
-            if s.interrupted {
-                return Err(BenchError::Interrupted);
-            }
-            walls.push(s.wall_time_s);
-        }
-    }
+    let walls = vec![first.summary.wall_time_s - first.sampling_s];
+    let timeable = first.failure.is_none();
     let errors = sampling::run_errors(&first.frames, &reference.frames, reference.diagonal);
     let complete = first.failure.is_none()
         && errors.len() == first.frames.len()
@@ -67,7 +116,7 @@ pub fn measure(
         .adapt
         .as_ref()
         .filter(|a| a.method != AdaptMethod::None);
-    Ok(Row {
+    let row = Row {
         label: rung.label.clone(),
         set: rung.set.clone(),
         adaptive: adapt.is_some(),
@@ -91,8 +140,8 @@ pub fn measure(
             TimeStep::Fixed(dt) => format!("{dt}"),
         },
         status,
-        reps: walls.len(),
-        wall_s: median(&mut walls),
+        reps: 0,
+        wall_s: Scalar::NAN,
         steps: first.summary.steps,
         mean_vertices: first.summary.vertices.mean,
         peak_vertices: first.summary.vertices.max,
@@ -118,6 +167,11 @@ pub fn measure(
             Vec::new()
         },
         pareto: false,
+    };
+    Ok(Sampled {
+        row,
+        walls,
+        timeable,
     })
 }
 

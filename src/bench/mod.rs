@@ -601,25 +601,50 @@ pub fn bench(
             Err(why) => (None, Some(why)),
         };
     let points = reference.sample_points();
-    let mut rows = Vec::new();
+    let mut sampled = Vec::new();
     let n = plan.scenes.len();
     for (i, (r, scene)) in plan.ladder.rung.iter().zip(&plan.scenes).enumerate() {
         log(&format!("[{}/{n}] {}", i + 1, r.label));
-        let how = (opts.reps, plan.compare);
-        let row = measure::measure(r, scene, &reference, &points, how, &run_opts, interrupt)?;
+        let m = measure::measure(
+            r,
+            scene,
+            &reference,
+            &points,
+            plan.compare,
+            &run_opts,
+            interrupt,
+        )?;
+        let row = &m.row;
         log(&format!(
             "[{}/{n}] {}: {} wall {:.2} s, {:.0} vertices (peak {:.0}), error ({}) {:.3e}",
             i + 1,
             r.label,
             row.status,
-            row.wall_s,
+            m.first_wall(),
             row.mean_vertices,
             row.peak_vertices,
             plan.compare.name(),
             row.error
         ));
-        rows.push(row);
+        sampled.push(m);
     }
+    // The timed repetitions, one of each rung per round (`measure::Sampled`).
+    let reps = opts.reps.max(1);
+    for round in 2..=reps {
+        for (i, (m, scene)) in sampled.iter_mut().zip(&plan.scenes).enumerate() {
+            if !m.timeable() {
+                continue;
+            }
+            let wall = measure::time_once(scene, &run_opts, interrupt)?;
+            m.add_wall(wall);
+            log(&format!(
+                "repetition {round}/{reps} [{}/{n}] {}: wall {wall:.2} s",
+                i + 1,
+                m.row.label
+            ));
+        }
+    }
+    let mut rows: Vec<_> = sampled.into_iter().map(measure::Sampled::finish).collect();
     let front = pareto::pareto_front(&rows.iter().map(|r| (r.wall_s, r.error)).collect::<Vec<_>>());
     for (row, on) in rows.iter_mut().zip(front) {
         row.pareto = on;

@@ -267,6 +267,28 @@ fn tiny_ladder_end_to_end_with_cache_and_a_failed_rung() {
     let mut lines = Vec::new();
     let first = bench(&opts, &stop, &mut |l| lines.push(l.to_owned())).expect("bench");
     assert!(!first.cache_hit);
+    // The timed repetitions run round by round after every rung's sampled run,
+    // in rung order, and a failed rung is not timed again (before, each rung's
+    // repetitions ran back to back, so one slow spell of the machine could
+    // fall on all of them).
+    let last_sampled = lines
+        .iter()
+        .rposition(|l| l.starts_with("[4/4] blows up: "))
+        .expect("the last rung's line");
+    let repetitions: Vec<(usize, &String)> = lines
+        .iter()
+        .enumerate()
+        .filter(|(_, l)| l.starts_with("repetition "))
+        .collect();
+    println!("{repetitions:?}");
+    assert_eq!(repetitions.len(), 3, "{lines:?}");
+    for (k, (at, line)) in repetitions.iter().enumerate() {
+        assert!(*at > last_sampled, "{lines:?}");
+        assert!(
+            line.starts_with(&format!("repetition 2/2 [{}/4] ", k + 1)),
+            "{line}"
+        );
+    }
     // Finest rung: 4 segments doubled once = 8; the reference is 1.5 x finer.
     assert!(
         first
@@ -977,8 +999,9 @@ fn a_clear_miss_is_decided_and_a_run_on_the_line_is_not() {
     assert!(!floor_decides(0.05, f64::NAN, 1e-3), "NaN decides nothing");
 }
 
-/// The published result (docs/speed-vs-error.md, "The result") is reproduced by
-/// `docs/bench/fourteenth-sitting.sh`. Every `drape bench` line of it must still
+/// The published result (docs/speed-vs-error.md, "The result" and "Fifteenth
+/// session") is reproduced by `docs/bench/fourteenth-sitting.sh` and
+/// `fifteenth-sitting.sh`. Every `drape bench` line of them must still
 /// name a scene and a ladder that load, and every rung, the reference (with
 /// `--reference-resolution`) and the mesh floor's run must make a valid scene
 /// with the line's `--duration`: a renamed or tightened scene key would
@@ -987,8 +1010,14 @@ fn a_clear_miss_is_decided_and_a_run_on_the_line_is_not() {
 #[test]
 fn the_published_sittings_ladders_load_and_every_run_is_a_valid_scene() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let script = std::fs::read_to_string(root.join("docs/bench/fourteenth-sitting.sh"))
-        .expect("docs/bench/fourteenth-sitting.sh");
+    let script = ["fourteenth-sitting.sh", "fifteenth-sitting.sh"]
+        .iter()
+        .map(|f| {
+            std::fs::read_to_string(root.join("docs/bench").join(f))
+                .unwrap_or_else(|e| panic!("docs/bench/{f}: {e}"))
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
     let mut lines = 0;
     let mut runs = 0;
     for line in script.lines().filter(|l| l.starts_with("run ")) {
@@ -1043,7 +1072,7 @@ fn the_published_sittings_ladders_load_and_every_run_is_a_valid_scene() {
         }
         lines += 1;
     }
-    assert_eq!(lines, 13, "the sitting's ladders");
+    assert_eq!(lines, 13 + 4, "the sittings' ladders");
     assert!(runs > 100, "{runs} runs");
     let mut ladders = 0;
     for entry in std::fs::read_dir(root.join("docs/bench")).expect("docs/bench") {
