@@ -1,0 +1,32 @@
+#!/bin/bash
+# Issue 14, fifteenth session (docs/speed-vs-error.md, "Fifteenth session"): the
+# tablecloth's impact with the sizing budget swept, on the fourteenth sitting's
+# engine (the engine did not change between the two), nothing else running,
+# with the bench's repetitions run round by round (new in this session). The
+# sweep runs three times over, to show how far its time ratios move from one
+# run of a ladder to the next.
+# Usage, from the repository root:
+#   cargo build --release && docs/bench/fifteenth-sitting.sh [OUT_DIR]
+# The reference and floors are the fourteenth sitting's tablecloth ladder's
+# (both ladders here have its reference): copy its cache, e.g.
+#   for n in tc-impact tc-impact-angle tc-impact-angle-2 tc-impact-angle-3; do mkdir -p bench-out/s16/$n && cp -a bench-out/s15/tc-impact/cache bench-out/s16/$n/; done
+# or let the bench compute them first (uniform 256 and 240 and the turned
+# diagonals, about 5 minutes on 2 cores).
+set -u
+D=${DRAPE:-./target/release/drape}
+O=${1:-bench-out/s16}
+mkdir -p "$O"
+run() {
+  n=$1
+  shift
+  echo "=== $n start $(date -u +%T) load $(cut -d' ' -f1 /proc/loadavg)"
+  echo "drape bench $* --out-dir $O/$n"
+  "$D" bench "$@" --out-dir "$O/$n" >"$O/$n.log" 2>&1
+  rc=$?
+  echo "=== $n end $(date -u +%T) rc=$rc"
+}
+run tc-impact scenes/tablecloth.toml --duration 0.36666666666666664 --ladder docs/bench/tablecloth-128-impact.toml --reference-resolution 256 --mesh-floor 240 --pattern-floor --reps 5
+run tc-impact-angle scenes/tablecloth.toml --duration 0.36666666666666664 --ladder docs/bench/tablecloth-128-impact-angle.toml --reference-resolution 256 --mesh-floor 240 --pattern-floor --reps 5
+run tc-impact-angle-2 scenes/tablecloth.toml --duration 0.36666666666666664 --ladder docs/bench/tablecloth-128-impact-angle.toml --reference-resolution 256 --mesh-floor 240 --pattern-floor --reps 5
+run tc-impact-angle-3 scenes/tablecloth.toml --duration 0.36666666666666664 --ladder docs/bench/tablecloth-128-impact-angle.toml --reference-resolution 256 --mesh-floor 240 --pattern-floor --reps 5
+echo "=== all done $(date -u +%T)"
