@@ -29,4 +29,13 @@ run tc-impact scenes/tablecloth.toml --duration 0.36666666666666664 --ladder doc
 run tc-impact-angle scenes/tablecloth.toml --duration 0.36666666666666664 --ladder docs/bench/tablecloth-128-impact-angle.toml --reference-resolution 256 --mesh-floor 240 --pattern-floor --reps 5
 run tc-impact-angle-2 scenes/tablecloth.toml --duration 0.36666666666666664 --ladder docs/bench/tablecloth-128-impact-angle.toml --reference-resolution 256 --mesh-floor 240 --pattern-floor --reps 5
 run tc-impact-angle-3 scenes/tablecloth.toml --duration 0.36666666666666664 --ladder docs/bench/tablecloth-128-impact-angle.toml --reference-resolution 256 --mesh-floor 240 --pattern-floor --reps 5
+# The other target ladders of the fourteenth sitting, timed again the same way
+# (5 repetitions round by round; their references and floors from that
+# sitting's caches: for n in cant-tensor cant-80 hs-strain hs128 ds-contact; do
+# mkdir -p bench-out/s16/$n && cp -a bench-out/s15/$n/cache bench-out/s16/$n/; done).
+run cant-tensor scenes/cantilever.toml --ladder docs/bench/cantilever-tensor.toml --mesh-floor 130 --pattern-floor --reps 5
+run cant-80 scenes/cantilever.toml --ladder docs/bench/cantilever-tensor-80.toml --mesh-floor 170 --reps 5
+run ds-contact scenes/drape_sphere.toml --duration 0.5333333333333333 --ladder docs/bench/drape_sphere-128-contact.toml --mesh-floor 176 --pattern-floor --reps 5
+run hs-strain scenes/hanging_sheet_rest.toml --ladder docs/bench/hanging_sheet_rest-strain.toml --mesh-floor 98 --reps 5
+run hs128 scenes/hanging_sheet_rest.toml --ladder docs/bench/hanging_sheet_rest-128-base.toml --reference-resolution 192 --no-floor --pattern-floor --reps 5
 echo "=== all done $(date -u +%T)"
