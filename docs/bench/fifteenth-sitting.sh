@@ -13,18 +13,8 @@
 # or let the bench compute them first (uniform 256 and 240 and the turned
 # diagonals, about 5 minutes on 2 cores).
 set -u
-D=${DRAPE:-./target/release/drape}
 O=${1:-bench-out/s16}
-mkdir -p "$O"
-run() {
-  n=$1
-  shift
-  echo "=== $n start $(date -u +%T) load $(cut -d' ' -f1 /proc/loadavg)"
-  echo "drape bench $* --out-dir $O/$n"
-  "$D" bench "$@" --out-dir "$O/$n" >"$O/$n.log" 2>&1
-  rc=$?
-  echo "=== $n end $(date -u +%T) rc=$rc"
-}
+. "$(dirname "$0")/sitting-run.sh"
 run tc-impact scenes/tablecloth.toml --duration 0.36666666666666664 --ladder docs/bench/tablecloth-128-impact.toml --reference-resolution 256 --mesh-floor 240 --pattern-floor --reps 5
 run tc-impact-angle scenes/tablecloth.toml --duration 0.36666666666666664 --ladder docs/bench/tablecloth-128-impact-angle.toml --reference-resolution 256 --mesh-floor 240 --pattern-floor --reps 5
 run tc-impact-angle-2 scenes/tablecloth.toml --duration 0.36666666666666664 --ladder docs/bench/tablecloth-128-impact-angle.toml --reference-resolution 256 --mesh-floor 240 --pattern-floor --reps 5

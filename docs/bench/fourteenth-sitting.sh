@@ -8,18 +8,8 @@
 # they are computed first (uniform 192 at rest on hanging_sheet_rest and its
 # turned-diagonal floor are the longest, tens of minutes each on 2 cores).
 set -u
-D=${DRAPE:-./target/release/drape}
 O=${1:-bench-out/s15}
-mkdir -p "$O"
-run() {
-  n=$1
-  shift
-  echo "=== $n start $(date -u +%T) load $(cut -d' ' -f1 /proc/loadavg)"
-  echo "drape bench $* --out-dir $O/$n"
-  "$D" bench "$@" --out-dir "$O/$n" >"$O/$n.log" 2>&1
-  rc=$?
-  echo "=== $n end $(date -u +%T) rc=$rc"
-}
+. "$(dirname "$0")/sitting-run.sh"
 run cant scenes/cantilever.toml --ladder docs/bench/cantilever.toml --reps 3
 run cant-tensor scenes/cantilever.toml --ladder docs/bench/cantilever-tensor.toml --mesh-floor 130 --pattern-floor --reps 3
 run cant-80 scenes/cantilever.toml --ladder docs/bench/cantilever-tensor-80.toml --mesh-floor 170 --reps 3
