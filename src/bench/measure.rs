@@ -48,6 +48,7 @@ impl Sampled {
     /// The row, with the median of the wall times and their number.
     pub fn finish(mut self) -> Row {
         self.row.reps = self.walls.len();
+        self.row.walls = self.walls.clone();
         self.row.wall_s = median(&mut self.walls);
         self.row
     }
@@ -142,6 +143,7 @@ pub fn measure(
         status,
         reps: 0,
         wall_s: Scalar::NAN,
+        walls: Vec::new(),
         steps: first.summary.steps,
         mean_vertices: first.summary.vertices.mean,
         peak_vertices: first.summary.vertices.max,

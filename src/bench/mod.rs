@@ -178,6 +178,10 @@ pub struct Row {
     pub reps: usize,
     /// Median wall time (without the error sampling), s.
     pub wall_s: Scalar,
+    /// Every repetition's wall time in the order run: the sampled run's (without
+    /// its sampling), then one per round (`measure::Sampled`); empty for a row
+    /// read back from a CSV.
+    pub walls: Vec<Scalar>,
     /// Steps taken.
     pub steps: u64,
     /// Mean vertices over the recorded frames.

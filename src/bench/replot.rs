@@ -75,6 +75,7 @@ pub fn read_csv(path: &Path) -> Result<Vec<Row>, BenchError> {
             status: f[11].clone(),
             reps: int(&f[12]) as usize,
             wall_s: num(&f[13]),
+            walls: Vec::new(),
             steps: int(&f[14]),
             mean_vertices: num(&f[15]),
             peak_vertices: num(&f[16]),

@@ -155,6 +155,11 @@ pub struct TargetCheck {
     pub error_ratio: Scalar,
     /// Adaptive wall time divided by the uniform's.
     pub time_ratio: Scalar,
+    /// The smallest and largest ratio of the two runs' wall times taken
+    /// repetition by repetition (the sampled runs, then each round's), when
+    /// both ran at least twice: how far the machine's drift moves the ratio
+    /// within one ladder (`docs/speed-vs-error.md`, "Fifteenth session").
+    pub time_ratio_range: Option<(Scalar, Scalar)>,
     /// The error is within 10 % of the uniform run's (or below it).
     pub within_10: bool,
     /// Within 10 % of the uniform's error at a quarter of its wall time or less.
@@ -179,12 +184,28 @@ pub fn target_checks(rows: &[Row]) -> Vec<TargetCheck> {
                 uniform: u.label.clone(),
                 error_ratio,
                 time_ratio,
+                time_ratio_range: ratio_range(&a.walls, &u.walls),
                 within_10,
                 met: within_10 && time_ratio <= 0.25,
                 met_tenth: within_10 && time_ratio <= 0.1,
             })
         })
         .collect()
+}
+
+/// The smallest and largest of `a[k] / u[k]` over the repetitions both have,
+/// when they have two or more ([`TargetCheck::time_ratio_range`]).
+fn ratio_range(a: &[Scalar], u: &[Scalar]) -> Option<(Scalar, Scalar)> {
+    let ratios: Vec<Scalar> = a.iter().zip(u).map(|(a, u)| a / u).collect();
+    if ratios.len() < 2 {
+        return None;
+    }
+    let lo = ratios.iter().copied().fold(Scalar::INFINITY, Scalar::min);
+    let hi = ratios
+        .iter()
+        .copied()
+        .fold(Scalar::NEG_INFINITY, Scalar::max);
+    Some((lo, hi))
 }
 
 /// The uniform run (that finished) with the finest edges and the step of the
@@ -384,7 +405,7 @@ fn targets(rows: &[Row], floor: Option<Scalar>) -> String {
         return String::new();
     }
     let mut out = String::from(
-        "\nTarget (an adaptive run within 10 % of the error of the uniform run with its finest edges, at <= 1/4 of that run's wall time on every scene, <= 1/10 on two):\n\n| adaptive | uniform | error ratio | within 10 % | wall time ratio | <= 1/4 | <= 1/10 | floor / uniform error | decided |\n|---|---|---:|:-:|---:|:-:|:-:|---:|:-:|\n",
+        "\nTarget (an adaptive run within 10 % of the error of the uniform run with its finest edges, at <= 1/4 of that run's wall time on every scene, <= 1/10 on two):\n\n| adaptive | uniform | error ratio | within 10 % | wall time ratio | per repetition | <= 1/4 | <= 1/10 | floor / uniform error | decided |\n|---|---|---:|:-:|---:|---:|:-:|:-:|---:|:-:|\n",
     );
     let yes = |b: bool| if b { "**yes**" } else { "no" };
     let error_of = |label: &str| {
@@ -403,12 +424,14 @@ fn targets(rows: &[Row], floor: Option<Scalar>) -> String {
         };
         let _ = writeln!(
             out,
-            "| {} | {} | {:.2} | {} | {:.3} | {} | {} | {ratio} | {decided} |",
+            "| {} | {} | {:.2} | {} | {:.3} | {} | {} | {} | {ratio} | {decided} |",
             c.adaptive,
             c.uniform,
             c.error_ratio,
             yes(c.within_10),
             c.time_ratio,
+            c.time_ratio_range
+                .map_or("-".to_owned(), |(lo, hi)| format!("{lo:.3} to {hi:.3}")),
             yes(c.met),
             yes(c.met_tenth)
         );

@@ -114,6 +114,7 @@ pub(crate) fn row(label: &str, adaptive: bool, res: u32, finest: u32, wall: f64,
         status: "ok".into(),
         reps: 1,
         wall_s: wall,
+        walls: vec![wall],
         steps: 10,
         mean_vertices: 25.0,
         peak_vertices: 30.0,
@@ -207,6 +208,23 @@ fn target_check_pairs_adaptive_with_uniform_at_its_finest_resolution() {
     assert!(checks[0].met && checks[0].uniform == "uniform 8");
     assert!(!checks[1].met);
     assert!((checks[0].time_ratio - 0.225).abs() < 1e-12);
+    // One repetition each: no range.
+    assert_eq!(checks[0].time_ratio_range, None);
+}
+
+/// The target check's per-repetition range: the adaptive run's k-th wall time
+/// over the uniform run's k-th, smallest and largest, over the repetitions both
+/// have (here 0.1, 0.25, 0.3; the adaptive run's fourth has no partner).
+#[test]
+fn the_time_ratio_range_pairs_the_runs_repetition_by_repetition() {
+    let mut uniform = row("uniform 8", false, 8, 8, 10.0, 0.010);
+    uniform.walls = vec![10.0, 8.0, 10.0];
+    let mut adaptive = row("adaptive", true, 4, 8, 2.0, 0.010);
+    adaptive.walls = vec![1.0, 2.0, 3.0, 100.0];
+    let checks = target_checks(&[uniform, adaptive]);
+    let (lo, hi) = checks[0].time_ratio_range.expect("a range");
+    println!("per repetition {lo} to {hi}");
+    assert!((lo - 0.1).abs() < 1e-12 && (hi - 0.3).abs() < 1e-12);
 }
 
 #[test]
@@ -313,6 +331,7 @@ fn tiny_ladder_end_to_end_with_cache_and_a_failed_rung() {
     for r in &first.rows[..3] {
         assert_eq!(r.status, "ok", "{}", r.label);
         assert_eq!(r.reps, 2);
+        assert_eq!(r.walls.len(), 2, "{}", r.label);
         assert!(
             r.mean_error.is_finite() && r.mean_error > 0.0,
             "{}",
@@ -1072,7 +1091,7 @@ fn the_published_sittings_ladders_load_and_every_run_is_a_valid_scene() {
         }
         lines += 1;
     }
-    assert_eq!(lines, 13 + 9, "the sittings' ladders");
+    assert_eq!(lines, 13 + 10, "the sittings' ladders");
     assert!(runs > 100, "{runs} runs");
     let mut ladders = 0;
     for entry in std::fs::read_dir(root.join("docs/bench")).expect("docs/bench") {
