@@ -223,8 +223,8 @@ fn main() -> ExitCode {
     }
 }
 
-/// Writes `text` to standard output. A closed pipe (`drape inspect F | head`) ends
-/// the output quietly, as `drape bench --list` does, instead of panicking in
+/// Writes `text` to standard output. A closed pipe (`drape inspect F | head`,
+/// `drape bench --list | head`) ends the output quietly instead of panicking in
 /// `print!` (regression test `inspect_into_a_closed_pipe_ends_quietly`); any other
 /// write error is an error.
 pub(crate) fn emit(text: &str) -> Result<()> {
@@ -363,15 +363,11 @@ fn cmd_bench(args: BenchArgs) -> Result<ExitCode> {
         pattern_floor: args.pattern_floor,
     };
     if args.list {
-        use std::io::Write;
-        let mut out = std::io::stdout().lock();
+        let mut text = String::new();
         for r in &drape::bench::resolved_ladder(&opts)?.rung {
-            // A closed pipe (`drape bench --list | head`) ends the listing
-            // quietly instead of panicking in `println!`.
-            if writeln!(out, "{}: {}", r.label, r.set.join(" ")).is_err() {
-                break;
-            }
+            text.push_str(&format!("{}: {}\n", r.label, r.set.join(" ")));
         }
+        emit(&text)?;
         return Ok(ExitCode::SUCCESS);
     }
     if args.replot {
