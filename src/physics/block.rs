@@ -28,8 +28,9 @@
 //! `A` and remove it in a few iterations. Where bending dominates (a stiff strip at
 //! fine resolution) it is not small: a cantilever strip of 969 vertices needed 100
 //! iterations a step with the fresh factor. So the solver switches to factoring
-//! every block (`factor_tips`) as soon as a fresh factor needs more than 10
-//! iterations (see `TIPS_AFTER` in the implicit module's direct solver).
+//! every block (`factor_tips`) once a fresh factor needs more iterations than the
+//! full factor's extra size is worth (the direct solver's module docs, "Which
+//! factor", in the implicit module).
 //!
 mod buckets;
 mod csc;

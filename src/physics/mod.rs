@@ -96,6 +96,10 @@ pub struct StepStats {
     pub symbolic_analyses: u64,
     /// Numerical Cholesky factorizations.
     pub factorizations: u64,
+    /// Of those, the ones of the full matrix, hinge tip-tip blocks included (the
+    /// direct solver switches to it where the reduced factor needs too many
+    /// iterations: `physics::implicit`'s direct solver, "Which factor").
+    pub full_factorizations: u64,
     /// Solves with a Cholesky factor (one per preconditioned iteration, plus one per
     /// solve to start it).
     pub factor_solves: u64,
@@ -118,8 +122,12 @@ impl StepStats {
             self.newton_iterations, self.cg_iterations
         );
         if self.factorizations > 0 {
+            let full = match self.full_factorizations {
+                0 => String::new(),
+                n => format!("{n} of every block, "),
+            };
             s += &format!(
-                ", {} factorizations ({} orderings); assembly {:.2} s, factorization {:.2} s, solves {:.2} s",
+                ", {} factorizations ({full}{} orderings); assembly {:.2} s, factorization {:.2} s, solves {:.2} s",
                 self.factorizations,
                 self.symbolic_analyses,
                 self.assembly_s,

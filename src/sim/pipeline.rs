@@ -428,6 +428,7 @@ fn absorb(total: &mut StepStats, step: &mut StepStats) {
         newton_iterations,
         symbolic_analyses,
         factorizations,
+        full_factorizations,
         factor_solves,
         assembly_s,
         factorization_s,
@@ -440,6 +441,7 @@ fn absorb(total: &mut StepStats, step: &mut StepStats) {
     total.newton_iterations += newton_iterations;
     total.symbolic_analyses += symbolic_analyses;
     total.factorizations += factorizations;
+    total.full_factorizations += full_factorizations;
     total.factor_solves += factor_solves;
     total.assembly_s += assembly_s;
     total.factorization_s += factorization_s;

@@ -387,3 +387,76 @@ fn a_sheet_hanging_at_rest_keeps_its_factor() {
     assert_eq!(steps, 60);
     assert!(factorizations <= 6, "{factorizations} factorizations");
 }
+
+/// The direct solver of `scene` with `overrides`, run for `frames` frames; returns
+/// its counters.
+fn solver_counters(scene: &str, overrides: &[&str], frames: usize) -> drape::physics::StepStats {
+    let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    let scene =
+        drape::scene::load_scene_file(std::path::Path::new(scene), &overrides).expect("scene");
+    let drape::sim::Simulation {
+        model,
+        mut state,
+        mut pipeline,
+    } = drape::sim::build(&scene.resolve().expect("resolve")).expect("build");
+    let frame = 1.0 / scene.simulation.frame_rate;
+    for _ in 0..frames {
+        pipeline
+            .advance_frame(&model, &mut state, frame)
+            .expect("frame");
+    }
+    state.effort.solver
+}
+
+/// Regression: the direct solver switched to the full factor (hinge tip-tip blocks
+/// included) as soon as a fresh reduced factor needed 10 iterations, whatever the
+/// two factors cost. A fabric finely meshed crosses that at once: uniform 128 of
+/// `hanging_sheet_rest` switched at its first step and took 23.8 s for its first
+/// 0.5 s against 13.6 s with the reduced factor (`physics::implicit`'s direct
+/// solver, "Which factor"). Here the same sheet scaled to 0.25 m at resolution 32
+/// (the same edge length, 1/128 m), whose fresh reduced factors need about a dozen
+/// iterations: with the rule that weighs the factors' sizes it keeps the reduced
+/// factor; the bending-dominated cantilever strip, 27 iterations or more, still
+/// switches.
+#[test]
+fn a_fine_fabric_keeps_the_reduced_factor_and_a_stiff_strip_switches() {
+    let sheet = solver_counters(
+        "scenes/hanging_sheet_rest.toml",
+        &[
+            "adapt.method=none",
+            "cloth.resolution=32",
+            "cloth.width=0.25",
+            "cloth.height=0.25",
+        ],
+        6,
+    );
+    println!(
+        "sheet, 0.2 s: {} solves, {} iterations, {} factorizations ({} of every block, {} orderings)",
+        sheet.newton_iterations,
+        sheet.cg_iterations,
+        sheet.factorizations,
+        sheet.full_factorizations,
+        sheet.symbolic_analyses
+    );
+    assert_eq!(
+        sheet.full_factorizations, 0,
+        "the sheet switched to the full factor"
+    );
+    assert!(
+        sheet.cg_iterations >= 10 * sheet.newton_iterations,
+        "the sheet no longer needs 10 iterations a solve: the test checks nothing"
+    );
+    let strip = solver_counters("scenes/cantilever.toml", &[], 6);
+    println!(
+        "cantilever, 0.2 s: {} solves, {} iterations, {} factorizations ({} of every block, {} orderings)",
+        strip.newton_iterations,
+        strip.cg_iterations,
+        strip.factorizations,
+        strip.full_factorizations,
+        strip.symbolic_analyses
+    );
+    assert!(
+        strip.full_factorizations > 0,
+        "the strip kept the reduced factor"
+    );
+}

@@ -25,6 +25,42 @@
 //! factors at 206 of 247 steps, with 2.8 iterations a step; `hanging_sheet_rest` at
 //! uniform 64 (coming to rest) needs 162 factorizations in 600 steps; the cantilever
 //! strip 196 in 840.
+//!
+//! # Which factor
+//! The reduced factor (block module docs, "The factored matrix") is cheap to make
+//! and to apply but leaves the tip blocks to the iterations; the full one is
+//! exact but larger. Counted in iterations with the reduced factor, a fresh reduced
+//! factor costs `F + k` (`F` the scene's `refactor_iterations`, `k` the iterations
+//! it needs) and a fresh full one about `F rho + rho` (one iteration), with `rho`
+//! the ratio of the two factors' stored values, taking a factorization and a
+//! solve to cost in proportion to the factor's size. The full factor pays once
+//! `k > F (rho - 1) + rho`, the break-even. When a fresh reduced factor has
+//! needed [`TIPS_CONSIDER`] iterations, the solver analyses the full pattern for
+//! `rho` (once per topology: one more ordering in the summary) and, if `k` has
+//! reached the break-even, factors every block from then on, for the rest of the
+//! run. Sizes and counts, never clock time, so the choice is the same on every
+//! machine and thread count.
+//!
+//! Measured (2026-11-25, `hanging_sheet_rest` at uniform 128, its first 0.5 s,
+//! each factor forced in turn by a scratch build): `rho = 3.97`, break-even 24.8;
+//! a fresh reduced factor needs 11 to 14 iterations; a reduced factorization took
+//! 56 ms and an iteration 10.5 ms, a full one 327 ms and 28 ms, so the times put
+//! the break-even at about 28.5. The figures behind the rule, and what it changed
+//! on every benchmark scene, are in `docs/performance.md`, "Which factor".
+//!
+//! Before (until 2026-11-25) the solver switched to the full factor as soon as a
+//! fresh reduced one needed 10 iterations, whatever the sizes. A fabric at fine
+//! resolution crosses that: uniform 128 of `hanging_sheet_rest` switched at its
+//! first step and took 23.8 s for that 0.5 s against 13.6 s with the reduced
+//! factor, and its adaptive runs from base 64 (level 3) and 32 (level 5), whose
+//! fresh factors need 9 to 11 iterations, switched during the run and took 4 to
+//! 5 times as long per factorization from then on.
+//! Tried and dropped the same day: the factorization's flop count (`w^3 / 3 + r
+//! w^2 + r^2 w` per supernode of `w` columns and `r` rows below) instead of the
+//! stored values. Its ratio was 10.6 where the measured time ratio was 5.8 (dense
+//! kernels run faster on the full factor's larger supernodes), which put the
+//! break-even at 71 iterations; the stored values err the other way, towards
+//! switching early, as before.
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -37,18 +73,17 @@ use super::{ImplicitScratch, SolveFailure};
 use crate::math::{Matrix3, Scalar, Vector};
 use crate::physics::block::{BlockPattern, ElementBlocks};
 use crate::physics::direct::{FactorError, Factorization};
+use crate::physics::elements::Elements;
 use crate::physics::forces::PAR_MIN;
 use crate::physics::{Model, Stepper};
 
-/// Iterations with a fresh factor of the reduced matrix (block module docs) after
-/// which the tip-tip blocks are factored too. A factor with them costs 2.5 to 4 times
-/// as much (65 x 65 grid: 1.99 against 0.80 million stored values, 45 against 11 to
-/// 16 ms per factorization and 3.4 against 1.0 to 1.7 ms per solve in one probe on
-/// the loaded 2-core machine), while a fresh reduced factor needs about 3 iterations
-/// on fabrics
-/// (`drape_sphere`) and 27 to 200 on a bending-dominated strip (resolutions 14 to
-/// 112): 10 separates the two with room on both sides.
-const TIPS_AFTER: u32 = 10;
+/// Iterations with a fresh factor of the reduced matrix (block module docs) at
+/// which the solver first asks whether factoring the tip-tip blocks too would be
+/// cheaper (module docs, "Which factor"). Below it the reduced factor is kept
+/// without asking: a fresh one needs about 3 iterations on fabrics
+/// (`drape_sphere`) and 27 to 200 on a bending-dominated strip (resolutions 14
+/// to 112).
+const TIPS_CONSIDER: u32 = 10;
 
 /// The direct solver's scratch: pattern, matrices, factor and iteration vectors.
 #[derive(Debug, Default, Clone)]
@@ -56,9 +91,13 @@ pub(super) struct AssembledScratch {
     /// Block pattern of the current mesh (`None`: not built yet).
     pattern: Option<Arc<BlockPattern>>,
     /// Factor the hinge tip-tip blocks too (block module docs): set for the rest of
-    /// the run once a fresh factor without them needed more than
-    /// `refactor_iterations` iterations.
+    /// the run once a fresh factor without them needed more iterations than
+    /// `tips_break_even` (module docs, "Which factor").
     factor_tips: bool,
+    /// For the current pattern: the iterations with a fresh reduced factor past
+    /// which the full factor is the cheaper one (module docs, "Which factor");
+    /// `None` until a solve has asked.
+    tips_break_even: Option<Scalar>,
     /// `A` as assembled.
     raw: Vec<Matrix3>,
     /// The lower blocks of `A` while it is assembled (upper ones are their mirrors).
@@ -86,6 +125,7 @@ impl AssembledScratch {
     /// Forgets the pattern and the factorization (the mesh changed).
     pub(super) fn mesh_changed(&mut self) {
         self.pattern = None;
+        self.tips_break_even = None;
         self.factorization.reset();
     }
 }
@@ -105,6 +145,7 @@ pub(super) fn solve(
     let a = &mut s.assembled;
     if a.pattern.is_none() {
         a.factorization.reset();
+        a.tips_break_even = None;
     }
     let pattern = a
         .pattern
@@ -230,21 +271,48 @@ fn iterate(
                     tolerance,
                 });
             }
-            if fresh && since_factor >= TIPS_AFTER && !a.factor_tips {
-                // Even a fresh factor of the reduced matrix is a poor preconditioner
-                // here: factor every block from now on.
-                // (Same blocks, so `pattern` still serves the products.)
+            if fresh && since_factor >= TIPS_CONSIDER && !a.factor_tips {
+                // Is a fresh reduced factor so poor a preconditioner here that the
+                // full one is cheaper? (Module docs, "Which factor".)
                 st.stats.solve_s += started.elapsed().as_secs_f64();
-                let full = Arc::new(BlockPattern::build(pattern.vertices(), &st.elements, true));
-                a.factor_tips = true;
-                a.pattern = Some(full.clone());
-                a.compensation.iter_mut().for_each(|m| *m = Matrix3::ZERO);
-                a.factorization.reset();
-                refactor(a, &full, &mut st.stats)?;
-                a.policy.factored(false);
+                let mut full = None;
+                let break_even = match a.tips_break_even {
+                    Some(k) => k,
+                    None => {
+                        let (k, pattern, analysed) = tips_break_even(
+                            a,
+                            pattern,
+                            &st.elements,
+                            factorization_cost,
+                            &mut st.stats,
+                        )?;
+                        a.tips_break_even = Some(k);
+                        full = Some((pattern, analysed));
+                        k
+                    }
+                };
                 started = Instant::now();
-                since_factor = 0;
-                continue 'restart;
+                if Scalar::from(since_factor) >= break_even {
+                    // Factor every block from now on (same blocks, so `pattern`
+                    // still serves the products).
+                    st.stats.solve_s += started.elapsed().as_secs_f64();
+                    let (full, analysed) = match full {
+                        Some(f) => f,
+                        None => (
+                            Arc::new(BlockPattern::build(pattern.vertices(), &st.elements, true)),
+                            Factorization::default(),
+                        ),
+                    };
+                    a.factor_tips = true;
+                    a.pattern = Some(full.clone());
+                    a.compensation.iter_mut().for_each(|m| *m = Matrix3::ZERO);
+                    a.factorization = analysed;
+                    refactor(a, &full, &mut st.stats)?;
+                    a.policy.factored(false);
+                    started = Instant::now();
+                    since_factor = 0;
+                    continue 'restart;
+                }
             }
             if !fresh
                 && a.policy
@@ -313,6 +381,30 @@ fn residual(a: &mut AssembledScratch, pattern: &BlockPattern) {
         .for_each(|(r, (b, ap))| *r = *b - *ap);
 }
 
+/// The break-even of module docs, "Which factor": `F (phi - 1) + rho` for the
+/// current pattern, with the full pattern and its analysis (kept in case the
+/// solver switches at once). Counts as one symbolic analysis, timed with the
+/// factorizations.
+fn tips_break_even(
+    a: &AssembledScratch,
+    pattern: &BlockPattern,
+    elements: &Elements,
+    factorization_cost: Scalar,
+    stats: &mut crate::physics::StepStats,
+) -> Result<(Scalar, Arc<BlockPattern>, Factorization), SolveFailure> {
+    let started = Instant::now();
+    let full = Arc::new(BlockPattern::build(pattern.vertices(), elements, true));
+    let mut analysed = Factorization::default();
+    analysed.analyse(&full).map_err(|_| SolveFailure::Setup)?;
+    stats.symbolic_analyses += 1;
+    stats.factorization_s += started.elapsed().as_secs_f64();
+    let rho = match (analysed.stored_values(), a.factorization.stored_values()) {
+        (Some(f), Some(r)) if r > 0 => f as Scalar / r as Scalar,
+        _ => return Err(SolveFailure::Setup),
+    };
+    Ok((factorization_cost * (rho - 1.0) + rho, full, analysed))
+}
+
 /// Factors `A_s`, analysing the pattern first when needed.
 fn refactor(
     a: &mut AssembledScratch,
@@ -333,6 +425,9 @@ fn refactor(
         .factor(pattern, &a.system, &a.compensation)
         .map_err(map);
     stats.factorizations += 1;
+    if a.factor_tips {
+        stats.full_factorizations += 1;
+    }
     stats.factorization_s += started.elapsed().as_secs_f64();
     result
 }
