@@ -5,8 +5,9 @@
 # Output: docs/bench/sixteenth-solver-survey.log. Usage, from the repository
 # root, with both builds' binaries copied aside:
 #   OLD=/tmp/drape-old NEW=/tmp/drape-new docs/bench/sixteenth-solver-survey.sh
-# The TIPS fields of the log's lines were printed by a scratch build (an
-# eprintln of the break-even, not committed) and are empty with `d10c340`.
+# The TIPS field stays empty with these builds: it caught the break-evens that a
+# scratch build of the rule printed in a first pass
+# (sixteenth-solver-survey-scratch.log). Part D is the drape_sphere script.
 set -u
 OLD=${OLD:-/tmp/drape-old}
 NEW=${NEW:-/tmp/drape-new}
@@ -45,3 +46,6 @@ run "hs_rest 8 L6 8deg s0.05" $S/hanging_sheet_rest.toml --set adapt.method=red_
 run "hs_rest 16 L6 6deg s0.04" $S/hanging_sheet_rest.toml --set adapt.method=red_green --set cloth.resolution=16 --set adapt.max_level=6 --set adapt.refine_angle=6.0 --set adapt.coarsen_angle=0.6 --set adapt.refine_strain=0.04 --set adapt.rollback=false
 run "tablecloth 32 L4 o0.5 impact" $S/tablecloth.toml --set adapt.method=red_green --set cloth.resolution=32 --set adapt.max_level=4 --set adapt.refine_obstacle=0.5 --set simulation.duration=0.36666666666666664
 run "flag (scene)" $S/flag.toml
+echo "== D: drape_sphere reach $(date -u +%H:%M:%S)"
+DRAPE=$NEW OUT=/tmp/reach docs/bench/sixteenth-drape_sphere-reach.sh > /tmp/reach.txt 2>&1
+echo "== end $(date -u +%H:%M:%S)"

@@ -57,9 +57,9 @@
 //! factor went from 1.01 to 4.56 million stored values at 5,635 vertices.
 //! Tried and dropped the same day: the factorization's flop count (`w^3 / 3 + r
 //! w^2 + r^2 w` per supernode of `w` columns and `r` rows below) instead of the
-//! stored values. Its ratio was 10.6 where the measured time ratio was 5.8 (dense
-//! kernels run faster on the full factor's larger supernodes), which put the
-//! break-even at 71 iterations; the stored values err the other way, towards
+//! stored values. Its ratio `phi` was 10.6 where the measured time ratio was 5.8
+//! (dense kernels run faster on the full factor's larger supernodes), which put
+//! the break-even `F (phi - 1) + rho` at 71 iterations; the stored values err the other way, towards
 //! switching early, as before.
 
 use std::sync::Arc;
@@ -80,9 +80,10 @@ use crate::physics::{Model, Stepper};
 /// Iterations with a fresh factor of the reduced matrix (block module docs) at
 /// which the solver first asks whether factoring the tip-tip blocks too would be
 /// cheaper (module docs, "Which factor"). Below it the reduced factor is kept
-/// without asking: a fresh one needs about 3 iterations on fabrics
-/// (`drape_sphere`) and 27 to 200 on a bending-dominated strip (resolutions 14
-/// to 112).
+/// without asking: a fresh one needs about 3 iterations on fabrics at
+/// `drape_sphere`'s resolution, 9 to 14 on `hanging_sheet_rest` at uniform
+/// 128's edges, and 27 to 200 on a bending-dominated strip (resolutions 14 to
+/// 112).
 const TIPS_CONSIDER: u32 = 10;
 
 /// The direct solver's scratch: pattern, matrices, factor and iteration vectors.
@@ -381,7 +382,7 @@ fn residual(a: &mut AssembledScratch, pattern: &BlockPattern) {
         .for_each(|(r, (b, ap))| *r = *b - *ap);
 }
 
-/// The break-even of module docs, "Which factor": `F (phi - 1) + rho` for the
+/// The break-even of module docs, "Which factor": `F (rho - 1) + rho` for the
 /// current pattern, with the full pattern and its analysis (kept in case the
 /// solver switches at once). Counts as one symbolic analysis, timed with the
 /// factorizations.
