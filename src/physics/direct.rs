@@ -196,8 +196,9 @@ impl Factorization {
             },
         )
         .map_err(|_| FactorError::Setup)?;
+        // The values are sized by `factor`: an analysis that is only measured (the
+        // direct solver's choice of factor) allocates none.
         self.factor.clear();
-        self.factor.resize(symbolic.len_val(), 0.0);
         self.symbolic = Some(Arc::new(symbolic));
         self.valid = false;
         Ok(())

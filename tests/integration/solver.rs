@@ -339,6 +339,14 @@ fn ordering_by_vertex_fills_no_more_than_scalar_amd() {
     }
 }
 
+/// The simulation of the scene file `scene` with `overrides`, and its frame length.
+fn simulation(scene: &str, overrides: &[String]) -> (drape::sim::Simulation, Scalar) {
+    let scene =
+        drape::scene::load_scene_file(std::path::Path::new(scene), overrides).expect("scene");
+    let sim = drape::sim::build(&scene.resolve().expect("resolve")).expect("build");
+    (sim, 1.0 / scene.simulation.frame_rate)
+}
+
 /// Regression: with a fixed count of iterations allowed on an older factor, a sheet
 /// hanging at rest was refactored at every step, because even a fresh factor needs
 /// a few iterations there (the dropped tip blocks, `physics::block` module docs):
@@ -356,17 +364,14 @@ fn a_sheet_hanging_at_rest_keeps_its_factor() {
         "simulation.refactor_iterations=1",
     ]
     .map(String::from);
-    let scene = drape::scene::load_scene_file(
-        std::path::Path::new("scenes/hanging_sheet_rest.toml"),
-        &overrides,
-    )
-    .expect("scene");
-    let drape::sim::Simulation {
-        model,
-        mut state,
-        mut pipeline,
-    } = drape::sim::build(&scene.resolve().expect("resolve")).expect("build");
-    let frame = 1.0 / 30.0;
+    let (
+        drape::sim::Simulation {
+            model,
+            mut state,
+            mut pipeline,
+        },
+        frame,
+    ) = simulation("scenes/hanging_sheet_rest.toml", &overrides);
     let mut counts = |frames: usize| {
         for _ in 0..frames {
             pipeline
@@ -392,14 +397,14 @@ fn a_sheet_hanging_at_rest_keeps_its_factor() {
 /// its counters.
 fn solver_counters(scene: &str, overrides: &[&str], frames: usize) -> drape::physics::StepStats {
     let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-    let scene =
-        drape::scene::load_scene_file(std::path::Path::new(scene), &overrides).expect("scene");
-    let drape::sim::Simulation {
-        model,
-        mut state,
-        mut pipeline,
-    } = drape::sim::build(&scene.resolve().expect("resolve")).expect("build");
-    let frame = 1.0 / scene.simulation.frame_rate;
+    let (
+        drape::sim::Simulation {
+            model,
+            mut state,
+            mut pipeline,
+        },
+        frame,
+    ) = simulation(scene, &overrides);
     for _ in 0..frames {
         pipeline
             .advance_frame(&model, &mut state, frame)
@@ -414,10 +419,11 @@ fn solver_counters(scene: &str, overrides: &[&str], frames: usize) -> drape::phy
 /// `hanging_sheet_rest` switched at its first step and took 23.8 s for its first
 /// 0.5 s against 13.6 s with the reduced factor (`physics::implicit`'s direct
 /// solver, "Which factor"). Here the same sheet scaled to 0.25 m at resolution 32
-/// (the same edge length, 1/128 m), whose fresh reduced factors need about a dozen
-/// iterations: with the rule that weighs the factors' sizes it keeps the reduced
-/// factor; the bending-dominated cantilever strip, 27 iterations or more, still
-/// switches.
+/// (the same edge length, 1/128 m), which needs 349 iterations in its 24 solves
+/// on the reduced factor (the old rule switched it: 44 iterations, 24 full
+/// factorizations): with the rule that weighs the factors' sizes it keeps the
+/// reduced factor; the bending-dominated cantilever strip, 27 iterations or more
+/// with a fresh reduced factor, still switches (42 of its 43 factorizations).
 #[test]
 fn a_fine_fabric_keeps_the_reduced_factor_and_a_stiff_strip_switches() {
     let sheet = solver_counters(

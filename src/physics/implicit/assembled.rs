@@ -59,8 +59,8 @@
 //! w^2 + r^2 w` per supernode of `w` columns and `r` rows below) instead of the
 //! stored values. Its ratio `phi` was 10.6 where the measured time ratio was 5.8
 //! (dense kernels run faster on the full factor's larger supernodes), which put
-//! the break-even `F (phi - 1) + rho` at 71 iterations; the stored values err the other way, towards
-//! switching early, as before.
+//! the break-even `F (phi - 1) + rho` at 71 iterations; the stored values err
+//! the other way, towards switching early, as before.
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -292,11 +292,9 @@ fn iterate(
                         k
                     }
                 };
-                started = Instant::now();
                 if Scalar::from(since_factor) >= break_even {
                     // Factor every block from now on (same blocks, so `pattern`
                     // still serves the products).
-                    st.stats.solve_s += started.elapsed().as_secs_f64();
                     let (full, analysed) = match full {
                         Some(f) => f,
                         None => (
@@ -314,6 +312,7 @@ fn iterate(
                     since_factor = 0;
                     continue 'restart;
                 }
+                started = Instant::now();
             }
             if !fresh
                 && a.policy
