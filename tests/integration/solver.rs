@@ -347,6 +347,21 @@ fn simulation(scene: &str, overrides: &[String]) -> (drape::sim::Simulation, Sca
     (sim, 1.0 / scene.simulation.frame_rate)
 }
 
+/// Advances `sim` by `frames` frames of `frame` s; returns the run's solver
+/// counters so far.
+fn run_frames(
+    sim: &mut drape::sim::Simulation,
+    frame: Scalar,
+    frames: usize,
+) -> drape::physics::StepStats {
+    for _ in 0..frames {
+        sim.pipeline
+            .advance_frame(&sim.model, &mut sim.state, frame)
+            .expect("frame");
+    }
+    sim.state.effort.solver
+}
+
 /// Regression: with a fixed count of iterations allowed on an older factor, a sheet
 /// hanging at rest was refactored at every step, because even a fresh factor needs
 /// a few iterations there (the dropped tip blocks, `physics::block` module docs):
@@ -364,21 +379,9 @@ fn a_sheet_hanging_at_rest_keeps_its_factor() {
         "simulation.refactor_iterations=1",
     ]
     .map(String::from);
-    let (
-        drape::sim::Simulation {
-            model,
-            mut state,
-            mut pipeline,
-        },
-        frame,
-    ) = simulation("scenes/hanging_sheet_rest.toml", &overrides);
+    let (mut sim, frame) = simulation("scenes/hanging_sheet_rest.toml", &overrides);
     let mut counts = |frames: usize| {
-        for _ in 0..frames {
-            pipeline
-                .advance_frame(&model, &mut state, frame)
-                .expect("frame");
-        }
-        let s = state.effort.solver;
+        let s = run_frames(&mut sim, frame, frames);
         (s.steps, s.factorizations, s.cg_iterations)
     };
     let settled = counts(75);
@@ -397,20 +400,8 @@ fn a_sheet_hanging_at_rest_keeps_its_factor() {
 /// its counters.
 fn solver_counters(scene: &str, overrides: &[&str], frames: usize) -> drape::physics::StepStats {
     let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-    let (
-        drape::sim::Simulation {
-            model,
-            mut state,
-            mut pipeline,
-        },
-        frame,
-    ) = simulation(scene, &overrides);
-    for _ in 0..frames {
-        pipeline
-            .advance_frame(&model, &mut state, frame)
-            .expect("frame");
-    }
-    state.effort.solver
+    let (mut sim, frame) = simulation(scene, &overrides);
+    run_frames(&mut sim, frame, frames)
 }
 
 /// Regression: the direct solver switched to the full factor (hinge tip-tip blocks
