@@ -1,4 +1,4 @@
-# Sourced by the sittings' scripts (fourteenth-sitting.sh, fifteenth-sitting.sh, sixteenth-sitting.sh):
+# Sourced by the sittings' scripts (fourteenth- to seventeenth-sitting.sh):
 # `run NAME ARGS...` runs `drape bench ARGS... --out-dir $O/NAME` with its output
 # in $O/NAME.log, and prints its start (with the load average) and end times.
 # $D is the drape binary (DRAPE, default ./target/release/drape), $O the output
