@@ -1018,15 +1018,16 @@ fn a_clear_miss_is_decided_and_a_run_on_the_line_is_not() {
     assert!(!floor_decides(0.05, f64::NAN, 1e-3), "NaN decides nothing");
 }
 
-/// The published result (docs/speed-vs-error.md, "The result", "Fifteenth
-/// session", "Sixteenth session" and "Seventeenth sitting") is reproduced by
-/// `docs/bench/fourteenth-sitting.sh`, `fifteenth-sitting.sh`,
-/// `sixteenth-sitting.sh` and `seventeenth-sitting.sh`. Every `drape bench` line of them must still
-/// name a scene and a ladder that load, and every rung, the reference (with
-/// `--reference-resolution`) and the mesh floor's run must make a valid scene
-/// with the line's `--duration`: a renamed or tightened scene key would
-/// otherwise break the reproduction without any test noticing. Every other
-/// ladder file under `docs/bench/` must parse too.
+/// The published result (docs/speed-vs-error.md, "The result": the
+/// seventeenth sitting; "Fifteenth session" and "Sixteenth session"; the
+/// fourteenth sitting in the history file) is reproduced by
+/// `docs/bench/seventeenth-sitting.sh`, `fourteenth-sitting.sh`,
+/// `fifteenth-sitting.sh` and `sixteenth-sitting.sh`. Every `drape bench`
+/// line of them must still name a scene and a ladder that load, and every
+/// rung, the reference (with `--reference-resolution`) and the mesh floor's
+/// run must make a valid scene with the line's `--duration`: a renamed or
+/// tightened scene key would otherwise break the reproduction without any
+/// test noticing. Every other ladder file under `docs/bench/` must parse too.
 #[test]
 fn the_published_sittings_ladders_load_and_every_run_is_a_valid_scene() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
