@@ -91,7 +91,7 @@ pub fn percent(e: Scalar) -> String {
     let p = e * 100.0;
     match p.abs() {
         x if !x.is_finite() => "-".to_owned(),
-        x if x == 0.0 => "0 %".to_owned(),
+        0.0 => "0 %".to_owned(),
         x if (1e-3..1e3).contains(&x) => {
             let decimals = (2 - x.log10().floor() as i32).max(0) as usize;
             format!("{p:.decimals$} %")
