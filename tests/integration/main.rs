@@ -15,6 +15,7 @@ mod cli;
 mod collide;
 mod common;
 mod elastica;
+mod docs_commands;
 mod elements;
 mod energy;
 mod fuzz;
