@@ -9,10 +9,12 @@ use super::tally::{Tally, TallyEnd};
 use super::{FrameState, Progress, RunError, RunOptions};
 use crate::adapt::Adapter;
 use crate::math::{Scalar, Vector};
-use crate::physics::{Energy, Model};
+use crate::physics::Energy;
 use crate::record::{RecordError, RecordTarget, Recorder, obj::write_frame_obj};
 use crate::scene::Scene;
-use crate::sim::{FrameFailed, MAX_STEP_HALVINGS, Pipeline, SimState, Simulation, StepFailure};
+use crate::sim::{
+    FrameFailed, FrameFailure, MAX_STEP_HALVINGS, Pipeline, Setup, SimParts, SimState, StepFailure,
+};
 use crate::summary::Summary;
 
 /// A run in progress: the simulation, its outputs and its running statistics.
@@ -21,7 +23,7 @@ use crate::summary::Summary;
 /// the summary.
 pub struct FrameLoop<'a> {
     scene: &'a Scene,
-    model: Model,
+    setup: Setup,
     state: SimState,
     pipeline: Pipeline,
     /// The energy of the state as it is, once measured (or handed over by the
@@ -50,20 +52,12 @@ pub struct FrameLoop<'a> {
     failure: Option<(u64, FrameFailure)>,
 }
 
-/// How a frame's steps failed (from [`FrameFailed::Steps`]).
-#[derive(Debug, Clone, Copy)]
-struct FrameFailure {
-    last_dt: Scalar,
-    what: StepFailure,
-    step: u64,
-}
-
 impl<'a> FrameLoop<'a> {
     /// A run of `scene` from the built simulation ([`crate::sim::build`]); opens
     /// the recording and the OBJ directory.
     pub fn new(
         scene: &'a Scene,
-        sim: Simulation,
+        sim: SimParts,
         opts: &RunOptions,
     ) -> Result<FrameLoop<'a>, RunError> {
         let recorder = match (&opts.record, &opts.live) {
@@ -88,15 +82,15 @@ impl<'a> FrameLoop<'a> {
             })?;
         }
         let frames = scene.simulation.frame_count();
-        let Simulation {
-            model,
+        let SimParts {
+            setup,
             state,
             pipeline,
         } = sim;
-        let tally = Tally::new(&model, &state.world, pipeline.stepper());
+        let tally = Tally::new(&setup.model, &state.world, pipeline.stepper());
         Ok(FrameLoop {
             scene,
-            model,
+            setup,
             state,
             pipeline,
             recorder,
@@ -146,26 +140,14 @@ impl<'a> FrameLoop<'a> {
         let t0 = Instant::now();
         let start_energy = self.energy_now.take();
         match self.pipeline.advance_frame_from(
-            &self.model,
+            &self.setup,
             &mut self.state,
             self.frame_interval,
             start_energy,
         ) {
             Ok(_) => {}
-            Err(FrameFailed::Steps {
-                last_dt,
-                failure,
-                step,
-            }) => {
-                let what = failure;
-                self.failure = Some((
-                    self.frame + 1,
-                    FrameFailure {
-                        last_dt,
-                        what,
-                        step,
-                    },
-                ));
+            Err(FrameFailed::Steps(f)) => {
+                self.failure = Some((self.frame + 1, f));
                 return Ok(false);
             }
             Err(FrameFailed::Remesh(e)) => return Err(RunError::Remesh(e)),
@@ -213,7 +195,7 @@ impl<'a> FrameLoop<'a> {
             None => self
                 .pipeline
                 .stepper()
-                .energy(&self.model, &self.state.world),
+                .energy(&self.setup.model, &self.state.world),
         };
         self.energy_now = Some(e);
         e
@@ -247,7 +229,7 @@ impl<'a> FrameLoop<'a> {
             frame_interval: self.frame_interval,
         };
         let (state, pipeline) = (&mut self.state, &mut self.pipeline);
-        recording::record_state(rec, &self.model, state, pipeline, &snap, &mut self.normals)?;
+        recording::record_state(rec, &self.setup, state, pipeline, &snap, &mut self.normals)?;
         self.recorded_frames += 1;
         self.last_recorded = Some(self.frame);
         Ok(())
@@ -275,16 +257,16 @@ impl<'a> FrameLoop<'a> {
             None => Ok(summary),
             Some((frame, f)) => Err(RunError::Numerical {
                 step: f.step,
-                failure: f.what,
+                failure: f.failure,
                 frame,
                 time: self.state.world.time,
                 halvings: MAX_STEP_HALVINGS,
                 dt: f.last_dt,
                 cause: format!(
                     "step {:.3e} s with the {:?} integrator; try a smaller `simulation.dt`, `dt = \"auto\"`, or `integrator = \"implicit\"`{}",
-                    self.pipeline.step_size(&self.model, &self.state.world),
-                    self.model.integrator,
-                    solver_hint(&f.what)
+                    self.pipeline.step_size(&self.setup, &self.state.world),
+                    self.setup.model.integrator,
+                    solver_hint(&f.failure)
                 ),
                 summary: Box::new(summary),
             }),
@@ -296,7 +278,7 @@ impl<'a> FrameLoop<'a> {
         let dt = if state.effort.min_dt.is_finite() {
             state.effort.min_dt
         } else {
-            pipe.step_size(&self.model, &state.world)
+            pipe.step_size(&self.setup, &state.world)
         };
         let stepper = pipe.stepper();
         self.tally.finish(TallyEnd {
@@ -311,10 +293,12 @@ impl<'a> FrameLoop<'a> {
             recording,
             state,
             mass_final: stepper.elements.total_mass(),
-            cusick: pipe
-                .collider()
-                .and_then(|c| c.cusick(self.scene, &state.world)),
-            cantilever: crate::cantilever::for_run(self.scene, &state.world, &self.model.material),
+            cusick: self.setup.obstacles.cusick(self.scene, &state.world),
+            cantilever: crate::cantilever::for_run(
+                self.scene,
+                &state.world,
+                &self.setup.model.material,
+            ),
         })
     }
 }
