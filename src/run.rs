@@ -7,6 +7,7 @@ use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 mod frame_loop;
+mod measure;
 mod recording;
 mod tally;
 
@@ -61,6 +62,14 @@ pub enum RunError {
     /// adaptive method.
     #[error(transparent)]
     Build(#[from] SimBuildError),
+    /// A measurement the scene asks for (`measure`) cannot be made on its cloth.
+    #[error("key `measure`: the {measurement} measurement {why}")]
+    Measurement {
+        /// The measurement.
+        measurement: crate::scene::Measurement,
+        /// What it needs that the cloth lacks.
+        why: &'static str,
+    },
     /// Recording failed.
     #[error("recording: {0}")]
     Record(#[from] RecordError),

@@ -60,6 +60,7 @@ impl<'a> FrameLoop<'a> {
         sim: SimParts,
         opts: &RunOptions,
     ) -> Result<FrameLoop<'a>, RunError> {
+        super::measure::check(scene, &sim.setup, &sim.state.world)?;
         let recorder = match (&opts.record, &opts.live) {
             (None, None) => None,
             (file, live) => {
@@ -281,6 +282,7 @@ impl<'a> FrameLoop<'a> {
             pipe.step_size(&self.setup, &state.world)
         };
         let stepper = pipe.stepper();
+        let (cusick, cantilever) = super::measure::at_end(self.scene, &self.setup, &state.world);
         self.tally.finish(TallyEnd {
             scene: self.scene.name.clone(),
             frames: self.frame + 1,
@@ -293,12 +295,8 @@ impl<'a> FrameLoop<'a> {
             recording,
             state,
             mass_final: stepper.elements.total_mass(),
-            cusick: self.setup.obstacles.cusick(self.scene, &state.world),
-            cantilever: crate::cantilever::for_run(
-                self.scene,
-                &state.world,
-                &self.setup.model.material,
-            ),
+            cusick,
+            cantilever,
         })
     }
 }
