@@ -10,8 +10,9 @@ use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::{EdgeChoice, RunArgs, load};
+use drape::bench::sampling::{SamplePoints, Sampler};
 use drape::record::{EdgeDisplay, LiveViewer};
-use drape::run::{Progress, RunError, RunOptions, run_built};
+use drape::run::{FrameState, Progress, RunError, RunOptions, run_built};
 use drape::scene::Scene;
 use drape::summary::Summary;
 
@@ -38,6 +39,10 @@ pub fn cmd_run(args: RunArgs) -> Result<ExitCode> {
         ),
         None => None,
     };
+    let points = match &args.sample_at {
+        Some(path) => Some(SamplePoints::load(path)?),
+        None => None,
+    };
     let interrupt = interrupt_on_ctrl_c()?;
     let bar = progress_bar(args.quiet);
     let mut on_progress = |p: Progress| {
@@ -45,15 +50,25 @@ pub fn cmd_run(args: RunArgs) -> Result<ExitCode> {
         bar.set_position(p.frame);
         bar.set_message(format!("t = {:.2} s", p.sim_time));
     };
+    let mut sampler = points.as_ref().map(Sampler::new);
+    let mut observe = |f: &FrameState| {
+        if let Some(s) = &mut sampler {
+            s.observe(f);
+        }
+    };
     let outcome = run_built(
         &scene,
         sim,
         &opts,
         &interrupt,
         &mut on_progress,
-        &mut |_| {},
+        &mut observe,
     );
     bar.finish_and_clear();
+    let samples = sampler.and_then(|s| s.finish(&outcome, &args.scene.overrides, opts.threads));
+    if let (Some(samples), Some(path)) = (samples, &args.samples_out) {
+        samples.store(path)?;
+    }
     report_outcome(outcome, args.summary.as_deref(), summary_file)
 }
 
