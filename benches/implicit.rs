@@ -295,8 +295,10 @@ fn creased(mesh: &drape::mesh::Mesh) -> drape::mesh::Mesh {
         refine_obstacle: None,
         alternate_diagonals: true,
     };
-    let mut adapter = Adapter::new(config, &world, 0.15).expect("the adapter starts");
-    adapter.pass(&mut world, 0).expect("a crease refines");
+    let mut adapter = Adapter::new(&config, &world, 0.15).expect("the adapter starts");
+    adapter
+        .remesh(&config, &mut world, 0)
+        .expect("a crease refines");
     world.mesh
 }
 

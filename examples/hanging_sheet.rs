@@ -20,7 +20,11 @@ fn main() -> anyhow::Result<()> {
     let options = RunOptions::default(); // no recording, one thread per core
     let mut lowest = Vec::new();
     let mut observe = |frame: &FrameState| {
-        let z = frame.positions.iter().map(|p| p.z).fold(f64::INFINITY, f64::min);
+        let z = frame
+            .positions
+            .iter()
+            .map(|p| p.z)
+            .fold(f64::INFINITY, f64::min);
         lowest.push((frame.sim_time, z, frame.triangles.len()));
     };
     let stop = AtomicBool::new(false);

@@ -374,6 +374,27 @@ pub enum AdaptCriterion {
     Sizing,
 }
 
+/// A textile measurement a scene asks for (`measure`), made on its end state.
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum Measurement {
+    /// The cantilever bending test (Peirce 1930, ASTM D1388): a rectangle held
+    /// over one end by fixed pins, under gravity alone ([`crate::cantilever`]).
+    Cantilever,
+    /// The Cusick drape test: a disk specimen on a vertical support cylinder
+    /// centred under it (`crate::collide::cusick`).
+    Cusick,
+}
+
+impl std::fmt::Display for Measurement {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Measurement::Cantilever => "cantilever",
+            Measurement::Cusick => "cusick",
+        })
+    }
+}
+
 /// The adaptive remeshing method.
 #[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq)]
 #[serde(rename_all = "snake_case")]

@@ -105,7 +105,12 @@ fn brief(args: &[String], dir: &Path) -> Vec<String> {
     match a.first().map(String::as_str) {
         Some("run") => {
             a = without(&without(&a, "--out"), "-o");
-            a.extend(s(&["--no-record", "-q", "--set", "simulation.duration=0.05"]));
+            a.extend(s(&[
+                "--no-record",
+                "-q",
+                "--set",
+                "simulation.duration=0.05",
+            ]));
         }
         Some("bench") if a.get(1).is_some_and(|x| x == "collect") => a.clear(),
         Some("bench") => {
@@ -156,9 +161,20 @@ fn workdir() -> PathBuf {
             }
         }
     }
-    let set = ["run", "--set", "simulation.duration=0.1", "-q", "--out", "default.rrd"];
+    let set = [
+        "run",
+        "--set",
+        "simulation.duration=0.1",
+        "-q",
+        "--out",
+        "default.rrd",
+    ];
     let out = drape(&set.map(String::from), &dir);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     dir
 }
 

@@ -28,8 +28,10 @@ fn meshes() -> (Vec<Mesh>, MaterialParams) {
         .collect();
     let mut world = World::new(grid.clone(), bent);
     let config = AdaptConfig::from_scene(scene.adapt.as_ref()).expect("it adapts");
-    let mut adapter = Adapter::new(config, &world, scene.material.density).unwrap();
-    adapter.pass(&mut world, 0).expect("the crease refines");
+    let mut adapter = Adapter::new(&config, &world, scene.material.density).unwrap();
+    adapter
+        .remesh(&config, &mut world, 0)
+        .expect("the crease refines");
     assert!(world.mesh.triangles.len() > grid.triangles.len());
     (vec![grid, world.mesh], Model::from_scene(&scene).material)
 }
