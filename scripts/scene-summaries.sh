@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Runs every shipped scene (scenes/*.toml and scenes/hard/*.toml) without
 # recording and writes each run's summary, with the timing fields removed, to
-# OUT/NAME.json. Two builds' outputs compared with `diff -r` show whether a
+# OUT/NAME.json, and each run's wall time to OUT/walls.tsv (not compared).
+# Two builds' outputs compared with `diff -r` show whether a
 # change altered any result:
 #
 #   scripts/scene-summaries.sh target/release/drape /tmp/new
@@ -12,12 +13,13 @@ drape=${1:?usage: scene-summaries.sh DRAPE OUT_DIR}
 out=${2:?usage: scene-summaries.sh DRAPE OUT_DIR}
 cd "$(dirname "$0")/.."
 mkdir -p "$out"
+: > "$out/walls.tsv"
 for scene in scenes/*.toml scenes/hard/*.toml; do
     name=$(basename "$(dirname "$scene")")-$(basename "$scene" .toml)
     raw="$out/$name.raw.json"
     "$drape" run "$scene" --no-record --quiet --summary "$raw" > /dev/null 2>&1 || true
     if [ -s "$raw" ]; then
-        python3 - "$raw" > "$out/$name.json" <<'PY'
+        python3 - "$raw" "$out/walls.tsv" > "$out/$name.json" <<'PY'
 import json, sys
 TIMING = {"wall_time_s", "simulation_wall_s", "recording_wall_s", "vertex_steps_per_s",
           "recording"}
@@ -28,7 +30,10 @@ def strip(v):
     if isinstance(v, list):
         return [strip(x) for x in v]
     return v
-print(json.dumps(strip(json.load(open(sys.argv[1]))), indent=1, sort_keys=True))
+s = json.load(open(sys.argv[1]))
+print(json.dumps(strip(s), indent=1, sort_keys=True))
+with open(sys.argv[2], "a") as walls:
+    walls.write(f"{s['scene']}\t{s['wall_time_s']:.2f}\t{s['vertices']['mean']:.0f}\n")
 PY
     else
         echo "no summary" > "$out/$name.json"

@@ -103,6 +103,14 @@ fn quiet() -> impl FnMut(&str) {
     |_| {}
 }
 
+/// Runs `opts` in-process into `dir/out`.
+fn bench_out(opts: &BenchOptions, dir: &Path) -> drape::bench::BenchResult {
+    let stop = AtomicBool::new(false);
+    bench(opts, &dir.join("out"), &stop, &mut quiet())
+        .expect("bench")
+        .0
+}
+
 /// The CSV without its wall-time columns (`wall_s`, `wall_min_s`,
 /// `wall_max_s`) and the Pareto flag, which depends on them.
 fn csv_without_times(text: &str) -> String {
@@ -392,13 +400,7 @@ fn the_lift_floor_is_a_floor_row_far_below_the_rungs() {
     let scene = tiny_scene(&dir);
     let mut opts = tiny_options(&scene, small_ladder());
     opts.floor = true;
-    let (res, _) = bench(
-        &opts,
-        &dir.join("out"),
-        &AtomicBool::new(false),
-        &mut quiet(),
-    )
-    .expect("bench");
+    let res = bench_out(&opts, &dir);
     let floor = res.rows.last().expect("rows");
     assert!(floor.run.floor && !floor.pareto, "{floor:?}");
     let smallest = res.rows.iter().filter(|r| !r.run.floor).map(|r| r.error);
@@ -462,13 +464,7 @@ fn time_ladder_end_to_end_error_falls_with_the_step() {
     opts.time_ladder = true;
     opts.overrides = vec!["cloth.resolution=6".into()];
     opts.duration = Some(0.2);
-    let (res, _) = bench(
-        &opts,
-        &dir.join("out"),
-        &AtomicBool::new(false),
-        &mut quiet(),
-    )
-    .expect("bench");
+    let res = bench_out(&opts, &dir);
     assert_eq!(res.plan.stem, "tiny-time");
     assert!(res.plan.common_dt.is_none());
     let e: Vec<f64> = res.rows.iter().map(|r| r.error).collect();
