@@ -9,7 +9,7 @@
 //! mirror, so the values are identical at any thread count.
 //!
 //! The pattern also carries the scalar compressed-column (CSC) structure of the
-//! lower triangle that the sparse Cholesky factorization reads ([`super::direct`]),
+//! lower triangle that the sparse Cholesky factorization reads ([`super::cholesky`]),
 //! with, for every scalar entry, the block and the component it comes from.
 //!
 //! # The factored matrix

@@ -286,7 +286,7 @@ fn solves_that_keep_failing_stop_the_run_with_a_message_and_a_complete_recording
 }
 
 /// The direct solver orders its unknowns by vertex (AMD on the vertex graph,
-/// `physics::direct`, "Ordering by vertex"). Pins that this costs no fill against
+/// `physics::cholesky`, "Ordering by vertex"). Pins that this costs no fill against
 /// faer's AMD on the scalar unknowns, which drape used before, on a uniform grid
 /// and on a red-green mesh refined along a crease (where a remesh orders again).
 /// Measured when written: grid 32 (1,089 vertices) 148,212 stored values both
@@ -295,7 +295,7 @@ fn solves_that_keep_failing_stop_the_run_with_a_message_and_a_complete_recording
 fn ordering_by_vertex_fills_no_more_than_scalar_amd() {
     use drape::adapt::Adapter;
     use drape::physics::block::BlockPattern;
-    use drape::physics::direct::{Factorization, Ordering};
+    use drape::physics::cholesky::{Factorization, Ordering};
     use drape::physics::elements::Elements;
     use drape::scene::AdaptMethod;
 

@@ -1,6 +1,6 @@
 //! The direct solver (`solver = "direct"`): `A` assembled into a fixed block pattern
 //! ([`crate::physics::block`]), its projection factored by a sparse Cholesky
-//! ([`crate::physics::direct`]), and conjugate gradients preconditioned by that
+//! ([`crate::physics::cholesky`]), and conjugate gradients preconditioned by that
 //! factor.
 //!
 //! Every step solves `A_s y = b_s` for the free part `y` of `dv = dv_c + y`, where
@@ -72,7 +72,7 @@ use super::refactor::RefactorPolicy;
 use super::{ImplicitScratch, SolveFailure};
 use crate::math::{Matrix3, Scalar, Vector};
 use crate::physics::block::{BlockPattern, ElementBlocks};
-use crate::physics::direct::{FactorError, Factorization};
+use crate::physics::cholesky::{FactorError, Factorization};
 use crate::physics::elements::Elements;
 use crate::physics::forces::PAR_MIN;
 use crate::physics::{Model, Stepper};
@@ -88,7 +88,7 @@ const TIPS_CONSIDER: u32 = 10;
 
 /// The direct solver's scratch: pattern, matrices, factor and iteration vectors.
 #[derive(Debug, Default, Clone)]
-pub(super) struct AssembledScratch {
+pub(super) struct DirectScratch {
     /// Block pattern of the current mesh (`None`: not built yet).
     pattern: Option<Arc<BlockPattern>>,
     /// Factor the hinge tip-tip blocks too (block module docs): set for the rest of
@@ -122,7 +122,7 @@ pub(super) struct AssembledScratch {
     ap: Vec<Vector>,
 }
 
-impl AssembledScratch {
+impl DirectScratch {
     /// Forgets the pattern and the factorization (the mesh changed).
     pub(super) fn mesh_changed(&mut self) {
         self.pattern = None;
@@ -143,7 +143,7 @@ pub(super) fn solve(
     let started = Instant::now();
     let n = st.implicit.dv.len();
     let s = &mut st.implicit;
-    let a = &mut s.assembled;
+    let a = &mut s.direct;
     if a.pattern.is_none() {
         a.factorization.reset();
         a.tips_break_even = None;
@@ -162,10 +162,10 @@ pub(super) fn solve(
         shape_jacobians: &s.shape_grad,
         h2: s.h2,
     };
-    let a = &mut s.assembled;
+    let a = &mut s.direct;
     pattern.gather(&terms, &mut a.lower, &mut a.raw);
     pattern.compensation(&terms, &a.projection, &mut a.compensation);
-    let a = &mut s.assembled;
+    let a = &mut s.direct;
     // b_s = S (b - A dv_c).
     a.ap.resize(n, Vector::ZERO);
     pattern.multiply(&a.raw, &a.prescribed, &mut a.ap);
@@ -180,7 +180,7 @@ pub(super) fn solve(
     st.stats.assembly_s += started.elapsed().as_secs_f64();
     let outcome = iterate(st, model, &pattern, reference);
     let s = &mut st.implicit;
-    let a = &mut s.assembled;
+    let a = &mut s.direct;
     // dv = dv_c + y.
     s.dv.par_iter_mut()
         .zip(a.prescribed.par_iter().zip(a.y.par_iter()))
@@ -196,7 +196,7 @@ pub(super) fn solve(
 /// `y`, and sets the projections.
 fn split_prescribed(s: &mut ImplicitScratch, held: &[bool]) {
     let n = s.dv.len();
-    let a = &mut s.assembled;
+    let a = &mut s.direct;
     a.projection.resize(n, None);
     a.prescribed.resize(n, Vector::ZERO);
     a.y.resize(n, Vector::ZERO);
@@ -240,7 +240,7 @@ fn iterate(
     let goal = tolerance * reference;
     let factorization_cost = Scalar::from(model.solver.refactor_iterations);
     let cap = model.cg_max_iterations;
-    let a = &mut st.implicit.assembled;
+    let a = &mut st.implicit.direct;
     let mut fresh = false;
     if !a.factorization.is_valid() || a.policy.renew_at_start(factorization_cost) {
         refactor(a, pattern, &mut st.stats)?;
@@ -341,7 +341,7 @@ fn iterate(
     };
     st.stats.cg_iterations += total as u64;
     if outcome.is_ok() {
-        st.implicit.assembled.policy.solved(since_factor);
+        st.implicit.direct.policy.solved(since_factor);
     }
     st.stats.solve_s += started.elapsed().as_secs_f64();
     outcome
@@ -350,7 +350,7 @@ fn iterate(
 /// One conjugate-gradient update with step `alpha`: `y += alpha p`,
 /// `r -= alpha A p`, `z = M^-1 r` (one solve with the factor), `p = z + beta p`
 /// with `beta = r.z / rz`. Returns the new `r.z`.
-fn pcg_update(a: &mut AssembledScratch, alpha: Scalar, rz: Scalar) -> Scalar {
+fn pcg_update(a: &mut DirectScratch, alpha: Scalar, rz: Scalar) -> Scalar {
     a.y.par_iter_mut()
         .zip(a.r.par_iter_mut())
         .zip(a.p.par_iter().zip(a.ap.par_iter()))
@@ -370,7 +370,7 @@ fn pcg_update(a: &mut AssembledScratch, alpha: Scalar, rz: Scalar) -> Scalar {
 }
 
 /// `r = b_s - A_s y`.
-fn residual(a: &mut AssembledScratch, pattern: &BlockPattern) {
+fn residual(a: &mut DirectScratch, pattern: &BlockPattern) {
     let n = a.rhs.len();
     a.ap.resize(n, Vector::ZERO);
     a.r.resize(n, Vector::ZERO);
@@ -386,7 +386,7 @@ fn residual(a: &mut AssembledScratch, pattern: &BlockPattern) {
 /// solver switches at once). Counts as one symbolic analysis, timed with the
 /// factorizations.
 fn tips_break_even(
-    a: &AssembledScratch,
+    a: &DirectScratch,
     pattern: &BlockPattern,
     elements: &Elements,
     factorization_cost: Scalar,
@@ -407,7 +407,7 @@ fn tips_break_even(
 
 /// Factors `A_s`, analysing the pattern first when needed.
 fn refactor(
-    a: &mut AssembledScratch,
+    a: &mut DirectScratch,
     pattern: &BlockPattern,
     stats: &mut crate::physics::StepStats,
 ) -> Result<(), SolveFailure> {
@@ -437,11 +437,11 @@ fn refactor(
 fn contact_pressure(st: &mut Stepper, pattern: &BlockPattern) {
     let s = &mut st.implicit;
     if s.filter.iter().any(|f| *f != Vector::ZERO) {
-        pattern.multiply(&s.assembled.raw, &s.dv, &mut s.assembled.ap);
+        pattern.multiply(&s.direct.raw, &s.dv, &mut s.direct.ap);
     }
     super::contact_push_from(
         &s.filter,
-        Some(&s.assembled.ap),
+        Some(&s.direct.ap),
         &s.b,
         &st.elements.mass,
         &mut st.contact_push,
