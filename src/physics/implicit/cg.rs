@@ -8,7 +8,7 @@
 
 use rayon::prelude::*;
 
-use super::{SolveFailure, without};
+use super::{ImplicitScratch, SolveFailure, without};
 use crate::math::{Scalar, Vector, deterministic_sum, deterministic_sum2};
 use crate::physics::forces::PAR_MIN;
 use crate::physics::shape::{SHAPE_SLOTS, rates, spread};
@@ -33,31 +33,7 @@ pub(super) fn solve(
     contact_push: bool,
 ) -> Result<(), SolveFailure> {
     let started = std::time::Instant::now();
-    let n = st.implicit.dv.len();
-    {
-        let c = &mut st.implicit.cg;
-        for buf in [&mut c.r, &mut c.z, &mut c.p, &mut c.ap] {
-            buf.resize(n, Vector::ZERO);
-        }
-    }
-    // r = b - A dv, filtered.
-    apply_operator(st, Which::Solution, held, true);
-    let s = &mut st.implicit;
-    let c = &mut s.cg;
-    c.r.par_iter_mut()
-        .zip(s.b.par_iter().zip(c.ap.par_iter()))
-        .zip(s.filter.par_iter())
-        .enumerate()
-        .for_each(|(i, ((r, (b, ap)), f))| {
-            *r = if held[i] {
-                Vector::ZERO
-            } else {
-                without(*f, *b - *ap)
-            };
-        });
-    precondition(&mut c.z, &c.r, &s.inv_diag, &s.filter);
-    c.p.copy_from_slice(&c.z);
-    let (mut rz, mut rr) = dot2(&c.r, &c.z);
+    let (mut rz, mut rr) = start(st, held);
     let tolerance = model.cg_tolerance;
     let goal = tolerance * reference;
     let mut iterations = 0;
@@ -74,30 +50,15 @@ pub(super) fn solve(
         }
         apply_operator(st, Which::Direction, held, true);
         let s = &mut st.implicit;
-        let c = &mut s.cg;
-        let pap = dot(&c.p, &c.ap);
+        let pap = dot(&s.cg.p, &s.cg.ap);
         if pap <= 0.0 || !pap.is_finite() {
             break Err(SolveFailure::NotPositiveDefinite);
         }
-        let alpha = rz / pap;
-        // One pass: step the solution and the residual, precondition.
-        s.dv.par_iter_mut()
-            .zip(c.r.par_iter_mut().zip(c.z.par_iter_mut()))
-            .zip(
-                c.p.par_iter()
-                    .zip(c.ap.par_iter().zip(s.inv_diag.par_iter())),
-            )
-            .zip(s.filter.par_iter())
-            .with_min_len(PAR_MIN)
-            .for_each(|(((d, (r, z)), (p, (ap, inv))), n)| {
-                *d += *p * alpha;
-                *r -= *ap * alpha;
-                *z = without(*n, *r * *inv);
-            });
         let rz_new;
-        (rz_new, rr) = dot2(&c.r, &c.z);
+        (rz_new, rr) = step(s, rz / pap);
         let beta = rz_new / rz;
         rz = rz_new;
+        let c = &mut s.cg;
         c.p.par_iter_mut()
             .zip(c.z.par_iter())
             .with_min_len(PAR_MIN)
@@ -110,6 +71,56 @@ pub(super) fn solve(
     }
     st.stats.solve_s += started.elapsed().as_secs_f64();
     outcome
+}
+
+/// Starts the iteration from the first guess `dv`: `r = b - A dv` (filtered,
+/// zero on held vertices), `z` the preconditioned `r`, `p = z`. Returns `r.z`
+/// and `r.r`.
+fn start(st: &mut Stepper, held: &[bool]) -> (Scalar, Scalar) {
+    let n = st.implicit.dv.len();
+    {
+        let c = &mut st.implicit.cg;
+        for buf in [&mut c.r, &mut c.z, &mut c.p, &mut c.ap] {
+            buf.resize(n, Vector::ZERO);
+        }
+    }
+    apply_operator(st, Which::Solution, held, true);
+    let s = &mut st.implicit;
+    let c = &mut s.cg;
+    c.r.par_iter_mut()
+        .zip(s.b.par_iter().zip(c.ap.par_iter()))
+        .zip(s.filter.par_iter())
+        .enumerate()
+        .for_each(|(i, ((r, (b, ap)), f))| {
+            *r = if held[i] {
+                Vector::ZERO
+            } else {
+                without(*f, *b - *ap)
+            };
+        });
+    precondition(&mut c.z, &c.r, &s.inv_diag, &s.filter);
+    c.p.copy_from_slice(&c.z);
+    dot2(&c.r, &c.z)
+}
+
+/// One pass with step `alpha`: `dv += alpha p`, `r -= alpha A p`, `z` the
+/// preconditioned `r`. Returns the new `r.z` and `r.r`.
+fn step(s: &mut ImplicitScratch, alpha: Scalar) -> (Scalar, Scalar) {
+    let c = &mut s.cg;
+    s.dv.par_iter_mut()
+        .zip(c.r.par_iter_mut().zip(c.z.par_iter_mut()))
+        .zip(
+            c.p.par_iter()
+                .zip(c.ap.par_iter().zip(s.inv_diag.par_iter())),
+        )
+        .zip(s.filter.par_iter())
+        .with_min_len(PAR_MIN)
+        .for_each(|(((d, (r, z)), (p, (ap, inv))), n)| {
+            *d += *p * alpha;
+            *r -= *ap * alpha;
+            *z = without(*n, *r * *inv);
+        });
+    dot2(&c.r, &c.z)
 }
 
 /// Which vector the operator is applied to.

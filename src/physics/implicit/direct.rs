@@ -75,7 +75,7 @@ use crate::physics::block::{BlockPattern, ElementBlocks};
 use crate::physics::cholesky::{FactorError, Factorization};
 use crate::physics::elements::Elements;
 use crate::physics::forces::PAR_MIN;
-use crate::physics::{Model, Stepper};
+use crate::physics::{Model, StepStats, Stepper};
 
 /// Iterations with a fresh factor of the reduced matrix (block module docs) at
 /// which the solver first asks whether factoring the tip-tip blocks too would be
@@ -241,26 +241,18 @@ fn iterate(
     let factorization_cost = Scalar::from(model.solver.refactor_iterations);
     let cap = model.cg_max_iterations;
     let a = &mut st.implicit.direct;
-    let mut fresh = false;
-    if !a.factorization.is_valid() || a.policy.renew_at_start(factorization_cost) {
+    let mut fresh = !a.factorization.is_valid() || a.policy.renew_at_start(factorization_cost);
+    if fresh {
         refactor(a, pattern, &mut st.stats)?;
         a.policy.factored(false);
-        fresh = true;
     }
-    // r = b_s - A_s y.
     let mut started = Instant::now();
     residual(a, pattern);
     let mut total = 0u32;
     let mut since_factor = 0u32;
     let outcome = 'restart: loop {
-        a.z.resize(a.r.len(), Vector::ZERO);
-        a.factorization.solve(&a.r, &mut a.z);
-        st.stats.factor_solves += 1;
-        a.p.clone_from(&a.z);
-        let mut rz = dot(&a.r, &a.z);
-        // `r.r` of the iterate at hand; `first`: its norm when this (re)start began.
-        let mut rr = dot(&a.r, &a.r);
-        let first = rr.sqrt();
+        let (mut rz, mut rr) = pcg_start(a, &mut st.stats);
+        let restart_norm = rr.sqrt();
         loop {
             if rr.sqrt() <= goal {
                 break 'restart Ok(());
@@ -273,50 +265,24 @@ fn iterate(
                 });
             }
             if fresh && since_factor >= TIPS_CONSIDER && !a.factor_tips {
-                // Is a fresh reduced factor so poor a preconditioner here that the
-                // full one is cheaper? (Module docs, "Which factor".)
                 st.stats.solve_s += started.elapsed().as_secs_f64();
-                let mut full = None;
-                let break_even = match a.tips_break_even {
-                    Some(k) => k,
-                    None => {
-                        let (k, pattern, analysed) = tips_break_even(
-                            a,
-                            pattern,
-                            &st.elements,
-                            factorization_cost,
-                            &mut st.stats,
-                        )?;
-                        a.tips_break_even = Some(k);
-                        full = Some((pattern, analysed));
-                        k
-                    }
-                };
-                if Scalar::from(since_factor) >= break_even {
-                    // Factor every block from now on (same blocks, so `pattern`
-                    // still serves the products).
-                    let (full, analysed) = match full {
-                        Some(f) => f,
-                        None => (
-                            Arc::new(BlockPattern::build(pattern.vertices(), &st.elements, true)),
-                            Factorization::default(),
-                        ),
-                    };
-                    a.factor_tips = true;
-                    a.pattern = Some(full.clone());
-                    a.compensation.iter_mut().for_each(|m| *m = Matrix3::ZERO);
-                    a.factorization = analysed;
-                    refactor(a, &full, &mut st.stats)?;
-                    a.policy.factored(false);
-                    started = Instant::now();
+                let switched = switch_to_full_factor(
+                    a,
+                    pattern,
+                    &st.elements,
+                    factorization_cost,
+                    since_factor,
+                    &mut st.stats,
+                )?;
+                started = Instant::now();
+                if switched {
                     since_factor = 0;
                     continue 'restart;
                 }
-                started = Instant::now();
             }
             if !fresh
                 && a.policy
-                    .give_up(factorization_cost, since_factor, first, rr.sqrt(), goal)
+                    .give_up(factorization_cost, since_factor, restart_norm, rr.sqrt(), goal)
             {
                 st.stats.solve_s += started.elapsed().as_secs_f64();
                 refactor(a, pattern, &mut st.stats)?;
@@ -327,13 +293,10 @@ fn iterate(
                 residual(a, pattern);
                 continue 'restart;
             }
-            pattern.multiply(&a.system, &a.p, &mut a.ap);
-            let pap = dot(&a.p, &a.ap);
-            if pap <= 0.0 || !pap.is_finite() {
+            let Some(next) = pcg_step(a, pattern, rz) else {
                 break 'restart Err(SolveFailure::NotPositiveDefinite);
-            }
-            rz = pcg_update(a, rz / pap, rz);
-            rr = dot(&a.r, &a.r);
+            };
+            (rz, rr) = next;
             st.stats.factor_solves += 1;
             total += 1;
             since_factor += 1;
@@ -345,6 +308,75 @@ fn iterate(
     }
     st.stats.solve_s += started.elapsed().as_secs_f64();
     outcome
+}
+
+/// Starts (or restarts) the preconditioned iteration from the residual `r`:
+/// `z = M^-1 r` (one solve with the factor), `p = z`. Returns `r.z` and `r.r`.
+fn pcg_start(a: &mut DirectScratch, stats: &mut StepStats) -> (Scalar, Scalar) {
+    a.z.resize(a.r.len(), Vector::ZERO);
+    a.factorization.solve(&a.r, &mut a.z);
+    stats.factor_solves += 1;
+    a.p.clone_from(&a.z);
+    let rz = dot(&a.r, &a.z);
+    let rr = dot(&a.r, &a.r);
+    (rz, rr)
+}
+
+/// Asked once a fresh reduced factor has needed `since_factor` (at least
+/// [`TIPS_CONSIDER`]) iterations: is it so poor a preconditioner here that the
+/// full one is cheaper (module docs, "Which factor")? If so, switches to factoring
+/// every block for the rest of the run, factors `A_s` that way and returns true.
+fn switch_to_full_factor(
+    a: &mut DirectScratch,
+    pattern: &BlockPattern,
+    elements: &Elements,
+    factorization_cost: Scalar,
+    since_factor: u32,
+    stats: &mut StepStats,
+) -> Result<bool, SolveFailure> {
+    let mut full = None;
+    let break_even = match a.tips_break_even {
+        Some(k) => k,
+        None => {
+            let (k, pattern, analysed) =
+                tips_break_even(a, pattern, elements, factorization_cost, stats)?;
+            a.tips_break_even = Some(k);
+            full = Some((pattern, analysed));
+            k
+        }
+    };
+    if Scalar::from(since_factor) >= break_even {
+        // Factor every block from now on (same blocks, so `pattern` still serves
+        // the products).
+        let (full, analysed) = match full {
+            Some(f) => f,
+            None => (
+                Arc::new(BlockPattern::build(pattern.vertices(), elements, true)),
+                Factorization::default(),
+            ),
+        };
+        a.factor_tips = true;
+        a.pattern = Some(full.clone());
+        a.compensation.iter_mut().for_each(|m| *m = Matrix3::ZERO);
+        a.factorization = analysed;
+        refactor(a, &full, stats)?;
+        a.policy.factored(false);
+        return Ok(true);
+    }
+    Ok(false)
+}
+
+/// One conjugate-gradient step from `p` and `rz = r.z`: `A_s p`, then the update
+/// with `alpha = rz / p.A_s p`. Returns the new `r.z` and `r.r`; `None` when
+/// `p.A_s p` is not positive (the matrix is not positive definite).
+fn pcg_step(a: &mut DirectScratch, pattern: &BlockPattern, rz: Scalar) -> Option<(Scalar, Scalar)> {
+    pattern.multiply(&a.system, &a.p, &mut a.ap);
+    let pap = dot(&a.p, &a.ap);
+    if pap <= 0.0 || !pap.is_finite() {
+        return None;
+    }
+    let rz_new = pcg_update(a, rz / pap, rz);
+    Some((rz_new, dot(&a.r, &a.r)))
 }
 
 /// One conjugate-gradient update with step `alpha`: `y += alpha p`,
@@ -390,7 +422,7 @@ fn tips_break_even(
     pattern: &BlockPattern,
     elements: &Elements,
     factorization_cost: Scalar,
-    stats: &mut crate::physics::StepStats,
+    stats: &mut StepStats,
 ) -> Result<(Scalar, Arc<BlockPattern>, Factorization), SolveFailure> {
     let started = Instant::now();
     let full = Arc::new(BlockPattern::build(pattern.vertices(), elements, true));
@@ -409,7 +441,7 @@ fn tips_break_even(
 fn refactor(
     a: &mut DirectScratch,
     pattern: &BlockPattern,
-    stats: &mut crate::physics::StepStats,
+    stats: &mut StepStats,
 ) -> Result<(), SolveFailure> {
     let started = Instant::now();
     let map = |e: FactorError| match e {
