@@ -156,6 +156,30 @@ pub fn transfer(
             }
         }
     }
+    conserve_momentum(world, &old_mass, &new_mass, &kept, &old_index, &new.origin, &mut v);
+    let anchor_of = carry_pins(world, &old_index, &new);
+    // The only fallible step comes before the world changes, so a refused
+    // mesh leaves the world as it was.
+    let mesh = Mesh::from_parts(new.material, new.triangles, new.levels)?;
+    world.pins.anchors = anchor_of.into_iter().flatten().collect();
+    world.mesh = mesh;
+    world.x = x;
+    world.v = v;
+    Ok(new.origin)
+}
+
+/// Gives the momentum that the changed lumped masses took or added back as one
+/// common velocity change of the new vertices whose mass changed (module docs).
+/// `kept` and `old_index`: per old vertex, whether it survives and its new index.
+fn conserve_momentum(
+    world: &World,
+    old_mass: &[Scalar],
+    new_mass: &[Scalar],
+    kept: &[bool],
+    old_index: &[u32],
+    origin: &[Origin],
+    v: &mut [Vector],
+) {
     // Momentum of the region whose masses change, before and after.
     let mut before = Vector::ZERO;
     for (j, &k) in kept.iter().enumerate() {
@@ -165,8 +189,8 @@ pub fn transfer(
             before += world.v[j] * old_mass[j];
         }
     }
-    let affected: Vec<usize> = (0..n)
-        .filter(|&i| match new.origin[i] {
+    let affected: Vec<usize> = (0..origin.len())
+        .filter(|&i| match origin[i] {
             Origin::Old(j) => {
                 (new_mass[i] - old_mass[j as usize]).abs() > 1e-14 * old_mass[j as usize]
             }
@@ -181,9 +205,13 @@ pub fn transfer(
             v[i] += dv;
         }
     }
-    // Pins: kept vertices keep their anchor; a midpoint of two vertices held by the
-    // same pin is held by it too (pin regions are convex in material space).
-    let mut anchor_of: Vec<Option<Anchor>> = vec![None; n];
+}
+
+/// The pin anchor of each new vertex: kept vertices keep their anchor; a midpoint
+/// of two vertices held by the same pin is held by it too (pin regions are convex
+/// in material space).
+fn carry_pins(world: &World, old_index: &[u32], new: &Remeshed) -> Vec<Option<Anchor>> {
+    let mut anchor_of: Vec<Option<Anchor>> = vec![None; new.origin.len()];
     for a in &world.pins.anchors {
         let i = old_index[a.vertex as usize];
         if i != u32::MAX {
@@ -203,14 +231,7 @@ pub fn transfer(
             });
         }
     }
-    // The only fallible step comes before the world changes, so a refused
-    // mesh leaves the world as it was.
-    let mesh = Mesh::from_parts(new.material, new.triangles, new.levels)?;
-    world.pins.anchors = anchor_of.into_iter().flatten().collect();
-    world.mesh = mesh;
-    world.x = x;
-    world.v = v;
-    Ok(new.origin)
+    anchor_of
 }
 
 /// The order of the vertices of a compacted mesh.
