@@ -264,11 +264,6 @@ impl Soup {
         }
     }
 
-    /// Triangles at edge (a, b), ascending.
-    pub fn triangles_at(&self, a: u32, b: u32) -> Vec<u32> {
-        self.tris_at(a, b).to_vec()
-    }
-
     /// Triangles at edge (a, b), ascending, without allocating (two or fewer).
     pub(super) fn tris_at(&self, a: u32, b: u32) -> TriList {
         self.edge_tris

@@ -269,11 +269,6 @@ impl Collider {
         }));
     }
 
-    /// True when some obstacle moves.
-    pub fn any_moving(&self) -> bool {
-        self.bodies.iter().any(Body::is_moving)
-    }
-
     /// Stores the start-of-step state; call right before the integrator step.
     pub fn begin_step(&mut self, world: &World) {
         self.x0.clear();

@@ -98,11 +98,6 @@ impl SelfCollider {
         }
     }
 
-    /// Number of culling patches of the current mesh.
-    pub fn patch_count(&self) -> usize {
-        self.patches.len()
-    }
-
     fn prepare(&mut self, mesh: &Mesh) {
         if self.built_for == mesh.triangles {
             return;
