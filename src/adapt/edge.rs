@@ -22,13 +22,6 @@
 //! a refusal undoes the chain's committed splits through their inverses.
 //! The adapter then compacts the soup and transfers the state
 //! (`transfer.rs`).
-//!
-//! Issue 13, measured: before, a refused split left its chain's splits in
-//! the mesh and counted them. Making splits atomic changes the flag scene
-//! (the one scene on this method): 1 s of it made 2187 splits and 102
-//! collapses before and 2270 and 50 now. The same build with the undo
-//! switched off reproduced the old summary exactly, so atomicity is the whole
-//! difference.
 
 use crate::math::{Scalar, Vector2};
 
@@ -79,7 +72,7 @@ impl Soup {
     /// Longest-edge bisection of edge (a, b); returns the operations done.
     /// Refused (returns false) if a needed split would go past `max_level`,
     /// below `min_len`, or below `min_angle`. Atomic: a refused split undoes
-    /// the neighbour splits it did first and reports nothing (issue 13; see
+    /// the neighbour splits it did first and reports nothing (test
     /// `refused_edge_split_leaves_no_partial_work`).
     pub fn split(
         &mut self,

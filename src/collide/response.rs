@@ -56,12 +56,12 @@ pub(super) fn respond(
         // thickness out): all of it for a vertex that began the step there,
         // which static friction so holds in place, none for one that reached
         // it only at the end. Correcting the whole step for a vertex that
-        // landed within it moved it back along the surface after the implicit
-        // solve, where its neighbours did not see it: the springs around it
-        // stretched and the landing created energy that grew with the
-        // resolution (`drape_sphere` at 1/120 s steps without the energy
-        // retries: 0.44 J at 64 segments and 0.96 J at 96, of 3.77 J; test
-        // `energy::friction_moving_a_landing_vertex_back_created_energy`).
+        // landed within it would move it back along the surface after the
+        // implicit solve, where its neighbours do not see it: the springs
+        // around it would stretch and the landing create energy that grows
+        // with the resolution (`drape_sphere` at 1/120 s steps without the
+        // energy retries: 0.44 J at 64 segments and 0.96 J at 96, of 3.77 J;
+        // test `energy::a_sheet_landing_on_a_ball_gains_no_energy_at_full_steps`).
         // Within the contact margin counts as on it (resting cloth sits
         // exactly a thickness out, to rounding).
         let gap0 = start - thick * CONTACT_MARGIN;

@@ -41,26 +41,14 @@
 //! run. Sizes and counts, never clock time, so the choice is the same on every
 //! machine and thread count.
 //!
-//! Measured (2026-11-25, `hanging_sheet_rest` at uniform 128, its first 0.5 s,
-//! each factor forced in turn by a scratch build): `rho = 3.97`, break-even 24.8;
-//! a fresh reduced factor needs 11 to 14 iterations; a reduced factorization took
-//! 56 ms and an iteration 10.5 ms, a full one 327 ms and 28 ms, so the times put
-//! the break-even at about 28.5. The figures behind the rule, and what it changed
-//! on every benchmark scene, are in `docs/performance.md`, "Which factor".
-//!
-//! Before (until 2026-11-25) the solver switched to the full factor as soon as a
-//! fresh reduced one needed 10 iterations, whatever the sizes. A fabric at fine
-//! resolution crosses that: uniform 128 of `hanging_sheet_rest` switched at its
-//! first step and took 23.8 s for that 0.5 s against 13.6 s with the reduced
-//! factor, and its adaptive runs from base 64 (level 3) and 32 (level 5), whose
-//! fresh factors need 9 to 11 iterations, switched during the run: base 64's
-//! factor went from 1.01 to 4.56 million stored values at 5,635 vertices.
-//! Tried and dropped the same day: the factorization's flop count (`w^3 / 3 + r
-//! w^2 + r^2 w` per supernode of `w` columns and `r` rows below) instead of the
-//! stored values. Its ratio `phi` was 10.6 where the measured time ratio was 5.8
-//! (dense kernels run faster on the full factor's larger supernodes), which put
-//! the break-even `F (phi - 1) + rho` at 71 iterations; the stored values err
-//! the other way, towards switching early, as before.
+//! On `hanging_sheet_rest` at uniform 128, `rho = 3.97` puts the break-even at
+//! 24.8 iterations, and timing each factor puts it at about 28.5: the stored
+//! values are a fair proxy (`docs/performance.md`, "Which factor"). A fixed
+//! iteration threshold would not do: fine fabrics need 9 to 14 iterations with a
+//! fresh reduced factor and would switch to a full factor four times its size.
+//! The factorization's flop count is no better a proxy than the stored values:
+//! it overstates the full factor's cost (dense kernels run faster on its larger
+//! supernodes), by as much as the stored values understate it.
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -281,8 +269,13 @@ fn iterate(
                 }
             }
             if !fresh
-                && a.policy
-                    .give_up(factorization_cost, since_factor, restart_norm, rr.sqrt(), goal)
+                && a.policy.give_up(
+                    factorization_cost,
+                    since_factor,
+                    restart_norm,
+                    rr.sqrt(),
+                    goal,
+                )
             {
                 st.stats.solve_s += started.elapsed().as_secs_f64();
                 refactor(a, pattern, &mut st.stats)?;
