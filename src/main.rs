@@ -3,25 +3,25 @@
 use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
 
 use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
+use cli::bench::{BenchArgs, cmd_bench};
 use cli::run::cmd_run;
 use drape::record::inspect::inspect;
 use drape::scene::{Scene, default_scene, load_scene_file};
 
 /// The subcommands that have a file of their own.
 mod cli {
+    pub mod bench;
     pub mod run;
 }
 
 /// Adaptive mass-spring cloth simulation, recorded to Rerun .rrd files.
 #[derive(Parser)]
 #[command(name = "drape", version, about, long_about = None)]
-struct Cli {
+pub(crate) struct Cli {
     #[command(subcommand)]
     command: Command,
 }
@@ -36,7 +36,8 @@ enum Command {
     Inspect(InspectArgs),
     /// Speed against error: run a ladder of uniform and adaptive settings on a
     /// scene (no recording), compare each with a fine cached reference, and
-    /// write OUT/SCENE.csv, OUT/SCENE-frames.csv, OUT/SCENE.md and OUT/SCENE.svg.
+    /// write DIR/SCENE.csv, DIR/SCENE-frames.csv, DIR/SCENE.md and DIR/SCENE.svg;
+    /// `bench plan` writes the runs as a job list, `bench collect` reads them back.
     Bench(BenchArgs),
     /// Run the hard-case stability suite (scenes/hard/) and print a pass/fail table.
     Stability(StabilityArgs),
@@ -73,79 +74,6 @@ struct InspectArgs {
     /// frame's stepping time, summed at the end.
     #[arg(long)]
     frames: bool,
-}
-
-#[derive(Args)]
-struct BenchArgs {
-    /// Scene file (TOML).
-    scene: PathBuf,
-    /// Override a scene value for every run and the reference, e.g. `--set simulation.frame_rate=15` (repeatable).
-    #[arg(long = "set", value_name = "KEY=VALUE")]
-    overrides: Vec<String>,
-    /// Ladder file: `[[rung]]` tables with `label` and `set = ["key=value", ...]`, and optional `reference = [...]`, `compare` and `step` (default: a ladder built from the scene, see README).
-    #[arg(long, value_name = "FILE.toml")]
-    ladder: Option<PathBuf>,
-    /// Run the time-step ladder instead: one uniform mesh at the scene's step, 1/2 and 1/4 of it, against 1/32 of it (files SCENE-time.*).
-    #[arg(long, conflicts_with_all = ["ladder", "reference_resolution", "step", "mesh_floor", "pattern_floor"])]
-    time_ladder: bool,
-    /// What the error compares: `frames` (every recorded frame, mean; dynamic scenes) or `rest` (the last frame; quasi-static scenes). Default: the ladder's `compare`, else `frames`.
-    #[arg(long, value_name = "HOW")]
-    compare: Option<drape::bench::Compare>,
-    /// Which step the runs take: `common` (one fixed step for every run and the reference: the error is the mesh's) or `own` (each run's scene setting). Default: the ladder's `step`, else `common`.
-    #[arg(long, value_name = "POLICY")]
-    step: Option<drape::bench::StepPolicy>,
-    /// Run only these rungs of the ladder, by label (comma-separated).
-    #[arg(long, value_name = "LABEL,...", value_delimiter = ',')]
-    rungs: Vec<String>,
-    /// Print the ladder's rungs (labels and overrides) and exit.
-    #[arg(long)]
-    list: bool,
-    /// Redraw DIR/SCENE.svg from an existing DIR/SCENE.csv without running anything.
-    #[arg(long)]
-    replot: bool,
-    /// Repetitions of each run; the median wall time is reported.
-    #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
-    reps: u32,
-    /// Simulated time of every run and the reference, s (default: the scene's duration).
-    #[arg(long, value_name = "S")]
-    duration: Option<f64>,
-    /// Worker threads (default: one per core).
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
-    threads: Option<u32>,
-    /// Output directory.
-    #[arg(long, value_name = "DIR", default_value = "bench-out")]
-    out_dir: PathBuf,
-    /// Recompute the reference even if DIR/cache/ holds it (the new one is not cached).
-    #[arg(long)]
-    no_cache: bool,
-    /// Skip the lift floor: by default the reference is run a second time with the
-    /// cloth started 1 micrometre higher, and the report says how far that run ends
-    /// from the reference (errors closer than that are not told apart). A mesh floor
-    /// asked for with --mesh-floor is still measured.
-    #[arg(long)]
-    no_floor: bool,
-    /// Also run the reference's settings with `cloth.resolution = N` (a rectangle) and report
-    /// how far it ends from the reference: the mesh floor (errors closer than the
-    /// larger floor are not told apart). Choose N near the reference's resolution
-    /// with the pins, clamps, the sheet's centre and the lines under obstacles' edges on
-    /// the same grid lines (e.g. 98 for 96 where they lie on even lines; 112 on the
-    /// tablecloth, whose table edges lie on lines at multiples of 16); see README.
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(2..))]
-    mesh_floor: Option<u32>,
-    /// Also run the reference's settings with every grid square's diagonal turned
-    /// (`cloth.diagonals = "alternating_flipped"`; a rectangle with alternating diagonals)
-    /// and report how far it ends from the reference: the pattern floor, how far the
-    /// triangulation alone moves the result (errors closer than the larger floor are not
-    /// told apart); see README.
-    #[arg(long)]
-    pattern_floor: bool,
-    /// Segments of the reference's uniform mesh (default: 1.5 times the finest rung's, rounded up to even);
-    /// with a ladder that names its own `reference`, that reference's `cloth.resolution`.
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(2..))]
-    reference_resolution: Option<u32>,
-    /// Sample points per side of the material-space grid of the error metric.
-    #[arg(long, value_name = "N", default_value_t = 24, value_parser = clap::value_parser!(u32).range(1..=1000))]
-    samples: u32,
 }
 
 #[derive(Args)]
@@ -203,6 +131,14 @@ struct RunArgs {
     /// No progress bar.
     #[arg(long, short)]
     quiet: bool,
+    /// Sample the cloth at the material points in this file (a bench plan's
+    /// `points.json`) at every recorded frame; with --samples-out.
+    #[arg(long, value_name = "POINTS.json", requires = "samples_out")]
+    sample_at: Option<PathBuf>,
+    /// Write the samples and the run's cost here as JSON (what `drape bench
+    /// collect` reads; written also when the run stops on a numerical failure).
+    #[arg(long, value_name = "FILE.json", requires = "sample_at")]
+    samples_out: Option<PathBuf>,
 }
 
 fn main() -> ExitCode {
@@ -224,7 +160,7 @@ fn main() -> ExitCode {
 }
 
 /// Writes `text` to standard output. A closed pipe (`drape inspect F | head`,
-/// `drape bench --list | head`) ends the output quietly instead of panicking in
+/// `drape bench plan ... | head`) ends the output quietly instead of panicking in
 /// `print!` (regression test `inspect_into_a_closed_pipe_ends_quietly`); any other
 /// write error is an error.
 pub(crate) fn emit(text: &str) -> Result<()> {
@@ -335,63 +271,5 @@ fn cmd_inspect(args: InspectArgs) -> Result<ExitCode> {
         None if args.frames => emit(&inspection.frames_table())?,
         None => emit(&inspection.report())?,
     }
-    Ok(ExitCode::SUCCESS)
-}
-
-fn cmd_bench(args: BenchArgs) -> Result<ExitCode> {
-    use drape::bench::{BenchOptions, Ladder, bench};
-    let opts = BenchOptions {
-        scene: args.scene.clone(),
-        overrides: args.overrides.clone(),
-        ladder: match &args.ladder {
-            Some(path) => Some(Ladder::load(path)?),
-            None => None,
-        },
-        time_ladder: args.time_ladder,
-        rungs: args.rungs.clone(),
-        compare: args.compare,
-        step: args.step,
-        reps: args.reps as usize,
-        duration: args.duration,
-        threads: args.threads.map(|n| n as usize),
-        out_dir: args.out_dir.clone(),
-        cache: !args.no_cache,
-        reference_resolution: args.reference_resolution,
-        grid: args.samples as usize,
-        floor: !args.no_floor,
-        mesh_floor: args.mesh_floor,
-        pattern_floor: args.pattern_floor,
-    };
-    if args.list {
-        let mut text = String::new();
-        for r in &drape::bench::resolved_ladder(&opts)?.rung {
-            text.push_str(&format!("{}: {}\n", r.label, r.set.join(" ")));
-        }
-        emit(&text)?;
-        return Ok(ExitCode::SUCCESS);
-    }
-    if args.replot {
-        let name = load_scene_file(&args.scene, &args.overrides)?.name;
-        let stem = if args.time_ladder {
-            format!("{name}-time")
-        } else {
-            name
-        };
-        let svg = drape::bench::replot::replot(&args.out_dir, &stem)?;
-        emit(&format!("wrote {}\n", svg.display()))?;
-        return Ok(ExitCode::SUCCESS);
-    }
-    let interrupt = Arc::new(AtomicBool::new(false));
-    {
-        let flag = interrupt.clone();
-        ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed))
-            .context("installing the Ctrl-C handler")?;
-    }
-    let result = bench(&opts, &interrupt, &mut |line| eprintln!("{line}"))?;
-    let mut text = drape::bench::report::markdown(&result, &args.scene);
-    for f in &result.files {
-        text.push_str(&format!("wrote {}\n", f.display()));
-    }
-    emit(&text)?;
     Ok(ExitCode::SUCCESS)
 }

@@ -2,16 +2,17 @@
 //! error against wall time on log-log axes, uniform runs as blue circles,
 //! adaptive runs as orange squares, the Pareto front as a dashed staircase
 //! through ringed points; points are numbered, with the key of numbers to
-//! labels on the right. The floor (the largest of the lift, mesh and pattern
-//! floors that were measured), when within two decades of the smallest error,
-//! is a dotted grey line labelled "largest floor": errors closer together than
-//! it are not told apart by the comparison.
+//! labels on the right. The largest floor run's error, when within two
+//! decades of the smallest error, is a dotted grey line labelled "largest
+//! floor": errors closer together than it are not told apart by the
+//! comparison.
 
 use plotters::coord::Shift;
 use plotters::coord::combinators::WithKeyPoints;
 use plotters::prelude::*;
 
-use super::{BenchError, Compare, Row};
+use super::collect::Row;
+use super::{BenchError, Compare};
 
 const W: u32 = 900;
 const H: u32 = 520;
@@ -65,19 +66,23 @@ fn tick(v: f64) -> String {
     }
 }
 
-/// True when the row can be drawn on log axes.
+/// True when the row is a candidate that can be drawn on log axes.
 fn drawable(r: &Row) -> bool {
-    r.wall_s.is_finite() && r.wall_s > 0.0 && r.error.is_finite() && r.error > 0.0
+    !r.run.floor && r.wall_s.is_finite() && r.wall_s > 0.0 && r.error.is_finite() && r.error > 0.0
 }
 
-/// The chart of `rows` (wall time against the compared error in percent) as
-/// SVG text, titled `title`, with the largest measured floor `floor` (relative
-/// to the diagonal, compared like the rows' errors) when there is one.
-pub fn svg(title: &str, rows: &[Row], floor: Option<f64>) -> Result<String, BenchError> {
+/// The chart of `rows` (wall time against the error compared as `compare`,
+/// in percent) as SVG text, titled `title`.
+pub fn svg(title: &str, rows: &[Row], compare: Compare) -> Result<String, BenchError> {
+    let floor = rows
+        .iter()
+        .filter(|r| r.run.floor && r.error.is_finite())
+        .map(|r| r.error)
+        .reduce(f64::max);
     let mut out = String::new();
     {
         let root = SVGBackend::with_string(&mut out, (W, H)).into_drawing_area();
-        draw(&root, title, rows, floor).map_err(|e| BenchError::Chart(e.to_string()))?;
+        draw(&root, (title, compare), rows, floor).map_err(|e| BenchError::Chart(e.to_string()))?;
         root.present()
             .map_err(|e| BenchError::Chart(e.to_string()))?;
     }
@@ -97,13 +102,12 @@ type DrawResult = Result<(), DrawingAreaErrorKind<std::io::Error>>;
 
 fn draw(
     root: &DrawingArea<SVGBackend<'_>, Shift>,
-    title: &str,
+    (title, compare): (&str, Compare),
     rows: &[Row],
     floor: Option<f64>,
 ) -> DrawResult {
     root.fill(&WHITE)?;
     let (plot, key) = root.split_horizontally(W - KEY_W);
-    let point = |r: &Row| (r.wall_s, 100.0 * r.error);
     let ok: Vec<&Row> = rows.iter().filter(|r| drawable(r)).collect();
     let (x0, x1) = decades(ok.iter().map(|r| r.wall_s));
     // The floor widens the error axis when it is within two decades of the
@@ -117,16 +121,13 @@ fn draw(
         .filter(|f| f.is_finite() && *f > 0.0 && *f >= 1e-2 * smallest);
     let (y0, y1) = decades(ok.iter().map(|r| 100.0 * r.error).chain(floor));
     let mut chart = ChartBuilder::on(&plot)
-        .caption(
-            format!("{title}: error against wall time"),
-            ("sans-serif", 17),
-        )
+        .caption(title, ("sans-serif", 17))
         .margin(12)
         .x_label_area_size(45)
         .y_label_area_size(65)
         .build_cartesian_2d(log_axis(x0, x1), log_axis(y0, y1))?;
-    let y_desc = match rows.first().map(|r| r.compare) {
-        Some(Compare::Rest) => "error at rest, % of the diagonal (log)",
+    let y_desc = match compare {
+        Compare::Rest => "error at rest, % of the diagonal (log)",
         _ => "mean error, % of the diagonal (log)",
     };
     chart
@@ -158,7 +159,28 @@ fn draw(
                 )
             });
     }
-    // The Pareto front: a staircase through its points in order of cost.
+    draw_points(&mut chart, rows, &ok)?;
+    chart
+        .configure_series_labels()
+        // Lower left: a front runs from the upper left to the lower right, so
+        // that corner (fast and accurate at once) is the one that stays empty.
+        .position(SeriesLabelPosition::LowerLeft)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()?;
+    draw_key(&key, rows)
+}
+
+type Chart<'a, 'b> = ChartContext<
+    'a,
+    SVGBackend<'b>,
+    Cartesian2d<WithKeyPoints<LogCoord<f64>>, WithKeyPoints<LogCoord<f64>>>,
+>;
+
+/// The Pareto front (a staircase through its points in order of cost), the
+/// uniform and adaptive runs, and each point's number.
+fn draw_points(chart: &mut Chart<'_, '_>, rows: &[Row], ok: &[&Row]) -> DrawResult {
+    let point = |r: &Row| (r.wall_s, 100.0 * r.error);
     let mut front: Vec<&Row> = ok.iter().copied().filter(|r| r.pareto).collect();
     front.sort_by(|a, b| a.wall_s.total_cmp(&b.wall_s));
     let mut stair = Vec::new();
@@ -180,13 +202,13 @@ fn draw(
     chart
         .draw_series(
             ok.iter()
-                .filter(|r| !r.adaptive)
+                .filter(|r| !r.run.adaptive())
                 .map(|r| Circle::new(point(r), 5, UNIFORM.filled())),
         )?
         .label("uniform mesh")
         .legend(|(x, y)| Circle::new((x, y), 5, UNIFORM.filled()));
     chart
-        .draw_series(ok.iter().filter(|r| r.adaptive).map(|r| {
+        .draw_series(ok.iter().filter(|r| r.run.adaptive()).map(|r| {
             EmptyElement::at(point(r)) + Rectangle::new([(-4, -4), (5, 5)], ADAPTIVE.filled())
         }))?
         .label("adaptive")
@@ -200,24 +222,20 @@ fn draw(
                     + Text::new(format!("{}", n + 1), (7, -15), ("sans-serif", 11))
             }),
     )?;
-    chart
-        .configure_series_labels()
-        // Lower left: a front runs from the upper left to the lower right, so
-        // that corner (fast and accurate at once) is the one that stays empty.
-        .position(SeriesLabelPosition::LowerLeft)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .draw()?;
-    draw_key(&key, rows)
+    Ok(())
 }
 
 /// The key of point numbers to run labels.
 fn draw_key(key: &DrawingArea<SVGBackend<'_>, Shift>, rows: &[Row]) -> DrawResult {
     key.draw(&Text::new("runs", (10, 50), ("sans-serif", 13)))?;
     for (n, r) in rows.iter().enumerate() {
-        let failed = if drawable(r) { "" } else { " (not drawn)" };
+        let note = match (r.run.floor, drawable(r)) {
+            (true, _) => " (floor)",
+            (false, true) => "",
+            (false, false) => " (not drawn)",
+        };
         key.draw(&Text::new(
-            format!("{} {}{failed}", n + 1, r.label),
+            format!("{} {}{note}", n + 1, r.run.label),
             (10, 72 + 15 * n as i32),
             ("sans-serif", 11),
         ))?;

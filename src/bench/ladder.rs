@@ -1,7 +1,8 @@
 //! The ladder of a benchmark: the runs (rungs) to compare, each a list of
-//! `--set` overrides applied to the scene, and the reference run's overrides.
+//! `--set` overrides applied to the scene, the reference's overrides, and the
+//! time steps the runs take.
 //!
-//! A ladder file (`drape bench --ladder FILE.toml`) looks like
+//! A ladder file (`drape bench SCENE --ladder FILE.toml`) looks like
 //!
 //! ```toml
 //! reference = ["cloth.resolution=128"]  # optional: the reference's own overrides
@@ -15,18 +16,27 @@
 //! [[rung]]
 //! label = "red_green 16 L4"
 //! set = ["adapt.method=red_green", "cloth.resolution=16", "adapt.max_level=4"]
+//!
+//! [[rung]]                              # a sensitivity floor: another fine mesh
+//! label = "uniform 96"
+//! set = ["adapt.method=none", "cloth.resolution=96"]
+//! floor = true
 //! ```
 
 use std::path::Path;
 
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 use super::BenchError;
 use crate::math::Scalar;
-use crate::scene::{AdaptMethod, Integrator, Scene};
+use crate::physics::timestep::fit_to_frame;
+use crate::physics::{Model, Stepper};
+use crate::run::RunError;
+use crate::scene::{AdaptMethod, Integrator, Scene, TimeStep};
+use crate::world::World;
 
 /// What the error compares.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Compare {
     /// Every recorded frame against the reference's at the same time; the
@@ -71,11 +81,11 @@ impl std::str::FromStr for Compare {
 }
 
 /// Which time step the runs take.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum StepPolicy {
-    /// Every rung and the reference take one fixed step (the scene's fixed step,
-    /// the implicit automatic step, or the explicit automatic step of the
+    /// Every rung and the reference take one fixed step (the scene's fixed
+    /// step, the implicit automatic step, or the explicit automatic step of the
     /// reference's mesh, the finest of the benchmark): the error is the mesh's.
     Common,
     /// Every run takes its own scene setting (an automatic explicit step then
@@ -113,6 +123,23 @@ pub struct Rung {
     /// `--set` overrides applied to the scene (after the user's own).
     #[serde(default)]
     pub set: Vec<String>,
+    /// A sensitivity floor rather than a candidate: a run as fine as the
+    /// reference that differs from it in a way no setting resolves (another
+    /// fine mesh, turned diagonals, the cloth lifted 1 um). Its error is how
+    /// close two errors may be and still be told apart.
+    #[serde(default)]
+    pub floor: bool,
+}
+
+impl Rung {
+    /// A candidate rung.
+    pub fn new(label: impl Into<String>, set: Vec<String>) -> Rung {
+        Rung {
+            label: label.into(),
+            set,
+            floor: false,
+        }
+    }
 }
 
 /// The runs of a benchmark and, optionally, the reference's own overrides, the
@@ -120,7 +147,7 @@ pub struct Rung {
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Ladder {
-    /// Overrides of the reference run (`None`: [`reference_overrides`] decides).
+    /// Overrides of the reference run (`None`: [`reference_overrides`]).
     #[serde(default)]
     pub reference: Option<Vec<String>>,
     /// What the error compares (`None`: frame by frame, unless the command line says).
@@ -137,10 +164,7 @@ pub struct Ladder {
 impl Ladder {
     /// Reads a ladder file.
     pub fn load(path: &Path) -> Result<Ladder, BenchError> {
-        let text = std::fs::read_to_string(path).map_err(|source| BenchError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let text = std::fs::read_to_string(path).map_err(|e| BenchError::io(path, e))?;
         Ladder::parse(&text).map_err(|message| BenchError::Ladder {
             path: path.to_path_buf(),
             message,
@@ -153,6 +177,11 @@ impl Ladder {
         if ladder.rung.is_empty() {
             return Err("no `[[rung]]`: the ladder needs at least one run".into());
         }
+        let mut labels: Vec<&str> = ladder.rung.iter().map(|r| r.label.as_str()).collect();
+        labels.sort_unstable();
+        if let Some(w) = labels.windows(2).find(|w| w[0] == w[1]) {
+            return Err(format!("two rungs are labelled `{}`", w[0]));
+        }
         Ok(ladder)
     }
 
@@ -162,14 +191,10 @@ impl Ladder {
             .iter()
             .find(|l| !self.rung.iter().any(|r| &r.label == *l))
         {
+            let known: Vec<&str> = self.rung.iter().map(|r| r.label.as_str()).collect();
             return Err(BenchError::UnknownRung {
                 label: missing.clone(),
-                known: self
-                    .rung
-                    .iter()
-                    .map(|r| r.label.clone())
-                    .collect::<Vec<_>>()
-                    .join(", "),
+                known: known.join(", "),
             });
         }
         self.rung.retain(|r| labels.contains(&r.label));
@@ -177,21 +202,11 @@ impl Ladder {
     }
 }
 
-fn rung(label: String, set: &[String]) -> Rung {
-    Rung {
-        label,
-        set: set.to_vec(),
-    }
-}
-
 /// The default ladder for `scene`: uniform meshes of 16 to 64 segments, and
-/// adaptive runs whose finest edges match 32 or 64 segments, with the scene's
-/// remeshing method (red-green if it has none), the other method (edge for
-/// red-green, red-green for the edge and tensor methods), tighter and looser
-/// thresholds, and, for explicit integrators under [`StepPolicy::Own`] and
-/// other methods than tensor, multirate stepping (under a common fixed step it would only subdivide
-/// that step further: it is a choice of step, not of mesh).
-pub fn default_ladder(scene: &Scene, step: StepPolicy) -> Ladder {
+/// adaptive runs whose finest edges match 32 or 64 segments with the scene's
+/// remeshing method (red-green if it has none) and the other of red-green and
+/// edge.
+pub fn default_ladder(scene: &Scene) -> Ladder {
     let method = match scene.adapt.as_ref().map(|a| a.method) {
         Some(AdaptMethod::Edge) => "edge",
         Some(AdaptMethod::Tensor) => "tensor",
@@ -202,67 +217,37 @@ pub fn default_ladder(scene: &Scene, step: StepPolicy) -> Ladder {
     } else {
         "red_green"
     };
-    let mut rungs = Vec::new();
-    for res in [16, 32, 48, 64] {
-        rungs.push(rung(
-            format!("uniform {res}"),
-            &[
+    let mut rung: Vec<Rung> = [16, 32, 48, 64]
+        .iter()
+        .map(|res| {
+            let set = vec![
                 "adapt.method=none".into(),
                 format!("cloth.resolution={res}"),
-            ],
-        ));
-    }
-    let adaptive = |m: &str, res: u32, level: u32, extra: &[&str]| -> Vec<String> {
+            ];
+            Rung::new(format!("uniform {res}"), set)
+        })
+        .collect();
+    let adaptive = |m: &str, res: u32, level: u32| {
         let mut set = vec![
             format!("adapt.method={m}"),
             format!("cloth.resolution={res}"),
             format!("adapt.max_level={level}"),
         ];
         if m != "red_green" {
-            // Rollback is paper A's (red-green only).
+            // Rollback is paper A's, on red-green's hierarchy only.
             set.push("adapt.rollback=false".into());
         }
-        set.extend(extra.iter().map(|s| (*s).to_owned()));
-        set
+        Rung::new(format!("{m} {res} L{level}"), set)
     };
-    let tight = ["adapt.refine_angle=8.0", "adapt.coarsen_angle=0.8"];
-    let loose = ["adapt.refine_angle=25.0", "adapt.coarsen_angle=3.0"];
-    rungs.push(rung(
-        format!("{method} 16 L2"),
-        &adaptive(method, 16, 2, &[]),
-    ));
-    rungs.push(rung(
-        format!("{method} 16 L4"),
-        &adaptive(method, 16, 4, &[]),
-    ));
-    rungs.push(rung(
-        format!("{method} 32 L2"),
-        &adaptive(method, 32, 2, &[]),
-    ));
-    rungs.push(rung(
-        format!("{method} 16 L4 tight"),
-        &adaptive(method, 16, 4, &tight),
-    ));
-    rungs.push(rung(
-        format!("{method} 16 L4 loose"),
-        &adaptive(method, 16, 4, &loose),
-    ));
-    rungs.push(rung(format!("{other} 16 L4"), &adaptive(other, 16, 4, &[])));
-    // Multirate stepping is paper A's, on red-green's and the edge method's levels.
-    if scene.simulation.integrator != Integrator::Implicit
-        && step == StepPolicy::Own
-        && method != "tensor"
-    {
-        rungs.push(rung(
-            format!("{method} 16 L4 multirate"),
-            &adaptive(method, 16, 4, &["adapt.multirate=true"]),
-        ));
-    }
+    rung.push(adaptive(method, 16, 2));
+    rung.push(adaptive(method, 16, 4));
+    rung.push(adaptive(method, 32, 2));
+    rung.push(adaptive(other, 16, 4));
     Ladder {
         reference: None,
         compare: None,
         step: None,
-        rung: rungs,
+        rung,
     }
 }
 
@@ -279,14 +264,79 @@ pub fn finest_resolution(scene: &Scene) -> u32 {
 }
 
 /// The reference run's overrides: uniform, without multirate, `resolution`
-/// segments (the caller picks one finer than every rung). The step is not
-/// touched here: under [`StepPolicy::Common`] the caller sets one step for
-/// every run and the reference; under [`StepPolicy::Own`] the reference keeps
-/// the scene's setting.
+/// segments (finer than every rung). The step is set by the caller.
 pub fn reference_overrides(resolution: u32) -> Vec<String> {
     vec![
         "adapt.method=none".to_owned(),
         "adapt.multirate=false".to_owned(),
         format!("cloth.resolution={resolution}"),
     ]
+}
+
+/// The steps of the time-step ladder's rungs, as divisors of the scene's step.
+pub const TIME_LADDER_DIVISORS: [u32; 3] = [1, 2, 4];
+
+/// The time-step ladder's reference step, as a divisor of the scene's step: 8
+/// times below the smallest rung's, so that for a first-order integrator the
+/// reference's own error is about 1/8 of that rung's.
+pub const TIME_REFERENCE_DIVISOR: u32 = 32;
+
+/// The time-step ladder on one uniform mesh (the scene's resolution): rungs at
+/// `dt / k` for `k` in [`TIME_LADDER_DIVISORS`], the reference at
+/// `dt / TIME_REFERENCE_DIVISOR` on the same mesh. `dt` is the scene's step
+/// ([`scene_step`] of the uniform scene).
+pub fn time_ladder(dt: Scalar) -> Ladder {
+    let uniform = ["adapt.method=none", "adapt.multirate=false"].map(String::from);
+    let rung = TIME_LADDER_DIVISORS
+        .iter()
+        .map(|&k| {
+            let h = dt / Scalar::from(k);
+            let mut set = uniform.to_vec();
+            set.push(dt_override(h));
+            let label = match k {
+                1 => format!("dt {h:.3e}"),
+                _ => format!("dt/{k} {h:.3e}"),
+            };
+            Rung::new(label, set)
+        })
+        .collect();
+    let mut reference = uniform.to_vec();
+    reference.push(dt_override(dt / Scalar::from(TIME_REFERENCE_DIVISOR)));
+    Ladder {
+        reference: Some(reference),
+        compare: None,
+        step: Some(StepPolicy::Own),
+        rung,
+    }
+}
+
+/// The step `scene` takes, fitted to fill its frames exactly: its fixed step,
+/// or its automatic one on its initial mesh (the implicit integrator's cap, or
+/// the explicit integrators' stability estimate; without multirate).
+pub fn scene_step(scene: &Scene) -> Result<Scalar, BenchError> {
+    let target = match scene.simulation.dt {
+        TimeStep::Fixed(dt) => dt,
+        TimeStep::Auto => {
+            let world = World::from_scene(scene).map_err(RunError::from)?;
+            let model = Model::from_scene(scene);
+            let mut stepper = Stepper::new(&model, &world);
+            stepper.multirate = false;
+            stepper.auto_dt(&model, &world)
+        }
+    };
+    Ok(fit_to_frame(target, scene.simulation.frame_interval()).1)
+}
+
+/// How `scene` sets its step, in words (for the report).
+pub fn step_origin(scene: &Scene) -> &'static str {
+    match (scene.simulation.dt, scene.simulation.integrator) {
+        (TimeStep::Fixed(_), _) => "the scene's fixed step",
+        (TimeStep::Auto, Integrator::Implicit) => "the implicit integrator's automatic step",
+        (TimeStep::Auto, _) => "the explicit stability estimate on the reference's mesh",
+    }
+}
+
+/// The override that sets a step, in a form that reads back to the same number.
+pub fn dt_override(dt: Scalar) -> String {
+    format!("simulation.dt={dt:e}")
 }

@@ -1,17 +1,48 @@
-//! Running a scene while sampling the cloth at fixed material points every
-//! recorded frame (the input of the error metric).
+//! A sampled run: the cloth's world positions at fixed material points at
+//! every recorded frame (the input of the error metric), with the run's
+//! cost. This is what one bench job writes (`drape run --sample-at POINTS.json
+//! --samples-out FILE.json`) and what the collector reads.
 
+use std::path::Path;
 use std::sync::atomic::AtomicBool;
-use std::time::Instant;
+use std::time::{Instant, SystemTime, UNIX_EPOCH};
 
 use serde::{Deserialize, Serialize};
 
-use super::metric::{locate, relative_offset, relative_rms, sample_positions};
+use super::BenchError;
+use super::metric::{locate, relative_rms, sample_positions};
 use crate::math::{Scalar, Vector, Vector2};
 use crate::mesh::Mesh;
-use crate::run::{FrameState, Progress, RunError, RunOptions, run_observed};
+use crate::run::{FrameState, RunError, RunOptions, run_observed};
 use crate::scene::Scene;
 use crate::summary::Summary;
+
+/// The format tag of a samples file; the collector refuses any other.
+pub const SAMPLES_FORMAT: &str = "drape-samples-1";
+
+/// The material points a job samples (`points.json` of a plan).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SamplePoints {
+    /// Material coordinates of each point, m.
+    pub points: Vec<[Scalar; 2]>,
+    /// The cloth's diagonal in material space, m (the error's scale).
+    pub diagonal: Scalar,
+}
+
+impl SamplePoints {
+    /// Reads a points file.
+    pub fn load(path: &Path) -> Result<SamplePoints, BenchError> {
+        read_json(path)
+    }
+
+    /// The points as vectors.
+    pub fn vectors(&self) -> Vec<Vector2> {
+        self.points
+            .iter()
+            .map(|p| Vector2::from_array(*p))
+            .collect()
+    }
+}
 
 /// The world positions of the sample points at one recorded frame.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -24,56 +55,157 @@ pub struct FrameSamples {
     pub positions: Vec<Option<[Scalar; 3]>>,
 }
 
-/// A run's outcome with its samples.
-#[derive(Debug, Clone)]
-pub struct SampledRun {
-    /// The run's summary (also for a run that failed numerically).
-    pub summary: Summary,
-    /// Samples of every frame done.
-    pub frames: Vec<FrameSamples>,
-    /// Wall time spent sampling (to subtract from the run's wall time), s.
-    pub sampling_s: Scalar,
+/// One sampled run: what a bench job writes.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Samples {
+    /// [`SAMPLES_FORMAT`].
+    pub format: String,
+    /// drape's version.
+    pub version: String,
+    /// The scene's `--set` overrides, in order (the collector checks them
+    /// against the job's).
+    pub overrides: Vec<String>,
+    /// `--threads` (`None`: one per core).
+    pub threads: Option<usize>,
+    /// The cloth's diagonal in material space, m (from the points file).
+    pub diagonal: Scalar,
+    /// The machine's cores as the run saw them.
+    pub cores: usize,
+    /// When the run started and finished, seconds since the Unix epoch (the
+    /// collector finds jobs that ran at the same time).
+    pub started: Scalar,
+    /// See `started`.
+    pub finished: Scalar,
+    /// Wall time of the run without its sampling, s.
+    pub wall_s: Scalar,
+    /// Steps taken.
+    pub steps: u64,
+    /// The smallest step, s.
+    pub dt: Scalar,
+    /// Mean vertices over the recorded frames.
+    pub mean_vertices: Scalar,
+    /// Peak vertices.
+    pub peak_vertices: Scalar,
     /// The numerical failure that stopped the run early, if any.
     pub failure: Option<String>,
+    /// Samples of every frame done.
+    pub frames: Vec<FrameSamples>,
 }
 
-/// Runs `scene` without recording, sampling `points` (material coordinates)
-/// at every recorded frame.
+impl Samples {
+    /// Reads a samples file, refusing another format.
+    pub fn load(path: &Path) -> Result<Samples, BenchError> {
+        let s: Samples = read_json(path)?;
+        if s.format != SAMPLES_FORMAT {
+            return Err(BenchError::Invalid {
+                path: path.to_path_buf(),
+                message: format!("format `{}`, expected `{SAMPLES_FORMAT}`", s.format),
+            });
+        }
+        Ok(s)
+    }
+
+    /// Writes the file (creating its directory).
+    pub fn store(&self, path: &Path) -> Result<(), BenchError> {
+        write_json(path, self)
+    }
+}
+
+/// Runs `scene` (loaded with `overrides`) without recording unless `opts`
+/// says, sampling `points` at every recorded frame. A numerical failure is a
+/// result (`failure`), not an error.
 pub fn sampled_run(
     scene: &Scene,
+    overrides: &[String],
     opts: &RunOptions,
-    points: &[Vector2],
+    points: &SamplePoints,
     interrupt: &AtomicBool,
-) -> Result<SampledRun, RunError> {
+) -> Result<Samples, RunError> {
+    let at = points.vectors();
     let mut frames = Vec::new();
     let mut sampling_s = 0.0;
     let mut observe = |f: &FrameState| {
         let t0 = Instant::now();
-        frames.push(sample_frame(f, points));
+        frames.push(sample_frame(f, &at));
         sampling_s += t0.elapsed().as_secs_f64();
     };
-    let outcome = run_observed(scene, opts, interrupt, &mut |_: Progress| {}, &mut observe);
+    let started = unix_now();
+    let outcome = run_observed(scene, opts, interrupt, &mut |_| {}, &mut observe);
+    let job = JobContext {
+        overrides,
+        threads: opts.threads,
+        diagonal: points.diagonal,
+        started,
+        sampling_s,
+    };
     let (summary, failure) = match outcome {
         Ok(s) => (s, None),
-        Err(RunError::Numerical {
-            frame,
-            time,
-            summary,
-            ..
-        }) => (
-            *summary,
-            Some(format!(
-                "numerical failure in frame {frame} (t = {time:.3} s)"
-            )),
-        ),
-        Err(e) => return Err(e),
+        Err(e) => match (numerical_failure(&e), e) {
+            (Some(text), RunError::Numerical { summary, .. }) => (*summary, Some(text)),
+            (_, e) => return Err(e),
+        },
     };
-    Ok(SampledRun {
-        summary,
-        frames,
-        sampling_s,
+    Ok(samples_of(&summary, failure, &job, frames))
+}
+
+/// A numerical failure in words (the samples file's `failure`); `None` for
+/// any other error.
+pub fn numerical_failure(e: &RunError) -> Option<String> {
+    match e {
+        RunError::Numerical { frame, time, .. } => Some(format!(
+            "numerical failure in frame {frame} (t = {time:.3} s)"
+        )),
+        _ => None,
+    }
+}
+
+/// How a sampled run was started, for its samples file.
+#[derive(Debug, Clone, Copy)]
+pub struct JobContext<'a> {
+    /// The scene's `--set` overrides.
+    pub overrides: &'a [String],
+    /// `--threads` (`None`: one per core).
+    pub threads: Option<usize>,
+    /// The points file's diagonal, m.
+    pub diagonal: Scalar,
+    /// When the run started, seconds since the Unix epoch.
+    pub started: Scalar,
+    /// Wall time spent sampling, s (taken out of the run's).
+    pub sampling_s: Scalar,
+}
+
+/// The samples file of a run: its summary, its numerical failure, how it
+/// was started and its frames.
+pub fn samples_of(
+    summary: &Summary,
+    failure: Option<String>,
+    job: &JobContext,
+    frames: Vec<FrameSamples>,
+) -> Samples {
+    Samples {
+        format: SAMPLES_FORMAT.to_owned(),
+        version: env!("CARGO_PKG_VERSION").to_owned(),
+        overrides: job.overrides.to_vec(),
+        threads: job.threads,
+        diagonal: job.diagonal,
+        cores: std::thread::available_parallelism().map_or(1, usize::from),
+        started: job.started,
+        finished: unix_now(),
+        wall_s: summary.wall_time_s - job.sampling_s,
+        steps: summary.steps,
+        dt: summary.dt,
+        mean_vertices: summary.vertices.mean,
+        peak_vertices: summary.vertices.max,
         failure,
-    })
+        frames,
+    }
+}
+
+/// Seconds since the Unix epoch.
+pub fn unix_now() -> Scalar {
+    SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .map_or(0.0, |d| d.as_secs_f64())
 }
 
 /// Samples one frame: locates the points in the frame's mesh by material
@@ -85,15 +217,9 @@ pub fn sample_frame(f: &FrameState, points: &[Vector2]) -> FrameSamples {
         levels: Vec::new(),
         edges: Vec::new(),
     };
-    let located = locate(&mesh, points);
-    let positions = located
+    let positions = locate(&mesh, points)
         .iter()
-        .map(|l| {
-            l.map(|l| {
-                let p = sample_positions(&mesh, f.positions, &[l])[0];
-                p.to_array()
-            })
-        })
+        .map(|l| l.map(|l| sample_positions(&mesh, f.positions, &[l])[0].to_array()))
         .collect();
     FrameSamples {
         frame: f.frame,
@@ -129,17 +255,6 @@ pub fn frame_error(
     matched(run, reference).map(|(a, b)| relative_rms(&a, &b, diagonal))
 }
 
-/// The offset of one frame against the reference's frame
-/// ([`super::metric::relative_offset`] over the samples found in both), with the
-/// same conditions as [`frame_error`].
-pub fn frame_offset(
-    run: &FrameSamples,
-    reference: &FrameSamples,
-    diagonal: Scalar,
-) -> Option<Scalar> {
-    matched(run, reference).map(|(a, b)| relative_offset(&a, &b, diagonal))
-}
-
 /// Per-frame errors of a run against the reference (matched by frame index;
 /// frames without a counterpart are left out), as `(time, error)`.
 pub fn run_errors(
@@ -161,54 +276,27 @@ pub fn last_frame_motion(frames: &[FrameSamples], diagonal: Scalar) -> Option<Sc
     let [.., a, b] = frames else {
         return None;
     };
-    let (p, q): (Vec<Vector>, Vec<Vector>) = a
-        .positions
-        .iter()
-        .zip(&b.positions)
-        .filter_map(|(p, q)| Some((Vector::from_array((*p)?), Vector::from_array((*q)?))))
-        .unzip();
-    (!p.is_empty()).then(|| relative_rms(&p, &q, diagonal))
+    let b = FrameSamples {
+        time: a.time,
+        ..b.clone()
+    };
+    frame_error(&b, a, diagonal)
 }
 
-/// Each sample point's error against the reference, relative to the diagonal:
-/// its distance from the reference's sample at the last frame (`at_rest`), or
-/// the RMS of that distance over the frames matched by number and time
-/// (otherwise); `NaN` for a point that no pair of frames holds in both. Where
-/// the error of [`run_errors`] is, for `drape bench`'s `SCENE-samples.csv`.
-pub fn sample_errors(
-    run: &[FrameSamples],
-    reference: &[FrameSamples],
-    diagonal: Scalar,
-    at_rest: bool,
-) -> Vec<Scalar> {
-    let n = reference.first().map_or(0, |r| r.positions.len());
-    let same_time = |a: &FrameSamples, b: &FrameSamples| {
-        a.frame == b.frame && (a.time - b.time).abs() <= 1e-9 * b.time.abs().max(1.0)
-    };
-    let pairs: Vec<(&FrameSamples, &FrameSamples)> = if at_rest {
-        run.last().zip(reference.last()).into_iter().collect()
-    } else {
-        run.iter()
-            .filter_map(|f| Some((f, reference.iter().find(|r| r.frame == f.frame)?)))
-            .collect()
-    };
-    let pairs: Vec<_> = pairs.into_iter().filter(|(a, b)| same_time(a, b)).collect();
-    (0..n)
-        .map(|i| {
-            let (mut sum, mut count) = (0.0, 0usize);
-            for (a, b) in &pairs {
-                let p = a.positions.get(i).copied().flatten();
-                let q = b.positions.get(i).copied().flatten();
-                if let (Some(p), Some(q)) = (p, q) {
-                    sum += Vector::from_array(p).distance_squared(Vector::from_array(q));
-                    count += 1;
-                }
-            }
-            if count == 0 {
-                Scalar::NAN
-            } else {
-                (sum / count as Scalar).sqrt() / diagonal
-            }
-        })
-        .collect()
+/// Reads a JSON file into `T`.
+pub(super) fn read_json<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T, BenchError> {
+    let text = std::fs::read_to_string(path).map_err(|e| BenchError::io(path, e))?;
+    serde_json::from_str(&text).map_err(|e| BenchError::Invalid {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    })
+}
+
+/// Writes `value` as JSON to `path`, creating its directory.
+pub(super) fn write_json<T: Serialize>(path: &Path, value: &T) -> Result<(), BenchError> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|e| BenchError::io(dir, e))?;
+    }
+    let text = serde_json::to_string(value).map_err(|e| BenchError::io(path, e.into()))?;
+    std::fs::write(path, text).map_err(|e| BenchError::io(path, e))
 }

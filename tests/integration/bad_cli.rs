@@ -107,18 +107,22 @@ fn command_line_usage_errors_exit_2() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// Regression: `drape bench --list | head` panicked ("failed printing to
+/// Regression: a listing piped into `head` panicked ("failed printing to
 /// stdout: Broken pipe", exit 101) when the reader closed the pipe early. The
 /// read end is closed here before drape writes anything.
 #[test]
-fn bench_list_into_a_closed_pipe_does_not_panic() {
+fn bench_plan_into_a_closed_pipe_does_not_panic() {
+    let out_dir = std::env::temp_dir().join(format!("drape-closed-pipe-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out_dir);
     let scene = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cantilever.toml");
     let ladder =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/bench/cantilever.toml");
     let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_drape"))
-        .args(["bench", "--list", "--ladder"])
+        .args(["bench", "plan", "--ladder"])
         .arg(&ladder)
         .arg(&scene)
+        .arg("--out")
+        .arg(&out_dir)
         .stdout(std::process::Stdio::piped())
         .stderr(std::process::Stdio::piped())
         .spawn()
@@ -128,4 +132,5 @@ fn bench_list_into_a_closed_pipe_does_not_panic() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(0), "stderr: {stderr}");
     assert!(!stderr.contains("panicked"), "stderr: {stderr}");
+    std::fs::remove_dir_all(&out_dir).ok();
 }
