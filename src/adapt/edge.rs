@@ -401,12 +401,7 @@ impl Soup {
 
     /// The triangles at `v` but not at `u`, each with its corners after `v`
     /// moves onto `u`; `None` when one would invert or fall below `min_angle`.
-    fn moved_triangles(
-        &self,
-        v: u32,
-        u: u32,
-        limits: &Limits,
-    ) -> Option<Vec<Moved>> {
+    fn moved_triangles(&self, v: u32, u: u32, limits: &Limits) -> Option<Vec<Moved>> {
         let mut replaced = Vec::new();
         for &t in &self.vert_tris[v as usize] {
             let Some(tri) = self.tris[t as usize] else {
