@@ -111,6 +111,23 @@ pub enum SolveFailure {
     Setup,
 }
 
+impl SolveFailure {
+    /// A linear solve stopped after `iterations` at residual norm `norm`, above
+    /// `tolerance` relative to `reference`.
+    fn not_converged(
+        iterations: u32,
+        norm: Scalar,
+        reference: Scalar,
+        tolerance: Scalar,
+    ) -> SolveFailure {
+        SolveFailure::NotConverged {
+            iterations,
+            residual: norm / reference.max(Scalar::MIN_POSITIVE),
+            tolerance,
+        }
+    }
+}
+
 /// Scratch memory of the implicit step, kept between steps.
 #[derive(Debug, Default, Clone)]
 pub struct ImplicitScratch {

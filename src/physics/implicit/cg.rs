@@ -42,11 +42,12 @@ pub(super) fn solve(
             break Ok(());
         }
         if iterations >= model.cg_max_iterations {
-            break Err(SolveFailure::NotConverged {
+            break Err(SolveFailure::not_converged(
                 iterations,
-                residual: rr.sqrt() / reference.max(Scalar::MIN_POSITIVE),
+                rr.sqrt(),
+                reference,
                 tolerance,
-            });
+            ));
         }
         apply_operator(st, Which::Direction, held, true);
         let s = &mut st.implicit;

@@ -242,15 +242,13 @@ fn iterate(
         let (mut rz, mut rr) = pcg_start(a, &mut st.stats);
         let restart_norm = rr.sqrt();
         loop {
-            if rr.sqrt() <= goal {
+            let norm = rr.sqrt();
+            if norm <= goal {
                 break 'restart Ok(());
             }
             if since_factor >= cap {
-                break 'restart Err(SolveFailure::NotConverged {
-                    iterations: total,
-                    residual: rr.sqrt() / reference.max(Scalar::MIN_POSITIVE),
-                    tolerance,
-                });
+                let failure = SolveFailure::not_converged(total, norm, reference, tolerance);
+                break 'restart Err(failure);
             }
             if fresh && since_factor >= TIPS_CONSIDER && !a.factor_tips {
                 st.stats.solve_s += started.elapsed().as_secs_f64();
@@ -269,13 +267,8 @@ fn iterate(
                 }
             }
             if !fresh
-                && a.policy.give_up(
-                    factorization_cost,
-                    since_factor,
-                    restart_norm,
-                    rr.sqrt(),
-                    goal,
-                )
+                && a.policy
+                    .give_up(factorization_cost, since_factor, restart_norm, norm, goal)
             {
                 st.stats.solve_s += started.elapsed().as_secs_f64();
                 refactor(a, pattern, &mut st.stats)?;
