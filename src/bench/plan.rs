@@ -151,6 +151,12 @@ impl Plan {
     /// Reads `DIR/plan.json`.
     pub fn load(dir: &Path) -> Result<Plan, BenchError> {
         let path = dir.join(PLAN_FILE);
+        if !path.is_file() {
+            return Err(BenchError::Plan(format!(
+                "{} is not a bench directory (it has no {PLAN_FILE}; `drape bench plan` makes one)",
+                dir.display()
+            )));
+        }
         let plan: Plan = read_json(&path)?;
         if plan.format != PLAN_FORMAT {
             let message = format!("format `{}`, expected `{PLAN_FORMAT}`", plan.format);

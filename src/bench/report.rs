@@ -86,11 +86,17 @@ pub fn frames_csv(result: &BenchResult) -> String {
     out
 }
 
-/// A relative error in percent with three significant digits.
+/// A relative error in percent with three significant digits (`-` for `NaN`).
 pub fn percent(e: Scalar) -> String {
-    match e.is_finite() {
-        true => format!("{:.3e} %", e * 100.0),
-        false => "-".to_owned(),
+    let p = e * 100.0;
+    match p.abs() {
+        x if !x.is_finite() => "-".to_owned(),
+        0.0 => "0 %".to_owned(),
+        x if (1e-3..1e3).contains(&x) => {
+            let decimals = (2 - x.log10().floor() as i32).max(0) as usize;
+            format!("{p:.decimals$} %")
+        }
+        _ => format!("{p:.2e} %"),
     }
 }
 

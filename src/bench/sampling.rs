@@ -111,9 +111,82 @@ impl Samples {
     }
 }
 
-/// Runs `scene` (loaded with `overrides`) without recording unless `opts`
-/// says, sampling `points` at every recorded frame. A numerical failure is a
-/// result (`failure`), not an error.
+/// Samples a run at every recorded frame ([`Sampler::observe`] is the run's
+/// frame observer) and makes its samples file ([`Sampler::finish`]).
+#[derive(Debug)]
+pub struct Sampler<'a> {
+    points: &'a SamplePoints,
+    at: Vec<Vector2>,
+    frames: Vec<FrameSamples>,
+    sampling_s: Scalar,
+    started: Scalar,
+}
+
+impl<'a> Sampler<'a> {
+    /// A sampler of `points`; the run starts now.
+    pub fn new(points: &'a SamplePoints) -> Sampler<'a> {
+        Sampler {
+            points,
+            at: points.vectors(),
+            frames: Vec::new(),
+            sampling_s: 0.0,
+            started: unix_now(),
+        }
+    }
+
+    /// Samples one recorded frame (its time is taken out of the run's).
+    pub fn observe(&mut self, f: &FrameState) {
+        let t0 = Instant::now();
+        self.frames.push(sample_frame(f, &self.at));
+        self.sampling_s += t0.elapsed().as_secs_f64();
+    }
+
+    /// The samples file of a run with `overrides` and `threads` that ended
+    /// (`Ok`) or stopped on a numerical failure (a result, in `failure`);
+    /// `None` for any other error, which leaves no summary.
+    pub fn finish(
+        self,
+        outcome: &Result<Summary, RunError>,
+        overrides: &[String],
+        threads: Option<usize>,
+    ) -> Option<Samples> {
+        let (summary, failure) = match outcome {
+            Ok(s) => (s, None),
+            Err(RunError::Numerical {
+                frame,
+                time,
+                summary,
+                ..
+            }) => (
+                summary.as_ref(),
+                Some(format!(
+                    "numerical failure in frame {frame} (t = {time:.3} s)"
+                )),
+            ),
+            Err(_) => return None,
+        };
+        Some(Samples {
+            format: SAMPLES_FORMAT.to_owned(),
+            version: env!("CARGO_PKG_VERSION").to_owned(),
+            overrides: overrides.to_vec(),
+            threads,
+            diagonal: self.points.diagonal,
+            cores: std::thread::available_parallelism().map_or(1, usize::from),
+            started: self.started,
+            finished: unix_now(),
+            wall_s: summary.wall_time_s - self.sampling_s,
+            steps: summary.steps,
+            dt: summary.dt,
+            mean_vertices: summary.vertices.mean,
+            peak_vertices: summary.vertices.max,
+            failure,
+            frames: self.frames,
+        })
+    }
+}
+
+/// Runs `scene` (loaded with `overrides`) as `opts` say, sampling `points`
+/// at every recorded frame. A numerical failure is a result, not an error.
 pub fn sampled_run(
     scene: &Scene,
     overrides: &[String],
@@ -121,88 +194,19 @@ pub fn sampled_run(
     points: &SamplePoints,
     interrupt: &AtomicBool,
 ) -> Result<Samples, RunError> {
-    let at = points.vectors();
-    let mut frames = Vec::new();
-    let mut sampling_s = 0.0;
-    let mut observe = |f: &FrameState| {
-        let t0 = Instant::now();
-        frames.push(sample_frame(f, &at));
-        sampling_s += t0.elapsed().as_secs_f64();
-    };
-    let started = unix_now();
-    let outcome = run_observed(scene, opts, interrupt, &mut |_| {}, &mut observe);
-    let job = JobContext {
-        overrides,
-        threads: opts.threads,
-        diagonal: points.diagonal,
-        started,
-        sampling_s,
-    };
-    let (summary, failure) = match outcome {
-        Ok(s) => (s, None),
-        Err(e) => match (numerical_failure(&e), e) {
-            (Some(text), RunError::Numerical { summary, .. }) => (*summary, Some(text)),
-            (_, e) => return Err(e),
-        },
-    };
-    Ok(samples_of(&summary, failure, &job, frames))
-}
-
-/// A numerical failure in words (the samples file's `failure`); `None` for
-/// any other error.
-pub fn numerical_failure(e: &RunError) -> Option<String> {
-    match e {
-        RunError::Numerical { frame, time, .. } => Some(format!(
-            "numerical failure in frame {frame} (t = {time:.3} s)"
-        )),
-        _ => None,
-    }
-}
-
-/// How a sampled run was started, for its samples file.
-#[derive(Debug, Clone, Copy)]
-pub struct JobContext<'a> {
-    /// The scene's `--set` overrides.
-    pub overrides: &'a [String],
-    /// `--threads` (`None`: one per core).
-    pub threads: Option<usize>,
-    /// The points file's diagonal, m.
-    pub diagonal: Scalar,
-    /// When the run started, seconds since the Unix epoch.
-    pub started: Scalar,
-    /// Wall time spent sampling, s (taken out of the run's).
-    pub sampling_s: Scalar,
-}
-
-/// The samples file of a run: its summary, its numerical failure, how it
-/// was started and its frames.
-pub fn samples_of(
-    summary: &Summary,
-    failure: Option<String>,
-    job: &JobContext,
-    frames: Vec<FrameSamples>,
-) -> Samples {
-    Samples {
-        format: SAMPLES_FORMAT.to_owned(),
-        version: env!("CARGO_PKG_VERSION").to_owned(),
-        overrides: job.overrides.to_vec(),
-        threads: job.threads,
-        diagonal: job.diagonal,
-        cores: std::thread::available_parallelism().map_or(1, usize::from),
-        started: job.started,
-        finished: unix_now(),
-        wall_s: summary.wall_time_s - job.sampling_s,
-        steps: summary.steps,
-        dt: summary.dt,
-        mean_vertices: summary.vertices.mean,
-        peak_vertices: summary.vertices.max,
-        failure,
-        frames,
+    let mut sampler = Sampler::new(points);
+    let outcome = run_observed(scene, opts, interrupt, &mut |_| {}, &mut |f| {
+        sampler.observe(f)
+    });
+    match (sampler.finish(&outcome, overrides, opts.threads), outcome) {
+        (Some(samples), _) => Ok(samples),
+        (None, Err(e)) => Err(e),
+        (None, Ok(_)) => unreachable!("a run that ended has a summary"),
     }
 }
 
 /// Seconds since the Unix epoch.
-pub fn unix_now() -> Scalar {
+fn unix_now() -> Scalar {
     SystemTime::now()
         .duration_since(UNIX_EPOCH)
         .map_or(0.0, |d| d.as_secs_f64())

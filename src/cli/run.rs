@@ -5,15 +5,12 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::Instant;
 
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::{EdgeChoice, RunArgs, load};
-use drape::bench::sampling::{
-    JobContext, SamplePoints, numerical_failure, sample_frame, samples_of, unix_now,
-};
+use drape::bench::sampling::{SamplePoints, Sampler};
 use drape::record::{EdgeDisplay, LiveViewer};
 use drape::run::{FrameState, Progress, RunError, RunOptions, run_built};
 use drape::scene::Scene;
@@ -53,16 +50,12 @@ pub fn cmd_run(args: RunArgs) -> Result<ExitCode> {
         bar.set_position(p.frame);
         bar.set_message(format!("t = {:.2} s", p.sim_time));
     };
-    let at = points.as_ref().map(SamplePoints::vectors);
-    let (mut frames, mut sampling_s) = (Vec::new(), 0.0);
+    let mut sampler = points.as_ref().map(Sampler::new);
     let mut observe = |f: &FrameState| {
-        if let Some(at) = &at {
-            let t0 = Instant::now();
-            frames.push(sample_frame(f, at));
-            sampling_s += t0.elapsed().as_secs_f64();
+        if let Some(s) = &mut sampler {
+            s.observe(f);
         }
     };
-    let started = unix_now();
     let outcome = run_built(
         &scene,
         sim,
@@ -72,24 +65,9 @@ pub fn cmd_run(args: RunArgs) -> Result<ExitCode> {
         &mut observe,
     );
     bar.finish_and_clear();
-    if let (Some(points), Some(path)) = (&points, &args.samples_out) {
-        let job = JobContext {
-            overrides: &args.scene.overrides,
-            threads: opts.threads,
-            diagonal: points.diagonal,
-            started,
-            sampling_s,
-        };
-        let parts = match &outcome {
-            Ok(s) => Some((s, None)),
-            Err(e @ RunError::Numerical { summary, .. }) => {
-                Some((summary.as_ref(), numerical_failure(e)))
-            }
-            Err(_) => None,
-        };
-        if let Some((summary, failure)) = parts {
-            samples_of(summary, failure, &job, frames).store(path)?;
-        }
+    let samples = sampler.and_then(|s| s.finish(&outcome, &args.scene.overrides, opts.threads));
+    if let (Some(samples), Some(path)) = (samples, &args.samples_out) {
+        samples.store(path)?;
     }
     report_outcome(outcome, args.summary.as_deref(), summary_file)
 }

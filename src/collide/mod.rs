@@ -234,12 +234,14 @@ impl Collider {
         !self.bodies.is_empty()
     }
 
-    /// Every obstacle triangulated at time `t`, in world coordinates.
-    pub fn obstacle_meshes(&self, t: Scalar) -> Vec<ObstacleMesh> {
+    /// Every obstacle triangulated at time `t`, in world coordinates; planes
+    /// as a square of half side `plane.1` around `plane.0` (see
+    /// [`obstacle::Body::world_triangles`]).
+    pub fn obstacle_meshes(&self, t: Scalar, plane: (Vector, Scalar)) -> Vec<ObstacleMesh> {
         self.bodies
             .iter()
             .map(|b| {
-                let (positions, triangles) = b.world_triangles(t);
+                let (positions, triangles) = b.world_triangles(t, plane);
                 ObstacleMesh {
                     name: b.name.clone(),
                     moving: b.is_moving(),

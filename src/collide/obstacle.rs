@@ -15,9 +15,6 @@ use crate::adapt::proximity::ObstaclePlane;
 use crate::math::{Scalar, Vector, rotation_from_euler_deg};
 use crate::spec::{Obstacle, ObstacleShape};
 
-/// Half the side of the square drawn for a plane in the recording, m.
-const PLANE_DISPLAY_HALF_SIZE: Scalar = 3.0;
-
 /// A rigid obstacle the cloth collides with.
 pub struct Body {
     /// Name for messages and the recording: `obstacle N (shape)`.
@@ -199,8 +196,9 @@ impl Body {
         (hit.normal.dot(dir) < 0.0).then_some((hit.time_of_impact, hit.normal))
     }
 
-    /// A triangulation of the obstacle in its local frame, for display.
-    pub fn local_triangles(&self) -> (Vec<Vector>, Vec<[u32; 3]>) {
+    /// A triangulation of the obstacle in its local frame, for display (a plane
+    /// has none: [`Body::world_triangles`] draws it around the cloth).
+    fn local_triangles(&self) -> (Vec<Vector>, Vec<[u32; 3]>) {
         if let Some(b) = self.shape.as_shape::<Ball>() {
             return b.to_trimesh(32, 16);
         }
@@ -216,21 +214,28 @@ impl Body {
         if let Some(m) = self.shape.as_shape::<TriMesh>() {
             return (m.vertices().to_vec(), m.indices().to_vec());
         }
-        if let Some(h) = self.shape.as_shape::<HalfSpace>() {
-            let n = h.normal;
-            let u = n.any_orthonormal_vector() * PLANE_DISPLAY_HALF_SIZE;
-            let v = n.cross(u);
-            return (
-                vec![-u - v, u - v, u + v, -u + v],
-                vec![[0, 1, 2], [0, 2, 3]],
-            );
-        }
         (Vec::new(), Vec::new())
     }
 
-    /// The display triangulation in world coordinates at time `t`.
-    pub fn world_triangles(&self, t: Scalar) -> (Vec<Vector>, Vec<[u32; 3]>) {
+    /// The display triangulation in world coordinates at time `t`. A plane,
+    /// which has no extent, is drawn as a square of half side `plane.1`
+    /// centred below (or above) `plane.0`: the cloth's place, so that the
+    /// viewer frames the cloth rather than a floor many times its size.
+    pub fn world_triangles(
+        &self,
+        t: Scalar,
+        plane: (Vector, Scalar),
+    ) -> (Vec<Vector>, Vec<[u32; 3]>) {
         let pose = self.pose(t);
+        if let Some(h) = self.shape.as_shape::<HalfSpace>() {
+            let n = pose.rotation * h.normal;
+            let (focus, half) = plane;
+            let centre = focus - n * n.dot(focus - pose.translation);
+            let u = n.any_orthonormal_vector() * half;
+            let v = n.cross(u);
+            let corners = [-u - v, u - v, u + v, -u + v].map(|c| centre + c);
+            return (corners.to_vec(), vec![[0, 1, 2], [0, 2, 3]]);
+        }
         let (mut v, i) = self.local_triangles();
         for p in &mut v {
             *p = pose.transform_point(*p);

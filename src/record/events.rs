@@ -24,19 +24,47 @@ pub fn event_rgb(kind: &str) -> [u8; 3] {
     }
 }
 
-/// Radius of the event points on screen, UI points.
+/// Radius of the event points on screen when the mesh's edge length is unknown, UI points.
 const EVENT_RADIUS_UI: f32 = 6.0;
 
+/// Radius of an event point as a fraction of the edge length at its level: small enough that
+/// a burst of splits leaves the triangles they made visible between the markers.
+const EVENT_RADIUS_PER_EDGE: f32 = 0.12;
+
+/// The mean edge length of a mesh (each triangle's three edges), m; `None` without triangles.
+pub(super) fn mean_edge_length(
+    positions: &[crate::math::Vector],
+    triangles: &[[u32; 3]],
+) -> Option<f32> {
+    let sum: f64 = triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| positions[i as usize]);
+            a.distance(b) + b.distance(c) + c.distance(a)
+        })
+        .sum();
+    let mean = sum / (3 * triangles.len()) as f64;
+    (mean.is_finite() && mean > 0.0).then_some(mean as f32)
+}
+
 /// The frame's events as labelled points (empty when there are none, so the 3D view shows only
-/// the current frame's events).
-pub(super) fn event_points(events: &[EventMark]) -> rerun::Points3D {
-    rerun::Points3D::new(events.iter().map(|e| convert::position(e.position)))
+/// the current frame's events), each sized to the edges at its level: `base_edge` is the
+/// unrefined mesh's mean edge length, halved every two levels (a red 1-4 split, or two edge
+/// bisections). Without it the points have a fixed size on screen.
+pub(super) fn event_points(events: &[EventMark], base_edge: Option<f32>) -> rerun::Points3D {
+    let points = rerun::Points3D::new(events.iter().map(|e| convert::position(e.position)))
         .with_colors(events.iter().map(|e| {
             let [r, g, b] = event_rgb(e.kind);
             rerun::Rgba32::from_rgb(r, g, b)
         }))
-        .with_labels(events.iter().map(|e| e.kind))
-        .with_radii([rerun::Radius::new_ui_points(EVENT_RADIUS_UI)])
+        .with_labels(events.iter().map(|e| e.kind));
+    match base_edge {
+        Some(h) => points.with_radii(events.iter().map(|e| {
+            let edge = h * 0.5f32.powf(f32::from(e.level) / 2.0);
+            rerun::Radius::new_scene_units(EVENT_RADIUS_PER_EDGE * edge)
+        })),
+        None => points.with_radii([rerun::Radius::new_ui_points(EVENT_RADIUS_UI)]),
+    }
 }
 
 /// One event's log line: `KIND after step S: level L[, angle A deg], at (x, y, z) m`, at level

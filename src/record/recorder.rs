@@ -41,6 +41,9 @@ pub struct Recorder {
     /// `plots/<name>` per scalar name, parsed once.
     scalar_paths: HashMap<String, EntityPath>,
     blueprint_sent: bool,
+    /// The first recorded frame's mean edge length, m: the unrefined mesh's, which sizes the
+    /// event points.
+    base_edge: Option<f32>,
 }
 
 impl std::fmt::Debug for Recorder {
@@ -116,6 +119,7 @@ impl Recorder {
             cloth_mesh: mesh::ClothMesh::default(),
             scalar_paths: HashMap::new(),
             blueprint_sent: false,
+            base_edge: None,
         };
         recorder.log_static_data()?;
         Ok(recorder)
@@ -166,6 +170,7 @@ impl Recorder {
             layout::send_blueprint(&self.stream, &names)
                 .map_err(|e| self.log_err("blueprint", e))?;
             self.blueprint_sent = true;
+            self.base_edge = events::mean_edge_length(frame.positions, frame.triangles);
         }
 
         self.stream.set_time_sequence(TIMELINE_FRAME, frame_index);
@@ -232,7 +237,10 @@ impl Recorder {
     /// `events/points` (one row, possibly empty) and one `events/log` line per event.
     fn log_events(&self, frame: &FrameView) -> Result<(), RecordError> {
         self.stream
-            .log(ENTITY_EVENT_POINTS, &events::event_points(frame.events))
+            .log(
+                ENTITY_EVENT_POINTS,
+                &events::event_points(frame.events, self.base_edge),
+            )
             .map_err(|e| self.log_err(ENTITY_EVENT_POINTS, e))?;
         for e in frame.events {
             self.stream

@@ -2,10 +2,11 @@
 //! events and the plots into a [`FrameView`] for the recorder.
 
 use crate::adapt::{AdaptEvent, Adapter, EventKind, edge_angles};
-use crate::math::Scalar;
+use crate::math::{Scalar, Vector};
 use crate::physics::{Energy, Model};
 use crate::record::{EventMark, FrameView, Recorder};
 use crate::sim::{Pipeline, SimState};
+use crate::world::World;
 
 use super::RunError;
 
@@ -87,7 +88,7 @@ pub(super) fn record_state(
     if pipe.collider().is_some() {
         let c = &state.ledger.collision;
         scalars.push(("collision/contacts", c.last_contacts as f64));
-        scalars.push(("penetration/max_m", c.last_penetration));
+        scalars.push(("penetration/max_mm", c.last_penetration * 1e3));
     }
     rec.record_frame(&FrameView {
         frame: snap.frame,
@@ -103,13 +104,23 @@ pub(super) fn record_state(
         events: &marks,
     })?;
     if let Some(c) = pipe.collider() {
-        for m in c.obstacle_meshes(world.time) {
+        for m in c.obstacle_meshes(world.time, plane_display(world)) {
             if m.moving || snap.frame == 0 {
                 rec.record_obstacle(&m.name, &m.positions, &m.triangles, !m.moving)?;
             }
         }
     }
     Ok(())
+}
+
+/// Where a plane obstacle is drawn: around the cloth's centre, out to 0.6 of
+/// its material diagonal (a square cloth's side is 0.71 of it), so that the
+/// cloth and the floor under it fill the 3D views.
+fn plane_display(world: &World) -> (Vector, Scalar) {
+    let n = world.x.len().max(1) as Scalar;
+    let centre = world.x.iter().copied().sum::<Vector>() / n;
+    let (lo, hi) = world.mesh.material_bounds();
+    (centre, 0.6 * lo.distance(hi))
 }
 
 /// The recording's plain view of an adaptivity event.

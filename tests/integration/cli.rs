@@ -102,11 +102,16 @@ fn write_scene(dir: &Path, name: &str, extra_cloth: &str) -> PathBuf {
 fn run_default_scene_writes_a_decodable_recording_and_a_complete_summary() {
     let dir = temp_dir("run");
     let (rrd, json) = (dir.join("x.rrd"), dir.join("s.json"));
+    // The default scene on a uniform 24-segment mesh, whose counts are fixed.
     let out = drape(
         &[
             "run",
             "--set",
             SHORT,
+            "--set",
+            "adapt.method=none",
+            "--set",
+            "cloth.resolution=24",
             "--out",
             path_str(&rrd),
             "--summary",
@@ -223,6 +228,21 @@ fn out_and_no_record_conflict() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// The first run a user makes shows adaptivity: the embedded default scene
+/// refines where the sheet folds and coarsens again within its first second.
+#[test]
+fn the_default_scene_refines_and_coarsens() {
+    let dir = temp_dir("default-adapts");
+    let args = ["run", "--set", "simulation.duration=1.0", "--no-record"];
+    let out = drape(&[&args[..], &["--summary", "s.json", "-q"]].concat(), &dir);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let s = read_json(&dir.join("s.json"));
+    let (splits, merges) = (int(&s, "/splits"), int(&s, "/merges"));
+    assert!(splits > 0 && merges > 0, "splits {splits}, merges {merges}");
+    assert!(int(&s, "/max_level") >= 2, "max level {}", s["max_level"]);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 #[test]
 fn obj_dir_gets_one_obj_per_recorded_frame() {
     let dir = temp_dir("obj-dir");
@@ -234,6 +254,8 @@ fn obj_dir_gets_one_obj_per_recorded_frame() {
             SHORT,
             "--set",
             "cloth.resolution=4",
+            "--set",
+            "adapt.method=none",
             "--no-record",
             "--obj-dir",
             path_str(&objs),

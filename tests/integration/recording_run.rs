@@ -155,7 +155,7 @@ fn adaptive_run_holds_the_whole_schema() {
         "adapt/flips",
         "adapt/rollbacks",
         "collision/contacts",
-        "penetration/max_m",
+        "penetration/max_mm",
     ] {
         expected.insert(format!("/plots/{plot}"));
     }

@@ -643,8 +643,10 @@ fn shipped_scenes_are_valid() {
     let s = default_scene(&[]).expect("default scene");
     assert_eq!(
         (s.name.as_str(), s.cloth.resolution, s.pin.len()),
-        ("default", Some(24), 2)
+        ("default", Some(16), 2)
     );
+    let adapt = s.adapt.as_ref().expect("the default scene adapts");
+    assert_eq!(adapt.method, drape::scene::AdaptMethod::RedGreen);
     assert!(s.air.is_some() && s.wind.is_none());
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
     let s = load_scene_file(&dir.join("hanging_sheet.toml"), &[]).expect("hanging_sheet");
