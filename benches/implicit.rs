@@ -20,7 +20,8 @@
 //! place (`Elements::rebuild`), and the symbolic analysis of the new pattern
 //! (ordered by vertex, as drape does, and by scalar unknown, as faer does alone).
 //!
-//! Run with `cargo bench --bench implicit`; `docs/performance.md` has the figures.
+//! Run with `cargo bench --bench implicit`; the figures at commit 03aac28 are in that
+//! commit's `docs/performance.md`.
 
 use std::hint::black_box;
 use std::time::{Duration, Instant};
@@ -294,8 +295,10 @@ fn creased(mesh: &drape::mesh::Mesh) -> drape::mesh::Mesh {
         refine_obstacle: None,
         alternate_diagonals: true,
     };
-    let mut adapter = Adapter::new(config, &world, 0.15).expect("the adapter starts");
-    adapter.pass(&mut world, 0).expect("a crease refines");
+    let mut adapter = Adapter::new(&config, &world, 0.15).expect("the adapter starts");
+    adapter
+        .remesh(&config, &mut world, 0)
+        .expect("a crease refines");
     world.mesh
 }
 

@@ -7,7 +7,8 @@
 //! rayon pools of 1 and 2 threads. Throughput is reported as vertex-steps per
 //! second (`Throughput::Elements(vertices)` per iteration of one step).
 //!
-//! Run with `cargo bench --bench step`; `docs/performance.md` has the figures.
+//! Run with `cargo bench --bench step`; the figures at commit 03aac28 are in that
+//! commit's `docs/performance.md`.
 
 use std::hint::black_box;
 use std::time::Duration;

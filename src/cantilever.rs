@@ -22,7 +22,7 @@ use serde::Serialize;
 use crate::math::{Scalar, Vector};
 use crate::mesh::Mesh;
 use crate::physics::MaterialParams;
-use crate::scene::{ClothShape, PinMotion, Scene};
+use crate::scene::Scene;
 use crate::world::World;
 
 /// The cantilever measurements at the end of a run.
@@ -155,6 +155,28 @@ pub fn bending_length_ratio(angle_deg: Scalar) -> Scalar {
     t.exp().powf(-1.0 / 3.0)
 }
 
+/// The clamp of a strip whose vertices `held` are held (one per vertex of
+/// `mesh`): `(sign, line, far)` when they are exactly those with `sign * u` up
+/// to `line`, strictly inside the strip whose free end is at `sign * u = far`
+/// (the clamp at the low end of `u` for sign 1, at the high end for -1).
+fn clamp(mesh: &Mesh, held: &[bool]) -> Option<(Scalar, Scalar, Scalar)> {
+    if held.len() != mesh.material.len() || !held.iter().any(|&h| h) {
+        return None;
+    }
+    let (lo, hi) = mesh.material_bounds();
+    let eps = 1e-9 * (hi.x - lo.x);
+    let u = |i: usize| mesh.material[i].x;
+    [1.0, -1.0].into_iter().find_map(|sign: Scalar| {
+        let line = (0..held.len())
+            .filter(|&i| held[i])
+            .map(|i| sign * u(i))
+            .fold(Scalar::NEG_INFINITY, Scalar::max);
+        let exact = (0..held.len()).all(|i| held[i] == (sign * u(i) <= line + eps));
+        let far = if sign > 0.0 { hi.x } else { -lo.x };
+        (exact && line < far - eps).then_some((sign, line, far))
+    })
+}
+
 /// Measures a cantilever (module docs) or returns `None` when the run is not one.
 /// `held`: per vertex, whether a fixed pin holds it.
 pub fn measure(
@@ -166,23 +188,13 @@ pub fn measure(
     bending: Scalar,
 ) -> Option<CantileverSummary> {
     let g = gravity.length();
-    if g <= 0.0 || held.len() != x.len() || !held.iter().any(|&h| h) {
+    if g <= 0.0 || held.len() != x.len() {
         return None;
     }
+    let (sign, line, far) = clamp(mesh, held)?;
     let (lo, hi) = mesh.material_bounds();
     let eps = 1e-9 * (hi.x - lo.x);
     let u = |i: usize| mesh.material[i].x;
-    // Clamp at the low end (sign 1) or the high end (sign -1), measured as s = sign u.
-    let clamp = [1.0, -1.0].into_iter().find_map(|sign: Scalar| {
-        let line = (0..x.len())
-            .filter(|&i| held[i])
-            .map(|i| sign * u(i))
-            .fold(Scalar::NEG_INFINITY, Scalar::max);
-        let exact = (0..x.len()).all(|i| held[i] == (sign * u(i) <= line + eps));
-        let far = if sign > 0.0 { hi.x } else { -lo.x };
-        (exact && line < far - eps).then_some((sign, line, far))
-    })?;
-    let (sign, line, far) = clamp;
     let mean_at = |s: Scalar| {
         let on: Vec<usize> = (0..x.len())
             .filter(|&i| (sign * u(i) - s).abs() <= eps)
@@ -217,25 +229,32 @@ pub fn measure(
     })
 }
 
-/// The cantilever measurements of a finished run, when the scene is one: a
-/// rectangle whose pins are all fixed for good and hold exactly one end, loaded
-/// by gravity alone (no wind, no obstacle: the elastica it is compared with
-/// assumes nothing else; a flag in wind was reported as a 9 deg "cantilever").
-pub fn for_run(scene: &Scene, world: &World, mat: &MaterialParams) -> Option<CantileverSummary> {
-    let fixed = |p: &crate::scene::Pin| p.motion == PinMotion::Fixed && p.release_time.is_none();
-    let gravity_alone = scene.wind.is_none() && scene.obstacle.is_empty();
-    if scene.cloth.shape != ClothShape::Rectangle || !scene.pin.iter().all(fixed) || !gravity_alone
-    {
-        return None;
-    }
+/// Per vertex of `world`, whether a pin holds it.
+fn held(world: &World) -> Vec<bool> {
     let mut held = vec![false; world.x.len()];
     for a in &world.pins.anchors {
         held[a.vertex as usize] = true;
     }
+    held
+}
+
+/// True when `world`'s pins hold exactly the vertices at one end of the strip
+/// (up to a clamp line strictly inside it), as the measurement needs; the rest
+/// of what it needs (a rectangle, fixed pins, gravity alone) the scene's
+/// `measure` key checks.
+pub fn clamps_one_end(world: &World) -> bool {
+    clamp(&world.mesh, &held(world)).is_some()
+}
+
+/// The cantilever measurements of a finished run of a scene that asks for
+/// them (`measure = ["cantilever"]`, which validation allows only for a
+/// rectangle held by fixed pins under gravity alone); `None` when its pins do
+/// not clamp one end ([`clamps_one_end`]).
+pub fn for_run(scene: &Scene, world: &World, mat: &MaterialParams) -> Option<CantileverSummary> {
     measure(
         &world.mesh,
         &world.x,
-        &held,
+        &held(world),
         Vector::from_array(scene.simulation.gravity),
         mat.density,
         mat.bending,

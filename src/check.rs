@@ -3,7 +3,7 @@
 use std::fmt::Write;
 
 use crate::adapt::AdaptConfig;
-use crate::collide::Collider;
+use crate::collide::{Collider, Obstacles};
 use crate::physics::timestep::fit_to_frame;
 use crate::physics::{Elements, ExternalForces, MaterialParams, Model, Stepper};
 use crate::run::RunError;
@@ -11,6 +11,7 @@ use crate::scene::{
     AdaptCriterion, AdaptMethod, BendingModel, ClothShape, Integrator, PinMotion, Scene,
     Simulation, Solver, StiffnessRule, TimeStep,
 };
+use crate::sim::SimBuildError;
 use crate::world::World;
 
 // Writing to a String cannot fail: every `writeln!` below ignores its `Ok(())`.
@@ -27,12 +28,17 @@ pub fn describe(scene: &Scene) -> Result<String, RunError> {
     let (ext, mat) = (&model.external, &model.material);
     describe_forces(&mut s, &world, &stepper.elements, mat, ext);
     let adapt = AdaptConfig::from_scene(scene.adapt.as_ref());
-    let collider = Collider::from_scene(scene)?;
-    let absent = not_modelled(mat, ext, adapt.as_ref(), collider.as_ref());
+    let obstacles = Obstacles::from_scene(scene).map_err(SimBuildError::from)?;
+    let collider = Collider::new(&obstacles, scene.self_collision.as_ref());
+    let absent = not_modelled(mat, ext, adapt.as_ref(), &obstacles, collider.as_ref());
     let _ = writeln!(s, "not modelled: {}", absent.join(", "));
     if let Some(c) = &collider {
         let _ = writeln!(s, "collisions:");
-        for line in c.describe() {
+        for line in obstacles
+            .describe()
+            .into_iter()
+            .chain(c.describe_self_collision())
+        {
             let _ = writeln!(s, "  {line}");
         }
     }
@@ -166,6 +172,7 @@ fn not_modelled(
     mat: &MaterialParams,
     ext: &ExternalForces,
     adapt: Option<&AdaptConfig>,
+    obstacles: &Obstacles,
     collider: Option<&Collider>,
 ) -> Vec<&'static str> {
     let mut absent = Vec::new();
@@ -187,7 +194,7 @@ fn not_modelled(
     if adapt.is_none() {
         absent.push("adaptive meshing");
     }
-    if !collider.is_some_and(Collider::has_obstacles) {
+    if obstacles.is_empty() {
         absent.push("obstacles and collisions");
     }
     if !collider.is_some_and(Collider::has_self_collision) {

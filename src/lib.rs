@@ -1,9 +1,10 @@
 //! drape: adaptive mass-spring cloth simulation recorded to Rerun `.rrd` files.
 //!
 //! Data flows one way (SPEC section 2):
-//! scene file -> [`scene::Scene`] -> [`sim::build`] -> a [`sim::Simulation`]: the
-//! [`physics::Model`] (fixed for the run), a [`sim::SimState`] and the
-//! [`sim::Pipeline`] that advances it (`pipeline.step(&model, &mut state, h)`) ->
+//! scene file -> [`scene::Scene`] -> [`sim::build`] -> [`sim::SimParts`]: the
+//! [`sim::Setup`] (the [`physics::Model`], the obstacles and the
+//! [`sim::Settings`], fixed for the run), a [`sim::SimState`] and the
+//! [`sim::Pipeline`] that advances it (`pipeline.step(&setup, &mut state, h)`) ->
 //! per frame ([`run::FrameLoop`]): the step's phases (forces + integrate, collide,
 //! account, health check, rollback, adapt; see [`sim`]) until the frame's time,
 //! then observe and record. The state is one cloneable value (the implicit

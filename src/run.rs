@@ -7,6 +7,7 @@ use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 mod frame_loop;
+mod measure;
 mod recording;
 mod tally;
 
@@ -19,7 +20,7 @@ pub use crate::sim::{
 use crate::math::{Scalar, Vector};
 use crate::record::{EdgeDisplay, LiveViewer, RecordError};
 use crate::scene::Scene;
-use crate::sim::{SimBuildError, Simulation};
+use crate::sim::{SimBuildError, SimParts};
 use crate::summary::Summary;
 use crate::world::BuildError;
 
@@ -57,18 +58,21 @@ pub struct Progress {
 /// Why a run failed.
 #[derive(Debug, thiserror::Error)]
 pub enum RunError {
-    /// The scene could not become a world.
-    #[error("{0}")]
-    Build(#[from] BuildError),
+    /// The scene could not become a simulation: its cloth, pins, obstacles or
+    /// adaptive method.
+    #[error(transparent)]
+    Build(#[from] SimBuildError),
+    /// A measurement the scene asks for (`measure`) cannot be made on its cloth.
+    #[error("key `measure`: the {measurement} measurement {why}")]
+    Measurement {
+        /// The measurement.
+        measurement: crate::scene::Measurement,
+        /// What it needs that the cloth lacks.
+        why: &'static str,
+    },
     /// Recording failed.
     #[error("recording: {0}")]
     Record(#[from] RecordError),
-    /// The scene's obstacles could not be built.
-    #[error("{0}")]
-    Collide(#[from] crate::collide::CollideError),
-    /// The adaptive method cannot work on the cloth's mesh.
-    #[error("{0}")]
-    Adapt(#[from] crate::adapt::tensor::NotAGrid),
     /// Remeshing produced an invalid mesh (a bug: please report it).
     #[error("adaptive remeshing: {0}")]
     Remesh(#[from] crate::mesh::MeshError),
@@ -120,13 +124,11 @@ pub struct FrameState<'a> {
     pub triangles: &'a [[u32; 3]],
 }
 
-impl From<SimBuildError> for RunError {
-    fn from(e: SimBuildError) -> RunError {
-        match e {
-            SimBuildError::Build(e) => RunError::Build(e),
-            SimBuildError::Collide(e) => RunError::Collide(e),
-            SimBuildError::Adapt(e) => RunError::Adapt(e),
-        }
+impl From<BuildError> for RunError {
+    /// The cloth or its pins could not be built (for callers that build a world
+    /// from the scene themselves).
+    fn from(e: BuildError) -> RunError {
+        RunError::Build(SimBuildError::Build(e))
     }
 }
 
@@ -159,7 +161,7 @@ pub fn run_observed(
 /// validated: `drape run` builds it before opening any output).
 pub fn run_built(
     scene: &Scene,
-    sim: Simulation,
+    sim: SimParts,
     opts: &RunOptions,
     interrupt: &AtomicBool,
     progress: &mut (dyn FnMut(Progress) + Send),

@@ -1,18 +1,20 @@
 //! One simulation as three values, in the manner of rapier's parameters, sets and
 //! pipeline:
 //!
-//! - [`Model`]: the physics, fixed for the run (material, external forces,
-//!   integrator, solver settings). Every call that advances a state is given it.
+//! - [`Setup`]: what is fixed for the run: the physics ([`Model`]: material,
+//!   external forces, integrator, solver settings), the obstacles and the
+//!   [`Settings`] (step size, multirate stepping, self-collision, adaptivity).
+//!   Every call that advances a state is given it.
 //! - [`SimState`]: everything a run's result depends on that changes as it runs
 //!   (mesh, positions, velocities, time, pins, the adaptive hierarchy, the resting
 //!   contacts, the implicit solver's warm start, the work ledger and the counters).
 //!   It is one cloneable value, so a frame retry or a rollback is one `clone_from`
 //!   and one restore.
 //! - [`Pipeline`]: the machinery that advances a state by a step
-//!   ([`Pipeline::step`]`(&model, &mut state, h)`) or a frame
+//!   ([`Pipeline::step`]`(&setup, &mut state, h)`) or a frame
 //!   ([`Pipeline::advance_frame`]): the element tables derived from the mesh, the
-//!   collision passes, the direct solver's stored factorization and scratch memory.
-//!   It holds no simulation state: it can be dropped and rebuilt from the model and
+//!   collision passes' scratch, the direct solver's stored factorization and scratch memory.
+//!   It holds no simulation state and no settings: it can be dropped and rebuilt from the setup and
 //!   the state at any step ([`Pipeline::new`]). Only the stored factorization (the
 //!   direct solver's preconditioner, refreshed when an older factor's
 //!   iterations outweigh a factorization) is lost then; the next solve factors afresh and its result differs
@@ -28,19 +30,22 @@
 
 mod bound;
 mod pipeline;
+mod setup;
 mod state;
 
 pub use bound::{EXPLOSION_FACTOR, EnergyBound, StepFailure};
 pub use pipeline::{
-    ENERGY_GAIN_TOLERANCE, FrameFailed, MAX_ENERGY_HALVINGS, MAX_STEP_HALVINGS, Pipeline,
+    ENERGY_GAIN_TOLERANCE, FrameFailed, FrameFailure, MAX_ENERGY_HALVINGS, MAX_STEP_HALVINGS,
+    Pipeline, StepError, StepOutcome,
 };
+pub use setup::{Settings, Setup, StepSize};
 pub use state::{Effort, Ledger, SimState};
 
-use crate::adapt::{AdaptConfig, Adapter};
-use crate::collide::{CollideError, Collider};
+use crate::adapt::Adapter;
+use crate::collide::{CollideError, Obstacles};
 use crate::math::Scalar;
 use crate::physics::Model;
-use crate::spec::{ClothSpec, Obstacle, Pin, SelfCollision};
+use crate::spec::{ClothSpec, Obstacle, Pin};
 use crate::world::{BuildError, World};
 
 /// Everything a simulation is built from: a scene resolved into the engine's
@@ -55,16 +60,10 @@ pub struct SimSpec {
     pub model: Model,
     /// The rigid obstacles.
     pub obstacles: Vec<Obstacle>,
-    /// Self-collision, when the scene turns it on.
-    pub self_collision: Option<SelfCollision>,
-    /// Adaptivity, when the scene adapts.
-    pub adapt: Option<AdaptConfig>,
-    /// Paper A's multirate stepping (explicit integrators, adaptive meshes).
-    pub multirate: bool,
+    /// Step size, multirate stepping, self-collision and adaptivity.
+    pub settings: Settings,
     /// Area density, kg/m^2 (the remesher's mass transfer).
     pub density: Scalar,
-    /// The fixed step, s (`None`: automatic).
-    pub fixed_dt: Option<Scalar>,
 }
 
 /// Why a specification could not become a simulation.
@@ -81,31 +80,37 @@ pub enum SimBuildError {
     Adapt(#[from] crate::adapt::tensor::NotAGrid),
 }
 
-/// A simulation ready to run: the model it integrates, its initial state and the
-/// pipeline that advances it (`pipeline.step(&model, &mut state, h)`).
-pub struct Simulation {
-    /// The physics, fixed for the run.
-    pub model: Model,
+/// A simulation ready to run: what it holds fixed, its initial state and the
+/// pipeline that advances it (`pipeline.step(&setup, &mut state, h)`).
+pub struct SimParts {
+    /// The physics, the obstacles and the settings, fixed for the run.
+    pub setup: Setup,
     /// The state, at the start of the run.
     pub state: SimState,
     /// The machinery that advances the state (scratch only).
     pub pipeline: Pipeline,
 }
 
-/// Builds the initial state and the pipeline of a specification. This is where a
-/// bad OBJ file or a pin that selects nothing is found, before any output is opened.
-pub fn build(spec: &SimSpec) -> Result<Simulation, SimBuildError> {
+/// Builds the setup, the initial state and the pipeline of a specification. This
+/// is where a bad OBJ file or a pin that selects nothing is found, before any
+/// output is opened.
+pub fn build(spec: &SimSpec) -> Result<SimParts, SimBuildError> {
     let world = World::from_spec(&spec.cloth, &spec.pins)?;
     let adapter = spec
+        .settings
         .adapt
+        .as_ref()
         .map(|c| Adapter::new(c, &world, spec.density))
         .transpose()?;
-    let collider = Collider::new(&spec.obstacles, spec.self_collision.as_ref())?;
-    let model = spec.model.clone();
-    let pipeline = Pipeline::new(&model, &world, collider, spec.fixed_dt, spec.multirate);
-    let state = SimState::new(&model, world, adapter, &pipeline);
-    Ok(Simulation {
-        model,
+    let setup = Setup {
+        model: spec.model.clone(),
+        obstacles: Obstacles::new(&spec.obstacles)?,
+        settings: spec.settings.clone(),
+    };
+    let pipeline = Pipeline::new(&setup, &world);
+    let state = SimState::new(&setup, world, adapter, &pipeline);
+    Ok(SimParts {
+        setup,
         state,
         pipeline,
     })

@@ -374,6 +374,27 @@ pub enum AdaptCriterion {
     Sizing,
 }
 
+/// A textile measurement a scene asks for (`measure`), made on its end state.
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum Measurement {
+    /// The cantilever bending test (Peirce 1930, ASTM D1388): a rectangle held
+    /// over one end by fixed pins, under gravity alone ([`crate::cantilever`]).
+    Cantilever,
+    /// The Cusick drape test: a disk specimen on a vertical support cylinder
+    /// centred under it (`crate::collide::cusick`).
+    Cusick,
+}
+
+impl std::fmt::Display for Measurement {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Measurement::Cantilever => "cantilever",
+            Measurement::Cusick => "cusick",
+        })
+    }
+}
+
 /// The adaptive remeshing method.
 #[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq)]
 #[serde(rename_all = "snake_case")]
@@ -398,7 +419,7 @@ fn default_coarsen_angle() -> f64 {
 fn default_max_level() -> u32 {
     4
 }
-/// Every 4 steps (`docs/speed-vs-error.md`): on
+/// Every 4 steps: on
 /// `tablecloth` adapting every step took 3.3 times the steps (retried frames)
 /// and 3.2 times the wall time of every 4; on `hanging_sheet` and
 /// `drape_sphere` every 4 had the same or a lower error than every step.
@@ -471,7 +492,7 @@ impl<'de> Deserialize<'de> for AdaptEvery {
 fn default_max_rollbacks() -> u32 {
     3
 }
-/// Sizing (`docs/speed-vs-error.md`): fewer vertices
+/// Sizing: fewer vertices
 /// than the angle criterion on every measured scene.
 fn default_criterion() -> AdaptCriterion {
     AdaptCriterion::Sizing

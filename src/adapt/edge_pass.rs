@@ -4,7 +4,7 @@
 use std::collections::HashMap;
 
 use super::transfer::{VertexOrder, compact, transfer};
-use super::{AdaptEvent, Adapter, EventKind, edge, edge_angles};
+use super::{AdaptConfig, AdaptEvent, Adapter, EventKind, MethodState, edge, edge_angles};
 use crate::math::{Scalar, Vector};
 use crate::mesh::MeshError;
 use crate::spec::AdaptCriterion;
@@ -13,7 +13,10 @@ use crate::world::World;
 impl Adapter {
     /// The stated minimum angle of the edge method, degrees (`None` for red_green).
     pub fn min_angle(&self) -> Option<Scalar> {
-        self.edge.map(|l| l.min_angle)
+        match &self.method {
+            MethodState::Edge(l) => Some(l.min_angle),
+            _ => None,
+        }
     }
 
     /// One pass of paper B's method: split edges above the upper threshold
@@ -21,6 +24,7 @@ impl Adapter {
     /// collapse short edges at vertices whose every edge is flat.
     pub(super) fn edge_pass(
         &mut self,
+        c: &AdaptConfig,
         world: &mut World,
         step: u64,
         limits: edge::Limits,
@@ -33,7 +37,7 @@ impl Adapter {
         let mut marks: Vec<(usize, Scalar)> = angles
             .iter()
             .enumerate()
-            .filter(|(_, a)| **a > self.config.refine_angle)
+            .filter(|(_, a)| **a > c.refine_angle)
             .map(|(e, a)| (e, *a))
             .collect();
         marks.sort_by(|x, y| y.1.total_cmp(&x.1).then(x.0.cmp(&y.0)));
@@ -45,7 +49,7 @@ impl Adapter {
         }
         let seeds: Vec<u32> = (soup.first_new..soup.material.len() as u32).collect();
         soup.flip_around(&seeds, &limits, &mut ops);
-        let by_length = self.collapse_candidates(world, &angles, &limits);
+        let by_length = collapse_candidates(c, world, &angles, &limits);
         let mut pinned = vec![false; m.vertex_count()];
         for a in &world.pins.anchors {
             pinned[a.vertex as usize] = true;
@@ -57,7 +61,7 @@ impl Adapter {
                 soup.collapse(u, v, &pinned, &limits, &mut ops);
             }
         }
-        let max_level = self.config.max_level;
+        let max_level = c.max_level;
         if ops.is_empty() {
             self.stats.note_levels(world, max_level);
             return Ok(false);
@@ -123,52 +127,6 @@ impl Adapter {
         }
     }
 
-    /// Edges shorter than the collapse limit whose both ends are flat (every
-    /// edge at them below both thresholds' limit), shortest first.
-    fn collapse_candidates(
-        &self,
-        world: &World,
-        angles: &[Scalar],
-        limits: &edge::Limits,
-    ) -> Vec<(Scalar, u32, u32)> {
-        let m = &world.mesh;
-        // Flat vertices: every edge at them below both thresholds' limit, or
-        // for the sizing criterion (`sizing.rs`) below refine / (2 hysteresis).
-        let flat_limit = match self.config.criterion {
-            AdaptCriterion::Angle => self
-                .config
-                .coarsen_angle
-                .min(0.5 * self.config.refine_angle),
-            AdaptCriterion::Sizing => 0.5 * self.config.refine_angle / self.config.hysteresis,
-        };
-        let mut vertex_max = vec![0.0 as Scalar; m.vertex_count()];
-        for (e, edge) in m.edges.iter().enumerate() {
-            for &v in &edge.vertices {
-                vertex_max[v as usize] = vertex_max[v as usize].max(angles[e]);
-            }
-        }
-        let mut by_length: Vec<(Scalar, u32, u32)> = m
-            .edges
-            .iter()
-            .filter(|e| {
-                e.vertices
-                    .iter()
-                    .all(|&v| vertex_max[v as usize] < flat_limit)
-            })
-            .map(|e| {
-                let [a, b] = e.vertices;
-                (
-                    m.material[a as usize].distance(m.material[b as usize]),
-                    a,
-                    b,
-                )
-            })
-            .filter(|&(len, _, _)| len < limits.collapse_below)
-            .collect();
-        by_length.sort_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))));
-        by_length
-    }
-
     /// Compacts the soup's live vertices and moves the world onto it; returns the
     /// map from soup vertex ids to new indices (`u32::MAX` for removed ones).
     fn rebuild_from_soup(
@@ -187,4 +145,47 @@ impl Adapter {
         self.last_origins = transfer(world, self.density, remeshed)?;
         Ok(map)
     }
+}
+
+/// Edges shorter than the collapse limit whose both ends are flat (every
+/// edge at them below both thresholds' limit), shortest first.
+fn collapse_candidates(
+    c: &AdaptConfig,
+    world: &World,
+    angles: &[Scalar],
+    limits: &edge::Limits,
+) -> Vec<(Scalar, u32, u32)> {
+    let m = &world.mesh;
+    // Flat vertices: every edge at them below both thresholds' limit, or
+    // for the sizing criterion (`sizing.rs`) below refine / (2 hysteresis).
+    let flat_limit = match c.criterion {
+        AdaptCriterion::Angle => c.coarsen_angle.min(0.5 * c.refine_angle),
+        AdaptCriterion::Sizing => 0.5 * c.refine_angle / c.hysteresis,
+    };
+    let mut vertex_max = vec![0.0 as Scalar; m.vertex_count()];
+    for (e, edge) in m.edges.iter().enumerate() {
+        for &v in &edge.vertices {
+            vertex_max[v as usize] = vertex_max[v as usize].max(angles[e]);
+        }
+    }
+    let mut by_length: Vec<(Scalar, u32, u32)> = m
+        .edges
+        .iter()
+        .filter(|e| {
+            e.vertices
+                .iter()
+                .all(|&v| vertex_max[v as usize] < flat_limit)
+        })
+        .map(|e| {
+            let [a, b] = e.vertices;
+            (
+                m.material[a as usize].distance(m.material[b as usize]),
+                a,
+                b,
+            )
+        })
+        .filter(|&(len, _, _)| len < limits.collapse_below)
+        .collect();
+    by_length.sort_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))));
+    by_length
 }

@@ -5,7 +5,8 @@
 
 use rayon::prelude::*;
 
-use super::{Adapter, sizing};
+use super::red_green_pass::RedGreenState;
+use super::{AdaptConfig, Adapter, MethodState, sizing};
 use crate::math::Scalar;
 use crate::spec::AdaptCriterion;
 use crate::world::World;
@@ -43,25 +44,43 @@ pub fn edge_angles_into(world: &World, out: &mut Vec<Scalar>) {
 
 impl Adapter {
     /// Leaves the criterion asks to split, with the (largest) angle that asked,
-    /// from angles measured on the world's current shape.
-    pub fn refinement_marks(&self, world: &World, angles: &[Scalar]) -> Vec<(u32, Scalar)> {
-        debug_assert_eq!(
-            !self.refinement_marks_unchecked(world, angles).is_empty(),
-            self.needs_refinement(world, angles),
-            "needs_refinement disagrees with refinement_marks"
-        );
-        self.refinement_marks_unchecked(world, angles)
+    /// from angles measured on the world's current shape (red-green only: the
+    /// other methods mark nothing for paper A's rollback).
+    pub fn refinement_marks(
+        &self,
+        config: &AdaptConfig,
+        world: &World,
+        angles: &[Scalar],
+    ) -> Vec<(u32, Scalar)> {
+        match &self.method {
+            MethodState::RedGreen(rg) => {
+                debug_assert_eq!(
+                    !rg.refinement_marks(config, world, angles).is_empty(),
+                    rg.needs_refinement(config, world, angles),
+                    "needs_refinement disagrees with refinement_marks"
+                );
+                rg.refinement_marks(config, world, angles)
+            }
+            _ => Vec::new(),
+        }
     }
 
     /// True when [`Adapter::refinement_marks`] would mark a leaf: the same rule,
     /// checked edge by edge without allocating (paper A's rollback asks it after
     /// every step, and nearly always gets no).
-    pub fn needs_refinement(&self, world: &World, angles: &[Scalar]) -> bool {
-        if self.edge.is_some() {
-            return false;
+    pub fn needs_refinement(&self, config: &AdaptConfig, world: &World, angles: &[Scalar]) -> bool {
+        match &self.method {
+            MethodState::RedGreen(rg) => rg.needs_refinement(config, world, angles),
+            _ => false,
         }
-        let sizing = self.config.criterion == AdaptCriterion::Sizing;
-        let strain = sizing && self.config.refine_strain.is_some();
+    }
+}
+
+impl RedGreenState {
+    /// [`Adapter::needs_refinement`] of the red-green method.
+    fn needs_refinement(&self, c: &AdaptConfig, world: &World, angles: &[Scalar]) -> bool {
+        let sizing = c.criterion == AdaptCriterion::Sizing;
+        let strain = sizing && c.refine_strain.is_some();
         // The cheap test first: most leaves of a refined mesh are at the finest
         // level and may not split, and for them nothing is measured. The edge's
         // curvature and strain jump are measured once, for its first leaf that
@@ -73,11 +92,11 @@ impl Adapter {
                 .filter(|&&t| t != crate::mesh::NO_TRIANGLE)
                 .any(|&t| {
                     let leaf = self.owner[t as usize];
-                    if !self.may_split(leaf) {
+                    if !self.may_split(c, leaf) {
                         return false;
                     }
                     if !sizing {
-                        return angles[e] > self.config.refine_angle;
+                        return angles[e] > c.refine_angle;
                     }
                     let (kappa, jump) = *measured.get_or_insert_with(|| {
                         let kappa = sizing::edge_curvature(world, edge, angles[e]);
@@ -88,26 +107,29 @@ impl Adapter {
                         };
                         (kappa, jump)
                     });
-                    self.sizing_wants_split(leaf, kappa, jump)
+                    self.sizing_wants_split(c, leaf, kappa, jump)
                 })
         })
     }
 
-    fn refinement_marks_unchecked(&self, world: &World, angles: &[Scalar]) -> Vec<(u32, Scalar)> {
-        if self.edge.is_some() {
-            return Vec::new(); // rollback is paper A's, with red_green only
-        }
-        if self.config.criterion == AdaptCriterion::Sizing {
-            return self.sizing_refinement_marks(&self.leaf_curvatures(world, angles, &[]));
+    /// [`Adapter::refinement_marks`] of the red-green method.
+    pub(super) fn refinement_marks(
+        &self,
+        c: &AdaptConfig,
+        world: &World,
+        angles: &[Scalar],
+    ) -> Vec<(u32, Scalar)> {
+        if c.criterion == AdaptCriterion::Sizing {
+            return self.sizing_refinement_marks(c, &self.leaf_curvatures(c, world, angles, &[]));
         }
         let mut marks: Vec<(u32, Scalar)> = Vec::new();
         for (e, edge) in world.mesh.edges.iter().enumerate() {
-            if angles[e] <= self.config.refine_angle {
+            if angles[e] <= c.refine_angle {
                 continue;
             }
             for &t in &edge.triangles {
                 let leaf = self.owner[t as usize];
-                if self.may_split(leaf) {
+                if self.may_split(c, leaf) {
                     marks.push((leaf, angles[e]));
                 }
             }
@@ -121,7 +143,12 @@ impl Adapter {
     /// triangles is below the lower threshold, and below half the upper one (a
     /// merge about doubles the angles, so this keeps a merge from being split
     /// again at once when the thresholds are close).
-    pub(super) fn merge_marks(&self, world: &World, angles: &[Scalar]) -> Vec<(u32, Scalar)> {
+    pub(super) fn merge_marks(
+        &self,
+        c: &AdaptConfig,
+        world: &World,
+        angles: &[Scalar],
+    ) -> Vec<(u32, Scalar)> {
         let mut leaf_max: std::collections::HashMap<u32, Scalar> = std::collections::HashMap::new();
         for (e, edge) in world.mesh.edges.iter().enumerate() {
             for &t in edge
@@ -133,10 +160,7 @@ impl Adapter {
                 *m = m.max(angles[e]);
             }
         }
-        let limit = self
-            .config
-            .coarsen_angle
-            .min(0.5 * self.config.refine_angle);
+        let limit = c.coarsen_angle.min(0.5 * c.refine_angle);
         let mut out = Vec::new();
         for p in self.hierarchy.mergeable_parents() {
             let children = self.hierarchy.children(p).unwrap_or_default();

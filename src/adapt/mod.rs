@@ -12,6 +12,7 @@ mod edge_pass;
 mod marks;
 pub mod proximity;
 pub mod red_green;
+mod red_green_pass;
 pub mod sizing;
 pub mod soup;
 pub mod tensor;
@@ -22,16 +23,15 @@ mod tri_list;
 pub use check::{ConsistencyError, boundary_length, check_consistency};
 pub use marks::{edge_angles, edge_angles_into};
 
-use std::collections::HashMap;
-
 use crate::math::{Scalar, Vector};
 use crate::mesh::MeshError;
 use crate::spec::{
     Adapt, AdaptCriterion, AdaptEvery, AdaptMethod, DEFAULT_HYSTERESIS, RedDiagonals,
 };
 use crate::world::World;
-use red_green::{Applied, RedGreen, RedGreenOp};
-use transfer::{Origin, VertexOrder, compact, transfer};
+use red_green::RedGreen;
+use red_green_pass::RedGreenState;
+use transfer::Origin;
 
 /// What happened, for the recording and the counters.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -189,32 +189,19 @@ impl AdaptConfig {
     }
 }
 
-/// The adaptive state of a run: settings, refinement hierarchy, counters, and the
-/// events not yet taken by the recorder.
+/// The adaptive state of a run: the remeshing method's own state, the
+/// counters, and the events not yet taken by the recorder. Its settings are not
+/// part of it: every call that remeshes is given the [`AdaptConfig`] (in a run,
+/// the one in [`crate::sim::Settings`]).
 #[derive(Debug, Clone)]
 pub struct Adapter {
-    /// Settings.
-    pub config: AdaptConfig,
     /// Counters.
     pub stats: AdaptStats,
     /// Events since the last [`Adapter::take_events`].
     events: Vec<AdaptEvent>,
-    hierarchy: RedGreen,
-    /// Leaf of the hierarchy that owns each triangle of the world's mesh.
-    owner: Vec<u32>,
-    /// The parents the latest pass merged, sorted (a split of one of them by
-    /// the criterion before the next pass is a bounce).
-    merged_last_pass: Vec<u32>,
-    /// The parents [`Adapter::apply`] merged since the pass began.
-    pass_merges: Vec<u32>,
-    /// Per parent: how many of its merges bounced (its sizing hysteresis is
-    /// doubled that many times; dropped when the parent itself merges away).
-    bounces: HashMap<u32, u32>,
+    /// What the method keeps between passes.
+    method: MethodState,
     density: Scalar,
-    /// Limits of the edge method (`None` for the others).
-    edge: Option<edge::Limits>,
-    /// The tensor method's grid (`None` for the others).
-    tensor: Option<tensor::TensorGrid>,
     /// Rest area and boundary length of the cloth, for [`Adapter::check`].
     area: Scalar,
     boundary: Scalar,
@@ -223,42 +210,60 @@ pub struct Adapter {
     last_origins: Vec<Origin>,
 }
 
+/// What each remeshing method keeps between passes.
+#[derive(Debug, Clone)]
+enum MethodState {
+    /// Paper A's refinement hierarchy (boxed: far larger than the others).
+    RedGreen(Box<RedGreenState>),
+    /// Paper B's limits (its mesh is the world's).
+    Edge(edge::Limits),
+    /// The rectangle's grid lines.
+    Tensor(tensor::TensorGrid),
+}
+
+/// What the caller has measured on the world already, for
+/// [`Adapter::remesh_with`] (the default: nothing).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Measured<'a> {
+    /// The world's current [`edge_angles`] (the rollback check has just
+    /// measured them), so the pass does not measure them again.
+    pub angles: Option<&'a [Scalar]>,
+    /// The tangent planes of the obstacle points nearest to the world's
+    /// vertices (one per vertex, from `Obstacles::nearest_planes`; empty: no
+    /// obstacles), which the sizing criterion's obstacle term measures
+    /// (`proximity.rs`; unused without `refine_obstacle`).
+    pub obstacle_planes: &'a [proximity::ObstaclePlane],
+}
+
 impl Adapter {
-    /// Starts adapting `world`'s mesh (its current triangles become level 0).
-    /// Fails only for the tensor method on a mesh that is not a rectangle's
-    /// grid (scene validation refuses that combination first).
+    /// Starts adapting `world`'s mesh with `config`'s method (its current
+    /// triangles become level 0; `AdaptMethod::None`, which a scene never
+    /// hands over, adapts as red-green). Fails only for the tensor method on a
+    /// mesh that is not a rectangle's grid (scene validation refuses that
+    /// combination first).
     pub fn new(
-        config: AdaptConfig,
+        config: &AdaptConfig,
         world: &World,
         density: Scalar,
     ) -> Result<Adapter, tensor::NotAGrid> {
-        let hierarchy = RedGreen::new(&world.mesh.triangles, &world.mesh.material);
-        let owner = (0..world.mesh.triangles.len() as u32).collect();
         let m = &world.mesh;
-        let edge = (config.method == AdaptMethod::Edge).then(|| {
-            edge::Limits::for_mesh(
+        let method = match config.method {
+            AdaptMethod::Edge => MethodState::Edge(edge::Limits::for_mesh(
                 &m.material,
                 &m.triangles,
                 config.max_level,
                 config.min_edge_length,
-            )
-        });
-        let tensor = match config.method {
-            AdaptMethod::Tensor => Some(tensor::TensorGrid::from_mesh(m)?),
-            _ => None,
+            )),
+            AdaptMethod::Tensor => MethodState::Tensor(tensor::TensorGrid::from_mesh(m)?),
+            AdaptMethod::RedGreen | AdaptMethod::None => {
+                MethodState::RedGreen(Box::new(RedGreenState::new(world)))
+            }
         };
         Ok(Adapter {
-            config,
             stats: AdaptStats::default(),
             events: Vec::new(),
-            hierarchy,
-            owner,
-            merged_last_pass: Vec::new(),
-            pass_merges: Vec::new(),
-            bounces: HashMap::new(),
+            method,
             density,
-            edge,
-            tensor,
             area: m.total_rest_area(),
             boundary: boundary_length(m),
             last_origins: Vec::new(),
@@ -279,12 +284,12 @@ impl Adapter {
     /// every remesh in debug builds; tests call it in release builds too.
     pub fn check(&self, world: &World) -> Result<(), ConsistencyError> {
         check_consistency(world, self.density, self.area, self.boundary)?;
-        if let Some(grid) = &self.tensor {
-            grid.check(&world.mesh).map_err(ConsistencyError::Tables)?;
+        match &self.method {
+            MethodState::Tensor(grid) => grid.check(&world.mesh),
+            MethodState::RedGreen(rg) => rg.hierarchy.check_tables(),
+            MethodState::Edge(_) => Ok(()),
         }
-        self.hierarchy
-            .check_tables()
-            .map_err(ConsistencyError::Tables)
+        .map_err(ConsistencyError::Tables)
     }
 
     /// [`Adapter::check`] as a debug assertion (no cost in release builds).
@@ -301,93 +306,44 @@ impl Adapter {
         std::mem::take(&mut self.events)
     }
 
-    /// The refinement hierarchy (for tests and inspection).
-    pub fn hierarchy(&self) -> &RedGreen {
-        &self.hierarchy
-    }
-
-    /// One adaptation pass on `world` after step `step`: merges, then splits,
-    /// then closure; returns true when the mesh changed.
-    pub fn pass(&mut self, world: &mut World, step: u64) -> Result<bool, MeshError> {
-        self.pass_near(world, step, None, &[])
-    }
-
-    /// [`Adapter::pass`] given the world's current [`edge_angles`] (the rollback
-    /// check has just measured them): the same pass without measuring again.
-    pub fn pass_measured(
-        &mut self,
-        world: &mut World,
-        step: u64,
-        angles: &[Scalar],
-    ) -> Result<bool, MeshError> {
-        self.pass_near(world, step, Some(angles), &[])
-    }
-
-    /// [`Adapter::pass`] with the world's current [`edge_angles`] when they are
-    /// known, and the tangent planes of the obstacle points nearest to its
-    /// vertices (one per vertex, from `Collider::nearest_planes`; empty: no
-    /// obstacles), which the sizing criterion's obstacle term measures
-    /// (`proximity.rs`; unused without `refine_obstacle`).
-    pub fn pass_near(
-        &mut self,
-        world: &mut World,
-        step: u64,
-        angles: Option<&[Scalar]>,
-        planes: &[proximity::ObstaclePlane],
-    ) -> Result<bool, MeshError> {
-        if self.tensor.is_some() {
-            return self.tensor_pass(world, step);
+    /// The refinement hierarchy (for tests and inspection; `None` for the edge
+    /// and tensor methods).
+    pub fn hierarchy(&self) -> Option<&RedGreen> {
+        match &self.method {
+            MethodState::RedGreen(rg) => Some(&rg.hierarchy),
+            _ => None,
         }
-        if let Some(limits) = self.edge {
-            return self.edge_pass(world, step, limits);
-        }
-        let measured;
-        let angles = match angles {
-            Some(a) => a,
-            None => {
-                measured = edge_angles(world);
-                &measured
-            }
-        };
-        debug_assert_eq!(angles.len(), world.mesh.edges.len(), "stale edge angles");
-        let (merges, splits) = match self.config.criterion {
-            AdaptCriterion::Angle => (
-                self.merge_marks(world, angles),
-                self.refinement_marks(world, angles),
-            ),
-            AdaptCriterion::Sizing => {
-                let curv = self.leaf_curvatures(world, angles, planes);
-                let merges = self.sizing_merge_marks(&curv);
-                (merges, self.sizing_refinement_marks(&curv))
-            }
-        };
-        self.stats.passes += 1;
-        self.pass_merges.clear();
-        let mut ops: Vec<(RedGreenOp, Option<Scalar>)> = merges
-            .iter()
-            .map(|&(p, a)| (RedGreenOp::Merge(p), Some(a)))
-            .collect();
-        ops.extend(splits.iter().map(|&(l, a)| (RedGreenOp::Split(l), Some(a))));
-        let changed = self.apply(world, &ops, step);
-        self.merged_last_pass = std::mem::take(&mut self.pass_merges);
-        self.merged_last_pass.sort_unstable();
-        self.stats.note_levels(world, self.config.max_level);
-        changed
     }
 
-    /// Refines the leaves in `marks` (from [`Adapter::refinement_marks`]) and
-    /// rebuilds the world; used by rollback on the restored state.
-    pub fn refine(
+    /// One adaptation pass of `config`'s method on `world` after step `step`
+    /// (red-green: merges, then splits, then closure); true when the mesh
+    /// changed.
+    pub fn remesh(
         &mut self,
+        config: &AdaptConfig,
         world: &mut World,
-        marks: &[(u32, Scalar)],
         step: u64,
     ) -> Result<bool, MeshError> {
-        let ops: Vec<_> = marks
-            .iter()
-            .map(|&(l, a)| (RedGreenOp::Split(l), Some(a)))
-            .collect();
-        self.apply(world, &ops, step)
+        self.remesh_with(config, world, step, Measured::default())
+    }
+
+    /// [`Adapter::remesh`] given what the caller has measured on the world
+    /// already ([`Measured`]).
+    pub fn remesh_with(
+        &mut self,
+        config: &AdaptConfig,
+        world: &mut World,
+        step: u64,
+        known: Measured,
+    ) -> Result<bool, MeshError> {
+        match &self.method {
+            MethodState::Tensor(_) => self.tensor_pass(config, world, step),
+            MethodState::Edge(limits) => {
+                let limits = *limits;
+                self.edge_pass(config, world, step, limits)
+            }
+            MethodState::RedGreen(_) => self.red_green_pass(config, world, step, known),
+        }
     }
 
     /// Records a rollback of step `step`.
@@ -401,113 +357,5 @@ impl Adapter {
             angle: None,
             step,
         });
-    }
-
-    /// Applies operations (each with the angle that asked for it), closes the
-    /// mesh and moves the world onto it. Atomic: if the world cannot take the
-    /// new mesh, the hierarchy's operations are undone (newest first, see
-    /// [`RedGreen::undo`]) and the world, the counters and the events stay as
-    /// they were. Red-green only: panics on an adapter of the tensor method,
-    /// whose grid the operations would leave out of step with the world.
-    pub fn apply(
-        &mut self,
-        world: &mut World,
-        ops: &[(RedGreenOp, Option<Scalar>)],
-        step: u64,
-    ) -> Result<bool, MeshError> {
-        assert!(
-            self.tensor.is_none(),
-            "red-green operations on an adapter of the tensor method"
-        );
-        let mut applied: Vec<Applied> = Vec::new();
-        let plain: Vec<RedGreenOp> = ops.iter().map(|o| o.0).collect();
-        self.hierarchy.apply(&plain, &mut applied);
-        // The angle that asked for each operation (forced splits have none).
-        let asked_for = |op: RedGreenOp| ops.iter().find(|o| o.0 == op).and_then(|o| o.1);
-        let mut asked: Vec<Option<Scalar>> = applied.iter().map(|a| asked_for(a.op)).collect();
-        let before = applied.len();
-        self.hierarchy.close(&mut applied);
-        asked.extend(std::iter::repeat_n(None, applied.len() - before));
-        if applied.is_empty() {
-            return Ok(false);
-        }
-        let mut events: Vec<AdaptEvent> = applied
-            .iter()
-            .zip(asked)
-            .map(|(a, angle)| red_green_event(world, a, angle, step))
-            .collect();
-        if let Err(e) = self.rebuild_world(world) {
-            for a in applied.iter().rev() {
-                self.hierarchy.undo(a);
-            }
-            return Err(e);
-        }
-        for (a, event) in applied.iter().zip(events.iter_mut()) {
-            match a.op {
-                RedGreenOp::Merge(n) => {
-                    self.stats.merges += 1;
-                    self.pass_merges.push(n);
-                    for c in a.children {
-                        self.bounces.remove(&c);
-                    }
-                }
-                RedGreenOp::Split(l) => {
-                    self.stats.splits += 1;
-                    self.stats.closure_splits += a.forced as u64;
-                    if !a.forced && self.merged_last_pass.binary_search(&l).is_ok() {
-                        *self.bounces.entry(l).or_default() += 1;
-                        self.stats.bounces += 1;
-                        event.kind = EventKind::Bounce;
-                    }
-                }
-            }
-        }
-        self.events.extend(events);
-        self.stats.changed_passes += 1;
-        self.stats.max_ops_per_pass = self.stats.max_ops_per_pass.max(applied.len() as u64);
-        self.debug_check(world);
-        Ok(true)
-    }
-
-    /// Builds the conforming mesh from the hierarchy, compacts the vertices and
-    /// transfers the world's state onto it (the world is unchanged on error).
-    fn rebuild_world(&mut self, world: &mut World) -> Result<(), MeshError> {
-        let (tris, levels, owner) = self.hierarchy.build(self.config.alternate_diagonals);
-        let (first_new, created) = self.hierarchy.created();
-        let (map, remeshed) = compact(
-            self.hierarchy.material(),
-            (first_new, created),
-            &tris,
-            levels,
-            VertexOrder::FirstUse,
-        );
-        let material = remeshed.material.clone();
-        self.last_origins = transfer(world, self.density, remeshed)?;
-        self.hierarchy.remap(&map, &material);
-        self.owner = owner;
-        Ok(())
-    }
-}
-
-/// The event of one red-green operation, at the world's positions before the
-/// remesh (the node's corners are vertices of the old mesh).
-fn red_green_event(world: &World, a: &Applied, angle: Option<Scalar>, step: u64) -> AdaptEvent {
-    let centre = a
-        .vertices
-        .iter()
-        .map(|&v| world.x[v as usize])
-        .sum::<Vector>()
-        / 3.0;
-    let kind = match a.op {
-        RedGreenOp::Merge(_) => EventKind::Merge,
-        RedGreenOp::Split(_) if a.forced => EventKind::ClosureSplit,
-        RedGreenOp::Split(_) => EventKind::Split,
-    };
-    AdaptEvent {
-        kind,
-        position: centre,
-        level: a.level,
-        angle: if a.forced { None } else { angle },
-        step,
     }
 }

@@ -49,7 +49,7 @@
 //! separate, much lower angle.
 //!
 //! On hanging_sheet, tablecloth, flag and drape_sphere it carries 11 to 44 %
-//! fewer vertices than the angle criterion (`docs/speed-vs-error.md`), though
+//! fewer vertices than the angle criterion, though
 //! the last three are curved past the budget almost everywhere (61 to 72 % of
 //! their triangles at the finest level on average). The default hysteresis is
 //! 2: 3 gives more vertices and no fewer passes that change the mesh.
@@ -135,8 +135,9 @@
 
 use std::collections::HashMap;
 
-use super::Adapter;
+use super::AdaptConfig;
 use super::proximity::{ObstaclePlane, edge_obstacle_lean};
+use super::red_green_pass::RedGreenState;
 use crate::math::{Scalar, Vector2};
 use crate::mesh::{Edge, NO_TRIANGLE};
 use crate::world::World;
@@ -260,20 +261,21 @@ impl LeafCurvature {
     }
 }
 
-impl Adapter {
+impl RedGreenState {
     /// The curvature of every leaf from the edge angles of the world's mesh
     /// (and the strain jumps, when `refine_strain` is set, and the leans towards
     /// the obstacles whose `planes` are given, one per vertex, when
     /// `refine_obstacle` is set).
     pub(super) fn leaf_curvatures(
         &self,
+        c: &AdaptConfig,
         world: &World,
         angles: &[Scalar],
         planes: &[ObstaclePlane],
     ) -> LeafCurvature {
         let kappa = edge_curvatures(world, angles);
-        let strain = self.config.refine_strain.is_some();
-        let planes = if self.config.refine_obstacle.is_some() {
+        let strain = c.refine_strain.is_some();
+        let planes = if c.refine_obstacle.is_some() {
             debug_assert!(planes.is_empty() || planes.len() == world.x.len());
             planes
         } else {
@@ -308,13 +310,17 @@ impl Adapter {
     /// Leaves coarser than their target (`kappa * D > refine_angle`, or a strain
     /// jump above `refine_strain`) that may still split, each with its largest
     /// measured angle (degrees).
-    pub(super) fn sizing_refinement_marks(&self, curv: &LeafCurvature) -> Vec<(u32, Scalar)> {
+    pub(super) fn sizing_refinement_marks(
+        &self,
+        c: &AdaptConfig,
+        curv: &LeafCurvature,
+    ) -> Vec<(u32, Scalar)> {
         let mut marks: Vec<(u32, Scalar)> = curv
             .by_leaf
             .iter()
             .filter(|&(&l, m)| {
-                (self.sizing_wants_split(l, m.kappa, m.jump) || self.obstacle_wants_split(m.lean))
-                    && self.may_split(l)
+                (self.sizing_wants_split(c, l, m.kappa, m.jump) || obstacle_wants_split(c, m.lean))
+                    && self.may_split(c, l)
             })
             .map(|(&l, m)| (l, m.angle))
             .collect();
@@ -325,16 +331,16 @@ impl Adapter {
     /// True when leaf `l`, with curvature `kappa` (rad/m) and strain jump `jump`
     /// measured at it, is coarser than its target: `kappa * D > refine_angle`,
     /// or `jump > refine_strain` when that is set.
-    pub(super) fn sizing_wants_split(&self, l: u32, kappa: Scalar, jump: Scalar) -> bool {
+    pub(super) fn sizing_wants_split(
+        &self,
+        c: &AdaptConfig,
+        l: u32,
+        kappa: Scalar,
+        jump: Scalar,
+    ) -> bool {
         // The strain test first: it needs no spacing.
-        self.config.refine_strain.is_some_and(|s| jump > s)
-            || kappa * self.node_spacing(l) > self.config.refine_angle.to_radians()
-    }
-
-    /// True when a leaf whose edges lean towards an obstacle by `lean` at most
-    /// (`proximity.rs`) is too coarse there: `lean > refine_obstacle`.
-    fn obstacle_wants_split(&self, lean: Scalar) -> bool {
-        self.config.refine_obstacle.is_some_and(|r| lean > r)
+        c.refine_strain.is_some_and(|s| jump > s)
+            || kappa * self.node_spacing(l) > c.refine_angle.to_radians()
     }
 
     /// Parents whose four leaf children would, merged, still be finer than
@@ -344,25 +350,23 @@ impl Adapter {
     ///
     /// A parent whose merges bounced (module docs, "Bounces") is held to `H`
     /// doubled once per bounce.
-    pub(super) fn sizing_merge_marks(&self, curv: &LeafCurvature) -> Vec<(u32, Scalar)> {
+    pub(super) fn sizing_merge_marks(
+        &self,
+        c: &AdaptConfig,
+        curv: &LeafCurvature,
+    ) -> Vec<(u32, Scalar)> {
         let mut out = Vec::new();
         for p in self.hierarchy.mergeable_parents() {
             let bounced = self.bounces.get(&p).copied().unwrap_or(0);
-            let h = self.config.hysteresis * Scalar::powi(2.0, bounced.min(MAX_DOUBLINGS) as i32);
-            let limit = self.config.refine_angle.to_radians() / h;
+            let h = c.hysteresis * Scalar::powi(2.0, bounced.min(MAX_DOUBLINGS) as i32);
+            let limit = c.refine_angle.to_radians() / h;
             let children = self.hierarchy.children(p).unwrap_or_default();
             let m = children
                 .iter()
-                .map(|&c| curv.get(c))
+                .map(|&child| curv.get(child))
                 .fold(LeafMeasure::default(), LeafMeasure::max);
-            let strain_ok = self
-                .config
-                .refine_strain
-                .is_none_or(|s| 2.0 * m.jump <= s / h);
-            let obstacle_ok = self
-                .config
-                .refine_obstacle
-                .is_none_or(|r| 2.0 * m.lean <= r / h);
+            let strain_ok = c.refine_strain.is_none_or(|s| 2.0 * m.jump <= s / h);
+            let obstacle_ok = c.refine_obstacle.is_none_or(|r| 2.0 * m.lean <= r / h);
             if m.kappa * self.node_spacing(p) <= limit && strain_ok && obstacle_ok {
                 out.push((p, m.angle));
             }
@@ -372,10 +376,16 @@ impl Adapter {
 
     /// True when leaf `l` may split: below the finest level and, with a
     /// minimum edge length, not making edges shorter than it.
-    pub(super) fn may_split(&self, l: u32) -> bool {
+    pub(super) fn may_split(&self, c: &AdaptConfig, l: u32) -> bool {
         let finer = self.hierarchy.level(l) as u32 + 2;
-        let long_enough = self.config.min_edge_length <= 0.0
-            || 0.5 * self.hierarchy.shortest_edge(l) >= self.config.min_edge_length;
-        finer <= self.config.max_level as u32 && long_enough
+        let long_enough =
+            c.min_edge_length <= 0.0 || 0.5 * self.hierarchy.shortest_edge(l) >= c.min_edge_length;
+        finer <= c.max_level as u32 && long_enough
     }
+}
+
+/// True when a leaf whose edges lean towards an obstacle by `lean` at most
+/// (`proximity.rs`) is too coarse there: `lean > refine_obstacle`.
+fn obstacle_wants_split(c: &AdaptConfig, lean: Scalar) -> bool {
+    c.refine_obstacle.is_some_and(|r| lean > r)
 }

@@ -4,7 +4,7 @@
 
 use super::tensor::{AxisOps, Thresholds};
 use super::transfer::transfer;
-use super::{AdaptEvent, Adapter, EventKind};
+use super::{AdaptConfig, AdaptEvent, Adapter, EventKind, MethodState};
 use crate::math::{Scalar, Vector};
 use crate::mesh::MeshError;
 use crate::spec::AdaptCriterion;
@@ -15,11 +15,15 @@ impl Adapter {
     /// the mesh changed. Atomic: if the world refuses the new mesh, the grid,
     /// the world, the events and the counters other than `passes` stay as
     /// they were.
-    pub(super) fn tensor_pass(&mut self, world: &mut World, step: u64) -> Result<bool, MeshError> {
-        let Some(grid) = self.tensor.as_mut() else {
+    pub(super) fn tensor_pass(
+        &mut self,
+        c: &AdaptConfig,
+        world: &mut World,
+        step: u64,
+    ) -> Result<bool, MeshError> {
+        let MethodState::Tensor(grid) = &mut self.method else {
             unreachable!("the tensor pass runs on an adapter with a tensor grid");
         };
-        let c = &self.config;
         let sizing = c.criterion == AdaptCriterion::Sizing;
         let refine = c.refine_angle.to_radians();
         let th = Thresholds {
@@ -79,7 +83,10 @@ impl Adapter {
 
     /// The tensor method's grid (`None` for the other methods).
     pub fn tensor_grid(&self) -> Option<&super::tensor::TensorGrid> {
-        self.tensor.as_ref()
+        match &self.method {
+            MethodState::Tensor(grid) => Some(grid),
+            _ => None,
+        }
     }
 }
 

@@ -29,8 +29,7 @@
 //! (roots in input order), so numbering the vertices in the order the
 //! triangle list first uses them keeps neighbours close (0.013 of the count in
 //! that test; the grid itself 0.020) at the cost of renumbering every vertex
-//! at each remesh, which the hierarchy's `remap` follows. Measured side by
-//! side in `docs/performance.md`, "Vertex order". The edge method keeps
+//! at each remesh, which the hierarchy's `remap` follows. The edge method keeps
 //! creation order: its triangle list is in slot order, which carries no
 //! locality for a numbering to follow.
 //!

@@ -275,7 +275,8 @@ pub fn make_plan(opts: &BenchOptions) -> Result<(Plan, SamplePoints), BenchError
     };
     let compare = opts.compare.or(ladder.compare).unwrap_or(Compare::Frames);
     let mut finest = 0;
-    for r in &ladder.rung {
+    // The reference is finer than every candidate; a floor may be as fine.
+    for r in ladder.rung.iter().filter(|r| !r.floor) {
         let scene = load(&opts.scene, &chain(&base_set, &r.set), &r.label)?;
         finest = finest.max(ladder::finest_resolution(&scene));
     }

@@ -149,49 +149,33 @@ pub struct ObstacleMesh {
     pub triangles: Vec<[u32; 3]>,
 }
 
-/// The collision passes of a scene and their per-step scratch.
-#[derive(Debug)]
-pub struct Collider {
+/// The rigid obstacles of a scene: their shapes, poses, motions and friction,
+/// fixed for the run (the simulation's [`crate::sim::Setup`] holds them; the
+/// [`Collider`] is given them every step).
+#[derive(Debug, Default)]
+pub struct Obstacles {
     bodies: Vec<Body>,
-    self_collider: Option<SelfCollider>,
-    x0: Vec<Vector>,
-    held: Vec<bool>,
-    t0: Scalar,
-    /// Per-step scratch, kept so that a step allocates nothing: each body's pose at the
-    /// start and the end of the step.
-    poses: Vec<(Pose, Pose)>,
-    /// Per-step scratch: per vertex, whether it touched an obstacle and the work done on it.
-    hits: Vec<(u64, Scalar)>,
 }
 
-impl Collider {
-    /// The collision passes of a scene's obstacles and self-collision; `None` when it
-    /// has neither (nothing runs, nothing costs). `crate::scene` builds it from a scene
-    /// (`Collider::from_scene`).
-    pub fn new(
-        obstacles: &[Obstacle],
-        self_collision: Option<&SelfCollision>,
-    ) -> Result<Option<Collider>, CollideError> {
-        if obstacles.is_empty() && self_collision.is_none() {
-            return Ok(None);
-        }
+impl Obstacles {
+    /// The obstacles of a scene's `[[obstacle]]` tables (none: an empty set).
+    /// `crate::scene` builds them from a scene (`Obstacles::from_scene`).
+    pub fn new(obstacles: &[Obstacle]) -> Result<Obstacles, CollideError> {
         let bodies = obstacles
             .iter()
             .enumerate()
             .map(|(i, o)| Body::from_spec(i, o))
             .collect::<Result<Vec<_>, _>>()?;
-        Ok(Some(Collider {
-            bodies,
-            self_collider: self_collision.map(SelfCollider::new),
-            x0: Vec::new(),
-            held: Vec::new(),
-            t0: 0.0,
-            poses: Vec::new(),
-            hits: Vec::new(),
-        }))
+        Ok(Obstacles { bodies })
     }
 
-    /// The obstacles, for `drape check`: name, friction, thickness, moving.
+    /// True when there are none.
+    pub fn is_empty(&self) -> bool {
+        self.bodies.is_empty()
+    }
+
+    /// The obstacles, for `drape check`: name, friction, thickness, moving, and
+    /// what the obstacle passes do (empty when there are none).
     pub fn describe(&self) -> Vec<String> {
         let mut out: Vec<String> = self
             .bodies
@@ -213,31 +197,13 @@ impl Collider {
                     .into(),
             );
         }
-        if let Some(s) = &self.self_collider {
-            out.push(format!(
-                "self-collision: thickness {} m, {} repulsion passes, vertex-triangle and edge-edge, Volino culling {}",
-                s.thickness,
-                s.iterations,
-                if s.culling { "on" } else { "off" }
-            ));
-        }
         out
-    }
-
-    /// True when self-collision runs.
-    pub fn has_self_collision(&self) -> bool {
-        self.self_collider.is_some()
-    }
-
-    /// True when there are obstacles.
-    pub fn has_obstacles(&self) -> bool {
-        !self.bodies.is_empty()
     }
 
     /// Every obstacle triangulated at time `t`, in world coordinates; planes
     /// as a square of half side `plane.1` around `plane.0` (see
     /// [`obstacle::Body::world_triangles`]).
-    pub fn obstacle_meshes(&self, t: Scalar, plane: (Vector, Scalar)) -> Vec<ObstacleMesh> {
+    pub fn meshes(&self, t: Scalar, plane: (Vector, Scalar)) -> Vec<ObstacleMesh> {
         self.bodies
             .iter()
             .map(|b| {
@@ -270,6 +236,56 @@ impl Collider {
                 .expect("at least one obstacle")
         }));
     }
+}
+
+/// The collision passes of a run and their per-step scratch (the obstacles
+/// themselves are the run's [`Obstacles`], given to every step).
+#[derive(Debug)]
+pub struct Collider {
+    self_collider: Option<SelfCollider>,
+    x0: Vec<Vector>,
+    held: Vec<bool>,
+    t0: Scalar,
+    /// Per-step scratch, kept so that a step allocates nothing: each body's pose at the
+    /// start and the end of the step.
+    poses: Vec<(Pose, Pose)>,
+    /// Per-step scratch: per vertex, whether it touched an obstacle and the work done on it.
+    hits: Vec<(u64, Scalar)>,
+}
+
+impl Collider {
+    /// The collision passes of a run with `obstacles` and self-collision; `None`
+    /// when it has neither (nothing runs, nothing costs).
+    pub fn new(obstacles: &Obstacles, self_collision: Option<&SelfCollision>) -> Option<Collider> {
+        if obstacles.is_empty() && self_collision.is_none() {
+            return None;
+        }
+        Some(Collider {
+            self_collider: self_collision.map(SelfCollider::new),
+            x0: Vec::new(),
+            held: Vec::new(),
+            t0: 0.0,
+            poses: Vec::new(),
+            hits: Vec::new(),
+        })
+    }
+
+    /// The self-collision pass, for `drape check` (`None`: it does not run).
+    pub fn describe_self_collision(&self) -> Option<String> {
+        self.self_collider.as_ref().map(|s| {
+            format!(
+                "self-collision: thickness {} m, {} repulsion passes, vertex-triangle and edge-edge, Volino culling {}",
+                s.thickness,
+                s.iterations,
+                if s.culling { "on" } else { "off" }
+            )
+        })
+    }
+
+    /// True when self-collision runs.
+    pub fn has_self_collision(&self) -> bool {
+        self.self_collider.is_some()
+    }
 
     /// Stores the start-of-step state; call right before the integrator step.
     pub fn begin_step(&mut self, world: &World) {
@@ -285,6 +301,7 @@ impl Collider {
     /// vertex (the simulation state's resting contacts, for the next implicit step).
     pub fn end_step(
         &mut self,
+        obstacles: &Obstacles,
         world: &mut World,
         h: Scalar,
         cloth: StepCloth,
@@ -294,12 +311,13 @@ impl Collider {
         let (t0, t1) = (self.t0, world.time);
         let started = Instant::now();
         self.poses.clear();
+        let bodies = &obstacles.bodies;
         self.poses
-            .extend(self.bodies.iter().map(|b| (b.pose(t0), b.pose(t1))));
-        let touching = if self.bodies.is_empty() {
+            .extend(bodies.iter().map(|b| (b.pose(t0), b.pose(t1))));
+        let touching = if bodies.is_empty() {
             0
         } else {
-            self.obstacle_pass(world, h, cloth, contacts, stats)
+            self.obstacle_pass(bodies, world, h, cloth, contacts, stats)
         };
         stats.collision_wall_s += started.elapsed().as_secs_f64();
         if let Some(sc) = self.self_collider.as_mut() {
@@ -317,8 +335,8 @@ impl Collider {
             stats.self_collision_wall_s += started.elapsed().as_secs_f64();
         }
         let started = Instant::now();
-        if !self.bodies.is_empty() {
-            let depth = self.final_obstacle_pass(world);
+        if !bodies.is_empty() {
+            let depth = self.final_obstacle_pass(bodies, world);
             stats.max_penetration = stats.max_penetration.max(depth);
             stats.last_penetration = depth;
         }
@@ -334,6 +352,7 @@ impl Collider {
     /// `stats.obstacle_work`, and returns how many vertices touch an obstacle.
     fn obstacle_pass(
         &mut self,
+        bodies: &[Body],
         world: &mut World,
         h: Scalar,
         cloth: StepCloth,
@@ -342,10 +361,10 @@ impl Collider {
     ) -> u64 {
         let StepCloth { pushed, mass } = cloth;
         let t1 = world.time;
-        let (bodies, x0, held, poses) = (&self.bodies, &self.x0, &self.held, &self.poses);
+        let (x0, held, poses) = (&self.x0, &self.held, &self.poses);
         contacts.clear();
         contacts.resize(world.x.len(), Contact::default());
-        let moving = self.bodies.iter().any(Body::is_moving);
+        let moving = bodies.iter().any(Body::is_moving);
         world
             .x
             .par_iter_mut()
@@ -389,9 +408,9 @@ impl Collider {
     /// The last proximity pass: when self-collision ran (it may have moved vertices
     /// into an obstacle), pushes unpinned vertices back out of every obstacle at its
     /// end-of-step pose. Returns the largest depth of a vertex below an obstacle surface.
-    fn final_obstacle_pass(&self, world: &mut World) -> Scalar {
+    fn final_obstacle_pass(&self, bodies: &[Body], world: &mut World) -> Scalar {
         let t1 = world.time;
-        let (bodies, held, poses) = (&self.bodies, &self.held, &self.poses);
+        let (held, poses) = (&self.held, &self.poses);
         let after_self = self.self_collider.is_some();
         world
             .x
@@ -411,10 +430,20 @@ impl Collider {
             })
             .reduce(|| 0.0, Scalar::max)
     }
+}
 
+impl Obstacles {
     /// The Cusick drape measurements, when the cloth is a disk specimen lying on a
     /// vertical cylinder (the support disk) centred under it.
     pub fn cusick_of(&self, cloth: &ClothSpec, world: &World) -> Option<cusick::CusickSummary> {
+        let (top, specimen, disk) = self.cusick_support(cloth)?;
+        Some(cusick::measure(&world.mesh, &world.x, top, specimen, disk))
+    }
+
+    /// The support of a Cusick test: the top centre of the vertical cylinder
+    /// centred under the disk specimen `cloth`, the specimen's radius and the
+    /// support's (smaller) radius; `None` when the cloth is not such a specimen.
+    pub fn cusick_support(&self, cloth: &ClothSpec) -> Option<(Vector, Scalar, Scalar)> {
         let ClothMesh::Disk {
             radius: specimen, ..
         } = cloth.mesh
@@ -428,7 +457,6 @@ impl Collider {
             .filter(|b| b.kind == ObstacleShape::Cylinder)
             .find_map(Body::vertical_cylinder_top)?;
         let off = (top - centre).truncate().length();
-        (off < 0.25 * disk && disk < specimen)
-            .then(|| cusick::measure(&world.mesh, &world.x, top, specimen, disk))
+        (off < 0.25 * disk && disk < specimen).then_some((top, specimen, disk))
     }
 }

@@ -88,8 +88,7 @@ impl ElementBlocks<'_> {
     /// its gradients by the other two angles are zero and their terms are
     /// skipped: a block with one tip sums one outer product or one term of
     /// `M J` instead of three, a tip-tip block one of each. Skipping exact
-    /// zeros leaves every block the same to the last bit (the summaries of the
-    /// scenes compared in `docs/performance.md`, "Shape blocks", are identical).
+    /// zeros leaves every block the same to the last bit.
     fn shape_block(&self, tri: usize, k: usize, l: usize) -> Matrix3 {
         let (m, jac) = (&self.shape_triangles[tri].m, &self.shape_jacobians[tri]);
         let mut out = Matrix3::ZERO;

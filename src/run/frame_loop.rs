@@ -9,10 +9,12 @@ use super::tally::{Tally, TallyEnd};
 use super::{FrameState, Progress, RunError, RunOptions};
 use crate::adapt::Adapter;
 use crate::math::{Scalar, Vector};
-use crate::physics::{Energy, Model};
+use crate::physics::Energy;
 use crate::record::{RecordError, RecordTarget, Recorder, obj::write_frame_obj};
 use crate::scene::Scene;
-use crate::sim::{FrameFailed, MAX_STEP_HALVINGS, Pipeline, SimState, Simulation, StepFailure};
+use crate::sim::{
+    FrameFailed, FrameFailure, MAX_STEP_HALVINGS, Pipeline, Setup, SimParts, SimState, StepFailure,
+};
 use crate::summary::Summary;
 
 /// A run in progress: the simulation, its outputs and its running statistics.
@@ -21,7 +23,7 @@ use crate::summary::Summary;
 /// the summary.
 pub struct FrameLoop<'a> {
     scene: &'a Scene,
-    model: Model,
+    setup: Setup,
     state: SimState,
     pipeline: Pipeline,
     /// The energy of the state as it is, once measured (or handed over by the
@@ -50,22 +52,15 @@ pub struct FrameLoop<'a> {
     failure: Option<(u64, FrameFailure)>,
 }
 
-/// How a frame's steps failed (from [`FrameFailed::Steps`]).
-#[derive(Debug, Clone, Copy)]
-struct FrameFailure {
-    last_dt: Scalar,
-    what: StepFailure,
-    step: u64,
-}
-
 impl<'a> FrameLoop<'a> {
     /// A run of `scene` from the built simulation ([`crate::sim::build`]); opens
     /// the recording and the OBJ directory.
     pub fn new(
         scene: &'a Scene,
-        sim: Simulation,
+        sim: SimParts,
         opts: &RunOptions,
     ) -> Result<FrameLoop<'a>, RunError> {
+        super::measure::check(scene, &sim.setup, &sim.state.world)?;
         let recorder = match (&opts.record, &opts.live) {
             (None, None) => None,
             (file, live) => {
@@ -88,15 +83,15 @@ impl<'a> FrameLoop<'a> {
             })?;
         }
         let frames = scene.simulation.frame_count();
-        let Simulation {
-            model,
+        let SimParts {
+            setup,
             state,
             pipeline,
         } = sim;
-        let tally = Tally::new(&model, &state.world, pipeline.stepper());
+        let tally = Tally::new(&setup.model, &state.world, pipeline.stepper());
         Ok(FrameLoop {
             scene,
-            model,
+            setup,
             state,
             pipeline,
             recorder,
@@ -146,26 +141,14 @@ impl<'a> FrameLoop<'a> {
         let t0 = Instant::now();
         let start_energy = self.energy_now.take();
         match self.pipeline.advance_frame_from(
-            &self.model,
+            &self.setup,
             &mut self.state,
             self.frame_interval,
             start_energy,
         ) {
             Ok(_) => {}
-            Err(FrameFailed::Steps {
-                last_dt,
-                failure,
-                step,
-            }) => {
-                let what = failure;
-                self.failure = Some((
-                    self.frame + 1,
-                    FrameFailure {
-                        last_dt,
-                        what,
-                        step,
-                    },
-                ));
+            Err(FrameFailed::Steps(f)) => {
+                self.failure = Some((self.frame + 1, f));
                 return Ok(false);
             }
             Err(FrameFailed::Remesh(e)) => return Err(RunError::Remesh(e)),
@@ -213,7 +196,7 @@ impl<'a> FrameLoop<'a> {
             None => self
                 .pipeline
                 .stepper()
-                .energy(&self.model, &self.state.world),
+                .energy(&self.setup.model, &self.state.world),
         };
         self.energy_now = Some(e);
         e
@@ -247,7 +230,7 @@ impl<'a> FrameLoop<'a> {
             frame_interval: self.frame_interval,
         };
         let (state, pipeline) = (&mut self.state, &mut self.pipeline);
-        recording::record_state(rec, &self.model, state, pipeline, &snap, &mut self.normals)?;
+        recording::record_state(rec, &self.setup, state, pipeline, &snap, &mut self.normals)?;
         self.recorded_frames += 1;
         self.last_recorded = Some(self.frame);
         Ok(())
@@ -275,16 +258,16 @@ impl<'a> FrameLoop<'a> {
             None => Ok(summary),
             Some((frame, f)) => Err(RunError::Numerical {
                 step: f.step,
-                failure: f.what,
+                failure: f.failure,
                 frame,
                 time: self.state.world.time,
                 halvings: MAX_STEP_HALVINGS,
                 dt: f.last_dt,
                 cause: format!(
                     "step {:.3e} s with the {:?} integrator; try a smaller `simulation.dt`, `dt = \"auto\"`, or `integrator = \"implicit\"`{}",
-                    self.pipeline.step_size(&self.model, &self.state.world),
-                    self.model.integrator,
-                    solver_hint(&f.what)
+                    self.pipeline.step_size(&self.setup, &self.state.world),
+                    self.setup.model.integrator,
+                    solver_hint(&f.failure)
                 ),
                 summary: Box::new(summary),
             }),
@@ -296,9 +279,10 @@ impl<'a> FrameLoop<'a> {
         let dt = if state.effort.min_dt.is_finite() {
             state.effort.min_dt
         } else {
-            pipe.step_size(&self.model, &state.world)
+            pipe.step_size(&self.setup, &state.world)
         };
         let stepper = pipe.stepper();
+        let (cusick, cantilever) = super::measure::at_end(self.scene, &self.setup, &state.world);
         self.tally.finish(TallyEnd {
             scene: self.scene.name.clone(),
             frames: self.frame + 1,
@@ -311,10 +295,8 @@ impl<'a> FrameLoop<'a> {
             recording,
             state,
             mass_final: stepper.elements.total_mass(),
-            cusick: pipe
-                .collider()
-                .and_then(|c| c.cusick(self.scene, &state.world)),
-            cantilever: crate::cantilever::for_run(self.scene, &state.world, &self.model.material),
+            cusick,
+            cantilever,
         })
     }
 }

@@ -3,9 +3,9 @@
 
 use crate::adapt::{AdaptEvent, Adapter, EventKind, edge_angles};
 use crate::math::{Scalar, Vector};
-use crate::physics::{Energy, Model};
+use crate::physics::Energy;
 use crate::record::{EventMark, FrameView, Recorder};
-use crate::sim::{Pipeline, SimState};
+use crate::sim::{Pipeline, Setup, SimState};
 use crate::world::World;
 
 use super::RunError;
@@ -38,7 +38,7 @@ pub(super) struct Snapshot {
 /// recorded frame).
 pub(super) fn record_state(
     rec: &mut Recorder,
-    model: &Model,
+    setup: &Setup,
     state: &mut SimState,
     pipe: &mut Pipeline,
     snap: &Snapshot,
@@ -55,7 +55,7 @@ pub(super) fn record_state(
     let edges: Vec<[u32; 2]> = world.mesh.edges.iter().map(|e| e.vertices).collect();
     world.vertex_normals(normals);
     let pinned: Vec<u32> = world.pins.anchors.iter().map(|a| a.vertex).collect();
-    let dt_now = pipe.step_taken(model, world, snap.frame_interval);
+    let dt_now = pipe.step_taken(setup, world, snap.frame_interval);
     let e = snap.energy;
     let mut scalars = vec![
         ("mesh/vertices", world.x.len() as f64),
@@ -103,11 +103,9 @@ pub(super) fn record_state(
         scalars: &scalars,
         events: &marks,
     })?;
-    if let Some(c) = pipe.collider() {
-        for m in c.obstacle_meshes(world.time, plane_display(world)) {
-            if m.moving || snap.frame == 0 {
-                rec.record_obstacle(&m.name, &m.positions, &m.triangles, !m.moving)?;
-            }
+    for m in setup.obstacles.meshes(world.time, plane_display(world)) {
+        if m.moving || snap.frame == 0 {
+            rec.record_obstacle(&m.name, &m.positions, &m.triangles, !m.moving)?;
         }
     }
     Ok(())

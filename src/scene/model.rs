@@ -9,8 +9,8 @@ use serde::Deserialize;
 // The engine's own types, deserialised straight from the file (see `crate::spec`).
 pub use crate::spec::{
     Adapt, AdaptCriterion, AdaptEvery, AdaptMethod, BendingModel, ClothShape, DEFAULT_THICKNESS,
-    DiagonalPattern, Integrator, Obstacle, ObstacleShape, Pin, PinMotion, SelfCollision, Solver,
-    StiffnessRule,
+    DiagonalPattern, Integrator, Measurement, Obstacle, ObstacleShape, Pin, PinMotion,
+    SelfCollision, Solver, StiffnessRule,
 };
 
 /// A whole scene file.
@@ -39,6 +39,10 @@ pub struct Scene {
     pub obstacle: Vec<Obstacle>,
     /// Self-collision; absent: the cloth may pass through itself (no cost).
     pub self_collision: Option<SelfCollision>,
+    /// The textile measurements made on the end state (`measure`), none by
+    /// default; each must apply to the scene (`validate_measure.rs`).
+    #[serde(default)]
+    pub measure: Vec<Measurement>,
 }
 
 /// `[simulation]`: time span, integrator and global forces.

@@ -5,14 +5,14 @@
 //! constructors below make one part each, for callers that need only that part.
 
 use crate::adapt::AdaptConfig;
-use crate::collide::{CollideError, Collider, cusick::CusickSummary};
+use crate::collide::{CollideError, Obstacles, cusick::CusickSummary};
 use crate::math::Vector;
 use crate::physics::{ExternalForces, MaterialParams, Model, SolverSettings, WindForce};
 use crate::spec::{ClothMesh, ClothSpec};
 use crate::world::{BuildError, World};
 
 use super::{Cloth, ClothShape, DEFAULT_AIR_DENSITY, Scene, TimeStep};
-use crate::sim::SimSpec;
+use crate::sim::{Settings, SimSpec, StepSize};
 
 impl Scene {
     /// The engine's specification of this (validated) scene: the one input of
@@ -23,14 +23,16 @@ impl Scene {
             pins: self.pin.clone(),
             model: Model::from_scene(self),
             obstacles: self.obstacle.clone(),
-            self_collision: self.self_collision.clone(),
-            adapt: AdaptConfig::from_scene(self.adapt.as_ref()),
-            multirate: self.adapt.as_ref().is_some_and(|a| a.multirate),
-            density: self.material.density,
-            fixed_dt: match self.simulation.dt {
-                TimeStep::Fixed(dt) => Some(dt),
-                TimeStep::Auto => None,
+            settings: Settings {
+                step: match self.simulation.dt {
+                    TimeStep::Fixed(dt) => StepSize::Fixed(dt),
+                    TimeStep::Auto => StepSize::Auto,
+                },
+                multirate: self.adapt.as_ref().is_some_and(|a| a.multirate),
+                self_collision: self.self_collision.clone(),
+                adapt: AdaptConfig::from_scene(self.adapt.as_ref()),
             },
+            density: self.material.density,
         })
     }
 }
@@ -76,11 +78,10 @@ impl World {
     }
 }
 
-impl Collider {
-    /// The collision passes `scene` declares; `None` when it has neither obstacles nor
-    /// self-collision (nothing runs, nothing costs).
-    pub fn from_scene(scene: &Scene) -> Result<Option<Collider>, CollideError> {
-        Collider::new(&scene.obstacle, scene.self_collision.as_ref())
+impl Obstacles {
+    /// The obstacles `scene` declares (none: an empty set).
+    pub fn from_scene(scene: &Scene) -> Result<Obstacles, CollideError> {
+        Obstacles::new(&scene.obstacle)
     }
 
     /// The Cusick drape measurements, when the scene is a disk specimen lying on a

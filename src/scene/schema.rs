@@ -10,6 +10,7 @@ pub(crate) fn allowed(path: &str) -> Option<&'static str> {
         .collect();
     Some(match key.join(".").as_str() {
         "name" => "a non-empty string without `/` or `\\`",
+        "measure" => "an array of measurements: \"cantilever\", \"cusick\"",
         "simulation" => "a table [simulation]",
         "simulation.duration" => "a finite number > 0 (s)",
         "simulation.frame_rate" => "a finite number > 0 (frames per second)",

@@ -59,7 +59,7 @@ pub(crate) fn validate(scene: &Scene, doc: &Table) -> Result<(), Issue> {
             return Err(Issue::new(path, Kind::NotApplicable, why));
         }
     }
-    Ok(())
+    super::validate_measure::measure(scene)
 }
 
 fn section<'a>(doc: &'a Table, key: &str) -> Option<&'a Table> {

@@ -1,7 +1,7 @@
 //! [`Pipeline`]: advances a [`SimState`] by a step or a frame; holds only scratch.
 
 use super::bound::is_finite;
-use super::{SimState, StepFailure};
+use super::{Setup, SimState, StepFailure, StepSize};
 use crate::collide::{Collider, StepCloth};
 use crate::math::Scalar;
 use crate::mesh::MeshError;
@@ -24,6 +24,47 @@ pub const ENERGY_GAIN_TOLERANCE: Scalar = 0.01;
 /// The most halvings spent on an energy gain (the frame is then accepted).
 pub const MAX_ENERGY_HALVINGS: u32 = 3;
 
+/// What an accepted step did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct StepOutcome {
+    /// Times the step was undone and redone on a refined mesh (paper A's
+    /// rollback).
+    pub rollbacks: u32,
+    /// True when the adaptation pass after the step changed the mesh.
+    pub remeshed: bool,
+}
+
+/// Why a step was not accepted.
+#[derive(Debug, thiserror::Error)]
+pub enum StepError {
+    /// The step was rejected (the frame retries it with a smaller step); the
+    /// state is left as the failed attempt made it.
+    #[error("{0}")]
+    Rejected(StepFailure),
+    /// Remeshing produced an invalid mesh (a bug: please report it).
+    #[error("adaptive remeshing: {0}")]
+    Remesh(#[from] MeshError),
+}
+
+impl From<StepFailure> for StepError {
+    fn from(why: StepFailure) -> StepError {
+        StepError::Rejected(why)
+    }
+}
+
+/// Every step size tried for a frame failed; the state is back at the
+/// frame's start.
+#[derive(Debug, Clone, Copy, thiserror::Error)]
+#[error("all step sizes failed, down to {last_dt:.3e} s: {failure}")]
+pub struct FrameFailure {
+    /// The last step tried, s.
+    pub last_dt: Scalar,
+    /// What went wrong with it.
+    pub failure: StepFailure,
+    /// The step (counted from the start of the run) that failed.
+    pub step: u64,
+}
+
 /// Why a frame could not be advanced.
 #[derive(Debug, thiserror::Error)]
 pub enum FrameFailed {
@@ -31,15 +72,8 @@ pub enum FrameFailed {
     #[error("adaptive remeshing: {0}")]
     Remesh(#[from] MeshError),
     /// Every step size tried failed; the state is back at the frame's start.
-    #[error("all step sizes failed, down to {last_dt:.3e} s: {failure}")]
-    Steps {
-        /// The last step tried, s.
-        last_dt: Scalar,
-        /// What went wrong with it.
-        failure: StepFailure,
-        /// The step (counted from the start of the run) that failed.
-        step: u64,
-    },
+    #[error("{0}")]
+    Steps(#[from] FrameFailure),
 }
 
 /// The machinery that advances a [`SimState`]: the stepper (force model, element
@@ -50,15 +84,11 @@ pub struct Pipeline {
     stepper: Stepper,
     /// Obstacle and self-collision passes (`None`: the scene has neither).
     collider: Option<Collider>,
-    /// The user's fixed step, or `None` for `dt = "auto"`.
-    fixed_dt: Option<Scalar>,
     /// Cache: the automatic step for the current mesh (refinement lowers the
     /// explicit stability limit, so a remesh forgets it).
     auto_dt: Option<Scalar>,
     /// Cache: the air's power at the end of the last step, W (the start of the next).
     air_power: Option<Scalar>,
-    /// Why the last rejected step failed.
-    failure: StepFailure,
     /// The frame's start, kept for a retry (buffers reused frame to frame).
     frame_start: Option<SimState>,
     /// The step's start, kept for paper A's rollback.
@@ -81,26 +111,17 @@ pub struct Pipeline {
 }
 
 impl Pipeline {
-    /// The pipeline of a run with `model` on `world`'s mesh. `fixed_dt`: the
-    /// scene's step (`None`: automatic); `multirate`: paper A's multirate stepping.
-    /// The pipeline does not keep the model: every call that advances a state is
-    /// given it.
-    pub fn new(
-        model: &Model,
-        world: &World,
-        collider: Option<Collider>,
-        fixed_dt: Option<Scalar>,
-        multirate: bool,
-    ) -> Pipeline {
-        let mut stepper = Stepper::new(model, world);
-        stepper.multirate = multirate;
+    /// The pipeline of a run with `setup` on `world`'s mesh. The pipeline does
+    /// not keep the setup: every call that advances a state is given it.
+    pub fn new(setup: &Setup, world: &World) -> Pipeline {
+        let settings = &setup.settings;
+        let mut stepper = Stepper::new(&setup.model, world);
+        stepper.multirate = settings.multirate;
         Pipeline {
             stepper,
-            collider,
-            fixed_dt,
+            collider: Collider::new(&setup.obstacles, settings.self_collision.as_ref()),
             auto_dt: None,
             air_power: None,
-            failure: StepFailure::NonFinite,
             frame_start: None,
             step_start: StepStart::default(),
             angles: Vec::new(),
@@ -133,11 +154,6 @@ impl Pipeline {
         self.collider.as_ref()
     }
 
-    /// Why the last rejected step failed.
-    pub fn failure(&self) -> StepFailure {
-        self.failure
-    }
-
     /// Advances one frame; on a rejected step (non-finite state, energy explosion,
     /// solver failure) restores the frame's start (mesh included) and retries with
     /// the step halved (up to [`MAX_STEP_HALVINGS`] times). A frame whose energy rose
@@ -147,11 +163,11 @@ impl Pipeline {
     /// of halvings spent.
     pub fn advance_frame(
         &mut self,
-        model: &Model,
+        setup: &Setup,
         state: &mut SimState,
         frame_interval: Scalar,
     ) -> Result<u64, FrameFailed> {
-        self.advance_frame_from(model, state, frame_interval, None)
+        self.advance_frame_from(setup, state, frame_interval, None)
     }
 
     /// [`Pipeline::advance_frame`] given the energy of `state` as it is, when
@@ -160,14 +176,14 @@ impl Pipeline {
     /// result is the same either way.
     pub fn advance_frame_from(
         &mut self,
-        model: &Model,
+        setup: &Setup,
         state: &mut SimState,
         frame_interval: Scalar,
         start_energy: Option<Energy>,
     ) -> Result<u64, FrameFailed> {
         self.frame_end_energy = None;
         debug_assert!(
-            start_energy.is_none_or(|e| e == self.stepper.energy(model, &state.world)),
+            start_energy.is_none_or(|e| e == self.stepper.energy(&setup.model, &state.world)),
             "the start energy given is not the state's"
         );
         let start = match self.frame_start.take() {
@@ -177,26 +193,38 @@ impl Pipeline {
             }
             None => state.clone(),
         };
-        let result = self.retry_frame(model, state, &start, frame_interval, start_energy);
+        let result = self.retry_frame(setup, state, &start, frame_interval, start_energy);
         self.frame_start = Some(start);
         result
     }
 
+    /// The frame's steps, retried from `start` with halved steps while a step is
+    /// rejected or the frame gains energy ([`Pipeline::advance_frame`]).
     fn retry_frame(
         &mut self,
-        model: &Model,
+        setup: &Setup,
         state: &mut SimState,
         start: &SimState,
         frame_interval: Scalar,
         start_energy: Option<Energy>,
     ) -> Result<u64, FrameFailed> {
         let t0 = state.world.time;
+        let model = &setup.model;
         // E - W at the frame start: without numerical error it can only fall.
         let energy_start = start_energy.unwrap_or_else(|| self.stepper.energy(model, &state.world));
         let balance_start = energy_start.total() - state.ledger.work();
         let mut last_gain = Scalar::INFINITY;
+        // Set by every rejected attempt: the last halving always ends in one.
+        let mut failure = StepFailure::NonFinite;
         for halving in 0..=MAX_STEP_HALVINGS {
-            let healthy = self.steps_through(model, state, frame_interval, halving)?;
+            let healthy = match self.steps_through(setup, state, frame_interval, halving) {
+                Ok(()) => true,
+                Err(StepError::Rejected(why)) => {
+                    failure = why;
+                    false
+                }
+                Err(StepError::Remesh(e)) => return Err(FrameFailed::Remesh(e)),
+            };
             state.world.time = t0 + frame_interval;
             if healthy {
                 let energy_end = self.stepper.energy(model, &state.world);
@@ -209,7 +237,7 @@ impl Pipeline {
                     let excess = balance - state.ledger.bound.initial;
                     state.ledger.excess_max = state.ledger.excess_max.max(excess);
                     state.effort.step_halvings += halving as u64;
-                    if !self.adapt_at_frame_end(model, state)? {
+                    if !self.adapt_at_frame_end(setup, state)? {
                         self.frame_end_energy = Some(energy_end);
                     }
                     return Ok(halving as u64);
@@ -218,99 +246,98 @@ impl Pipeline {
                 state.effort.energy_retries += 1;
             }
             state.restore(start);
-            self.mesh_changed(model, state);
+            self.mesh_changed(setup, state);
         }
-        let last_dt = self.step_size(model, &state.world) / (1u64 << MAX_STEP_HALVINGS) as Scalar;
-        Err(FrameFailed::Steps {
+        let last_dt = self.step_size(setup, &state.world) / (1u64 << MAX_STEP_HALVINGS) as Scalar;
+        Err(FrameFailed::Steps(FrameFailure {
             last_dt,
-            failure: self.failure,
+            failure,
             step: state.ledger.steps_done + 1,
-        })
+        }))
     }
 
     /// Steps through `frame_interval` with the current mesh's step divided by
     /// `2^halving`, the last steps evened out so the frame ends exactly on its time.
-    /// False when a step was rejected.
+    /// Stops at the first step not accepted.
     fn steps_through(
         &mut self,
-        model: &Model,
+        setup: &Setup,
         state: &mut SimState,
         frame_interval: Scalar,
         halving: u32,
-    ) -> Result<bool, MeshError> {
+    ) -> Result<(), StepError> {
         let shrink = (1u64 << halving) as Scalar;
         let mut done = 0.0;
         while done < frame_interval * (1.0 - 1e-12) {
             let remaining = frame_interval - done;
-            let h = evened_step(remaining, self.step_size(model, &state.world) / shrink);
-            if !self.step(model, state, h)? {
-                return Ok(false);
-            }
+            let h = evened_step(remaining, self.step_size(setup, &state.world) / shrink);
+            self.step(setup, state, h)?;
             state.effort.min_dt = state.effort.min_dt.min(h);
             self.last_step = Some(h);
             done += h;
         }
-        Ok(true)
+        Ok(())
     }
 
     /// The step the run takes, for display: the last accepted step (the current
     /// mesh's step evened out so that the frame ends on its time, and halved
     /// on a retried frame), or before the first step the one a frame of
     /// `frame_interval` seconds will take.
-    pub fn step_taken(&mut self, model: &Model, world: &World, frame_interval: Scalar) -> Scalar {
+    pub fn step_taken(&mut self, setup: &Setup, world: &World, frame_interval: Scalar) -> Scalar {
         if let Some(h) = self.last_step {
             return h;
         }
-        evened_step(frame_interval, self.step_size(model, world))
+        evened_step(frame_interval, self.step_size(setup, world))
     }
 
-    /// The step for the current mesh: the fixed one, or `model`'s automatic estimate.
-    pub fn step_size(&mut self, model: &Model, world: &World) -> Scalar {
-        if let Some(dt) = self.fixed_dt {
+    /// The step for the current mesh: the fixed one, or the stepper's automatic
+    /// estimate for `setup`'s model.
+    pub fn step_size(&mut self, setup: &Setup, world: &World) -> Scalar {
+        if let StepSize::Fixed(dt) = setup.settings.step {
             return dt;
         }
         *self
             .auto_dt
-            .get_or_insert_with(|| self.stepper.auto_dt(model, world))
+            .get_or_insert_with(|| self.stepper.auto_dt(&setup.model, world))
     }
 
     /// One step of `h` seconds, in phases: forces + integrate, collide, account,
     /// health check (together [`Pipeline::attempt`]), rollback (paper A: redo the
     /// step on a refined mesh when it bent past the upper threshold), adapt.
-    /// Returns false when the step was rejected ([`Pipeline::failure`] says why);
-    /// the state is then not restored (the frame retry does that). With
+    /// A rejected step ([`StepError::Rejected`], with why) leaves the state as
+    /// the failed attempt made it (the frame retry restores it). With
     /// `adapt.every = "frame"` the adaptation pass is not part of the step: it
     /// runs in [`Pipeline::advance_frame`], once the frame's steps are accepted.
     pub fn step(
         &mut self,
-        model: &Model,
+        setup: &Setup,
         state: &mut SimState,
         h: Scalar,
-    ) -> Result<bool, MeshError> {
+    ) -> Result<StepOutcome, StepError> {
         debug_assert_eq!(
             self.stepper.elements.mass.len(),
             state.world.x.len(),
             "the pipeline's elements are not those of the state's mesh: call mesh_changed"
         );
-        let rollback = state.adapter.as_ref().is_some_and(|a| a.config.rollback);
-        let mut tries = 0;
+        let rollback = setup.settings.adapt.as_ref().is_some_and(|a| a.rollback);
+        let mut rollbacks = 0;
         loop {
             self.angles_fresh = false;
             if rollback {
                 self.remember_step_start(state);
             }
-            if let Err(why) = self.attempt(model, state, h) {
-                self.failure = why;
-                return Ok(false);
-            }
-            if rollback && self.rollback(model, state, &mut tries)? {
+            self.attempt(setup, state, h)?;
+            if rollback && self.rollback(setup, state, &mut rollbacks)? {
                 continue;
             }
             break;
         }
         state.ledger.steps_done += 1;
-        self.adapt(model, state)?;
-        Ok(true)
+        let remeshed = self.adapt(setup, state)?;
+        Ok(StepOutcome {
+            rollbacks,
+            remeshed,
+        })
     }
 
     /// The phases of one attempt at a step: forces + integrate, collide, account,
@@ -318,17 +345,18 @@ impl Pipeline {
     /// (filtered there, see [`crate::physics::implicit`]).
     fn attempt(
         &mut self,
-        model: &Model,
+        setup: &Setup,
         state: &mut SimState,
         h: Scalar,
     ) -> Result<(), StepFailure> {
+        let model = &setup.model;
         let air0 = match self.air_power.take() {
             Some(p) => p,
             None => self.stepper.air_power(model, &state.world),
         };
         let pinned = self.stepper.pinned_start(model, &state.world);
         self.integrate(model, state, h)?;
-        self.collide(model, state, h)?;
+        self.collide(setup, state, h)?;
         // Account: the work of the air (trapezoid over the step) and of moving pins.
         let air1 = self.stepper.air_power(model, &state.world);
         self.air_power = Some(air1);
@@ -371,7 +399,7 @@ impl Pipeline {
     /// state's resting contacts.
     fn collide(
         &mut self,
-        model: &Model,
+        setup: &Setup,
         state: &mut SimState,
         h: Scalar,
     ) -> Result<(), StepFailure> {
@@ -383,36 +411,37 @@ impl Pipeline {
         state
             .ledger
             .bound
-            .check(&state.world, &self.stepper, model, work)?;
+            .check(&state.world, &self.stepper, &setup.model, work)?;
         let cloth = StepCloth {
             pushed: &self.stepper.contact_push,
             mass: &self.stepper.elements.mass,
         };
         let (world, contacts) = (&mut state.world, &mut state.contacts);
-        c.end_step(world, h, cloth, contacts, &mut state.ledger.collision);
+        let stats = &mut state.ledger.collision;
+        c.end_step(&setup.obstacles, world, h, cloth, contacts, stats);
         Ok(())
     }
 
-    /// Makes the pipeline that of `state`'s mesh under `model`: rebuilds the element
+    /// Makes the pipeline that of `state`'s mesh under `setup`: rebuilds the element
     /// tables and forgets every cache (step size, air power, stored factorization).
     /// The state is not touched, so a state saved from another pipeline continues
     /// exactly as it would have there (its contacts and warm start are its own).
     /// Call it before stepping a state this pipeline was not built for.
-    pub fn attach(&mut self, model: &Model, state: &SimState) {
-        self.stepper.rebuild(model, &state.world);
+    pub fn attach(&mut self, setup: &Setup, state: &SimState) {
+        self.stepper.rebuild(&setup.model, &state.world);
         self.auto_dt = None;
         self.air_power = None;
         self.angles_fresh = false;
     }
 
     /// After the state's mesh changed (remeshing, or a restored start): rebuilds
-    /// `model`'s force elements and forgets the step size, the air power, and the
+    /// `setup`'s force elements and forgets the step size, the air power, and the
     /// state's (now stale) contacts and warm start. The pipeline calls it after its
     /// own remeshing and restores; call it after changing a state's mesh outside the
     /// pipeline (for a state saved elsewhere, whose contacts and warm start still
     /// fit its mesh, [`Pipeline::attach`] keeps them).
-    pub fn mesh_changed(&mut self, model: &Model, state: &mut SimState) {
-        self.attach(model, state);
+    pub fn mesh_changed(&mut self, setup: &Setup, state: &mut SimState) {
+        self.attach(setup, state);
         state.contacts.clear();
         state.warm_start.clear();
     }

@@ -3,10 +3,10 @@
 use crate::adapt::Adapter;
 use crate::collide::CollisionStats;
 use crate::math::{Scalar, Vector};
-use crate::physics::{Contact, Model, StepStats};
+use crate::physics::{Contact, StepStats};
 use crate::world::World;
 
-use super::{EnergyBound, Pipeline};
+use super::{EnergyBound, Pipeline, Setup};
 
 /// The simulation state: one cloneable value (see the [module docs](super)).
 ///
@@ -86,14 +86,14 @@ impl Default for Effort {
 }
 
 impl SimState {
-    /// The state at the start of a run of `model` (no steps taken) on `world`.
+    /// The state at the start of a run of `setup` (no steps taken) on `world`.
     pub fn new(
-        model: &Model,
+        setup: &Setup,
         world: World,
         adapter: Option<Adapter>,
         pipeline: &Pipeline,
     ) -> SimState {
-        let bound = EnergyBound::new(&world, pipeline.stepper(), model);
+        let bound = EnergyBound::new(&world, pipeline.stepper(), &setup.model);
         SimState {
             world,
             adapter,

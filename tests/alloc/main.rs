@@ -16,7 +16,7 @@ use std::path::Path;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 use drape::scene::load_scene_file;
-use drape::sim::{Simulation, build};
+use drape::sim::{SimParts, build};
 
 struct Counting;
 
@@ -87,12 +87,12 @@ const WARM_FRAME: f64 = 1.0 / 30.0;
 fn allocations(scene: &str, overrides: &[&str], warm: usize, steps: usize) -> Count {
     let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
     let scene = load_scene_file(Path::new(scene), &overrides).expect("scene");
-    let Simulation {
-        model,
+    let SimParts {
+        mut setup,
         mut state,
         pipeline: mut pipe,
     } = build(&scene.resolve().expect("resolve")).expect("build");
-    let h = pipe.step_size(&model, &state.world);
+    let h = pipe.step_size(&setup, &state.world);
     let base_vertices = state.world.x.len();
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
@@ -100,7 +100,7 @@ fn allocations(scene: &str, overrides: &[&str], warm: usize, steps: usize) -> Co
         .expect("pool");
     pool.install(|| {
         for _ in 0..warm {
-            pipe.advance_frame(&model, &mut state, WARM_FRAME)
+            pipe.advance_frame(&setup, &mut state, WARM_FRAME)
                 .expect("warm-up frame");
         }
         // Adaptive cases: the mesh adapted during the warm-up and is now frozen
@@ -109,27 +109,27 @@ fn allocations(scene: &str, overrides: &[&str], warm: usize, steps: usize) -> Co
         // can pass an infinite threshold, so it never stops early and never
         // refines).
         let mut rollback_checked = false;
-        if let Some(a) = state.adapter.as_mut() {
-            a.config.every = drape::spec::AdaptEvery::Steps(u32::MAX);
-            if a.config.rollback && a.config.max_rollbacks > 0 {
-                a.config.refine_angle = f64::INFINITY;
+        if let Some(a) = setup.settings.adapt.as_mut() {
+            a.every = drape::spec::AdaptEvery::Steps(u32::MAX);
+            if a.rollback && a.max_rollbacks > 0 {
+                a.refine_angle = f64::INFINITY;
                 rollback_checked = true;
             }
         }
         // One step on the frozen mesh before counting: the warm-up's last step
         // may have remeshed, and the solver builds its tables for a new mesh
         // lazily, on its first solve.
-        assert!(
-            pipe.step(&model, &mut state, h).expect("remesh"),
-            "step rejected"
-        );
+        if let Err(e) = pipe.step(&setup, &mut state, h) {
+            panic!("step rejected: {e}");
+        }
         ALLOCATIONS.store(0, Ordering::Relaxed);
         BYTES.store(0, Ordering::Relaxed);
         let before = state.ledger.collision;
         COUNTING.store(true, Ordering::Relaxed);
         for _ in 0..steps {
-            let ok = pipe.step(&model, &mut state, h).expect("remesh");
-            assert!(ok, "step rejected");
+            if let Err(e) = pipe.step(&setup, &mut state, h) {
+                panic!("step rejected: {e}");
+            }
         }
         COUNTING.store(false, Ordering::Relaxed);
         let after = state.ledger.collision;

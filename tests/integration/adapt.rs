@@ -103,11 +103,12 @@ proptest! {
         let pattern = if alternating { DiagonalPattern::Alternating } else { DiagonalPattern::Regular };
         let mut w = world(4, pattern);
         let (area, bound) = (w.mesh.total_rest_area(), boundary(&w));
-        let mut ad = Adapter::new(config(), &w, DENSITY)
+        let cfg = config();
+        let mut ad = Adapter::new(&cfg, &w, DENSITY)
         .expect("the adapter starts");
         let (p0, scale) = momentum(&w);
         for (step, (refine, pick)) in ops.into_iter().enumerate() {
-            let h = ad.hierarchy();
+            let h = ad.hierarchy().expect("red-green");
             let op = if refine {
                 let leaves: Vec<u32> = h.leaves().into_iter().filter(|&l| h.level(l) + 2 <= 6).collect();
                 if leaves.is_empty() { continue; }
@@ -117,7 +118,7 @@ proptest! {
                 if parents.is_empty() { continue; }
                 RedGreenOp::Merge(parents[pick as usize % parents.len()])
             };
-            ad.apply(&mut w, &[(op, None)], step as u64).unwrap();
+            ad.apply(&cfg, &mut w, &[(op, None)], step as u64).unwrap();
             check_consistency(&w, DENSITY, area, bound).map_err(|e| TestCaseError::fail(format!("after {op:?}: {e}")))?;
             let (p, _) = momentum(&w);
             prop_assert!((p - p0).length() <= 1e-13 * scale, "momentum {p:?} vs {p0:?} after {op:?}");
@@ -138,7 +139,8 @@ proptest! {
     ) {
         let mut w = world(6, DiagonalPattern::Regular);
         let (area, bound) = (w.mesh.total_rest_area(), boundary(&w));
-        let mut ad = Adapter::new(edge_config(), &w, DENSITY)
+        let cfg = edge_config();
+        let mut ad = Adapter::new(&cfg, &w, DENSITY)
         .expect("the adapter starts");
         let stated = ad.min_angle().unwrap();
         let (p0, scale) = momentum(&w);
@@ -151,7 +153,7 @@ proptest! {
             // What the mesh sees of the bump: one lying between the nodes of the
             // 1/6 m grid can bend no edge past 15 degrees however tall it is.
             let sampled = largest_dihedral_deg(&w);
-            ad.pass(&mut w, step as u64).unwrap();
+            ad.remesh(&cfg, &mut w, step as u64).unwrap();
             check_consistency(&w, DENSITY, area, bound).map_err(|e| TestCaseError::fail(format!("step {step}: {e}")))?;
             prop_assert!(smallest_angle(&w) >= stated - 1e-9, "angle {} below {stated}", smallest_angle(&w));
             let (p, _) = momentum(&w);
@@ -168,9 +170,10 @@ fn refining_then_coarsening_a_flat_sheet_restores_the_original_mesh() {
     for pattern in [DiagonalPattern::Regular, DiagonalPattern::Alternating] {
         let mut w = world(6, pattern);
         let original = w.mesh.clone();
-        let mut ad = Adapter::new(config(), &w, DENSITY).expect("the adapter starts");
+        let cfg = config();
+        let mut ad = Adapter::new(&cfg, &w, DENSITY).expect("the adapter starts");
         // Refine around the centre twice (the second round splits children).
-        crate::common::refine_around(&mut ad, &mut w, (drape::math::Vector2::ZERO, 0.25), 2);
+        crate::common::refine_around(&mut ad, &cfg, &mut w, (drape::math::Vector2::ZERO, 0.25), 2);
         let refined = w.mesh.vertex_count();
         assert!(
             refined > original.vertex_count() + 20,
@@ -178,7 +181,7 @@ fn refining_then_coarsening_a_flat_sheet_restores_the_original_mesh() {
         );
         // Flat geometry: every angle is zero, so passes merge until nothing changes.
         let mut passes = 0;
-        while ad.pass(&mut w, 10 + passes).unwrap() {
+        while ad.remesh(&cfg, &mut w, 10 + passes).unwrap() {
             passes += 1;
             assert!(passes < 20, "coarsening does not terminate");
         }
@@ -257,9 +260,10 @@ fn mean_edge_index_spread(m: &drape::mesh::Mesh) -> Scalar {
 fn red_green_numbers_vertices_in_triangle_order() {
     let mut w = world(32, DiagonalPattern::Alternating);
     let base = mean_edge_index_spread(&w.mesh);
-    let mut ad = Adapter::new(config(), &w, DENSITY).expect("the adapter starts");
+    let cfg = config();
+    let mut ad = Adapter::new(&cfg, &w, DENSITY).expect("the adapter starts");
     let centre = drape::math::Vector2::new(0.2, -0.1);
-    crate::common::refine_around(&mut ad, &mut w, (centre, 0.2), 2);
+    crate::common::refine_around(&mut ad, &cfg, &mut w, (centre, 0.2), 2);
     let spread = mean_edge_index_spread(&w.mesh);
     // Every vertex is first used no later than the triangles before it use new
     // ones: the numbering follows the triangle list.
@@ -276,20 +280,22 @@ fn paper_a_level_rules_on_hand_built_cases() {
     // A 2 x 2 grid with regular diagonals: 8 triangles. Triangle 1-5-4 (in the
     // lower-right square, touching the centre vertex 4) has three interior edges.
     let mut w = world(2, DiagonalPattern::Regular);
-    let mut ad = Adapter::new(config(), &w, DENSITY).expect("the adapter starts");
+    let cfg = config();
+    let mut ad = Adapter::new(&cfg, &w, DENSITY).expect("the adapter starts");
     let t = ad
         .hierarchy()
+        .expect("red-green")
         .leaves()
         .into_iter()
         .find(|&l| {
-            let mut v = ad.hierarchy().vertices(l);
+            let mut v = ad.hierarchy().expect("red-green").vertices(l);
             v.sort();
             v == [1, 4, 5]
         })
         .expect("triangle 1-5-4");
     // A single 1-4 split: four children at level 2; each neighbour across an edge
     // gets one hanging node and is closed by a 1-2 split into two level-1 triangles.
-    ad.apply(&mut w, &[(RedGreenOp::Split(t), None)], 0)
+    ad.apply(&cfg, &mut w, &[(RedGreenOp::Split(t), None)], 0)
         .unwrap();
     let neighbours = 3;
     assert_eq!(
@@ -320,8 +326,8 @@ fn paper_a_level_rules_on_hand_built_cases() {
     assert!(midpoints.iter().all(|&v| vertex_level(v) == 2));
     // Splitting the middle child (level 2 -> 4) gives its three siblings one hanging
     // node each: they become greens at level 3.
-    let middle = ad.hierarchy().children(t).unwrap()[3];
-    ad.apply(&mut w, &[(RedGreenOp::Split(middle), None)], 1)
+    let middle = ad.hierarchy().expect("red-green").children(t).unwrap()[3];
+    ad.apply(&cfg, &mut w, &[(RedGreenOp::Split(middle), None)], 1)
         .unwrap();
     let counts = level_counts(&w);
     assert!(counts.contains(&(4, 4)), "{counts:?}");
@@ -330,13 +336,13 @@ fn paper_a_level_rules_on_hand_built_cases() {
         "three siblings closed by 1-2 splits: {counts:?}"
     );
     // Merging undoes the odd levels by one and the even levels by two (paper A rule 4).
-    ad.apply(&mut w, &[(RedGreenOp::Merge(middle), None)], 2)
+    ad.apply(&cfg, &mut w, &[(RedGreenOp::Merge(middle), None)], 2)
         .unwrap();
     assert_eq!(
         level_counts(&w),
         vec![(0, 8 - 1 - neighbours), (1, 2 * neighbours), (2, 4)]
     );
-    ad.apply(&mut w, &[(RedGreenOp::Merge(t), None)], 3)
+    ad.apply(&cfg, &mut w, &[(RedGreenOp::Merge(t), None)], 3)
         .unwrap();
     assert_eq!(level_counts(&w), vec![(0, 8)]);
 }
@@ -344,18 +350,19 @@ fn paper_a_level_rules_on_hand_built_cases() {
 #[test]
 fn a_split_first_splits_a_coarser_neighbour_to_keep_levels_within_one_split() {
     let mut w = world(2, DiagonalPattern::Regular);
-    let mut ad = Adapter::new(config(), &w, DENSITY).expect("the adapter starts");
-    let t = ad.hierarchy().leaves()[3];
-    ad.apply(&mut w, &[(RedGreenOp::Split(t), None)], 0)
+    let cfg = config();
+    let mut ad = Adapter::new(&cfg, &w, DENSITY).expect("the adapter starts");
+    let t = ad.hierarchy().expect("red-green").leaves()[3];
+    ad.apply(&cfg, &mut w, &[(RedGreenOp::Split(t), None)], 0)
         .unwrap();
     // Split every corner child: their outer edges lie on coarser neighbours,
     // which must be split first (forced), never leaving a quarter-point node.
-    let corners = ad.hierarchy().children(t).unwrap();
+    let corners = ad.hierarchy().expect("red-green").children(t).unwrap();
     let ops: Vec<_> = corners[..3]
         .iter()
         .map(|&c| (RedGreenOp::Split(c), None))
         .collect();
-    ad.apply(&mut w, &ops, 1).unwrap();
+    ad.apply(&cfg, &mut w, &ops, 1).unwrap();
     let (area, bound) = (1.0, 4.0);
     check_consistency(&w, DENSITY, area, bound).unwrap();
     assert!(
@@ -382,14 +389,16 @@ fn pins_survive_refinement_and_coarsening() {
         m
     };
     let before = pinned_material(&w);
-    let mut ad = Adapter::new(config(), &w, DENSITY).expect("the adapter starts");
+    let cfg = config();
+    let mut ad = Adapter::new(&cfg, &w, DENSITY).expect("the adapter starts");
     let all: Vec<_> = ad
         .hierarchy()
+        .expect("red-green")
         .leaves()
         .into_iter()
         .map(|l| (RedGreenOp::Split(l), None))
         .collect();
-    ad.apply(&mut w, &all, 0).unwrap();
+    ad.apply(&cfg, &mut w, &all, 0).unwrap();
     // Every vertex on the top edge is pinned, the new midpoints included.
     let top = w
         .mesh
@@ -406,7 +415,7 @@ fn pins_survive_refinement_and_coarsening() {
     assert_eq!(top, 9);
     assert_eq!(pinned_top, 9);
     assert_eq!(w.pins.anchors.len(), 10, "top edge plus the corner");
-    while ad.pass(&mut w, 1).unwrap() {}
+    while ad.remesh(&cfg, &mut w, 1).unwrap() {}
     assert_eq!(
         pinned_material(&w),
         before,
@@ -436,11 +445,11 @@ fn close_thresholds_do_not_thrash() {
             max_level: 4,
             ..config()
         };
-        let mut ad = Adapter::new(cfg, &w, DENSITY).expect("the adapter starts");
+        let mut ad = Adapter::new(&cfg, &w, DENSITY).expect("the adapter starts");
         let steps = 150;
         for step in 0..steps {
             st.step(&mut w, 0.01).expect("the step is solved");
-            if ad.pass(&mut w, step).unwrap() {
+            if ad.remesh(&cfg, &mut w, step).unwrap() {
                 st.rebuild(&w);
             }
         }
@@ -575,12 +584,13 @@ fn edge_method_never_goes_below_its_minimum_angle_and_keeps_the_invariants() {
     .unwrap();
     let (area, bound) = (w.mesh.total_rest_area(), boundary(&w));
     let mut st = swinging_stepper(&w, Integrator::Implicit, 0.001);
-    let mut ad = Adapter::new(edge_config(), &w, DENSITY).expect("the adapter starts");
+    let cfg = edge_config();
+    let mut ad = Adapter::new(&cfg, &w, DENSITY).expect("the adapter starts");
     let stated = ad.min_angle().expect("edge method");
     let mut worst: Scalar = 180.0;
     for step in 0..150 {
         st.step(&mut w, 0.01).expect("the step is solved");
-        if ad.pass(&mut w, step).unwrap() {
+        if ad.remesh(&cfg, &mut w, step).unwrap() {
             st.rebuild(&w);
             check_consistency(&w, DENSITY, area, bound).unwrap();
             worst = worst.min(smallest_angle(&w));
@@ -600,7 +610,8 @@ fn edge_method_refine_then_flatten_returns_near_the_original_vertex_count() {
     let mut w = world(8, DiagonalPattern::Alternating);
     let original = w.mesh.vertex_count();
     let (area, bound) = (w.mesh.total_rest_area(), boundary(&w));
-    let mut ad = Adapter::new(edge_config(), &w, DENSITY).expect("the adapter starts");
+    let cfg = edge_config();
+    let mut ad = Adapter::new(&cfg, &w, DENSITY).expect("the adapter starts");
     // Bend the sheet sharply along a line so that edges there exceed 15 degrees.
     let bend = |w: &mut World| {
         for (x, m) in w.x.iter_mut().zip(&w.mesh.material) {
@@ -609,7 +620,7 @@ fn edge_method_refine_then_flatten_returns_near_the_original_vertex_count() {
     };
     for step in 0..4 {
         bend(&mut w);
-        ad.pass(&mut w, step).unwrap();
+        ad.remesh(&cfg, &mut w, step).unwrap();
     }
     let refined = w.mesh.vertex_count();
     let (p0, scale) = momentum(&w);
@@ -619,7 +630,7 @@ fn edge_method_refine_then_flatten_returns_near_the_original_vertex_count() {
         for (x, m) in w.x.iter_mut().zip(&w.mesh.material) {
             *x = m.extend(0.0);
         }
-        if !ad.pass(&mut w, 10 + passes).unwrap() {
+        if !ad.remesh(&cfg, &mut w, 10 + passes).unwrap() {
             break;
         }
         passes += 1;
@@ -658,22 +669,18 @@ fn swinging_explicit(
     let n0 = w.x.len();
     let mut st = swinging_stepper(&w, integrator, 1e-4);
     st.multirate = multirate;
-    let mut ad = Adapter::new(
-        AdaptConfig {
-            max_level: 4,
-            every: drape::scene::AdaptEvery::Steps(20),
-            ..config()
-        },
-        &w,
-        DENSITY,
-    )
-    .expect("the adapter starts");
+    let cfg = AdaptConfig {
+        max_level: 4,
+        every: drape::scene::AdaptEvery::Steps(20),
+        ..config()
+    };
+    let mut ad = Adapter::new(&cfg, &w, DENSITY).expect("the adapter starts");
     let mut steps = 0;
     while w.time < duration - 1e-12 {
         let h = (st.auto_dt(&w) * dt_scale).min(duration - w.time);
         st.step(&mut w, h).expect("the step is solved");
         steps += 1;
-        if steps % 20 == 0 && ad.pass(&mut w, steps).unwrap() {
+        if steps % 20 == 0 && ad.remesh(&cfg, &mut w, steps).unwrap() {
             st.rebuild(&w);
         }
     }

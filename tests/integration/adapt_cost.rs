@@ -57,7 +57,7 @@ fn cost(method: AdaptMethod) {
         bending_model: BendingModel::ShapeOperator,
         stiffness_rule: StiffnessRule::Consistent,
     };
-    let mut ad = Adapter::new(config, &w, 0.15).unwrap();
+    let mut ad = Adapter::new(&config, &w, 0.15).unwrap();
     let (mut pass_s, mut rebuild_s, mut times) = (0.0, 0.0, Vec::new());
     let mut vertices = 0;
     for k in 0..60 {
@@ -65,7 +65,7 @@ fn cost(method: AdaptMethod) {
             *x = drape(*p, k);
         }
         let t = Instant::now();
-        let changed = ad.pass(&mut w, k as u64).unwrap();
+        let changed = ad.remesh(&config, &mut w, k as u64).unwrap();
         let dt = t.elapsed().as_secs_f64();
         pass_s += dt;
         times.push(dt);

@@ -5,7 +5,7 @@
 //! (no dynamics), so each pass sees exactly the geometry the test describes.
 
 use drape::adapt::sizing::spacing;
-use drape::adapt::{AdaptConfig, Adapter};
+use drape::adapt::{AdaptConfig, Adapter, Measured};
 use drape::math::{Scalar, Vector, Vector2};
 use drape::mesh;
 use drape::scene::{AdaptCriterion, AdaptMethod, DiagonalPattern};
@@ -44,10 +44,15 @@ fn prescribe(w: &mut World, shape: impl Fn(Vector2) -> Vector) {
 }
 
 /// Passes with the shape prescribed before each, until one changes nothing.
-fn settle(w: &mut World, ad: &mut Adapter, shape: impl Fn(Vector2) -> Vector) -> u64 {
+fn settle(
+    w: &mut World,
+    ad: &mut Adapter,
+    config: &AdaptConfig,
+    shape: impl Fn(Vector2) -> Vector,
+) -> u64 {
     for pass in 0..30 {
         prescribe(w, &shape);
-        if !ad.pass(w, pass).expect("pass") {
+        if !ad.remesh(config, w, pass).expect("pass") {
             return pass;
         }
     }
@@ -59,8 +64,9 @@ fn sizing_on_a_flat_sheet_refines_nothing() {
     for pattern in [DiagonalPattern::Regular, DiagonalPattern::Alternating] {
         let mut w = flat_world(8, pattern);
         let before = w.mesh.triangles.clone();
-        let mut ad = Adapter::new(sizing(15.0, 4), &w, DENSITY).expect("the adapter starts");
-        let passes = settle(&mut w, &mut ad, |p| p.extend(0.0));
+        let cfg = sizing(15.0, 4);
+        let mut ad = Adapter::new(&cfg, &w, DENSITY).expect("the adapter starts");
+        let passes = settle(&mut w, &mut ad, &cfg, |p| p.extend(0.0));
         assert_eq!((passes, ad.stats.splits), (0, 0), "{pattern:?}");
         assert_eq!(w.mesh.triangles, before);
     }
@@ -97,9 +103,9 @@ fn sizing_on_a_cylinder_refines_to_the_predicted_level() {
         for (r, predicted) in [(1.15, 2u8), (2.3, 4u8)] {
             let radius = d0 / (r * budget_deg.to_radians());
             let mut w = flat_world(res, pattern);
-            let mut ad =
-                Adapter::new(sizing(budget_deg, 6), &w, DENSITY).expect("the adapter starts");
-            let passes = settle(&mut w, &mut ad, cylinder(radius));
+            let cfg = sizing(budget_deg, 6);
+            let mut ad = Adapter::new(&cfg, &w, DENSITY).expect("the adapter starts");
+            let passes = settle(&mut w, &mut ad, &cfg, cylinder(radius));
             // Away from the u boundary (where a triangle's one vertical leg
             // is a boundary edge and measures nothing) every triangle is at
             // the predicted level.
@@ -168,21 +174,17 @@ fn sweep(criterion: AdaptCriterion) -> Sweep {
     let (height, sigma, step) = (0.05, 0.06, 0.02);
     let (lo, hi) = (-0.2, -0.1);
     let mut w = flat_world(16, DiagonalPattern::Alternating);
-    let mut ad = Adapter::new(
-        AdaptConfig {
-            criterion,
-            ..sizing(15.0, 4)
-        },
-        &w,
-        DENSITY,
-    )
-    .expect("the adapter starts");
+    let cfg = AdaptConfig {
+        criterion,
+        ..sizing(15.0, 4)
+    };
+    let mut ad = Adapter::new(&cfg, &w, DENSITY).expect("the adapter starts");
     let (mut peak, mut after_left, mut after_centre) = (0u8, None, None);
     let (mut since_left, mut since_centre) = (0u32, 0u32);
     for k in 0..=60u64 {
         let c = -0.6 + step * k as Scalar;
         prescribe(&mut w, fold(c, height, sigma));
-        ad.pass(&mut w, k).expect("pass");
+        ad.remesh(&cfg, &mut w, k).expect("pass");
         let level = max_level_in(&w, lo, hi);
         if (lo..=hi).contains(&c) {
             peak = peak.max(level);
@@ -303,8 +305,9 @@ fn strain_jumps_refine_the_mesh_at_point_pins() {
 #[test]
 fn top_level_statistics_count_triangles_and_area() {
     let mut w = flat_world(16, DiagonalPattern::Alternating);
-    let mut ad = Adapter::new(sizing(15.0, 4), &w, DENSITY).expect("the adapter starts");
-    settle(&mut w, &mut ad, fold(0.0, 0.08, 0.05));
+    let cfg = sizing(15.0, 4);
+    let mut ad = Adapter::new(&cfg, &w, DENSITY).expect("the adapter starts");
+    settle(&mut w, &mut ad, &cfg, fold(0.0, 0.08, 0.05));
     let m = &w.mesh;
     let top: Vec<usize> = (0..m.triangles.len())
         .filter(|&t| m.levels[t] >= 4)
@@ -378,11 +381,18 @@ fn an_edge_leaning_towards_an_obstacle_refines_near_it_only() {
     let leaning =
         |lift: Scalar| move |p: Vector2| Vector::new(p.x, p.y, lift + 0.01 + 0.2 * (p.x + 0.5));
     // Passes with the shape prescribed before each, until one changes nothing.
-    let settle = |w: &mut World, ad: &mut Adapter, shape: &dyn Fn(Vector2) -> Vector| {
+    let settle = |w: &mut World,
+                  ad: &mut Adapter,
+                  config: &AdaptConfig,
+                  shape: &dyn Fn(Vector2) -> Vector| {
         for pass in 0..30 {
             prescribe(w, shape);
             let planes = vec![ground; w.x.len()];
-            if !ad.pass_near(w, pass, None, &planes).expect("pass") {
+            let known = Measured {
+                angles: None,
+                obstacle_planes: &planes,
+            };
+            if !ad.remesh_with(config, w, pass, known).expect("pass") {
                 return pass;
             }
         }
@@ -392,13 +402,13 @@ fn an_edge_leaning_towards_an_obstacle_refines_near_it_only() {
     config.refine_obstacle = Some(1.0);
 
     let mut w = flat_world(8, DiagonalPattern::Alternating);
-    let mut ad = Adapter::new(config, &w, DENSITY).expect("the adapter starts");
-    settle(&mut w, &mut ad, &leaning(0.0));
+    let mut ad = Adapter::new(&config, &w, DENSITY).expect("the adapter starts");
+    settle(&mut w, &mut ad, &config, &leaning(0.0));
     let (near, far) = (max_level_in(&w, -0.5, -0.45), max_level_in(&w, -0.25, 0.5));
     // Base edges 1/8 m lean 2.5 cm over the first column (1 cm high): split
     // twice; from 0.25 m on the sheet is over 6 cm high and stays at the base.
     assert_eq!((near, far), (4, 0), "{:?}", ad.stats);
-    settle(&mut w, &mut ad, &leaning(1.0));
+    settle(&mut w, &mut ad, &config, &leaning(1.0));
     let lifted = w.mesh.levels.iter().copied().max().unwrap_or(0);
     assert_eq!(
         lifted, 0,
@@ -407,13 +417,14 @@ fn an_edge_leaning_towards_an_obstacle_refines_near_it_only() {
     );
 
     let mut w = flat_world(8, DiagonalPattern::Alternating);
-    let mut ad = Adapter::new(config, &w, DENSITY).expect("the adapter starts");
-    settle(&mut w, &mut ad, &|p: Vector2| p.extend(0.01));
+    let mut ad = Adapter::new(&config, &w, DENSITY).expect("the adapter starts");
+    settle(&mut w, &mut ad, &config, &|p: Vector2| p.extend(0.01));
     assert_eq!(ad.stats.splits, 0, "parallel 1 cm above the plane");
 
     let mut w = flat_world(8, DiagonalPattern::Alternating);
-    let mut ad = Adapter::new(sizing(15.0, 4), &w, DENSITY).expect("the adapter starts");
-    settle(&mut w, &mut ad, &leaning(0.0));
+    let cfg = sizing(15.0, 4);
+    let mut ad = Adapter::new(&cfg, &w, DENSITY).expect("the adapter starts");
+    settle(&mut w, &mut ad, &cfg, &leaning(0.0));
     assert_eq!(ad.stats.splits, 0, "leaning, without refine_obstacle");
 }
 

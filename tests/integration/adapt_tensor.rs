@@ -66,11 +66,12 @@ fn on_surface(old: &Mesh, x: &[Vector], p: Vector2) -> Option<Vector> {
 #[test]
 fn a_sheet_bent_along_u_is_halved_along_u_only() {
     let mut w = sheet(8, 4, DiagonalPattern::Alternating, bent_along_u(0.3));
-    let mut ad = Adapter::new(tensor_config(10.0, 4), &w, DENSITY).expect("a grid");
+    let cfg = tensor_config(10.0, 4);
+    let mut ad = Adapter::new(&cfg, &w, DENSITY).expect("a grid");
     let (u0, v0) = ad.tensor_grid().expect("tensor").lines();
     let old = w.mesh.clone();
     let old_x = w.x.clone();
-    assert!(ad.pass(&mut w, 0).unwrap(), "the bend refines");
+    assert!(ad.remesh(&cfg, &mut w, 0).unwrap(), "the bend refines");
     let (u1, v1) = ad.tensor_grid().expect("tensor").lines();
     assert_eq!(v1, v0, "a bend along u does not halve rows");
     assert!(u1.len() > u0.len(), "u-lines {} -> {}", u0.len(), u1.len());
@@ -100,10 +101,11 @@ fn cell_centres_lie_on_the_old_diagonal() {
         let dome =
             |p: Vector2| Vector::new(p.x, p.y, 2.0 * p.x * p.x + 3.0 * p.y * p.y + p.x * p.y);
         let mut w = sheet(6, 4, pattern, dome);
-        let mut ad = Adapter::new(tensor_config(5.0, 2), &w, DENSITY).expect("a grid");
+        let cfg = tensor_config(5.0, 2);
+        let mut ad = Adapter::new(&cfg, &w, DENSITY).expect("a grid");
         let old = w.mesh.clone();
         let old_x = w.x.clone();
-        assert!(ad.pass(&mut w, 0).unwrap());
+        assert!(ad.remesh(&cfg, &mut w, 0).unwrap());
         let (u, v) = ad.tensor_grid().unwrap().lines();
         assert_eq!((u.len(), v.len()), (13, 9), "refined both ways");
         let worst = w
@@ -125,10 +127,11 @@ fn refined_everywhere_it_is_the_uniform_grid() {
     for pattern in [DiagonalPattern::Alternating, DiagonalPattern::Regular] {
         let bowl = |p: Vector2| Vector::new(p.x, p.y, 3.0 * (p.x * p.x + p.y * p.y));
         let mut w = sheet(4, 2, pattern, bowl);
-        let mut ad = Adapter::new(tensor_config(0.5, 4), &w, DENSITY).expect("a grid");
+        let cfg = tensor_config(0.5, 4);
+        let mut ad = Adapter::new(&cfg, &w, DENSITY).expect("a grid");
         for step in 0..4 {
             shape_world(&mut w, bowl);
-            ad.pass(&mut w, step).unwrap();
+            ad.remesh(&cfg, &mut w, step).unwrap();
         }
         let uniform = mesh::rectangle_cells(1.0, 0.5, 16, Some(8), pattern).unwrap();
         assert_eq!(w.mesh.material, uniform.material, "{pattern:?}");
@@ -149,15 +152,15 @@ fn a_flattened_sheet_returns_to_the_base_grid() {
         };
         let mut w = sheet(8, 2, DiagonalPattern::Alternating, bent_along_u(0.2));
         let base = w.mesh.clone();
-        let mut ad = Adapter::new(config, &w, DENSITY).expect("a grid");
+        let mut ad = Adapter::new(&config, &w, DENSITY).expect("a grid");
         for step in 0..3 {
             shape_world(&mut w, bent_along_u(0.2));
-            ad.pass(&mut w, step).unwrap();
+            ad.remesh(&config, &mut w, step).unwrap();
         }
         let refined = w.mesh.vertex_count();
         w.x = w.mesh.material.iter().map(|p| p.extend(0.0)).collect();
         let mut passes = 0;
-        while ad.pass(&mut w, 10 + passes).unwrap() {
+        while ad.remesh(&config, &mut w, 10 + passes).unwrap() {
             ad.check(&w).expect("consistent after the pass");
             passes += 1;
             assert!(
@@ -189,11 +192,12 @@ fn neighbouring_columns_differ_by_one_halving() {
         }
     };
     let mut w = sheet(4, 1, DiagonalPattern::Regular, crease(0.0));
-    let mut ad = Adapter::new(tensor_config(1.0, 8), &w, DENSITY).expect("a grid");
+    let cfg = tensor_config(1.0, 8);
+    let mut ad = Adapter::new(&cfg, &w, DENSITY).expect("a grid");
     for step in 0..6 {
         let at = if step < 2 { 0.0 } else { 0.0625 };
         shape_world(&mut w, crease(at));
-        ad.pass(&mut w, step).unwrap();
+        ad.remesh(&cfg, &mut w, step).unwrap();
         ad.check(&w).expect("consistent after the pass");
         let (u, _) = ad.tensor_grid().unwrap().lines();
         let widths: Vec<Scalar> = u.windows(2).map(|p| p[1] - p[0]).collect();
@@ -278,8 +282,8 @@ method = "tensor"
     }
     let disk = mesh::disk(0.5, 8).unwrap();
     let x = disk.material.iter().map(|p| p.extend(0.0)).collect();
-    let e =
-        Adapter::new(tensor_config(5.0, 4), &World::new(disk, x), DENSITY).expect_err("not a grid");
+    let cfg = tensor_config(5.0, 4);
+    let e = Adapter::new(&cfg, &World::new(disk, x), DENSITY).expect_err("not a grid");
     assert!(
         e.to_string()
             .contains("needs the grid of a generated rectangle"),
@@ -302,7 +306,8 @@ proptest::proptest! {
     ) {
         let pattern = if alternating { DiagonalPattern::Alternating } else { DiagonalPattern::Regular };
         let mut w = sheet(6, 3, pattern, |p: Vector2| p.extend(0.0));
-        let mut ad = Adapter::new(tensor_config(5.0, 6), &w, DENSITY).expect("a grid");
+        let cfg = tensor_config(5.0, 6);
+        let mut ad = Adapter::new(&cfg, &w, DENSITY).expect("a grid");
         for (step, &(at, along_u, angle)) in creases.iter().enumerate() {
             // Within the sheet: |u| < 0.5, |v| < 0.25.
             let at = at * if along_u { 0.5 } else { 0.25 };
@@ -314,7 +319,7 @@ proptest::proptest! {
             };
             shape_world(&mut w, fold);
             let (old, old_x) = (w.mesh.clone(), w.x.clone());
-            ad.pass(&mut w, step as u64).unwrap();
+            ad.remesh(&cfg, &mut w, step as u64).unwrap();
             for (i, p) in w.mesh.material.iter().enumerate() {
                 let s = on_surface(&old, &old_x, *p).expect("inside the sheet");
                 proptest::prop_assert!((s - w.x[i]).length() < 1e-12, "pass {}: vertex {} off the old surface", step, i);
@@ -333,8 +338,9 @@ proptest::proptest! {
 fn a_flat_sheet_distorted_in_its_plane_does_not_refine() {
     let swirl = |p: Vector2| Vector::new(p.x + 0.3 * p.y * p.y, p.y + 0.2 * p.x * p.x, 0.0);
     let mut w = sheet(8, 4, DiagonalPattern::Alternating, swirl);
-    let mut ad = Adapter::new(tensor_config(2.0, 4), &w, DENSITY).expect("a grid");
-    let changed = ad.pass(&mut w, 0).unwrap();
+    let cfg = tensor_config(2.0, 4);
+    let mut ad = Adapter::new(&cfg, &w, DENSITY).expect("a grid");
+    let changed = ad.remesh(&cfg, &mut w, 0).unwrap();
     assert!(!changed, "in-plane distortion refined: {:?}", ad.stats);
     // The same sheet rolled out of its plane refines.
     let rolled = |p: Vector2| {
@@ -342,7 +348,7 @@ fn a_flat_sheet_distorted_in_its_plane_does_not_refine() {
         Vector::new(q.x, 0.3 * q.y.sin(), 0.3 * (1.0 - q.y.cos()))
     };
     shape_world(&mut w, rolled);
-    assert!(ad.pass(&mut w, 1).unwrap());
+    assert!(ad.remesh(&cfg, &mut w, 1).unwrap());
 }
 
 /// Pins, `min_edge_length` and events: a line inserted across a pinned
@@ -374,10 +380,10 @@ fn pins_min_edge_and_events() {
             start: w.x[v as usize],
         })
         .collect();
-    let mut ad = Adapter::new(config, &w, DENSITY).expect("a grid");
+    let mut ad = Adapter::new(&config, &w, DENSITY).expect("a grid");
     for step in 0..4 {
         shape_world(&mut w, bent_along_u(0.2));
-        ad.pass(&mut w, step).unwrap();
+        ad.remesh(&config, &mut w, step).unwrap();
         assert_eq!(
             pinned_top(&w),
             top(&w),
@@ -411,7 +417,7 @@ fn pins_min_edge_and_events() {
     // Flat again: every inserted line goes, with its pinned midpoints.
     w.x = w.mesh.material.iter().map(|p| p.extend(0.0)).collect();
     for step in 4..10 {
-        ad.pass(&mut w, step).unwrap();
+        ad.remesh(&config, &mut w, step).unwrap();
     }
     assert_eq!(w.mesh.vertex_count(), 9 * 3);
     assert_eq!(pinned_top(&w), top(&w));

@@ -569,3 +569,42 @@ fn bad_pins_are_refused() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A measurement the scene asks for that its built cloth cannot give is refused
+/// before the run starts, with the reason: the cantilever clamped in the middle
+/// of the strip, the Cusick support moved from under the specimen.
+#[test]
+fn a_measurement_the_built_cloth_cannot_give_stops_the_run_before_it_starts() {
+    let cases = [
+        (
+            "scenes/cantilever.toml",
+            ["pin.0.box_min=[-0.01,-0.02]", "pin.0.box_max=[0.01,0.02]"],
+            "the cantilever measurement needs the pins to hold exactly the vertices at one end",
+        ),
+        (
+            "scenes/cusick.toml",
+            [
+                "obstacle.0.position=[0.3,0.0,0.0]",
+                "simulation.duration=0.05",
+            ],
+            "the cusick measurement needs the disk specimen to lie centred on a vertical cylinder",
+        ),
+    ];
+    for (file, sets, needle) in cases {
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        let scene = drape::scene::load_scene_file(std::path::Path::new(file), &sets)
+            .expect("the scene alone allows it");
+        let e = drape::run::run(
+            &scene,
+            &drape::run::RunOptions::default(),
+            &std::sync::atomic::AtomicBool::new(false),
+            &mut |_| {},
+        )
+        .expect_err("refused");
+        assert!(
+            matches!(e, drape::run::RunError::Measurement { .. }),
+            "{file}: {e}"
+        );
+        assert!(e.to_string().contains(needle), "{file}: {e}");
+    }
+}

@@ -495,6 +495,9 @@ fn every_shipped_scene_and_the_default_pass_check() {
 
 /// Regression: the flag (held along one edge, in wind) got a cantilever report
 /// ("chord angle 8.94 deg, elastica 90.19 deg"); the test needs gravity alone.
+/// The measurement is now made only where a scene asks for it (`measure`):
+/// the cantilever scene does and gets the report, the flag does not and gets
+/// none, and the flag asking for it is refused with the reason.
 #[test]
 fn cantilever_report_only_for_a_strip_under_gravity_alone() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
@@ -523,5 +526,21 @@ fn cantilever_report_only_for_a_strip_under_gravity_alone() {
         );
         assert_eq!(stdout(&out).contains("Cantilever:"), expect, "{scene}");
     }
+    let flag = root.join("scenes/flag.toml");
+    let args = [
+        "run",
+        path_str(&flag),
+        "--set",
+        "measure=[\"cantilever\"]",
+        "--no-record",
+        "-q",
+    ];
+    let out = drape(&args, &dir);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("key `measure`: the cantilever measurement compares with the elastica under gravity alone, and this scene has [wind]"),
+        "{}",
+        stderr(&out)
+    );
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -3,9 +3,8 @@
 //! incline, self-collision after crumpling, Volino culling, determinism.
 
 use drape::math::{Scalar, Vector};
-use drape::physics::Model;
 use drape::scene::{Scene, load_scene_str};
-use drape::sim::{EnergyBound, Pipeline, SimState, Simulation, build};
+use drape::sim::{EnergyBound, Pipeline, Setup, SimParts, SimState, build};
 
 /// A scene: a `size` m square sheet at `resolution`, with extra TOML appended.
 fn scene(size: Scalar, resolution: u32, z: Scalar, extra: &str) -> Scene {
@@ -38,34 +37,32 @@ damping = 0.001
 /// A scene's simulation, stepped by the public pipeline (the run's own step:
 /// forces + integrate, collide, account, health check).
 struct Sim {
-    model: Model,
+    setup: Setup,
     state: SimState,
     pipe: Pipeline,
 }
 
 impl Sim {
     fn new(scene: &Scene) -> Sim {
-        let Simulation {
-            model,
+        let SimParts {
+            setup,
             state,
             pipeline: pipe,
         } = build(&scene.resolve().expect("resolve")).expect("simulation");
         assert!(pipe.collider().is_some(), "the scene collides");
-        Sim { model, state, pipe }
+        Sim { setup, state, pipe }
     }
 
     fn step(&mut self, h: Scalar) {
-        let accepted = self
-            .pipe
-            .step(&self.model, &mut self.state, h)
-            .expect("remesh");
-        assert!(accepted, "step rejected: {}", self.pipe.failure());
+        if let Err(e) = self.pipe.step(&self.setup, &mut self.state, h) {
+            panic!("step rejected: {e}");
+        }
     }
 
     fn kinetic(&self) -> Scalar {
         self.pipe
             .stepper()
-            .energy(&self.model, &self.state.world)
+            .energy(&self.setup.model, &self.state.world)
             .kinetic
     }
 
@@ -165,7 +162,8 @@ fn a_20_m_per_s_sheet_does_not_tunnel_through_a_5_mm_box() {
             *v = Vector::new(0.0, 0.0, -20.0);
         }
         // The run's energy bound includes the kinetic energy given here.
-        sim.state.ledger.bound = EnergyBound::new(&sim.state.world, sim.pipe.stepper(), &sim.model);
+        sim.state.ledger.bound =
+            EnergyBound::new(&sim.state.world, sim.pipe.stepper(), &sim.setup.model);
         let mut lowest: Scalar = Scalar::INFINITY;
         let steps = (0.1 / dt) as usize;
         for _ in 0..steps {
@@ -389,7 +387,7 @@ fn a_broken_obstacle_obj_is_a_clear_error() {
         1.0,
         &format!("[[obstacle]]\nshape = \"mesh\"\npath = \"{garbage}\""),
     );
-    let e = drape::collide::Collider::from_scene(&s).expect_err("garbage OBJ");
+    let e = drape::collide::Obstacles::from_scene(&s).expect_err("garbage OBJ");
     assert!(e.to_string().contains("garbage.obj"), "{e}");
     let missing = load_scene_str(
         "name = \"t\"\n[simulation]\nduration = 1.0\n[cloth]\nshape = \"disk\"\nradius = 0.1\nresolution = 4\n[material]\ndensity = 0.1\nstretch = 1.0\n[[obstacle]]\nshape = \"box\"\nradius = 0.5\n",
@@ -430,7 +428,7 @@ friction_kinetic = 0.4
     let e0 = sim
         .pipe
         .stepper()
-        .energy(&sim.model, &sim.state.world)
+        .energy(&sim.setup.model, &sim.state.world)
         .total();
     let mut e_max: Scalar = e0;
     for _ in 0..200 {
@@ -438,7 +436,7 @@ friction_kinetic = 0.4
         e_max = e_max.max(
             sim.pipe
                 .stepper()
-                .energy(&sim.model, &sim.state.world)
+                .energy(&sim.setup.model, &sim.state.world)
                 .total(),
         );
     }

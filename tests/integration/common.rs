@@ -61,19 +61,19 @@ pub fn angle_config(method: AdaptMethod) -> AdaptConfig {
 /// `world` onto the result (the second round splits the first's children).
 pub fn refine_around(
     adapter: &mut drape::adapt::Adapter,
+    config: &AdaptConfig,
     world: &mut World,
     (centre, radius): (drape::math::Vector2, Scalar),
     rounds: u64,
 ) {
     use drape::adapt::red_green::RedGreenOp;
     for round in 0..rounds {
-        let ops: Vec<_> = adapter
-            .hierarchy()
+        let hierarchy = adapter.hierarchy().expect("red-green");
+        let ops: Vec<_> = hierarchy
             .leaves()
             .into_iter()
             .filter(|&l| {
-                let c = adapter
-                    .hierarchy()
+                let c = hierarchy
                     .vertices(l)
                     .iter()
                     .map(|&v| world.mesh.material[v as usize])
@@ -83,7 +83,9 @@ pub fn refine_around(
             })
             .map(|l| (RedGreenOp::Split(l), None))
             .collect();
-        adapter.apply(world, &ops, round).expect("refinement");
+        adapter
+            .apply(config, world, &ops, round)
+            .expect("refinement");
     }
 }
 

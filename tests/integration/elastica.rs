@@ -176,10 +176,10 @@ pub fn settle_adaptive(overhang: Scalar, mat: &MaterialParams) -> Settled {
         coarsen_angle: 0.5,
         ..crate::common::angle_config(AdaptMethod::RedGreen)
     };
-    let mut adapter = Adapter::new(config, &world, mat.density).expect("the adapter starts");
+    let mut adapter = Adapter::new(&config, &world, mat.density).expect("the adapter starts");
     let mut settled = settle_on(&world.mesh.clone(), &mut world.x, mat, overhang);
     for pass in 0..12 {
-        if !adapter.pass(&mut world, pass).unwrap() {
+        if !adapter.remesh(&config, &mut world, pass).unwrap() {
             break;
         }
         settled = settle_on(&world.mesh.clone(), &mut world.x, mat, overhang);
@@ -206,11 +206,11 @@ fn settle_tensor(
         coarsen_angle: refine_angle / 10.0,
         ..crate::common::angle_config(AdaptMethod::Tensor)
     };
-    let mut adapter = Adapter::new(config, &world, mat.density).expect("a rectangle's grid");
+    let mut adapter = Adapter::new(&config, &world, mat.density).expect("a rectangle's grid");
     let mut settled = settle_on(&world.mesh.clone(), &mut world.x, mat, overhang);
     let mut mesh_settled = false;
     for pass in 0..12 {
-        if !adapter.pass(&mut world, pass).unwrap() {
+        if !adapter.remesh(&config, &mut world, pass).unwrap() {
             mesh_settled = true;
             break;
         }

@@ -12,7 +12,7 @@ use drape::physics::{Elements, MaterialParams};
 use drape::scene::{
     AdaptCriterion, AdaptMethod, BendingModel, DiagonalPattern, StiffnessRule, load_scene_file,
 };
-use drape::sim::{Simulation, build};
+use drape::sim::{SimParts, build};
 use drape::world::World;
 use proptest::prelude::*;
 
@@ -56,7 +56,7 @@ proptest! {
             alternate_diagonals: alternate,
             ..crate::common::angle_config(method)
         };
-        let mut ad = Adapter::new(config, &w, 0.15)
+        let mut ad = Adapter::new(&config, &w, 0.15)
         .expect("the adapter starts");
         let clamped = |mesh: &Mesh| if clamp { clamp_left(mesh) } else { Vec::new() };
         let mut el = Elements::build_clamped(&w.mesh, &mat, &clamped(&w.mesh));
@@ -65,7 +65,7 @@ proptest! {
             for (x, p) in w.x.iter_mut().zip(&w.mesh.material) {
                 *x = crate::adapt_cost::drape(*p, k);
             }
-            if j % cadence != 0 || !ad.pass(&mut w, j as u64).unwrap() {
+            if j % cadence != 0 || !ad.remesh(&config, &mut w, j as u64).unwrap() {
                 continue;
             }
             let c = clamped(&w.mesh);
@@ -122,8 +122,8 @@ fn the_pipelines_remeshes_rebuild_incrementally() {
     ]
     .map(String::from);
     let scene = load_scene_file(Path::new("scenes/cantilever.toml"), &overrides).expect("scene");
-    let Simulation {
-        model,
+    let SimParts {
+        setup,
         mut state,
         mut pipeline,
     } = build(&scene.resolve().expect("resolve")).expect("build");
@@ -135,7 +135,7 @@ fn the_pipelines_remeshes_rebuild_incrementally() {
             .as_ref()
             .map_or(0, |a| a.stats.splits + a.stats.merges);
         pipeline
-            .advance_frame(&model, &mut state, 1.0 / 30.0)
+            .advance_frame(&setup, &mut state, 1.0 / 30.0)
             .unwrap_or_else(|e| panic!("frame {frame}: {e}"));
         let after = state
             .adapter
@@ -145,7 +145,7 @@ fn the_pipelines_remeshes_rebuild_incrementally() {
         let w = &state.world;
         let fresh = Elements::build_clamped(
             &w.mesh,
-            &model.material,
+            &setup.model.material,
             &w.pins.clamped(w.mesh.vertex_count()),
         );
         assert!(

@@ -118,17 +118,17 @@ fn the_frame_end_energy_handed_over_is_the_states() {
         let before = changes(&given.state);
         given
             .pipeline
-            .advance_frame_from(&given.model, &mut given.state, 1.0 / 30.0, start)
+            .advance_frame_from(&given.setup, &mut given.state, 1.0 / 30.0, start)
             .unwrap_or_else(|e| panic!("frame {frame}: {e}"));
         plain
             .pipeline
-            .advance_frame(&plain.model, &mut plain.state, 1.0 / 30.0)
+            .advance_frame(&plain.setup, &mut plain.state, 1.0 / 30.0)
             .unwrap_or_else(|e| panic!("frame {frame}: {e}"));
         let remeshed = changes(&given.state) > before;
         let fresh = given
             .pipeline
             .stepper()
-            .energy(&given.model, &given.state.world);
+            .energy(&given.setup.model, &given.state.world);
         match given.pipeline.take_frame_end_energy() {
             Some(e) => {
                 assert_eq!(e, fresh, "frame {frame}");

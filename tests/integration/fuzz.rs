@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-use drape::collide::Collider;
+use drape::collide::Obstacles;
 use drape::mesh::load_obj;
 use drape::scene::{Scene, load_scene_str};
 use drape::world::World;
@@ -197,7 +197,7 @@ fn build(scene: &Scene) {
     if scene.cloth.resolution.unwrap_or(0) <= 96 {
         // Errors are fine (e.g. a pin box with no vertex); panics are not.
         let _ = World::from_scene(scene);
-        let _ = Collider::from_scene(scene);
+        let _ = Obstacles::from_scene(scene);
     }
 }
 
@@ -305,7 +305,7 @@ fn load_bytes(bytes: &[u8], uv_scale: f64, name: &str) -> Result<(), TestCaseErr
         format!("obstacle.0.path=\"{}\"", path.display()),
     ];
     let scene = drape::scene::default_scene(&sets).expect("an obstacle scene");
-    let _ = Collider::from_scene(&scene);
+    let _ = Obstacles::from_scene(&scene);
     std::fs::remove_file(&path).ok();
     match loaded {
         Err(e) => prop_assert!(!e.to_string().is_empty()),

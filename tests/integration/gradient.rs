@@ -38,9 +38,9 @@ fn adapted_mesh() -> Mesh {
         coarsen_angle: 1.0,
         ..crate::common::angle_config(AdaptMethod::RedGreen)
     };
-    let mut adapter = Adapter::new(config, &world, 0.15).expect("the adapter starts");
+    let mut adapter = Adapter::new(&config, &world, 0.15).expect("the adapter starts");
     for pass in 0..3 {
-        adapter.pass(&mut world, pass).unwrap();
+        adapter.remesh(&config, &mut world, pass).unwrap();
     }
     world.mesh
 }

@@ -14,6 +14,7 @@ mod canonical;
 mod cli;
 mod collide;
 mod common;
+mod docs_commands;
 mod elastica;
 mod elements;
 mod energy;

@@ -129,15 +129,16 @@ fn samples_are_the_same_cloth_points_on_an_adapted_mesh() {
         .collect();
     let before = sample_positions(&w.mesh, &w.x, &before_loc);
     let cfg = crate::common::angle_config(AdaptMethod::RedGreen);
-    let mut ad = Adapter::new(cfg, &w, 0.15).expect("the adapter starts");
+    let mut ad = Adapter::new(&cfg, &w, 0.15).expect("the adapter starts");
     let leaves: Vec<_> = ad
         .hierarchy()
+        .expect("red-green")
         .leaves()
         .into_iter()
         .step_by(3)
         .map(|l| (RedGreenOp::Split(l), None))
         .collect();
-    ad.apply(&mut w, &leaves, 0).unwrap();
+    ad.apply(&cfg, &mut w, &leaves, 0).unwrap();
     let after_loc: Vec<_> = locate(&w.mesh, &samples)
         .into_iter()
         .map(Option::unwrap)

@@ -511,8 +511,8 @@ fn partly_refined_sheet_bends_like_the_continuum_in(alternate: bool, region: &st
         alternate_diagonals: alternate,
         ..crate::common::angle_config(drape::scene::AdaptMethod::RedGreen)
     };
-    let mut adapter = Adapter::new(config, &world, 0.15).unwrap();
-    let h = adapter.hierarchy();
+    let mut adapter = Adapter::new(&config, &world, 0.15).unwrap();
+    let h = adapter.hierarchy().expect("red-green");
     let marks: Vec<(u32, Scalar)> = h
         .leaves()
         .into_iter()
@@ -530,7 +530,9 @@ fn partly_refined_sheet_bends_like_the_continuum_in(alternate: bool, region: &st
         })
         .map(|t| (t, 20.0))
         .collect();
-    adapter.refine(&mut world, &marks, 0).expect("refine");
+    adapter
+        .refine(&config, &mut world, &marks, 0)
+        .expect("refine");
     let m = &world.mesh;
     let mat = MaterialParams {
         bending: 1e-3,

@@ -246,13 +246,13 @@ fn incremental_tables_equal_a_rebuild_over_draping_passes() {
             max_rollbacks: 3,
             ..crate::common::angle_config(method)
         };
-        let mut ad = Adapter::new(config, &w, 0.15).expect("the adapter starts");
+        let mut ad = Adapter::new(&config, &w, 0.15).expect("the adapter starts");
         let mut changed = 0;
         for k in 0..30 {
             for (x, p) in w.x.iter_mut().zip(&w.mesh.material) {
                 *x = crate::adapt_cost::drape(*p, k);
             }
-            if ad.pass(&mut w, k as u64).unwrap() {
+            if ad.remesh(&config, &mut w, k as u64).unwrap() {
                 changed += 1;
                 ad.check(&w)
                     .unwrap_or_else(|e| panic!("{method:?} pass {k}: {e}"));
@@ -323,7 +323,7 @@ proptest! {
             alternate_diagonals: alternate,
             ..crate::common::angle_config(method)
         };
-        let mut ad = Adapter::new(config, &w, 0.15)
+        let mut ad = Adapter::new(&config, &w, 0.15)
         .expect("the adapter starts");
         for (j, &k) in shapes.iter().enumerate() {
             for (x, p) in w.x.iter_mut().zip(&w.mesh.material) {
@@ -331,19 +331,19 @@ proptest! {
             }
             let angles = edge_angles(&w);
             prop_assert_eq!(
-                ad.needs_refinement(&w, &angles),
-                !ad.refinement_marks(&w, &angles).is_empty(),
+                ad.needs_refinement(&config, &w, &angles),
+                !ad.refinement_marks(&config, &w, &angles).is_empty(),
                 "shape {}: the rollback check disagrees with the marks", j
             );
             if j % cadence != 0 {
                 continue;
             }
-            ad.pass(&mut w, j as u64).unwrap();
+            ad.remesh(&config, &mut w, j as u64).unwrap();
             if let Err(e) = ad.check(&w) {
                 prop_assert!(false, "{:?} pass after shape {}: {}", method, j, e);
             }
             if method == AdaptMethod::RedGreen {
-                let h = ad.hierarchy();
+                let h = ad.hierarchy().expect("red-green");
                 let (tris, _, _) = h.build(alternate);
                 prop_assert_eq!(
                     by_position(&w.mesh.material, &w.mesh.triangles),

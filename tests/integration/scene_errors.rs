@@ -779,3 +779,36 @@ fn bending_length_is_an_alternative_to_bending() {
     let e = error_at(&text, 13, "material.bending_length", Kind::NotApplicable);
     assert!(e.to_string().contains("gravity"), "{e}");
 }
+
+/// `measure` asks for textile measurements; one that cannot apply to the scene
+/// is refused at its line with the reason, and a scene that asks for none (or
+/// for one that applies) loads.
+#[test]
+fn a_measurement_that_does_not_apply_names_the_measure_key() {
+    let asked = |m: &str| {
+        edit(
+            "name = \"t\"\n",
+            &format!("name = \"t\"\nmeasure = [{m}]\n"),
+        )
+    };
+    // BASE pins two corners: a rectangle under gravity alone, so the scene
+    // allows the cantilever (whether its pins clamp one end is a run check).
+    load_scene_str(&asked("\"cantilever\""), "test.toml", &[]).expect("cantilever allowed");
+    let e = error_at(&asked("\"cusick\""), 2, "measure", Kind::NotApplicable);
+    assert!(e.to_string().contains("needs a disk specimen"), "{e}");
+    let windy = asked("\"cantilever\"") + "[wind]\nvelocity = [1.0, 0.0, 0.0]\n";
+    let e = error_at(&windy, 2, "measure", Kind::NotApplicable);
+    assert!(
+        e.to_string()
+            .contains("gravity alone, and this scene has [wind]"),
+        "{e}"
+    );
+    let twice = asked("\"cantilever\", \"cantilever\"");
+    let e = error_at(&twice, 2, "measure", Kind::BadValue);
+    assert!(
+        e.to_string().contains("\"cantilever\" is listed twice"),
+        "{e}"
+    );
+    let e = error_at(&asked("\"drape\""), 2, "measure", Kind::BadValue);
+    assert!(e.to_string().contains("\"cantilever\", \"cusick\""), "{e}");
+}

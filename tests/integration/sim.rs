@@ -4,10 +4,9 @@
 
 use std::path::Path;
 
-use drape::adapt::edge_angles;
-use drape::physics::Model;
+use drape::adapt::{AdaptConfig, edge_angles};
 use drape::scene::{Scene, load_scene_file};
-use drape::sim::{Pipeline, SimState, Simulation, build};
+use drape::sim::{Pipeline, Setup, SimParts, SimState, build};
 
 /// `scenes/hard/thrash.toml` (a sheet flapping in wind, red-green adaptivity after
 /// every step with rollback) with at most one rollback per step, so that a step is
@@ -17,14 +16,21 @@ fn thrash() -> Scene {
     load_scene_file(Path::new("scenes/hard/thrash.toml"), &overrides).expect("thrash scene")
 }
 
-/// The model, initial state and pipeline of `scene`.
-fn parts(scene: &Scene) -> (Model, SimState, Pipeline) {
-    let Simulation {
-        model,
+/// The setup, initial state and pipeline of `scene`.
+fn parts(scene: &Scene) -> (Setup, SimState, Pipeline) {
+    let SimParts {
+        setup,
         state,
         pipeline,
     } = build(&scene.resolve().expect("resolve")).expect("build");
-    (model, state, pipeline)
+    (setup, state, pipeline)
+}
+
+/// The setup of `scene` with its adaptivity settings changed by `change`.
+fn setup_with(scene: &Scene, change: impl Fn(&mut AdaptConfig)) -> Setup {
+    let mut setup = parts(scene).0;
+    change(setup.settings.adapt.as_mut().expect("adaptive"));
+    setup
 }
 
 fn rollbacks(state: &SimState) -> u64 {
@@ -34,7 +40,7 @@ fn rollbacks(state: &SimState) -> u64 {
 /// Steps `state` until a step rolls back; returns the state before that step (and
 /// leaves `twin`, a second simulation run in lockstep, at that same state).
 fn until_rollback(
-    model: &Model,
+    setup: &Setup,
     state: &mut SimState,
     pipe: &mut Pipeline,
     twin: &mut (SimState, Pipeline),
@@ -43,14 +49,14 @@ fn until_rollback(
     for step in 0..400 {
         let saved = state.clone();
         let before = rollbacks(state);
-        assert!(
-            pipe.step(model, state, h).expect("remesh"),
-            "step {step} rejected"
-        );
+        let outcome = pipe
+            .step(setup, state, h)
+            .unwrap_or_else(|e| panic!("step {step}: {e}"));
         if rollbacks(state) > before {
+            assert_eq!(outcome.rollbacks as u64, rollbacks(state) - before);
             return saved;
         }
-        assert!(twin.1.step(model, &mut twin.0, h).expect("remesh"));
+        twin.1.step(setup, &mut twin.0, h).expect("step accepted");
     }
     panic!("no step rolled back in 400 steps");
 }
@@ -63,34 +69,44 @@ fn until_rollback(
 #[test]
 fn rollback_keeps_only_the_accepted_attempts_work() {
     let scene = thrash();
-    let (model, mut state, mut pipe) = parts(&scene);
+    let (setup, mut state, mut pipe) = parts(&scene);
     let (_, twin_state, twin_pipe) = parts(&scene);
     let mut twin = (twin_state, twin_pipe);
-    let h = pipe.step_size(&model, &state.world);
-    let saved = until_rollback(&model, &mut state, &mut pipe, &mut twin, h);
+    let h = pipe.step_size(&setup, &state.world);
+    let saved = until_rollback(&setup, &mut state, &mut pipe, &mut twin, h);
     let work0 = saved.ledger.external_work;
     let (mut twin_state, mut twin_pipe) = twin;
     assert_eq!(twin_state.world.x, saved.world.x, "the twin is in lockstep");
 
     // The trial: the same step without rollback, on the old mesh.
+    let trial_setup = setup_with(&scene, |a| {
+        a.rollback = false;
+        a.every = drape::spec::AdaptEvery::Steps(u32::MAX);
+    });
     let mut trial = saved.clone();
-    if let Some(a) = trial.adapter.as_mut() {
-        a.config.rollback = false;
-        a.config.every = drape::spec::AdaptEvery::Steps(u32::MAX);
-    }
-    assert!(twin_pipe.step(&model, &mut trial, h).expect("remesh"));
+    twin_pipe
+        .step(&trial_setup, &mut trial, h)
+        .expect("step accepted");
     let ad = trial.adapter.as_ref().expect("adaptive");
-    let marks = ad.refinement_marks(&trial.world, &edge_angles(&trial.world));
+    let config = setup.settings.adapt.as_ref().expect("adaptive");
+    let marks = ad.refinement_marks(config, &trial.world, &edge_angles(&trial.world));
     assert!(!marks.is_empty(), "the trial bends past the threshold");
 
     // The accepted attempt: refine the start, step once without rollback.
     twin_state.restore(&saved);
     let ad = twin_state.adapter.as_mut().expect("adaptive");
-    ad.refine(&mut twin_state.world, &marks, saved.ledger.steps_done)
-        .expect("refine");
-    ad.config.rollback = false;
-    twin_pipe.mesh_changed(&model, &mut twin_state);
-    assert!(twin_pipe.step(&model, &mut twin_state, h).expect("remesh"));
+    ad.refine(
+        config,
+        &mut twin_state.world,
+        &marks,
+        saved.ledger.steps_done,
+    )
+    .expect("refine");
+    let accepted_setup = setup_with(&scene, |a| a.rollback = false);
+    twin_pipe.mesh_changed(&accepted_setup, &mut twin_state);
+    twin_pipe
+        .step(&accepted_setup, &mut twin_state, h)
+        .expect("step accepted");
 
     let real = state.ledger.external_work - work0;
     let accepted = twin_state.ledger.external_work - work0;
@@ -114,20 +130,20 @@ fn rollback_keeps_only_the_accepted_attempts_work() {
 /// state. Returns the original and the replayed end states and the largest move
 /// of a vertex over the second half.
 fn replay_on_a_fresh_pipeline(scene: &Scene, steps: usize) -> (SimState, SimState, f64) {
-    let (model, mut state, mut pipe) = parts(scene);
-    let h = pipe.step_size(&model, &state.world);
+    let (setup, mut state, mut pipe) = parts(scene);
+    let h = pipe.step_size(&setup, &state.world);
     for _ in 0..steps {
-        assert!(pipe.step(&model, &mut state, h).expect("remesh"));
+        pipe.step(&setup, &mut state, h).expect("step accepted");
     }
     let saved = state.clone();
     for _ in 0..steps {
-        assert!(pipe.step(&model, &mut state, h).expect("remesh"));
+        pipe.step(&setup, &mut state, h).expect("step accepted");
     }
     let (_, _, mut fresh) = parts(scene);
     let mut replay = saved.clone();
-    fresh.attach(&model, &replay);
+    fresh.attach(&setup, &replay);
     for _ in 0..steps {
-        assert!(fresh.step(&model, &mut replay, h).expect("remesh"));
+        fresh.step(&setup, &mut replay, h).expect("step accepted");
     }
     let moved = state
         .world

@@ -294,13 +294,11 @@ fn ordering_by_vertex_fills_no_more_than_scalar_amd() {
         .map(|p| p.extend((p.x - 0.1).max(0.0)))
         .collect();
     let mut world = World::new(grid.clone(), bent);
-    let mut adapter = Adapter::new(
-        crate::common::angle_config(AdaptMethod::RedGreen),
-        &world,
-        0.15,
-    )
-    .expect("the adapter starts");
-    adapter.pass(&mut world, 0).expect("the crease refines");
+    let cfg = crate::common::angle_config(AdaptMethod::RedGreen);
+    let mut adapter = Adapter::new(&cfg, &world, 0.15).expect("the adapter starts");
+    adapter
+        .remesh(&cfg, &mut world, 0)
+        .expect("the crease refines");
     assert!(world.mesh.vertex_count() > grid.vertex_count());
     let material = MaterialParams {
         bending_model: BendingModel::ShapeOperator,
@@ -324,7 +322,7 @@ fn ordering_by_vertex_fills_no_more_than_scalar_amd() {
 }
 
 /// The simulation of the scene file `scene` with `overrides`, and its frame length.
-fn simulation(scene: &str, overrides: &[String]) -> (drape::sim::Simulation, Scalar) {
+fn simulation(scene: &str, overrides: &[String]) -> (drape::sim::SimParts, Scalar) {
     let scene =
         drape::scene::load_scene_file(std::path::Path::new(scene), overrides).expect("scene");
     let sim = drape::sim::build(&scene.resolve().expect("resolve")).expect("build");
@@ -334,13 +332,13 @@ fn simulation(scene: &str, overrides: &[String]) -> (drape::sim::Simulation, Sca
 /// Advances `sim` by `frames` frames of `frame` s; returns the run's solver
 /// counters so far.
 fn run_frames(
-    sim: &mut drape::sim::Simulation,
+    sim: &mut drape::sim::SimParts,
     frame: Scalar,
     frames: usize,
 ) -> drape::physics::StepStats {
     for _ in 0..frames {
         sim.pipeline
-            .advance_frame(&sim.model, &mut sim.state, frame)
+            .advance_frame(&sim.setup, &mut sim.state, frame)
             .expect("frame");
     }
     sim.state.effort.solver

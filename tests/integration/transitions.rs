@@ -26,9 +26,9 @@ fn two_levels(
         alternate_diagonals: alternate,
         ..crate::common::angle_config(AdaptMethod::RedGreen)
     };
-    let mut adapter = Adapter::new(config, &world, 0.15).unwrap();
+    let mut adapter = Adapter::new(&config, &world, 0.15).unwrap();
     for inside in [&first as &dyn Fn(Vector2) -> bool, &second] {
-        let h = adapter.hierarchy();
+        let h = adapter.hierarchy().expect("red-green");
         let marks: Vec<(u32, Scalar)> = h
             .leaves()
             .into_iter()
@@ -38,7 +38,9 @@ fn two_levels(
             })
             .map(|t| (t, 20.0))
             .collect();
-        adapter.refine(&mut world, &marks, 0).expect("refine");
+        adapter
+            .refine(&config, &mut world, &marks, 0)
+            .expect("refine");
     }
     world.mesh
 }
@@ -198,9 +200,9 @@ fn green_closures_stretch_unlike_the_grid() {
             max_level: 6,
             ..crate::common::angle_config(AdaptMethod::RedGreen)
         };
-        let mut adapter = Adapter::new(config, &world, 0.15).unwrap();
+        let mut adapter = Adapter::new(&config, &world, 0.15).unwrap();
         let centre = Vector2::new(0.1, -0.05);
-        crate::common::refine_around(&mut adapter, &mut world, (centre, 0.25), 2);
+        crate::common::refine_around(&mut adapter, &config, &mut world, (centre, 0.25), 2);
         let green: Scalar = world
             .mesh
             .triangles

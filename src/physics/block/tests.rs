@@ -1,6 +1,6 @@
 //! The pattern's derived tables against the searches they replaced: mirrors by
 //! per-row cursors, and the shape triangles' dropped blocks from one lookup per
-//! pair of slots (the "cheaper block pattern" of docs/performance.md).
+//! pair of slots.
 
 use super::BlockPattern;
 use crate::adapt::{AdaptConfig, Adapter};
@@ -28,8 +28,10 @@ fn meshes() -> (Vec<Mesh>, MaterialParams) {
         .collect();
     let mut world = World::new(grid.clone(), bent);
     let config = AdaptConfig::from_scene(scene.adapt.as_ref()).expect("it adapts");
-    let mut adapter = Adapter::new(config, &world, scene.material.density).unwrap();
-    adapter.pass(&mut world, 0).expect("the crease refines");
+    let mut adapter = Adapter::new(&config, &world, scene.material.density).unwrap();
+    adapter
+        .remesh(&config, &mut world, 0)
+        .expect("the crease refines");
     assert!(world.mesh.triangles.len() > grid.triangles.len());
     (vec![grid, world.mesh], Model::from_scene(&scene).material)
 }

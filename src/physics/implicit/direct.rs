@@ -20,7 +20,7 @@
 //! fast the matrix changes: falling, folding cloth refactors often, cloth at rest
 //! almost never.
 //!
-//! Measured (docs/performance.md, "When to factor anew"): on a falling, draping sheet
+//! For example, on a falling, draping sheet
 //! (`drape_sphere`, 2 s) the matrix changes enough in one step that the solver
 //! factors at 206 of 247 steps, with 2.8 iterations a step; `hanging_sheet_rest` at
 //! uniform 64 (coming to rest) needs 162 factorizations in 600 steps; the cantilever
@@ -43,7 +43,7 @@
 //!
 //! On `hanging_sheet_rest` at uniform 128, `rho = 3.97` puts the break-even at
 //! 24.8 iterations, and timing each factor puts it at about 28.5: the stored
-//! values are a fair proxy (`docs/performance.md`, "Which factor"). A fixed
+//! values are a fair proxy (`docs/model.md`, "The linear solver"). A fixed
 //! iteration threshold would not do: fine fabrics need 9 to 14 iterations with a
 //! fresh reduced factor and would switch to a full factor four times its size.
 //! The factorization's flop count is no better a proxy than the stored values:

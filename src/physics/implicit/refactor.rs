@@ -39,7 +39,7 @@
 //! every scene: even a fresh factor needs about 5 iterations on
 //! `hanging_sheet_rest` at uniform 64, so a count of 4 refactors at almost every
 //! step while the sheet hangs at rest, yet on `drape_sphere` a count of 1 is faster
-//! than 4 or 8 (`docs/performance.md`). Weighing the costs as above suits both.
+//! than 4 or 8. Weighing the costs as above suits both.
 
 use crate::math::Scalar;
 

@@ -3,12 +3,11 @@
 //! end of a frame.
 
 use super::Pipeline;
-use crate::adapt::edge_angles_into;
 use crate::adapt::transfer::carry_contacts;
+use crate::adapt::{Measured, edge_angles_into};
 use crate::math::{Scalar, Vector};
 use crate::mesh::MeshError;
-use crate::physics::Model;
-use crate::sim::{Ledger, SimState};
+use crate::sim::{Ledger, Setup, SimState};
 use crate::spec::AdaptEvery;
 
 /// What a rollback restores: the step's start positions, velocities, time and
@@ -37,24 +36,24 @@ impl Pipeline {
     /// (redo the step).
     pub(super) fn rollback(
         &mut self,
-        model: &Model,
+        setup: &Setup,
         state: &mut SimState,
         tries: &mut u32,
     ) -> Result<bool, MeshError> {
-        let Some(ad) = state.adapter.as_mut() else {
+        let (Some(ad), Some(config)) = (state.adapter.as_mut(), &setup.settings.adapt) else {
             return Ok(false);
         };
-        if *tries >= ad.config.max_rollbacks {
+        if *tries >= config.max_rollbacks {
             return Ok(false);
         }
         edge_angles_into(&state.world, &mut self.angles);
         self.angles_fresh = true;
         // Nearly every step bends no edge past the threshold: answered without
         // allocating; the marks are collected only for a rollback.
-        if !ad.needs_refinement(&state.world, &self.angles) {
+        if !ad.needs_refinement(config, &state.world, &self.angles) {
             return Ok(false);
         }
-        let marks = ad.refinement_marks(&state.world, &self.angles);
+        let marks = ad.refinement_marks(config, &state.world, &self.angles);
         self.angles_fresh = false;
         let s = &mut self.step_start;
         std::mem::swap(&mut state.world.x, &mut s.x);
@@ -70,23 +69,23 @@ impl Pipeline {
         let start_contacts = std::mem::take(&mut self.stepper.contacts);
         let old_vertices = state.world.x.len();
         let had_contacts = !start_contacts.is_empty();
-        let carried = if ad.refine(&mut state.world, &marks, state.ledger.steps_done)? {
+        let steps_done = state.ledger.steps_done;
+        let carried = if ad.refine(config, &mut state.world, &marks, steps_done)? {
             carry_contacts(&start_contacts, old_vertices, ad.last_origins())
         } else {
             Some(start_contacts).filter(|c| c.len() == old_vertices)
         };
-        self.mesh_changed_with(model, state, carried, had_contacts);
+        self.mesh_changed_with(setup, state, carried, had_contacts);
         *tries += 1;
         Ok(true)
     }
 
-    /// Adapt: the remeshing pass after every `adapt.every` accepted steps.
-    pub(super) fn adapt(&mut self, model: &Model, state: &mut SimState) -> Result<(), MeshError> {
-        match state.adapter.as_ref() {
-            Some(ad) if ad.config.every.after_step(state.ledger.steps_done) => {
-                self.remesh(model, state).map(|_| ())
-            }
-            _ => Ok(()),
+    /// Adapt: the remeshing pass after every `adapt.every` accepted steps. True
+    /// when it changed the mesh.
+    pub(super) fn adapt(&mut self, setup: &Setup, state: &mut SimState) -> Result<bool, MeshError> {
+        match &setup.settings.adapt {
+            Some(c) if c.every.after_step(state.ledger.steps_done) => self.remesh(setup, state),
+            _ => Ok(false),
         }
     }
 
@@ -94,11 +93,11 @@ impl Pipeline {
     /// steps are accepted. True when it changed the mesh.
     pub(super) fn adapt_at_frame_end(
         &mut self,
-        model: &Model,
+        setup: &Setup,
         state: &mut SimState,
     ) -> Result<bool, MeshError> {
-        match state.adapter.as_ref() {
-            Some(ad) if ad.config.every == AdaptEvery::Frame => self.remesh(model, state),
+        match &setup.settings.adapt {
+            Some(c) if c.every == AdaptEvery::Frame => self.remesh(setup, state),
             _ => Ok(false),
         }
     }
@@ -107,23 +106,25 @@ impl Pipeline {
     /// rollback check measured on it, when it did). True when it changed the mesh.
     pub(super) fn remesh(
         &mut self,
-        model: &Model,
+        setup: &Setup,
         state: &mut SimState,
     ) -> Result<bool, MeshError> {
-        let Some(ad) = state.adapter.as_mut() else {
+        let (Some(ad), Some(config)) = (state.adapter.as_mut(), &setup.settings.adapt) else {
             return Ok(false);
         };
         let step = state.ledger.steps_done;
         self.obstacle_planes.clear();
-        if ad.config.refine_obstacle.is_some()
-            && let Some(c) = &self.collider
-        {
+        if config.refine_obstacle.is_some() {
             let w = &state.world;
-            c.nearest_planes(&w.x, w.time, &mut self.obstacle_planes);
+            let planes = &mut self.obstacle_planes;
+            setup.obstacles.nearest_planes(&w.x, w.time, planes);
         }
-        let angles = self.angles_fresh.then_some(self.angles.as_slice());
+        let known = Measured {
+            angles: self.angles_fresh.then_some(self.angles.as_slice()),
+            obstacle_planes: &self.obstacle_planes,
+        };
         let old_vertices = state.world.x.len();
-        let changed = ad.pass_near(&mut state.world, step, angles, &self.obstacle_planes)?;
+        let changed = ad.remesh_with(config, &mut state.world, step, known)?;
         self.angles_fresh = false;
         if changed {
             // The contacts the last step ended in, carried onto the new mesh:
@@ -131,7 +132,7 @@ impl Pipeline {
             // `crate::adapt::transfer::carry_contacts`).
             let carried = carry_contacts(&state.contacts, old_vertices, ad.last_origins());
             let had_contacts = !state.contacts.is_empty();
-            self.mesh_changed_with(model, state, carried, had_contacts);
+            self.mesh_changed_with(setup, state, carried, had_contacts);
         }
         Ok(changed)
     }
@@ -143,7 +144,7 @@ impl Pipeline {
     /// every remesh did before contacts were carried.
     fn mesh_changed_with(
         &mut self,
-        model: &Model,
+        setup: &Setup,
         state: &mut SimState,
         carried: Option<Vec<crate::physics::Contact>>,
         had_contacts: bool,
@@ -152,7 +153,7 @@ impl Pipeline {
             carried.is_some() || !had_contacts,
             "resting contacts that do not fit the mesh they were carried from"
         );
-        self.mesh_changed(model, state);
+        self.mesh_changed(setup, state);
         if let Some(contacts) = carried {
             state.contacts = contacts;
         }
