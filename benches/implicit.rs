@@ -29,7 +29,7 @@ use std::time::{Duration, Instant};
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group};
 use drape::math::{Scalar, Vector};
 use drape::physics::block::BlockPattern;
-use drape::physics::direct::{Factorization, Ordering};
+use drape::physics::cholesky::{Factorization, Ordering};
 use drape::physics::elements::Elements;
 use drape::physics::{
     ExternalForces, MaterialParams, Model, Solver, SolverSettings, StepStats, Stepper,

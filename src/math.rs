@@ -54,8 +54,8 @@ where
         (a, b)
     };
     if chunks <= STACK_CHUNKS {
-        // The chunk sums on the stack: no allocation per call (issue 13: these
-        // sums run several times a step). Same chunks, same order as below.
+        // The chunk sums on the stack: no allocation per call (these sums run
+        // several times a step). Same chunks, same order as below.
         let mut partial = [(0.0, 0.0); STACK_CHUNKS];
         partial[..chunks]
             .par_iter_mut()

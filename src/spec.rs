@@ -313,7 +313,7 @@ pub struct Adapt {
     #[serde(default)]
     pub multirate: bool,
     /// What decides where to refine and coarsen: the papers' angle thresholds,
-    /// or a target size from the curvature (issue 14, `src/adapt/sizing.rs`).
+    /// or a target size from the curvature (`src/adapt/sizing.rs`).
     #[serde(default = "default_criterion")]
     pub criterion: AdaptCriterion,
     /// Sizing criterion only: four children merge when their parent would
@@ -419,7 +419,7 @@ fn default_coarsen_angle() -> f64 {
 fn default_max_level() -> u32 {
     4
 }
-/// Every 4 steps (issue 14, measured in `docs/speed-vs-error.md`): on
+/// Every 4 steps: on
 /// `tablecloth` adapting every step took 3.3 times the steps (retried frames)
 /// and 3.2 times the wall time of every 4; on `hanging_sheet` and
 /// `drape_sphere` every 4 had the same or a lower error than every step.
@@ -492,7 +492,7 @@ impl<'de> Deserialize<'de> for AdaptEvery {
 fn default_max_rollbacks() -> u32 {
     3
 }
-/// Sizing (issue 14, measured in `docs/speed-vs-error.md`): fewer vertices
+/// Sizing: fewer vertices
 /// than the angle criterion on every measured scene.
 fn default_criterion() -> AdaptCriterion {
     AdaptCriterion::Sizing

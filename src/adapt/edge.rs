@@ -22,13 +22,6 @@
 //! a refusal undoes the chain's committed splits through their inverses.
 //! The adapter then compacts the soup and transfers the state
 //! (`transfer.rs`).
-//!
-//! Issue 13, measured: before, a refused split left its chain's splits in
-//! the mesh and counted them. Making splits atomic changes the flag scene
-//! (the one scene on this method): 1 s of it made 2187 splits and 102
-//! collapses before and 2270 and 50 now. The same build with the undo
-//! switched off reproduced the old summary exactly, so atomicity is the whole
-//! difference.
 
 use crate::math::{Scalar, Vector2};
 
@@ -44,6 +37,21 @@ pub enum EdgeOp {
     /// Vertex `.0` merged into vertex `.1`.
     Collapse(u32, u32),
 }
+
+/// A triangle to be halved by a split: slot `t` with corners `tri`, the split
+/// edge running p -> q, `o` the opposite corner.
+struct Halved {
+    t: u32,
+    tri: [u32; 3],
+    p: u32,
+    q: u32,
+    o: u32,
+    level: u8,
+}
+
+/// A triangle that a collapse moves: its slot, its corners and its corners after
+/// the collapse.
+type Moved = (u32, [u32; 3], [u32; 3]);
 
 fn sorted(a: u32, b: u32) -> (u32, u32) {
     (a.min(b), a.max(b))
@@ -64,7 +72,7 @@ impl Soup {
     /// Longest-edge bisection of edge (a, b); returns the operations done.
     /// Refused (returns false) if a needed split would go past `max_level`,
     /// below `min_len`, or below `min_angle`. Atomic: a refused split undoes
-    /// the neighbour splits it did first and reports nothing (issue 13; see
+    /// the neighbour splits it did first and reports nothing (test
     /// `refused_edge_split_leaves_no_partial_work`).
     pub fn split(
         &mut self,
@@ -95,8 +103,65 @@ impl Soup {
         if depth > 64 || !self.has_edge(a, b) {
             return false;
         }
-        // Split the longest edge of each adjacent triangle first, until (a, b)
-        // is the longest edge of every triangle at it.
+        if !self.split_longer_edges_at(a, b, limits, out, depth) {
+            return false;
+        }
+        let around = self.tris_at(a, b);
+        if around.is_empty() {
+            return false;
+        }
+        let m_pos = (self.material[a as usize] + self.material[b as usize]) * 0.5;
+        if self.len2(a, b).sqrt() * 0.5 < limits.min_edge {
+            return false;
+        }
+        let mut plan = Vec::new();
+        for t in around.iter() {
+            let Some(tri) = self.tris[t as usize] else {
+                continue;
+            };
+            let Some(half) = self.halve(t, tri, a, b, m_pos, limits) else {
+                return false;
+            };
+            plan.push(half);
+        }
+        let m = self.material.len() as u32;
+        let base = self.tris.len() as u32;
+        let mut op = SoupOp {
+            vertex: Some(VertexChange::Append {
+                id: m,
+                material: m_pos,
+                parent: (a, b),
+            }),
+            slots: (base, base + 2 * plan.len() as u32),
+            ..SoupOp::default()
+        };
+        let mut touched = Vec::new();
+        for (k, h) in plan.iter().enumerate() {
+            let slot = base + 2 * k as u32;
+            op.removed.push((h.t, h.tri, h.level));
+            op.added.push((slot, [h.p, m, h.o], h.level + 1));
+            op.added.push((slot + 1, [m, h.q, h.o], h.level + 1));
+            touched.extend([h.p, h.q, h.o]);
+        }
+        // The new vertex is not in the soup yet: its flag starts false.
+        op.touched = vec![(m, false, true)];
+        op.touched.extend(self.touching(&touched));
+        self.commit(op);
+        out.push(EdgeOp::Split(a, b));
+        true
+    }
+
+    /// Splits the longest edge of each triangle at (a, b) first, until (a, b) is
+    /// the longest edge of every triangle at it (Rivara). False when a needed
+    /// split is refused.
+    fn split_longer_edges_at(
+        &mut self,
+        a: u32,
+        b: u32,
+        limits: &Limits,
+        out: &mut Vec<EdgeOp>,
+        depth: u32,
+    ) -> bool {
         'settle: loop {
             for t in self.tris_at(a, b).iter() {
                 let Some(tri) = self.tris[t as usize] else {
@@ -116,63 +181,45 @@ impl Soup {
                     continue 'settle;
                 }
             }
-            break;
+            return true;
         }
-        let around = self.tris_at(a, b);
-        if around.is_empty() {
-            return false;
+    }
+
+    /// Triangle `t` (corners `tri`) halved across its edge (a, b) at the material
+    /// point `m_pos`; `None` when a half would go past `max_level` or below
+    /// `min_angle`.
+    fn halve(
+        &self,
+        t: u32,
+        tri: [u32; 3],
+        a: u32,
+        b: u32,
+        m_pos: Vector2,
+        limits: &Limits,
+    ) -> Option<Halved> {
+        let k = (0..3)
+            .find(|&k| sorted(tri[k], tri[(k + 1) % 3]) == sorted(a, b))
+            .unwrap_or(0);
+        let (p, q, o) = (tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]);
+        let level = self.levels[t as usize];
+        if level as u32 + 1 > limits.max_level as u32 {
+            return None;
         }
-        let m_pos = (self.material[a as usize] + self.material[b as usize]) * 0.5;
-        if self.len2(a, b).sqrt() * 0.5 < limits.min_edge {
-            return false;
+        let mp = self.material[p as usize];
+        let (mq, mo) = (self.material[q as usize], self.material[o as usize]);
+        if min_angle_deg([mp, m_pos, mo]) < limits.min_angle
+            || min_angle_deg([m_pos, mq, mo]) < limits.min_angle
+        {
+            return None;
         }
-        let mut plan = Vec::new();
-        for t in around.iter() {
-            let Some(tri) = self.tris[t as usize] else {
-                continue;
-            };
-            let k = (0..3)
-                .find(|&k| sorted(tri[k], tri[(k + 1) % 3]) == sorted(a, b))
-                .unwrap_or(0);
-            let (p, q, o) = (tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]);
-            let level = self.levels[t as usize];
-            if level as u32 + 1 > limits.max_level as u32 {
-                return false;
-            }
-            let mp = self.material[p as usize];
-            let (mq, mo) = (self.material[q as usize], self.material[o as usize]);
-            if min_angle_deg([mp, m_pos, mo]) < limits.min_angle
-                || min_angle_deg([m_pos, mq, mo]) < limits.min_angle
-            {
-                return false;
-            }
-            plan.push((t, tri, p, q, o, level));
-        }
-        let m = self.material.len() as u32;
-        let base = self.tris.len() as u32;
-        let mut op = SoupOp {
-            vertex: Some(VertexChange::Append {
-                id: m,
-                material: m_pos,
-                parent: (a, b),
-            }),
-            slots: (base, base + 2 * plan.len() as u32),
-            ..SoupOp::default()
-        };
-        let mut touched = Vec::new();
-        for (k, &(t, tri, p, q, o, level)) in plan.iter().enumerate() {
-            let slot = base + 2 * k as u32;
-            op.removed.push((t, tri, level));
-            op.added.push((slot, [p, m, o], level + 1));
-            op.added.push((slot + 1, [m, q, o], level + 1));
-            touched.extend([p, q, o]);
-        }
-        // The new vertex is not in the soup yet: its flag starts false.
-        op.touched = vec![(m, false, true)];
-        op.touched.extend(self.touching(&touched));
-        self.commit(op);
-        out.push(EdgeOp::Split(a, b));
-        true
+        Some(Halved {
+            t,
+            tri,
+            p,
+            q,
+            o,
+            level,
+        })
     }
 
     /// Flips interior edges at the given vertices while that improves the
@@ -298,42 +345,12 @@ impl Soup {
         if common != shared.len() {
             return false;
         }
-        if self.on_boundary(v) {
-            // Only along a straight boundary: (u, v) is a boundary edge and v's
-            // other boundary neighbour continues the line from u through v.
-            if shared.len() != 1 {
-                return false;
-            }
-            let others: Vec<u32> = nv
-                .iter()
-                .copied()
-                .filter(|&w| w != u && self.tris_at(v, w).len() == 1)
-                .collect();
-            let [w] = others[..] else { return false };
-            let (pu, pv, pw) = (
-                self.material[u as usize],
-                self.material[v as usize],
-                self.material[w as usize],
-            );
-            if (pv - pu).perp_dot(pw - pv).abs() > 1e-12 * (pv - pu).length_squared().max(1e-300) {
-                return false;
-            }
+        if self.on_boundary(v) && !self.straight_boundary(v, u, &nv, shared.len()) {
+            return false;
         }
-        let mut replaced = Vec::new();
-        for &t in &self.vert_tris[v as usize] {
-            let Some(tri) = self.tris[t as usize] else {
-                continue;
-            };
-            if tri.contains(&u) {
-                continue;
-            }
-            let new = tri.map(|w| if w == v { u } else { w });
-            let p = self.corners(new);
-            if (p[1] - p[0]).perp_dot(p[2] - p[0]) <= 0.0 || min_angle_deg(p) < limits.min_angle {
-                return false;
-            }
-            replaced.push((t, tri, new));
-        }
+        let Some(replaced) = self.moved_triangles(v, u, limits) else {
+            return false;
+        };
         let base = self.tris.len() as u32;
         let mut op = SoupOp {
             vertex: Some(VertexChange::Remove(v)),
@@ -356,6 +373,51 @@ impl Soup {
         self.commit(op);
         out.push(EdgeOp::Collapse(v, u));
         true
+    }
+
+    /// A boundary vertex `v` (neighbours `nv`) collapses into `u` only along a
+    /// straight boundary: (u, v) is a boundary edge (one shared triangle) and v's
+    /// other boundary neighbour continues the line from u through v.
+    fn straight_boundary(&self, v: u32, u: u32, nv: &[u32], shared: usize) -> bool {
+        if shared != 1 {
+            return false;
+        }
+        let others: Vec<u32> = nv
+            .iter()
+            .copied()
+            .filter(|&w| w != u && self.tris_at(v, w).len() == 1)
+            .collect();
+        let [w] = others[..] else { return false };
+        let (pu, pv, pw) = (
+            self.material[u as usize],
+            self.material[v as usize],
+            self.material[w as usize],
+        );
+        if (pv - pu).perp_dot(pw - pv).abs() > 1e-12 * (pv - pu).length_squared().max(1e-300) {
+            return false;
+        }
+        true
+    }
+
+    /// The triangles at `v` but not at `u`, each with its corners after `v`
+    /// moves onto `u`; `None` when one would invert or fall below `min_angle`.
+    fn moved_triangles(&self, v: u32, u: u32, limits: &Limits) -> Option<Vec<Moved>> {
+        let mut replaced = Vec::new();
+        for &t in &self.vert_tris[v as usize] {
+            let Some(tri) = self.tris[t as usize] else {
+                continue;
+            };
+            if tri.contains(&u) {
+                continue;
+            }
+            let new = tri.map(|w| if w == v { u } else { w });
+            let p = self.corners(new);
+            if (p[1] - p[0]).perp_dot(p[2] - p[0]) <= 0.0 || min_angle_deg(p) < limits.min_angle {
+                return None;
+            }
+            replaced.push((t, tri, new));
+        }
+        Some(replaced)
     }
 }
 

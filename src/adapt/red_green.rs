@@ -15,7 +15,7 @@
 //! are appended, and [`RedGreen::remap`] follows the world's compaction
 //! (`red_green/mesh.rs`, which also builds the conforming mesh).
 //!
-//! Operations are values (issue 13): every split or merge done is reported as
+//! Operations are values: every split or merge done is reported as
 //! an [`Applied`] that records what it added and removed, and [`RedGreen::undo`]
 //! applies its exact inverse (`red_green/undo.rs`). The adapter uses it to keep
 //! a pass atomic when the world refuses the new mesh.

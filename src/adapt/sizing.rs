@@ -1,4 +1,4 @@
-//! The sizing criterion (issue 14): a target size from the curvature, so that
+//! The sizing criterion: a target size from the curvature, so that
 //! only the folds reach the finest level and a region coarsens again once a
 //! fold has passed.
 //!
@@ -23,11 +23,9 @@
 //! grid the rule below refines a triangle where the angle criterion would
 //! refine at its hypotenuse, and holds its legs to the same curvature (a leg
 //! triggers at 15 * 0.745 / 0.471 = 23.7 deg instead of 15).
-//! Tried first and dropped: `D = (2/3) sqrt(2 A)` (0.667 a, between the two);
-//! it asks about 1.4 times the curvature of the angle criterion's legs, and
-//! on `hanging_sheet` (2 s, every step) it carried 976 vertices on average
-//! against the angle criterion's 805, with 2274 splits and 218 rollbacks
-//! against 936 and 97.
+//! (`D = (2/3) sqrt(2 A)`, between the two, would ask about 1.4 times the
+//! curvature of the angle criterion's legs and refine more, with more
+//! rollbacks.)
 //!
 //! Rule, with the budget `theta_b = refine_angle`:
 //! - the target spacing of a triangle is `D* = theta_b / kappa` (no target,
@@ -50,16 +48,11 @@
 //! coarsening threshold is tied to the refinement one by H instead of being a
 //! separate, much lower angle.
 //!
-//! Measured (`docs/speed-vs-error.md`, issue 14 section): fewer vertices than
-//! the angle criterion on hanging_sheet, tablecloth, flag and drape_sphere (-11
-//! to -44 %), but tablecloth, flag and drape_sphere still have 61 to 72 % of
-//! their triangles at the finest level on average: they are curved past the
-//! budget almost everywhere. A hysteresis of 3 instead of 2 gave more vertices
-//! (599 against 485 on hanging_sheet, 2 s) and no fewer passes that changed the
-//! mesh. Not tried: smoothing the curvature over neighbours (it would refine
-//! more, not less), and a velocity term (refining ahead of a moving fold, which
-//! might save some of the rollbacks: 234 against the angle criterion's 183 on
-//! hanging_sheet over 4 s).
+//! On hanging_sheet, tablecloth, flag and drape_sphere it carries 11 to 44 %
+//! fewer vertices than the angle criterion, though
+//! the last three are curved past the budget almost everywhere (61 to 72 % of
+//! their triangles at the finest level on average). The default hysteresis is
+//! 2: 3 gives more vertices and no fewer passes that change the mesh.
 //!
 //! # Strain jumps (`refine_strain`, off by default)
 //! Curvature cannot see where the membrane strain concentrates. A sheet hung
@@ -83,54 +76,28 @@
 //! merge only when twice their largest jump is at most `refine_strain / H`.
 //! Red-green only (the edge method's collapse test has no such term).
 //!
-//! Measured (`drape bench scenes/hanging_sheet_rest.toml`, ladder with the
-//! rungs below, red_green 16 L4; uniform 64 1.139e-3 of the diagonal in
-//! 15.7 s): no strain term 3.38e-3 in 3.9 s; `refine_strain = 0.02` 1.54e-3 in
-//! 6.3 s (689 -> 1122 mean vertices); 0.005 1.42e-3 in 11.6 s; 0.002 1.62e-3
-//! in 26.9 s with 3,759 vertices, nearly uniform 64's 4,225 and still worse
-//! than it. So the indicator buys most of what refinement can give here, and
-//! what is left is not where the mesh is coarse: a red-green mesh refined
-//! everywhere is a different triangulation from the uniform grid (its
-//! diagonals run other ways), and a mass-spring membrane's stiffness depends
-//! on the triangulation: refined everywhere to 64 it is 0.226 % of the
-//! diagonal from uniform 128 and 0.290 % from itself refined to 128, where
-//! uniform 64 is 0.186 % and 0.236 % from them (`docs/speed-vs-error-history.md`).
-//! Those figures are with the red children as split; with the alternating
-//! diagonals that came after (`red_green/mesh.rs`, now the default) a mesh
-//! refined everywhere is the uniform grid, and the same ladder (third sitting,
-//! 3 repetitions; uniform 64 1.139e-3 in 22.6 s on a slower day) gives
-//! `refine_strain = 0.02` 1.43e-3 in 10.5 s (997 mean vertices), 0.01 1.27e-3
-//! in 10.7 s, 0.01 without rollback 1.19e-3 (x1.05) in 9.1 s, 0.005 1.13e-3
-//! in 47.8 s (rollbacks: 1,375 steps for 600); with `refine_angle = 8`, 0.02
-//! 1.24e-3 (x1.09) in 7.0 s against uniform 64's 24.1 s in the same run.
-//! Those figures are from before the bounce rule (below), which changes every
-//! strain rung that bounced: tight 0.02 ends at 1.45e-3 (x1.27) with it, 0.01
-//! at 1.21e-3 in 0.77 of its former time and 0.005 at 1.12e-3 in 0.43
-//! (`docs/speed-vs-error-history.md`, "Bounces"). With base 8, `max_level = 6`, 8 /
-//! 0.8 deg and no rollback, 0.04 is within 7 % of uniform 64's error at 0.19
-//! to 0.21 of its time and 0.05 at 0.88 of it, while 0.06 to 0.15 are 1.12 to
-//! 1.39 times it: the adaptive runs' error at rest is mostly the shape of the
-//! sheet's coarse middle, uniform 64's mostly its shift (`docs/speed-vs-error-history.md`,
-//! "Strain thresholds").
-//! Not the default: it is measured on one scene.
+//! On `hanging_sheet_rest` (`drape bench`, red_green 16 L4 against uniform 64)
+//! the term brings the error at rest from about 3 times uniform 64's to within
+//! 10 to 30 % of it at under half its time; with base 8, `max_level = 6`, 8 /
+//! 0.8 deg and no rollback, `refine_strain = 0.04` is within 7 % of uniform
+//! 64's error at about 0.2 of its time. Not the default: it is measured on one
+//! scene.
 //!
 //! # What neither measure sees: folds the coarse mesh has not formed
 //! Both measures judge the mesh by what it shows, so they cannot refine a
 //! feature that the coarse mesh does not form. On `hanging_sheet_rest` at
-//! uniform 128's finest edges (eleventh sitting, `docs/speed-vs-error-history.md`,
-//! from `drape bench`'s per-point errors) the adaptive runs' remaining error
-//! is the folds of the sheet's lower half: a few millimetres deep, they have
+//! uniform 128's finest edges (from `drape bench`'s per-point errors) the
+//! adaptive runs' remaining error is the folds of the sheet's lower half: a
+//! few millimetres deep, they have
 //! 0.24 to 0.58 of the reference's depth on a base of 16 or 32 (uniform 128
 //! 0.74 to 0.83), and there the base-16 run's dihedral angles stay below
 //! 5.7 deg, under a 6 deg budget, so nothing refines them; from a base of
 //! 64 (8 deg, `refine_strain = 0.04`) the run has 0.94 of uniform 128's
-//! error at 0.18 of its time, no longer a tenth. Tried and not kept: lower angles (5 and 4 deg: more
-//! vertices, no less error). Not tried, on a measurement: a compression term
-//! (ARCSim refines where the cloth is compressed, where it will buckle);
-//! here the compressed area is the same on every mesh (smallest principal
-//! strain below -0.1 % on 0.64 to 0.67 of the sheet at base 16, uniform 64
-//! and uniform 128), so it would refine two thirds of the sheet whatever
-//! the folds do.
+//! error at 0.18 of its time. Lower angles (5 and 4 deg) add vertices, not
+//! accuracy. A compression term (ARCSim refines where the cloth is
+//! compressed, where it will buckle) would not help here: the compressed area
+//! is the same on every mesh (about two thirds of the sheet), so it would
+//! refine that whatever the folds do.
 //!
 //! # Bounces (the churn at rest)
 //! Judging a merge by the children's measures assumes that the merged parent
@@ -138,15 +105,12 @@
 //! solution it is not so: right after the merge the positions are the fine
 //! mesh's, but within the steps to the next pass the coarse mesh relaxes to
 //! its own equilibrium, and that one has the larger curvature or strain jump
-//! the split test then finds. So the next pass split the parent again, the
-//! fine mesh relaxed back, the pass after merged it, and so on for as long as
-//! the run lasted. On `hanging_sheet_rest` with base 8 and `max_level = 6`
-//! (`refine_angle = 7`, `coarsen_angle = 0.7`, `refine_strain = 0.02`, no
-//! rollback) every one of the 60 passes of its last 2 s, the sheet at rest,
-//! changed the mesh (180 splits and 180 merges, each pass paying a new
-//! ordering and factorization). A debug print of one such parent: the
-//! children's largest strain jump 0.0033 (merge allowed up to 0.01); four
-//! steps after the merge its green halves 0.030 apart (split above 0.02).
+//! the split test then finds. So the next pass would split the parent again,
+//! the fine mesh relax back, the pass after merge it, and so on for as long as
+//! the run lasts, each pass paying a new ordering and factorization (on
+//! `hanging_sheet_rest` with base 8 and `max_level = 6`, a parent whose
+//! children's largest strain jump is 0.0033, merge allowed up to 0.01, has
+//! green halves 0.030 apart four steps after the merge, split above 0.02).
 //!
 //! A merge that the criterion splits again before the next pass has run is a
 //! *bounce* (counted as `bounces` in the summary's `adapt`): the coarse mesh
@@ -155,22 +119,13 @@
 //! again only when its children's measures have fallen that much further, as
 //! they do when a fold has passed and not while the sheet hangs still. The
 //! count is dropped when the parent itself merges away into its own parent.
-//! The run above then bounces 14 times and its mesh stops changing (44 of 90
-//! passes change it in 3 s, the last before 2 s; test
-//! `a_sheet_at_rest_stops_remeshing`). Runs that never bounced are unchanged
-//! bit for bit.
+//! The run above then bounces 14 times and its mesh stops changing (test
+//! `a_sheet_at_rest_stops_remeshing`); a run that never bounces is the same
+//! as without the rule.
 //!
-//! Tried first and dropped (same day): predicting the merged parent's
-//! measures instead, by measuring the triangles the merge would emit (the
-//! parent, or its two green halves around the midpoint a finer neighbour still
-//! uses, against the triangles across its boundary) at the current positions.
-//! The predictions were right for the positions they saw and the churn went on
-//! unchanged (60 of 60 late passes): what the merge changes is the positions,
-//! by the relaxation above. Measuring every green-closed leaf as its whole
-//! triangle, in both tests, stopped the churn, but the halves' kink is a real
-//! sign that the coarse side is too coarse: without it the ladder's runs
-//! carried fewer vertices at more error (`red_green 16 L4 tight` 1.59e-3
-//! against 1.30e-3 of the diagonal, `s0.02` 2.15e-3 against 1.43e-3).
+//! Predicting the merged parent's measures at the current positions does not
+//! stop the churn, since what the merge changes is the positions, by the
+//! relaxation above.
 //!
 //! The edge method (paper B) with this criterion keeps its splits (an edge's
 //! measured angle is its own `kappa_e * d_e`, so the rule is the angle rule

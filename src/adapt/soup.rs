@@ -4,18 +4,15 @@
 //! removes, and which vertices it marks as touched. [`Soup::commit`] applies
 //! one and keeps it in the pass's journal; [`SoupOp::inverse`] is the exact
 //! undo, which [`Soup::undo_to`] uses to take back a chain of splits whose last
-//! one was refused (issue 13: before, the chain's first splits stayed in the
-//! mesh).
+//! one was refused, so that a refused split leaves no partial work.
 //!
 //! Exactness of the undo: triangle ids in the incidence lists are kept sorted
-//! (the old code appended, and new ids were always the largest, so the lists
-//! were sorted then too and every forward result is unchanged), so removing the
-//! added triangles and putting back the removed ones gives the same lists; the
-//! slot count is recorded and restored, so new slots get the same ids again.
-//! An undo that put the removed triangles back in fresh slots (as `kill` and
-//! `add` did before) was the first idea and does not work: the live order, and
-//! so the world's triangle order after compaction, would change with each
-//! refused split.
+//! (new ids are always the largest, so appending keeps them sorted), so
+//! removing the added triangles and putting back the removed ones gives the
+//! same lists; the slot count is recorded and restored, so new slots get the
+//! same ids again. Putting the removed triangles back in fresh slots instead
+//! would not do: the live order, and so the world's triangle order after
+//! compaction, would change with each refused split.
 
 use crate::math::Vector2;
 use crate::mesh::PairMap;
@@ -262,11 +259,6 @@ impl Soup {
             Some(VertexChange::Restore(v)) => self.removed[v as usize] = false,
             _ => {}
         }
-    }
-
-    /// Triangles at edge (a, b), ascending.
-    pub fn triangles_at(&self, a: u32, b: u32) -> Vec<u32> {
-        self.tris_at(a, b).to_vec()
     }
 
     /// Triangles at edge (a, b), ascending, without allocating (two or fewer).

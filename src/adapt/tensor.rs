@@ -4,12 +4,11 @@
 //!
 //! Why. A strip bent along its length (the cantilever) needs short cells
 //! along the bend and none across it: one cell across the strip gives the
-//! square cells' rest error within 1 % at 1/25 of the wall time
-//! (`docs/speed-vs-error-history.md`, "Anisotropic cells"), but red-green's 1-4
-//! splits halve a cell both ways, so from a base one cell across it carries
-//! 169 vertices at level 4 where 82 do. Anisotropic bisection in a metric
-//! (tried on the edge method, same section) made oblique thin triangles on
-//! which drape's bending is wrong; every structured mesh of stretched right
+//! square cells' rest error within 1 % at 1/25 of the wall time, but
+//! red-green's 1-4 splits halve a cell both ways, so from a base one cell
+//! across it carries 169 vertices at level 4 where 82 do. Anisotropic
+//! bisection in a metric makes oblique thin triangles on which drape's
+//! bending is wrong (`crate::physics::shape`); every structured mesh of stretched right
 //! triangles bends exactly. This method keeps the mesh such a structured
 //! mesh: the cloth is a tensor grid, its u-lines and v-lines each kept in a
 //! one-dimensional binary hierarchy, and a pass inserts a line halving a
@@ -51,12 +50,11 @@
 //! measure, so it is never refined that way (the cantilever with
 //! `cloth.short_side_segments = 1`: exactly what it needs).
 //!
-//! Tried first and dropped: the lines' whole turn as the measure. It counts
-//! a line curving within the surface, so a flat sheet sheared in its plane
-//! refined (12 splits in the test
+//! The lines' whole turn is not the measure: it counts a line curving within
+//! the surface, so a flat sheet sheared in its plane would refine (test
 //! `a_flat_sheet_distorted_in_its_plane_does_not_refine`).
 //!
-//! Measured (`docs/speed-vs-error-history.md`, "The tensor method"): on the
+//! Where it pays: on the
 //! cantilever from its own square cells, 1.03 times uniform 40's error at
 //! rest in 0.18 of its wall time, 0.82 of the time of the uniform mesh of
 //! its own finest cells; on `hanging_sheet_rest`, `drape_sphere`,

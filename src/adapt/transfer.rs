@@ -8,23 +8,10 @@
 //! vertices whose mass changed, so momentum is conserved to round-off and the
 //! correction stays local to the remeshed region.
 //!
-//! Tried and dropped (2026-11-24): placing a new vertex on the curved surface
-//! instead of the chord, `(a + b) / 2 - (((b - a) . n_a) n_a + ((a - b) . n_b) n_b) / 8`
-//! with the area-weighted vertex normals (the PN-triangle edge midpoint,
-//! exact to second order on a circle: it adds the sagitta `L^2 / 8R`), so
-//! that a split does not flatten a bend. Frame by frame against the bench's
-//! references (build `a511d06` with the change): `drape_sphere` over 2.5 s
-//! red_green 16 L4 0.671 -> 0.571 %, loose 0.575 -> 0.629 %, edge 16 L4
-//! 0.644 -> 0.773 %; `tablecloth` over its landing (0.6 s) red_green 16 L4
-//! 0.449 -> 0.450 %, edge 16 L4 0.442 -> 0.461 %. No consistent gain, and
-//! none resolved: every change is smaller than the mesh floor, how far a
-//! uniform mesh two segments finer ends from the reference (0.762 % and
-//! 0.251 %; `docs/speed-vs-error-history.md`, "Ninth sitting"); the midpoint also
-//! leaves the old surface, which the tensor method's checks rely on. Tried
-//! again in the twelfth sitting over `drape_sphere`'s contact, where the
-//! comparison decides (uniform error falling at order 1.76, mesh floor 0.025
-//! %): the adaptive runs' errors moved by 0.3 to 3.4 % (red_green 32 L4
-//! 0.236 -> 0.228 %) against misses of 4 to 7 times uniform 128's error.
+//! A new vertex goes on the chord, not on the curved surface (the PN-triangle
+//! edge midpoint, which adds the sagitta `L^2 / 8R`): the curved midpoint
+//! changes no benchmark error by more than the comparison resolves, and it
+//! leaves the old surface, which the tensor method's checks rely on.
 //!
 //! # Vertex order
 //! Compaction chooses the new mesh's vertex numbering (`VertexOrder`). Kept
@@ -42,8 +29,7 @@
 //! (roots in input order), so numbering the vertices in the order the
 //! triangle list first uses them keeps neighbours close (0.013 of the count in
 //! that test; the grid itself 0.020) at the cost of renumbering every vertex
-//! at each remesh, which the hierarchy's `remap` follows. Measured side by
-//! side in `docs/performance.md`, "Vertex order". The edge method keeps
+//! at each remesh, which the hierarchy's `remap` follows. The edge method keeps
 //! creation order: its triangle list is in slot order, which carries no
 //! locality for a numbering to follow.
 //!
@@ -95,20 +81,17 @@ pub fn lumped_masses(material: &[Vector2], triangles: &[[u32; 3]], density: Scal
 }
 
 /// The resting contacts of a remeshed world from the old one's (`old`, one per
-/// old vertex; `origins`, one per new vertex, from [`transfer`]): a kept vertex keeps its contact, a new vertex has none (the
-/// step's collision response deals with it, as it did with every vertex
-/// after a remesh before). `None` when `old` does not match the old mesh
-/// (`old_vertices`). Without it a remesh dropped every contact, and the
-/// implicit step after it solved the cloth as if it could sink into the
-/// obstacle (`src/physics/implicit.rs`, "Pins and contacts").
+/// old vertex; `origins`, one per new vertex, from [`transfer`]): a kept vertex
+/// keeps its contact, a new vertex has none (the step's collision response
+/// deals with it). `None` when `old` does not match the old mesh
+/// (`old_vertices`). Without carried contacts, the implicit step after a
+/// remesh would solve the cloth as if it could sink into the obstacle
+/// (`src/physics/implicit.rs`, "Pins and contacts").
 ///
-/// Tried and dropped (twelfth sitting, `docs/speed-vs-error-history.md`): a midpoint
-/// resting where both ends of its edge rest, on their normals' mean
-/// direction. It gave the same errors on `drape_sphere`'s contact (within
-/// 3e-6 of the diagonal, 0.1 % of each run's error) and made the tablecloth's landing retry frames for energy
-/// gain (red_green 16 L4: 234 steps against 180 with kept contacts only, 162
-/// without carrying any): a midpoint of two vertices on either side of the
-/// table's edge gets a normal at 45 degrees that it does not rest on.
+/// A midpoint gets no contact even where both ends of its edge rest: a
+/// midpoint of two vertices on either side of a table's edge would get a
+/// normal at 45 degrees that it does not rest on, and the tablecloth's landing
+/// retries frames for energy gain.
 pub fn carry_contacts(
     old: &[Contact],
     old_vertices: usize,
@@ -156,6 +139,38 @@ pub fn transfer(
             }
         }
     }
+    conserve_momentum(
+        world,
+        &old_mass,
+        &new_mass,
+        &kept,
+        &old_index,
+        &new.origin,
+        &mut v,
+    );
+    let anchor_of = carry_pins(world, &old_index, &new);
+    // The only fallible step comes before the world changes, so a refused
+    // mesh leaves the world as it was.
+    let mesh = Mesh::from_parts(new.material, new.triangles, new.levels)?;
+    world.pins.anchors = anchor_of.into_iter().flatten().collect();
+    world.mesh = mesh;
+    world.x = x;
+    world.v = v;
+    Ok(new.origin)
+}
+
+/// Gives the momentum that the changed lumped masses took or added back as one
+/// common velocity change of the new vertices whose mass changed (module docs).
+/// `kept` and `old_index`: per old vertex, whether it survives and its new index.
+fn conserve_momentum(
+    world: &World,
+    old_mass: &[Scalar],
+    new_mass: &[Scalar],
+    kept: &[bool],
+    old_index: &[u32],
+    origin: &[Origin],
+    v: &mut [Vector],
+) {
     // Momentum of the region whose masses change, before and after.
     let mut before = Vector::ZERO;
     for (j, &k) in kept.iter().enumerate() {
@@ -165,8 +180,8 @@ pub fn transfer(
             before += world.v[j] * old_mass[j];
         }
     }
-    let affected: Vec<usize> = (0..n)
-        .filter(|&i| match new.origin[i] {
+    let affected: Vec<usize> = (0..origin.len())
+        .filter(|&i| match origin[i] {
             Origin::Old(j) => {
                 (new_mass[i] - old_mass[j as usize]).abs() > 1e-14 * old_mass[j as usize]
             }
@@ -181,9 +196,13 @@ pub fn transfer(
             v[i] += dv;
         }
     }
-    // Pins: kept vertices keep their anchor; a midpoint of two vertices held by the
-    // same pin is held by it too (pin regions are convex in material space).
-    let mut anchor_of: Vec<Option<Anchor>> = vec![None; n];
+}
+
+/// The pin anchor of each new vertex: kept vertices keep their anchor; a midpoint
+/// of two vertices held by the same pin is held by it too (pin regions are convex
+/// in material space).
+fn carry_pins(world: &World, old_index: &[u32], new: &Remeshed) -> Vec<Option<Anchor>> {
+    let mut anchor_of: Vec<Option<Anchor>> = vec![None; new.origin.len()];
     for a in &world.pins.anchors {
         let i = old_index[a.vertex as usize];
         if i != u32::MAX {
@@ -203,14 +222,7 @@ pub fn transfer(
             });
         }
     }
-    // The only fallible step comes before the world changes, so a refused
-    // mesh leaves the world as it was.
-    let mesh = Mesh::from_parts(new.material, new.triangles, new.levels)?;
-    world.pins.anchors = anchor_of.into_iter().flatten().collect();
-    world.mesh = mesh;
-    world.x = x;
-    world.v = v;
-    Ok(new.origin)
+    anchor_of
 }
 
 /// The order of the vertices of a compacted mesh.

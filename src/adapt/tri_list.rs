@@ -1,8 +1,8 @@
 //! A sorted list of triangle ids at one edge that holds two ids without
-//! allocating. A manifold soup has at most two triangles at an edge; before
-//! issue 13 each edge of the edge method's soup had its own `Vec`, one heap
-//! allocation per edge per pass. More than two (a non-manifold state, which
-//! `Mesh::from_parts` refuses later) spill into `more`.
+//! allocating. A manifold soup has at most two triangles at an edge, so a
+//! `Vec` per edge would cost one heap allocation per edge per pass. More than
+//! two (a non-manifold state, which `Mesh::from_parts` refuses later) spill
+//! into `more`.
 
 /// Sorted triangle ids at an edge.
 #[derive(Debug, Clone, Default)]

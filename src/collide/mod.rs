@@ -236,11 +236,6 @@ impl Obstacles {
                 .expect("at least one obstacle")
         }));
     }
-
-    /// True when some obstacle moves.
-    pub fn any_moving(&self) -> bool {
-        self.bodies.iter().any(Body::is_moving)
-    }
 }
 
 /// The collision passes of a run and their per-step scratch (the obstacles

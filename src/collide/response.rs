@@ -33,22 +33,9 @@ pub(super) fn respond(
         return None;
     }
     let thick = b.thickness;
-    // The contact plane: outward normal and its offset n . s at the surface point s.
-    let mut plane = None;
     // Signed distance of the start of the step from the surface.
     let start = b.probe(q0).signed;
-    if start >= 0.0
-        && let Some((toi, n)) = b.first_entry(q0, q1)
-    {
-        plane = Some((n, n.dot(q0 + (q1 - q0) * toi)));
-    }
-    if plane.is_none() {
-        let p = b.probe(q1);
-        if p.signed < thick * CONTACT_MARGIN {
-            plane = Some((p.normal, p.normal.dot(q1) - p.signed));
-        }
-    }
-    let (n, offset) = plane?;
+    let (n, offset) = contact_plane(b, q0, q1, start)?;
     let mut q = q1 + n * (offset + thick - n.dot(q1));
     let rot = pose1.rotation;
     let mut u = rot.inverse() * (*v - b.point_velocity(t1, pose1.transform_point(q)));
@@ -69,22 +56,17 @@ pub(super) fn respond(
         // thickness out): all of it for a vertex that began the step there,
         // which static friction so holds in place, none for one that reached
         // it only at the end. Correcting the whole step for a vertex that
-        // landed within it moved it back along the surface after the implicit
-        // solve, where its neighbours did not see it: the springs around it
-        // stretched and the landing created energy that grew with the
-        // resolution (`drape_sphere` at 1/120 s steps without the energy
-        // retries: 0.44 J at 64 segments and 0.96 J at 96, of 3.77 J; test
-        // `energy::friction_moving_a_landing_vertex_back_created_energy`).
+        // landed within it would move it back along the surface after the
+        // implicit solve, where its neighbours do not see it: the springs
+        // around it would stretch and the landing create energy that grows
+        // with the resolution (`drape_sphere` at 1/120 s steps without the
+        // energy retries: 0.44 J at 64 segments and 0.96 J at 96, of 3.77 J;
+        // test `energy::a_sheet_landing_on_a_ball_gains_no_energy_at_full_steps`).
         // Within the contact margin counts as on it (resting cloth sits
         // exactly a thickness out, to rounding).
         let gap0 = start - thick * CONTACT_MARGIN;
         let gap1 = n.dot(q1) - offset - thick;
-        let before = if gap0 > 0.0 && gap0 > gap1 {
-            (gap0 / (gap0 - gap1)).min(1.0)
-        } else {
-            0.0
-        };
-        q += (ut_new - ut) * (h * (1.0 - before));
+        q += (ut_new - ut) * (h * (1.0 - before_contact(gap0, gap1)));
         u = ut_new + n * un.max(0.0);
     }
     // Curved surfaces and corners: make sure the final point is a thickness outside.
@@ -100,6 +82,34 @@ pub(super) fn respond(
         normal,
         normal_speed: surface.dot(normal),
     })
+}
+
+/// The contact plane of a vertex moving from `q0` (signed distance `start`) to `q1`
+/// in the body's frame: outward normal and its offset `n . s` at the surface point
+/// `s`. The plane where the step first enters the surface, else the one under `q1`
+/// when it ends within the contact margin; `None` when the vertex stays clear.
+fn contact_plane(b: &Body, q0: Vector, q1: Vector, start: Scalar) -> Option<(Vector, Scalar)> {
+    if start >= 0.0
+        && let Some((toi, n)) = b.first_entry(q0, q1)
+    {
+        return Some((n, n.dot(q0 + (q1 - q0) * toi)));
+    }
+    let p = b.probe(q1);
+    if p.signed < b.thickness * CONTACT_MARGIN {
+        return Some((p.normal, p.normal.dot(q1) - p.signed));
+    }
+    None
+}
+
+/// The fraction of the step before the vertex reached the contact layer, from its
+/// gaps to the layer at the start and the end of the step (zero when it began
+/// the step there).
+fn before_contact(gap0: Scalar, gap1: Scalar) -> Scalar {
+    if gap0 > 0.0 && gap0 > gap1 {
+        (gap0 / (gap0 - gap1)).min(1.0)
+    } else {
+        0.0
+    }
 }
 
 /// Pushes a vertex that came within the thickness back out along the normal and removes

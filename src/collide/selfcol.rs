@@ -57,7 +57,7 @@ pub struct SelfCollider {
 }
 
 /// The per-step buffers of [`SelfCollider::resolve`], kept between steps: once they
-/// have grown to the mesh's size a step allocates nothing (issue 13). Their contents
+/// have grown to the mesh's size a step allocates nothing. Their contents
 /// do not survive a step, except the patch trees, which keep their shape and are
 /// refitted to the new boxes.
 #[derive(Debug, Clone, Default)]
@@ -96,11 +96,6 @@ impl SelfCollider {
             trees_built: false,
             scratch: Scratch::default(),
         }
-    }
-
-    /// Number of culling patches of the current mesh.
-    pub fn patch_count(&self) -> usize {
-        self.patches.len()
     }
 
     fn prepare(&mut self, mesh: &Mesh) {

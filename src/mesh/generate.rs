@@ -20,8 +20,7 @@ pub fn rectangle(
 /// (`None`: as many as make square cells, as [`rectangle`]). Fewer give cells
 /// longer across the sheet than along it, each split into two right triangles:
 /// for a strip that bends along its length only (the cantilever), where
-/// resolution across it buys nothing (`docs/speed-vs-error-history.md`, "Anisotropic
-/// cells").
+/// resolution across it buys nothing.
 pub fn rectangle_cells(
     width: Scalar,
     height: Scalar,

@@ -3,9 +3,8 @@
 //! The remeshing tables (`adapt::red_green`, `adapt::soup`) look up and insert
 //! tens of thousands of `(u32, u32)` keys per pass. The standard library's
 //! SipHash is built to resist hash flooding, which keys computed from our own
-//! mesh do not need; profiling the tablecloth scene before issue 13 (perf,
-//! 0.3 s of simulated time) put SipHash's symbols (`Hasher::write`,
-//! `hash_one`) at 2.8% of the whole run's samples. This is the
+//! mesh do not need; with SipHash, `perf` on the tablecloth scene puts its
+//! symbols (`Hasher::write`, `hash_one`) at 2.8% of the run. This is the
 //! multiply-rotate hash of rustc's `FxHasher` with a final fold of the high
 //! half into the low one (hashbrown takes the bucket from the low bits and the
 //! control byte from the top 7). Iteration order is fixed too (no random seed),

@@ -9,7 +9,7 @@
 //! mirror, so the values are identical at any thread count.
 //!
 //! The pattern also carries the scalar compressed-column (CSC) structure of the
-//! lower triangle that the sparse Cholesky factorization reads ([`super::direct`]),
+//! lower triangle that the sparse Cholesky factorization reads ([`super::cholesky`]),
 //! with, for every scalar entry, the block and the component it comes from.
 //!
 //! # The factored matrix
@@ -80,21 +80,15 @@ pub struct ElementBlocks<'a> {
 impl ElementBlocks<'_> {
     /// Block `(k, l)` of shape triangle `tri`: `h^2 sum_ab M_ab J_ak J_bl^T`.
     ///
-    /// Tried and dropped (2026-11-23): computing `M J` once per triangle and
-    /// step into a second per-triangle array, so that a block only sums three
-    /// outer products. Same blocks to the last bit, but slower: this function
-    /// took 2,831 and 2,095 `perf` samples instead of 1,930 and 1,797 on
-    /// `hanging_sheet_rest` at uniform 48 (two runs each, in turn; wall 10.5 /
-    /// 9.0 against 8.6 / 8.3 s). The gather reads blocks in pattern order, not
-    /// triangle order, so the likely cause is that a second 432-byte row per
-    /// triangle costs more cache misses than the arithmetic it saves.
+    /// `M J` is not precomputed per triangle and step: the gather reads blocks
+    /// in pattern order, not triangle order, and a second 432-byte row per
+    /// triangle measured slower than the arithmetic it saves.
     ///
     /// A tip slot `3 + a` moves angle `a` only (`shape.rs`, `HINGE_SLOTS`), so
     /// its gradients by the other two angles are zero and their terms are
     /// skipped: a block with one tip sums one outer product or one term of
     /// `M J` instead of three, a tip-tip block one of each. Skipping exact
-    /// zeros leaves every block the same to the last bit (the summaries of the
-    /// scenes compared in `docs/performance.md`, "Shape blocks", are identical).
+    /// zeros leaves every block the same to the last bit.
     fn shape_block(&self, tri: usize, k: usize, l: usize) -> Matrix3 {
         let (m, jac) = (&self.shape_triangles[tri].m, &self.shape_jacobians[tri]);
         let mut out = Matrix3::ZERO;
@@ -140,15 +134,9 @@ pub struct BlockPattern {
     /// Per vertex, CSC-like: the shape-triangle blocks `(tri, k, l)` of row `i` that
     /// the factorization drops; each is compensated by its Frobenius norm on the
     /// diagonal (`[[s I, -B], [-B^T, s I]]` is positive semi-definite for
-    /// `s >= |B|`), so the factored matrix stays positive definite. Tried and
-    /// dropped (2026-11-23): every such block involves a tip, whose angle
-    /// gradient feeds one angle only, so `B = u v^T` has rank one and the
-    /// tightest compensation is `B B^T / |B|` on row `i` (rank one along `u`)
-    /// instead of `|B| I`. It saved almost nothing: CG iterations 1,658 ->
-    /// 1,641 on `hanging_sheet_rest` at uniform 64 over 2 s, 637 -> 635 on
-    /// `drape_sphere` over 1 s (the factorization counts unchanged, 240 and
-    /// 87): how the dropped blocks are compensated is not what makes a fresh
-    /// factor need about 5 iterations a step there (not measured further).
+    /// `s >= |B|`), so the factored matrix stays positive definite. The tighter
+    /// rank-one compensation `B B^T / |B|` (each such `B = u v^T` involves a
+    /// tip) saves about 1 % of the iterations, not worth its code.
     shape_dropped_start: Vec<u32>,
     shape_dropped: Vec<(u32, u8, u8)>,
     /// Per block (lower blocks only; empty range for upper ones): its sources.

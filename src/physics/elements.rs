@@ -22,17 +22,9 @@
 //!   less energy than the grid under a stretch along an axis and 48 to 50 %
 //!   more in shear, per area (test `green_closures_stretch_unlike_the_grid`;
 //!   a mass-spring membrane does not pass the patch test in general).
-//!   Tried and not adopted (fifteenth session, `docs/speed-vs-error.md`,
-//!   "Fifteenth session", patch `docs/bench/fifteenth-green-fit.patch`): each
-//!   triangle not shaped like the grid's takes its three springs' shares
-//!   `w_e stretch A_t / L_e^2`, the `w_e >= 0` fitted (least squares, sum 3 so
-//!   that equal biaxial stretch stays exact) to the alternating grid's mean
-//!   membrane tensor. The greens' deviation fell 1.8 to 5.3 times (shear of
-//!   the graded sheet 1.038 -> 1.013 of the grid's at resolution 16), but no
-//!   target moved: partial refinement on `drape_sphere` stayed no better than
-//!   uniform 64 (0.141 against 0.139 %), and `hanging_sheet_rest`'s 1/4 run at
-//!   uniform 64's edges went from 0.88 to 1.12 times its error (its accuracy
-//!   partly came from the greens' softness).
+//!   Fitting per-spring weights on such triangles to the grid's membrane
+//!   tensor cuts that deviation several times but improves no benchmark
+//!   error, so it is not adopted.
 //! * Stretch, `paper_a`: every spring of level n has `k = stretch * 2^(n/2)`
 //!   (paper A, eq. 1, with `k_0 = stretch`). Level 0 springs of a uniform mesh
 //!   all get the same constant, which in 2D is itself resolution independent; the

@@ -21,15 +21,11 @@ pub(crate) const PAR_MIN: usize = 1024;
 /// Row count below which a per-row pass of the direct solver's block matrix
 /// runs on one thread (the product by rows, the compensation). Each row sums
 /// tens of 3 x 3 blocks, so far fewer rows than [`PAR_MIN`] cheap elements
-/// pay for a split. Measured (2026-11-23, one sitting, builds in turn):
-/// `hanging_sheet_rest` red-green 16 L4 at 8 / 0.8 deg with `refine_strain =
-/// 0.02` has about 1,200 vertices, so below `PAR_MIN` these passes ran on one
-/// of the two cores; at 128 its wall time went from 5.61 / 5.64 s to 5.21 /
-/// 5.23 s (assembly 1.71 -> 1.43 s), identical summary. Uniform 64 (4,225
-/// vertices): 14.62 / 14.53 s before, 14.66 / 16.0 s after (that 16.0 s run
-/// was slower in every phase, factorization 5.77 against 5.35 s: noise). The
-/// assembly's per-vertex gather at 128 as well gained nothing further (5.24 /
-/// 5.28 against 5.22 / 5.37 s) and stays at `PAR_MIN`.
+/// pay for a split: on an adaptive `hanging_sheet_rest` of about 1,200
+/// vertices, splitting these passes at 128 rows instead of [`PAR_MIN`] cuts
+/// the wall time by 7 % on two cores with an identical summary, and uniform
+/// 64 is unchanged. The assembly's per-vertex gather gains nothing from it and
+/// stays at `PAR_MIN`.
 pub(crate) const PAR_MIN_ROWS: usize = 128;
 
 /// Wind as an aerodynamic pressure on each triangle.

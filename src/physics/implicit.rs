@@ -24,7 +24,7 @@
 //! converged after `newton_iterations` fails (see below).
 //!
 //! # Linear solvers
-//! * `direct` (default, [`assembled`]): `A` assembled into a fixed block pattern and
+//! * `direct` (default, [`direct`]): `A` assembled into a fixed block pattern and
 //!   factored by a sparse Cholesky; the factor is kept and used to precondition
 //!   conjugate gradients in the following steps, and the matrix is factored anew
 //!   when the iterations the older factor costs outweigh a factorization, worth
@@ -60,12 +60,12 @@
 //! positive definite on all of space and whose solution has the prescribed parts
 //! unchanged.
 
-mod assemble;
-mod assembled;
 mod cg;
+mod direct;
+mod linearise;
 mod refactor;
 
-use assemble::assemble;
+use linearise::linearise;
 
 use rayon::prelude::*;
 
@@ -111,6 +111,23 @@ pub enum SolveFailure {
     Setup,
 }
 
+impl SolveFailure {
+    /// A linear solve stopped after `iterations` at residual norm `norm`, above
+    /// `tolerance` relative to `reference`.
+    fn not_converged(
+        iterations: u32,
+        norm: Scalar,
+        reference: Scalar,
+        tolerance: Scalar,
+    ) -> SolveFailure {
+        SolveFailure::NotConverged {
+            iterations,
+            residual: norm / reference.max(Scalar::MIN_POSITIVE),
+            tolerance,
+        }
+    }
+}
+
 /// Scratch memory of the implicit step, kept between steps.
 #[derive(Debug, Default, Clone)]
 pub struct ImplicitScratch {
@@ -141,14 +158,14 @@ pub struct ImplicitScratch {
     x0: Vec<Vector>,
     v0: Vec<Vector>,
     cg: cg::CgScratch,
-    assembled: assembled::AssembledScratch,
+    direct: direct::DirectScratch,
 }
 
 impl ImplicitScratch {
     /// Forgets everything tied to the mesh (pattern, factorization). The warm
     /// start is simulation state, not scratch: its owner clears it.
     pub fn mesh_changed(&mut self) {
-        self.assembled.mesh_changed();
+        self.direct.mesh_changed();
     }
 }
 
@@ -174,7 +191,7 @@ pub fn backward_euler(
         s.v0.clear();
         s.v0.extend_from_slice(&w.v);
     }
-    assemble(st, model, w, h, false);
+    linearise(st, model, w, h, false);
     let s = &mut st.implicit;
     s.dv.clear();
     // A warm start of another mesh should have been cleared with that mesh.
@@ -227,7 +244,7 @@ fn newton(
     }
     let mut residual = Scalar::INFINITY;
     for k in 1..=settings.newton_iterations {
-        assemble(st, model, w, h, true);
+        linearise(st, model, w, h, true);
         residual = filtered_norm(&st.implicit, held) / reference.max(Scalar::MIN_POSITIVE);
         if residual <= settings.newton_tolerance || k == settings.newton_iterations {
             break;
@@ -316,7 +333,7 @@ fn linear_solve(
 ) -> Result<(), SolveFailure> {
     match model.solver.solver {
         Solver::Cg => cg::solve(st, model, held, reference, contact_push),
-        Solver::Direct => assembled::solve(st, model, held, reference, contact_push),
+        Solver::Direct => direct::solve(st, model, held, reference, contact_push),
     }
 }
 

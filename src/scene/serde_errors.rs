@@ -6,7 +6,8 @@ use super::error::{Issue, KeyPath, SceneErrorKind, Seg, dotted};
 use super::schema;
 use super::spans::path_at;
 
-/// Turns a serde error into an issue at the key its span points to.
+/// Turns a serde error into an issue at the key its span points to. Long because it
+/// is one branch per serde message form, read in one place.
 pub(crate) fn translate(canon: &str, e: &toml::de::Error) -> Issue {
     let mut path = match (DeTable::parse(canon), e.span()) {
         // The root's own span is empty: errors there are about the whole document.

@@ -1,4 +1,4 @@
-//! Allocations per step in the hot paths (issue 13, deliverable 5): after a
+//! Allocations per step in the hot paths: after a
 //! warm-up, stepping a scene whose mesh does not change must not touch the heap.
 //!
 //! A counting global allocator wraps the system one; each case builds a
@@ -160,19 +160,6 @@ struct Count {
     rollback_checked: bool,
 }
 
-/// Runs one case and prints its count; returns the number of allocations.
-fn case(label: &str, scene: &str, overrides: &[&str], warm: usize, steps: usize) -> Count {
-    let clock = std::time::Instant::now();
-    let c = allocations(scene, overrides, warm, steps);
-    println!("  ({:.1} s)", clock.elapsed().as_secs_f64());
-    println!(
-        "{label}: {} allocations ({} bytes) in {steps} steps after {warm} warm-up frames \
-         ({} vertices, {} at the start; {} obstacle contacts, {} self-collision pairs tested in the counted steps)",
-        c.allocations, c.bytes, c.vertices, c.base_vertices, c.contacts, c.self_pairs
-    );
-    c
-}
-
 /// What a case must exercise during its counted steps, so that it tests the
 /// path it names.
 #[derive(Clone, Copy)]
@@ -193,15 +180,14 @@ enum Exercises {
 
 /// One test so that the cases never overlap (the counter is global).
 ///
-/// Regression: `deterministic_sum` collected its chunk sums into a vector, so
-/// every step allocated (measured before the fix: sphere_push 600 allocations in
-/// 200 steps, crumple 300 in 100, flag 400 in 100, hanging_sheet 500 in 20).
+/// `deterministic_sum`, which runs several times a step, keeps its chunk sums on
+/// the stack; collecting them into a vector would allocate at every step.
 #[test]
 fn steps_of_an_unchanging_mesh_do_not_allocate() {
     TRACE.store(std::env::var_os("ALLOC_TRACE").is_some(), Ordering::Relaxed);
     let mut failures = Vec::new();
     let mut check = |label: &str, scene: &str, overrides: &[&str], warm, steps, what| {
-        let c = case(label, scene, overrides, warm, steps);
+        let c = allocations(scene, overrides, warm, steps);
         let covered = match what {
             Exercises::Stepping => true,
             Exercises::Contact => c.contacts > 0,
@@ -209,12 +195,17 @@ fn steps_of_an_unchanging_mesh_do_not_allocate() {
             Exercises::Refinement => c.vertices > c.base_vertices,
             Exercises::RollbackCheck => c.rollback_checked && c.vertices > c.base_vertices,
         };
+        let seen = format!(
+            "{} allocations ({} bytes) in {steps} steps after {warm} warm-up frames ({} \
+             vertices, {} at the start; {} obstacle contacts, {} self-collision pairs tested)",
+            c.allocations, c.bytes, c.vertices, c.base_vertices, c.contacts, c.self_pairs
+        );
         assert!(
             covered,
-            "{label}: the counted steps miss the path under test"
+            "{label}: the counted steps miss the path under test: {seen}"
         );
         if c.allocations != 0 {
-            failures.push(format!("{label}: {}", c.allocations));
+            failures.push(format!("{label}: {seen}"));
         }
     };
     // Obstacle contact and friction: the cloth lies on the sphere.
@@ -228,9 +219,8 @@ fn steps_of_an_unchanging_mesh_do_not_allocate() {
     );
     // Self-collision on the floor: boxes, BVH refit, candidate pairs, impulses.
     // 30 warm-up frames: the per-patch pair lists grow to their peak as the sheet
-    // crumples; after 15, the trajectory of the cost-weighing refactor rule had a
-    // patch's list first grow in the counted steps (5 allocations, 32 to 512 bytes,
-    // in `collect_pairs`: growth to a high-water mark, not a per-step allocation).
+    // crumples; after only 15, a patch's list can first grow in the counted steps
+    // (in `collect_pairs`: growth to a high-water mark, not a per-step allocation).
     check(
         "crumple, uniform, implicit (floor and self-collision)",
         "scenes/crumple.toml",
@@ -276,9 +266,9 @@ fn steps_of_an_unchanging_mesh_do_not_allocate() {
         100,
         Exercises::Refinement,
     );
-    // Paper A's rollback check after every step (issue 13: it measured the edge
-    // angles, and with the sizing rule the leaf curvatures, into new vectors
-    // and maps every step), on the implicit hanging sheet.
+    // Paper A's rollback check after every step (it measures the edge angles,
+    // and with the sizing rule the leaf curvatures, into reused buffers), on the
+    // implicit hanging sheet.
     check(
         "hanging_sheet, red-green with rollback (sizing rule), implicit",
         "scenes/hanging_sheet.toml",

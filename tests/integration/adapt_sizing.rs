@@ -1,4 +1,4 @@
-//! The sizing criterion (issue 14, `src/adapt/sizing.rs`): a flat sheet does
+//! The sizing criterion (`src/adapt/sizing.rs`): a flat sheet does
 //! not refine, a cylinder refines to the level the rule predicts, and a fold
 //! that passes over a region leaves it coarse again within a bounded number of
 //! passes. Shapes are prescribed from material coordinates before every pass
@@ -124,12 +124,11 @@ fn sizing_on_a_cylinder_refines_to_the_predicted_level() {
                 interior.iter().copied().min().unwrap_or(0),
                 interior.iter().copied().max().unwrap_or(0),
             );
-            println!(
-                "{pattern:?}, D0 / (budget R) = {r}: R = {radius:.4} m, {passes} passes, interior levels {lo}..={hi}, {} triangles",
-                m.triangles.len()
-            );
             assert_eq!((lo, hi), (predicted, predicted), "{pattern:?}, r = {r}");
-            assert!(m.levels.iter().all(|&l| l <= predicted));
+            assert!(
+                m.levels.iter().all(|&l| l <= predicted),
+                "{pattern:?}, r = {r}: R = {radius:.4} m, {passes} passes"
+            );
         }
     }
 }
@@ -214,26 +213,22 @@ fn sweep(criterion: AdaptCriterion) -> Sweep {
 
 #[test]
 fn a_passing_fold_leaves_the_region_coarse_again() {
-    let report = |name: &str, s: &Sweep| {
-        println!(
-            "{name}: region level {} under the fold; back within one level of the base {:?} passes after the fold's centre left it, {:?} after the fold left (3 sigma past); {} splits, {} merges",
-            s.peak, s.after_centre, s.after_left, s.splits, s.merges
-        )
-    };
     let sizing = sweep(AdaptCriterion::Sizing);
-    report("sizing", &sizing);
-    // For comparison only: the papers' criterion on the same sweep.
-    report("angle (papers)", &sweep(AdaptCriterion::Angle));
+    let seen = format!(
+        "region level {} under the fold; back within one level of the base {:?} passes after \
+         the fold's centre left it, {:?} after the fold left (3 sigma past); {} splits, {} merges",
+        sizing.peak, sizing.after_centre, sizing.after_left, sizing.splits, sizing.merges
+    );
     assert_eq!(
         sizing.peak, 4,
-        "the fold refines the region to the finest level"
+        "the fold refines the region to the finest level: {seen}"
     );
     // Two red levels to undo, one merge per level and pass, and a merge may
     // wait one pass for a finer neighbour to merge first: at most 4 passes.
     let after = sizing
         .after_left
-        .expect("the region coarsens after the fold has passed");
-    assert!(after <= 4, "coarse again after {after} passes");
+        .unwrap_or_else(|| panic!("the region coarsens after the fold has passed: {seen}"));
+    assert!(after <= 4, "coarse again after {after} passes: {seen}");
 }
 
 /// `refine_strain` (sizing.rs, "Strain jumps"): a sheet hanging from two point
@@ -290,17 +285,15 @@ fn strain_jumps_refine_the_mesh_at_point_pins() {
     let graded = corner_area(Some("0.02"));
     // Base cells are 1/8 m: a base triangle has 1/128 m^2, the finest (level 4,
     // two red splits) 1/2048 m^2.
-    println!(
-        "corner triangle areas: curvature only {coarse:?} m^2, with refine_strain 0.02 {graded:?} m^2"
-    );
     for k in 0..2 {
         assert!(
             graded[k] <= 1.0 / 2048.0 * 1.0001,
-            "corner {k}: not at the finest level"
+            "corner {k}: not at the finest level: areas {graded:?} m^2"
         );
         assert!(
             coarse[k] > graded[k],
-            "corner {k}: the strain term refines more"
+            "corner {k}: the strain term refines more: areas {graded:?} m^2 against \
+             {coarse:?} m^2 from curvature only"
         );
     }
 }
@@ -322,13 +315,6 @@ fn top_level_statistics_count_triangles_and_area() {
     let by_count = top.len() as Scalar / m.triangles.len() as Scalar;
     let by_area = top.iter().map(|&t| m.rest_area(t)).sum::<Scalar>() / m.total_rest_area();
     let s = ad.stats;
-    println!(
-        "fold at level 4: {} of {} triangles ({by_count:.3}), {by_area:.3} of the area; stats {:.3} / {:.3}",
-        top.len(),
-        m.triangles.len(),
-        s.top_level_fraction_final,
-        s.top_level_area_fraction_final
-    );
     assert!(!top.is_empty(), "the fold reaches the finest level");
     assert!((s.top_level_fraction_final - by_count).abs() < 1e-12);
     assert!((s.top_level_area_fraction_final - by_area).abs() < 1e-12);
@@ -371,12 +357,11 @@ fn a_sheet_at_rest_stops_remeshing() {
     )
     .expect("run");
     let a = summary.adapt.expect("adaptive");
-    println!(
-        "frames whose mesh changed: {changes} in 3 s, {late_changes} after 2 s; {} splits, {} merges, {} bounces, {} of {} passes changed the mesh",
-        a.splits, a.merges, a.bounces, a.changed_passes, a.passes
-    );
     assert!(a.bounces > 0, "the case bounces (else it tests nothing)");
-    assert_eq!(late_changes, 0, "the mesh still changes at rest");
+    assert_eq!(
+        late_changes, 0,
+        "the mesh still changes at rest ({changes} frames changed it in 3 s): {a:?}"
+    );
 }
 
 /// `refine_obstacle` (`src/adapt/proximity.rs`): a flat sheet leaning over a
@@ -420,37 +405,27 @@ fn an_edge_leaning_towards_an_obstacle_refines_near_it_only() {
     let mut ad = Adapter::new(&config, &w, DENSITY).expect("the adapter starts");
     settle(&mut w, &mut ad, &config, &leaning(0.0));
     let (near, far) = (max_level_in(&w, -0.5, -0.45), max_level_in(&w, -0.25, 0.5));
-    println!(
-        "leaning 1 cm above the plane: level {near} within 5 cm of the low edge, {far} from 25 cm on; {} splits, {} triangles",
-        ad.stats.splits,
-        w.mesh.triangles.len()
-    );
     // Base edges 1/8 m lean 2.5 cm over the first column (1 cm high): split
     // twice; from 0.25 m on the sheet is over 6 cm high and stays at the base.
-    assert_eq!((near, far), (4, 0));
+    assert_eq!((near, far), (4, 0), "{:?}", ad.stats);
     settle(&mut w, &mut ad, &config, &leaning(1.0));
     let lifted = w.mesh.levels.iter().copied().max().unwrap_or(0);
-    println!(
-        "lifted 1 m: finest level {lifted}, {} merges",
-        ad.stats.merges
+    assert_eq!(
+        lifted, 0,
+        "coarse again away from the plane: {:?}",
+        ad.stats
     );
-    assert_eq!(lifted, 0, "coarse again away from the plane");
 
     let mut w = flat_world(8, DiagonalPattern::Alternating);
     let mut ad = Adapter::new(&config, &w, DENSITY).expect("the adapter starts");
     settle(&mut w, &mut ad, &config, &|p: Vector2| p.extend(0.01));
-    println!("parallel 1 cm above the plane: {} splits", ad.stats.splits);
-    assert_eq!(ad.stats.splits, 0);
+    assert_eq!(ad.stats.splits, 0, "parallel 1 cm above the plane");
 
     let mut w = flat_world(8, DiagonalPattern::Alternating);
     let cfg = sizing(15.0, 4);
     let mut ad = Adapter::new(&cfg, &w, DENSITY).expect("the adapter starts");
     settle(&mut w, &mut ad, &cfg, &leaning(0.0));
-    println!(
-        "leaning, without refine_obstacle: {} splits",
-        ad.stats.splits
-    );
-    assert_eq!(ad.stats.splits, 0);
+    assert_eq!(ad.stats.splits, 0, "leaning, without refine_obstacle");
 }
 
 /// The obstacle term in a run: `drape_sphere` at base 8, 0.3 s after the drop
@@ -488,10 +463,10 @@ fn a_sheet_falling_onto_a_ball_is_refined_before_it_lands() {
     };
     let (plain, plain_contacts) = run(None);
     let (refined, contacts) = run(Some("0.5"));
-    println!(
-        "vertices at 0.3 s: {plain} without the obstacle term, {refined} with refine_obstacle = 0.5 (mean contacts {plain_contacts}, {contacts})"
-    );
     assert_eq!(plain, 81, "the falling sheet stays at its base mesh");
-    assert!(refined > plain, "refined ahead of the contact");
+    assert!(
+        refined > plain,
+        "refined ahead of the contact: {refined} vertices"
+    );
     assert_eq!((plain_contacts, contacts), (0.0, 0.0), "not yet landed");
 }

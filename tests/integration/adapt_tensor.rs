@@ -73,16 +73,8 @@ fn a_sheet_bent_along_u_is_halved_along_u_only() {
     let old_x = w.x.clone();
     assert!(ad.remesh(&cfg, &mut w, 0).unwrap(), "the bend refines");
     let (u1, v1) = ad.tensor_grid().expect("tensor").lines();
-    println!(
-        "u-lines {} -> {}: {:?}; v-lines {} -> {}",
-        u0.len(),
-        u1.len(),
-        u1,
-        v0.len(),
-        v1.len()
-    );
     assert_eq!(v1, v0, "a bend along u does not halve rows");
-    assert!(u1.len() > u0.len());
+    assert!(u1.len() > u0.len(), "u-lines {} -> {}", u0.len(), u1.len());
     let added: Vec<Scalar> = u1.iter().copied().filter(|u| !u0.contains(u)).collect();
     // Flat for u <= 0: the only columns there that may split are the one at
     // the crease and its neighbour (the one-halving rule).
@@ -93,7 +85,6 @@ fn a_sheet_bent_along_u_is_halved_along_u_only() {
         let s = on_surface(&old, &old_x, *p).expect("inside the sheet");
         worst = worst.max((s - w.x[i]).length());
     }
-    println!("largest distance of a vertex from the old surface: {worst:.3e} m");
     assert!(worst < 1e-12, "{worst:e}");
     check_consistency(&w, DENSITY, 0.5, 3.0).unwrap();
     ad.check(&w).unwrap();
@@ -124,7 +115,6 @@ fn cell_centres_lie_on_the_old_diagonal() {
             .enumerate()
             .map(|(i, p)| (on_surface(&old, &old_x, *p).unwrap() - w.x[i]).length())
             .fold(0.0, Scalar::max);
-        println!("{pattern:?}: largest distance from the old surface {worst:.3e} m");
         assert!(worst < 1e-12, "{pattern:?}: {worst:e}");
     }
 }
@@ -178,8 +168,10 @@ fn a_flattened_sheet_returns_to_the_base_grid() {
                 "{criterion:?}: still coarsening after 3 passes"
             );
         }
-        println!("{criterion:?}: {refined} vertices bent, base grid again after {passes} passes");
-        assert!(refined > base.vertex_count());
+        assert!(
+            refined > base.vertex_count(),
+            "{criterion:?}: {refined} vertices bent"
+        );
         assert_eq!(w.mesh.material, base.material);
         assert_eq!(w.mesh.triangles, base.triangles);
         let stats = ad.stats;
@@ -209,7 +201,6 @@ fn neighbouring_columns_differ_by_one_halving() {
         ad.check(&w).expect("consistent after the pass");
         let (u, _) = ad.tensor_grid().unwrap().lines();
         let widths: Vec<Scalar> = u.windows(2).map(|p| p[1] - p[0]).collect();
-        println!("pass {step}, crease at {at}: column widths {widths:?}");
         for p in widths.windows(2) {
             let r = p[0].max(p[1]) / p[0].min(p[1]);
             assert!(r < 2.0 + 1e-9, "pass {step}: neighbouring widths {p:?}");
@@ -220,8 +211,7 @@ fn neighbouring_columns_differ_by_one_halving() {
         u.windows(2).any(|p| p[1] - p[0] < 0.25 / 16.0 + 1e-12),
         "refined to level 8"
     );
-    println!("forced splits: {}", ad.stats.closure_splits);
-    assert!(ad.stats.closure_splits > 0);
+    assert!(ad.stats.closure_splits > 0, "{:?}", ad.stats);
 }
 
 /// The method needs a rectangle's grid, an even `max_level`, and no rollback,
@@ -243,14 +233,14 @@ stretch = 200.0
 method = "tensor"
 "#;
     let e = load_scene_str(base, "t.toml", &[]).expect_err("a disk");
-    println!("{e}");
     assert_eq!(
         (e.kind, e.key.as_deref(), e.line),
         (
             SceneErrorKind::NotApplicable,
             Some("adapt.method"),
             Some(12)
-        )
+        ),
+        "{e}"
     );
     let rect = base.replace(
         "shape = \"disk\"\nradius = 0.5",
@@ -288,17 +278,16 @@ method = "tensor"
             key
         };
         let e = load_scene_str(&rect, "t.toml", &sets).expect_err(set);
-        println!("{e}");
         assert_eq!((e.kind, e.key.as_deref()), (kind, Some(key)), "{e}");
     }
     let disk = mesh::disk(0.5, 8).unwrap();
     let x = disk.material.iter().map(|p| p.extend(0.0)).collect();
     let cfg = tensor_config(5.0, 4);
     let e = Adapter::new(&cfg, &World::new(disk, x), DENSITY).expect_err("not a grid");
-    println!("{e}");
     assert!(
         e.to_string()
-            .contains("needs the grid of a generated rectangle")
+            .contains("needs the grid of a generated rectangle"),
+        "{e}"
     );
 }
 
@@ -352,11 +341,7 @@ fn a_flat_sheet_distorted_in_its_plane_does_not_refine() {
     let cfg = tensor_config(2.0, 4);
     let mut ad = Adapter::new(&cfg, &w, DENSITY).expect("a grid");
     let changed = ad.remesh(&cfg, &mut w, 0).unwrap();
-    println!(
-        "in-plane distortion: changed {changed}, splits {}",
-        ad.stats.splits
-    );
-    assert!(!changed);
+    assert!(!changed, "in-plane distortion refined: {:?}", ad.stats);
     // The same sheet rolled out of its plane refines.
     let rolled = |p: Vector2| {
         let q = swirl(p);
@@ -407,22 +392,17 @@ fn pins_min_edge_and_events() {
     }
     let (u, _) = ad.tensor_grid().unwrap().lines();
     let narrowest = u.windows(2).map(|p| p[1] - p[0]).fold(1.0, Scalar::min);
-    println!("{} u-lines, narrowest column {narrowest} m", u.len());
     assert!((0.05 - 1e-12..0.1).contains(&narrowest), "{narrowest}");
     let events = ad.take_events();
     let asked: Vec<_> = events
         .iter()
         .filter(|e| e.kind == drape::adapt::EventKind::Split)
         .collect();
-    println!(
-        "{} split events, {} forced; levels {:?}",
-        asked.len(),
-        ad.stats.closure_splits,
-        asked.iter().map(|e| e.level).collect::<Vec<_>>()
-    );
     assert_eq!(
         asked.len() as u64 + ad.stats.closure_splits,
-        ad.stats.splits
+        ad.stats.splits,
+        "split events at levels {:?}",
+        asked.iter().map(|e| e.level).collect::<Vec<_>>()
     );
     assert_eq!(
         ad.stats.splits as usize,

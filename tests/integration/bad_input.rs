@@ -601,8 +601,10 @@ fn a_measurement_the_built_cloth_cannot_give_stops_the_run_before_it_starts() {
             &mut |_| {},
         )
         .expect_err("refused");
-        println!("{file}: {e}");
-        assert!(matches!(e, drape::run::RunError::Measurement { .. }), "{e}");
-        assert!(e.to_string().contains(needle), "{e}");
+        assert!(
+            matches!(e, drape::run::RunError::Measurement { .. }),
+            "{file}: {e}"
+        );
+        assert!(e.to_string().contains(needle), "{file}: {e}");
     }
 }

@@ -345,8 +345,7 @@ fn thread_count_does_not_change_the_result() {
         // As printed in the JSON: the shortest round-trip decimal, so equal text is equal bits.
         finals.push((s["energy"]["final"].to_string(), s["steps"].clone()));
     }
-    println!("energy.final with 1 and 2 threads: {finals:?}");
-    assert_eq!(finals[0], finals[1]);
+    assert_eq!(finals[0], finals[1], "energy.final with 1 and 2 threads");
     // A zero thread count is refused by the parser.
     let out = drape(&["run", "--threads", "0", "--no-record"], &dir);
     assert_eq!(out.status.code(), Some(2));
@@ -457,11 +456,9 @@ fn unwritable_out_fails_before_simulating() {
         .stderr(Stdio::piped())
         .spawn()
         .expect("spawn drape");
-    let started = Instant::now();
     let out = wait_at_most(child, Duration::from_secs(20));
     let err = stderr(&out);
-    println!("failed after {:?}: {err}", started.elapsed());
-    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(err.starts_with("error: "), "{err}");
     assert!(err.contains("/nonexistent-dir/x.rrd"), "{err}");
     assert_eq!(err.trim_end().lines().count(), 1, "one line: {err}");

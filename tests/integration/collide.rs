@@ -1,4 +1,4 @@
-//! Collisions (issue 4's required tests): resting contact on a plane and a sphere, no
+//! Collisions: resting contact on a plane and a sphere, no
 //! tunneling at 20 m/s through a 5 mm box for each integrator, Coulomb friction on an
 //! incline, self-collision after crumpling, Volino culling, determinism.
 
@@ -124,17 +124,17 @@ fn sheet_rests_on_a_plane_and_on_a_sphere_without_sinking() {
             worst = worst.min(d);
         }
         let ke = sim.kinetic();
-        println!(
-            "rest on {}: closest vertex {worst:.6} m from the surface (thickness {THICK}), kinetic energy after 2 s {ke:.3e} J, {:.0} contacts/step",
-            obstacle.lines().next().unwrap_or(""),
-            sim.state.ledger.collision.mean_contacts()
-        );
         assert!(
             worst >= THICK * (1.0 - 1e-6),
             "a vertex came {worst} m from the surface"
         );
         assert!(ke < 1e-5, "kinetic energy {ke} J: not at rest");
-        assert_eq!(sim.state.ledger.collision.max_penetration, 0.0);
+        assert_eq!(
+            sim.state.ledger.collision.max_penetration,
+            0.0,
+            "rest on {}",
+            obstacle.lines().next().unwrap_or("")
+        );
     }
 }
 
@@ -177,13 +177,9 @@ fn a_20_m_per_s_sheet_does_not_tunnel_through_a_5_mm_box() {
                 .fold(Scalar::INFINITY, Scalar::min);
             lowest = lowest.min(z);
         }
-        println!(
-            "20 m/s onto a 5 mm box, {integrator}, dt {dt}: lowest vertex {lowest:.6} m, box top {box_top} m, {} steps",
-            steps
-        );
         assert!(
             lowest >= box_top + THICK * (1.0 - 1e-6),
-            "{integrator}: a vertex reached z = {lowest}"
+            "{integrator}: a vertex reached z = {lowest} (box top {box_top} m, dt {dt}, {steps} steps)"
         );
     }
 }
@@ -218,7 +214,6 @@ fn coulomb_friction_holds_below_and_slides_above_the_friction_angle() {
     let g = 9.81;
     // Static: tan(20 deg) = 0.364 < 0.5.
     let (v, moved) = incline(20.0, 0.5, 0.4, 1.0);
-    println!("incline 20 deg, mu_s 0.5: speed {v:.3e} m/s, moved {moved:.3e} m after 1 s");
     assert!(
         moved < 1e-6 && v.abs() < 1e-6,
         "slipped: {moved} m, {v} m/s"
@@ -230,9 +225,6 @@ fn coulomb_friction_holds_below_and_slides_above_the_friction_angle() {
     let expected = g * (a.sin() - mu_k * a.cos());
     let measured = v / t;
     let rel = (measured - expected).abs() / expected;
-    println!(
-        "incline 30 deg, mu_s 0.3, mu_k 0.2: acceleration {measured:.4} m/s^2, g (sin a - mu_k cos a) = {expected:.4}, relative error {rel:.2e}"
-    );
     assert!(rel < 0.05, "acceleration {measured}, expected {expected}");
 }
 
@@ -249,11 +241,7 @@ fn a_moving_box_carries_the_sheet_by_friction() {
         sim.step(1e-3);
     }
     let v = sim.com_velocity();
-    println!(
-        "sheet on a box moving at 0.2 m/s: sheet velocity {:?} m/s after 0.5 s",
-        v.to_array()
-    );
-    assert!((v.x - 0.2).abs() < 1e-3, "{v:?}");
+    assert!((v.x - 0.2).abs() < 1e-3, "sheet velocity {v:?} m/s");
 }
 
 /// Orientation of `d` against the plane through `a`, `b`, `c` (6 times the signed volume).
@@ -322,15 +310,6 @@ fn crumpled_sheet_does_not_intersect_itself() {
         sim.step(h);
     }
     let bad = intersecting_pairs(&sim.state.world.mesh.triangles, &sim.state.world.x);
-    let st = &sim.state.ledger.collision;
-    println!(
-        "crumple (24, 1.2 s): {} intersecting non-adjacent triangle pairs of {} triangles; {:.0} pairs tested/step, culled fraction {:.3}, kinetic energy {:.3e} J",
-        bad.len(),
-        sim.state.world.mesh.triangles.len(),
-        st.mean_self_pairs_tested(),
-        st.self_culled_fraction(),
-        sim.kinetic()
-    );
     assert!(bad.is_empty(), "intersecting pairs: {bad:?}");
 }
 
@@ -356,15 +335,16 @@ fn volino_culling_removes_most_pair_tests_on_a_gently_curved_sheet() {
     for _ in 0..200 {
         plain.step(1e-3);
     }
-    println!(
-        "Volino culling on a gently curved sheet: culled fraction {:.3}; {:.0} triangle pairs tested/step with culling, {:.0} without",
-        st.self_culled_fraction(),
+    assert!(
+        st.self_culled_fraction() > 0.5,
+        "culled fraction {}",
+        st.self_culled_fraction()
+    );
+    assert!(
+        st.mean_self_pairs_tested() < 0.5 * plain.state.ledger.collision.mean_self_pairs_tested(),
+        "{} triangle pairs tested a step with culling, {} without",
         st.mean_self_pairs_tested(),
         plain.state.ledger.collision.mean_self_pairs_tested()
-    );
-    assert!(st.self_culled_fraction() > 0.5);
-    assert!(
-        st.mean_self_pairs_tested() < 0.5 * plain.state.ledger.collision.mean_self_pairs_tested()
     );
 }
 
@@ -408,7 +388,6 @@ fn a_broken_obstacle_obj_is_a_clear_error() {
         &format!("[[obstacle]]\nshape = \"mesh\"\npath = \"{garbage}\""),
     );
     let e = drape::collide::Obstacles::from_scene(&s).expect_err("garbage OBJ");
-    println!("{e}");
     assert!(e.to_string().contains("garbage.obj"), "{e}");
     let missing = load_scene_str(
         "name = \"t\"\n[simulation]\nduration = 1.0\n[cloth]\nshape = \"disk\"\nradius = 0.1\nresolution = 4\n[material]\ndensity = 0.1\nstretch = 1.0\n[[obstacle]]\nshape = \"box\"\nradius = 0.5\n",
@@ -416,9 +395,12 @@ fn a_broken_obstacle_obj_is_a_clear_error() {
         &[],
     )
     .expect_err("radius on a box");
-    println!("{missing}");
-    assert_eq!(missing.line, Some(13));
-    assert_eq!(missing.key.as_deref(), Some("obstacle.0.radius"));
+    assert_eq!(missing.line, Some(13), "{missing}");
+    assert_eq!(
+        missing.key.as_deref(),
+        Some("obstacle.0.radius"),
+        "{missing}"
+    );
 }
 
 /// Regression: the implicit solve did not know about resting contact, so with 4 ms
@@ -467,9 +449,6 @@ friction_kinetic = 0.4
             a.distance(b) / mesh.rest_length(e) - 1.0
         })
         .fold(0.0, Scalar::max);
-    println!(
-        "table edge, 4 ms implicit steps: energy {e0:.5} -> max {e_max:.5} J, largest strain {max_strain:.3}"
-    );
     // Drag only removes energy, so the total never rises (1e-3 relative allowance
     // for the solver tolerance).
     assert!(

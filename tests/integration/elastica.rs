@@ -1,4 +1,4 @@
-//! Bending against the textile cantilever (issue 12): a strip clamped flat and
+//! Bending against the textile cantilever: a strip clamped flat and
 //! overhanging under its own weight, solved to static equilibrium with the
 //! library's forces (`statics.rs`) and compared with
 //! * beam theory, tip deflection `rho g L^4 / (8 B)` for small deflection, and
@@ -228,14 +228,9 @@ fn settle_tensor(
         .fold(Scalar::INFINITY, Scalar::min);
     let at_finest = u.windows(2).filter(|p| p[1] - p[0] < 1.5 * finest).count();
     let uniform = overhang / (4 * res) as Scalar;
-    println!(
-        "tensor strip: {} columns, {at_finest} at the finest width {finest:.4e} m (uniform {}: {uniform:.4e} m)",
-        u.len() - 1,
-        4 * res
-    );
     assert!(
         (finest - uniform).abs() < 1e-9 * overhang,
-        "finest {finest}"
+        "finest {finest} m, uniform {uniform} m ({at_finest} columns at the finest)"
     );
     settled
 }
@@ -259,14 +254,13 @@ fn heavy_elastica_reference() {
     // Small load: beam theory's lambda / 8; overhang of twice the bending length:
     // Peirce's 41.5 deg.
     let (drop, _) = heavy_elastica(1e-4);
-    println!(
-        "elastica lambda 1e-4: drop/L {drop:.6e}, beam theory {:.6e}",
+    assert!(
+        (drop / (1e-4 / 8.0) - 1.0).abs() < 1e-6,
+        "drop/L {drop:e}, beam theory {:e}",
         1e-4 / 8.0
     );
-    assert!((drop / (1e-4 / 8.0) - 1.0).abs() < 1e-6);
     let (drop, reach) = heavy_elastica(8.0);
     let angle = drop.atan2(reach).to_degrees();
-    println!("elastica L = 2c: drop/L {drop:.8}, reach/L {reach:.8}, chord angle {angle:.5} deg");
     assert!((angle - 41.5).abs() < 0.1, "chord angle {angle}");
     // Refining the integration does not move it: the reference is converged.
     assert!(heavy_elastica(8.0).0 == drop);
@@ -277,20 +271,16 @@ fn heavy_elastica_reference() {
 fn check_chord(resolutions: &[Option<u32>]) -> Vec<String> {
     let mut failures = Vec::new();
     for &res in resolutions {
-        let t0 = std::time::Instant::now();
         let (angle, exact, s) = large(BendingModel::ShapeOperator, StiffnessRule::Consistent, res);
         let err = angle - exact;
         let label = res.map_or("adaptive".to_string(), |r| format!("res {r}"));
-        println!(
-            "shape_operator {label:>9}: chord angle {angle:.3} deg, elastica {exact:.3} deg, error {err:+.3} deg ({} vertices, {} Newton iterations, residual {:.1e} N, {:.2} s)",
-            s.vertices,
-            s.newton,
-            s.residual,
-            t0.elapsed().as_secs_f64()
-        );
         let allowed = if res == Some(8) { 3.0 } else { 1.5 };
         if err.is_nan() || err.abs() >= allowed {
-            failures.push(format!("{label}: error {err:+.3} deg"));
+            failures.push(format!(
+                "{label}: chord angle {angle:.3} deg, elastica {exact:.3} deg, error {err:+.3} deg \
+                 ({} vertices, {} Newton iterations, residual {:.1e} N)",
+                s.vertices, s.newton, s.residual
+            ));
         }
     }
     failures
@@ -298,7 +288,6 @@ fn check_chord(resolutions: &[Option<u32>]) -> Vec<String> {
 
 /// Tip deflection against beam theory and the elastica at resolution `res`.
 fn check_tip(res: u32) -> Option<String> {
-    let t0 = std::time::Instant::now();
     let bending: Scalar = 1e-3;
     let overhang: Scalar = 0.05;
     let beam = RHO * G * overhang.powi(4) / (8.0 * bending);
@@ -311,14 +300,14 @@ fn check_tip(res: u32) -> Option<String> {
     );
     let s = settle(overhang, res, &mat);
     let ratio = s.drop / beam;
-    println!(
-        "shape_operator res {res:2}: tip drop {:.6e} m = {ratio:.4} x beam theory {beam:.6e} m, {:.4} x elastica {exact:.6e} m ({:.2} s)",
-        s.drop,
-        s.drop / exact,
-        t0.elapsed().as_secs_f64()
-    );
     let off = (s.drop / exact - 1.0).abs();
-    (off.is_nan() || off >= 0.03).then(|| format!("res {res}: {ratio:.4}"))
+    (off.is_nan() || off >= 0.03).then(|| {
+        format!(
+            "res {res}: tip drop {:e} m = {ratio:.4} x beam theory, {:.4} x elastica",
+            s.drop,
+            s.drop / exact
+        )
+    })
 }
 
 #[test]
@@ -404,18 +393,8 @@ fn large_strip() -> (Scalar, MaterialParams, Scalar) {
 fn a_strip_one_cell_wide_bends_like_one_with_square_cells() {
     let (c, mat, exact) = large_strip();
     let square = settle(2.0 * c, 32, &mat);
-    println!(
-        "square cells: chord angle {:.4} deg ({} vertices), elastica {exact:.4} deg",
-        square.chord_deg, square.vertices
-    );
     for across in [2, 1] {
         let s = settle_across(2.0 * c, 32, across, &mat);
-        println!(
-            "{across} across: chord angle {:.4} deg ({} vertices), {:+.2e} deg from square cells",
-            s.chord_deg,
-            s.vertices,
-            s.chord_deg - square.chord_deg
-        );
         assert!(s.vertices < square.vertices / 2, "{} vertices", s.vertices);
         assert!(
             (s.chord_deg - square.chord_deg).abs() < 1e-3,
@@ -441,31 +420,22 @@ fn a_tensor_refined_strip_bends_like_the_uniform_one() {
     let uniform = settle_across(2.0 * c, 32, 1, &mat);
     let base = settle_across(2.0 * c, 8, 1, &mat);
     let tensor = settle_tensor(2.0 * c, 8, 1.0, &mat);
-    for (name, s) in [
-        ("base 8", &base),
-        ("uniform 32", &uniform),
-        ("tensor 8 L4 r1", &tensor),
-    ] {
-        println!(
-            "{name} across 1: chord angle {:.4} deg ({:+.4} from the elastica {exact:.4}), {} vertices",
-            s.chord_deg,
-            s.chord_deg - exact,
-            s.vertices
-        );
-    }
     assert!(
         tensor.vertices < uniform.vertices,
-        "{} vertices",
-        tensor.vertices
+        "{} vertices against uniform 32's {}",
+        tensor.vertices,
+        uniform.vertices
     );
     let off = (tensor.chord_deg - uniform.chord_deg).abs();
     assert!(
         off < 0.1 * (base.chord_deg - uniform.chord_deg).abs(),
-        "{off} deg from uniform 32"
+        "{off} deg from uniform 32 ({:.4} deg; base {:.4} deg)",
+        uniform.chord_deg,
+        base.chord_deg
     );
     assert!(
         (tensor.chord_deg - exact).abs() < 0.1,
-        "{:.4} deg",
+        "{:.4} deg, elastica {exact:.4} deg",
         tensor.chord_deg
     );
 }
@@ -544,23 +514,20 @@ fn irregular_strip(
 /// of the vertices sit on the regular outline. Using the transitions' exact
 /// operator (`P`) on every interior triangle was tried and overshoots the
 /// other way: +0.63 to +0.66 deg at a quarter cell, +0.91 / +0.92 at 64
-/// along, +3.5 / +5.1 with 2 cells across (`docs/speed-vs-error-history.md`,
-/// "Bending on irregular triangles"). The test fails if the error grows, or
+/// along, +3.5 / +5.1 with 2 cells across. The test fails if the error grows, or
 /// if a fix removes it (then the bands and the docs should say so).
 #[test]
 fn an_irregular_strip_bends_stiffer_than_the_elastica() {
     let (c, mat, exact) = large_strip();
-    println!("elastica {exact:.4} deg (the regular grid: the test above)");
     for (shift, jitter, seed, lo, hi) in [(0.5, 0.0, 1, -0.8, -0.4), (0.0, 0.25, 1, -1.5, -0.9)] {
         let m = irregular_strip(2.0 * c, 32, 8, shift, jitter, seed);
         let mut x: Vec<Vector> = m.material.iter().map(|p| p.extend(0.0)).collect();
         let s = settle_on(&m, &mut x, &mat, 2.0 * c);
         let off = s.chord_deg - exact;
-        println!(
-            "shift {shift} jitter {jitter} seed {seed}: chord angle {:.4} deg ({off:+.3} from the elastica), {} vertices",
-            s.chord_deg, s.vertices
-        );
         assert!(s.residual < 1e-9, "not settled: {:.1e} N", s.residual);
-        assert!((lo..hi).contains(&off), "{off:+.3} deg outside {lo}..{hi}");
+        assert!(
+            (lo..hi).contains(&off),
+            "shift {shift} jitter {jitter}: {off:+.3} deg from the elastica {exact:.4}, outside {lo}..{hi}"
+        );
     }
 }

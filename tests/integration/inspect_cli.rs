@@ -81,8 +81,7 @@ fn inspect_prints_the_overview_and_a_frame() {
     let p = path.to_str().expect("utf-8");
     let out = drape(&["inspect", p]);
     let s = text(&out.stdout);
-    println!("{s}{}", text(&out.stderr));
-    assert_eq!(out.status.code(), Some(0));
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
     let id = drape::record::recording_id("known");
     for want in [
         "complete (stream footer present)".to_owned(),
@@ -94,7 +93,7 @@ fn inspect_prints_the_overview_and_a_frame() {
         "events: 3 (merge 1, rollback 1, split 1)".to_owned(),
         "frames with the most events: 1 (2), 2 (1)".to_owned(),
     ] {
-        assert!(s.contains(&want), "missing {want:?}");
+        assert!(s.contains(&want), "missing {want:?} in:\n{s}");
     }
     let rows = |entity: &str| {
         s.lines()
@@ -110,8 +109,7 @@ fn inspect_prints_the_overview_and_a_frame() {
 
     let out = drape(&["inspect", p, "--frame", "1"]);
     let s = text(&out.stdout);
-    println!("{s}");
-    assert_eq!(out.status.code(), Some(0));
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
     for want in [
         "frame 1, sim_time 0.5000 s",
         "mesh: 2 triangles, 4 vertices (topology as last logged)",
@@ -122,12 +120,12 @@ fn inspect_prints_the_overview_and_a_frame() {
         "  split after step 3: level 1, angle 20.00 deg, at (0.500, 0.500, 0.000) m",
         "  merge after step 4: level 0",
     ] {
-        assert!(s.contains(want), "missing {want:?}");
+        assert!(s.contains(want), "missing {want:?} in:\n{s}");
     }
 
     let out = drape(&["inspect", p, "--frame", "9"]);
     let err = text(&out.stderr);
-    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(
         err.contains("frame 9 is not in the recording (it holds frames 0 to 2)"),
         "{err}"
@@ -174,8 +172,7 @@ fn inspect_frames_prints_a_line_per_frame_and_the_stepping_total() {
     let p = path.to_str().expect("utf-8");
     let out = drape(&["inspect", p, "--frames"]);
     let s = text(&out.stdout);
-    println!("{s}{}", text(&out.stderr));
-    assert_eq!(out.status.code(), Some(0));
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
     let rows: Vec<Vec<&str>> = s.lines().map(|l| l.split_whitespace().collect()).collect();
     assert_eq!(
         rows[0],
@@ -242,7 +239,6 @@ fn inspect_into_a_closed_pipe_ends_quietly() {
         drop(child.stdout.take());
         let out = child.wait_with_output().expect("wait for drape");
         let err = text(&out.stderr);
-        println!("{args:?}: exit {:?}, stderr {err:?}", out.status.code());
         assert_eq!(out.status.code(), Some(0), "{err}");
         assert!(!err.contains("panicked"), "{err}");
     }
@@ -253,8 +249,7 @@ fn inspect_into_a_closed_pipe_ends_quietly() {
 fn inspect_refuses_missing_and_non_rrd_files() {
     let out = drape(&["inspect", "/nonexistent-dir/x.rrd"]);
     let err = text(&out.stderr);
-    println!("{err}");
-    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(
         err.starts_with("error: cannot read /nonexistent-dir/x.rrd"),
         "{err}"
@@ -263,8 +258,7 @@ fn inspect_refuses_missing_and_non_rrd_files() {
     let toml = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/flag.toml");
     let out = drape(&["inspect", toml.to_str().expect("utf-8")]);
     let err = text(&out.stderr);
-    println!("{err}");
-    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(err.contains("is not a Rerun .rrd recording"), "{err}");
     assert_eq!(err.trim_end().lines().count(), 1, "{err}");
 }
@@ -292,8 +286,7 @@ fn live_viewer_errors_come_before_simulating() {
     };
     let out = run(&["--spawn"], dir.to_str().expect("utf-8"));
     let err = text(&out.stderr);
-    println!("{err}");
-    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(
         err.contains("--spawn needs the Rerun viewer 0.36.3 as `rerun` on PATH"),
         "{err}"
@@ -301,8 +294,7 @@ fn live_viewer_errors_come_before_simulating() {
 
     let out = run(&["--connect", "not a url"], "/usr/bin:/bin");
     let err = text(&out.stderr);
-    println!("{err}");
-    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(err.contains("not a url"), "{err}");
     assert!(err.contains("rerun+http://127.0.0.1:9876/proxy"), "{err}");
     std::fs::remove_dir_all(&dir).ok();

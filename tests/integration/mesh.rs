@@ -32,7 +32,6 @@ fn temp_dir(name: &str) -> PathBuf {
 /// Loads a fixture that must be refused; returns the error.
 fn refused(name: &str) -> ObjError {
     let err = mesh::load_obj(&data(name), 1.0).expect_err(name);
-    println!("{name}: {err}");
     assert!(
         err.to_string().contains(name),
         "the message names the file: {err}"
@@ -194,7 +193,6 @@ fn missing_garbage_and_empty_obj_files_are_read_errors_naming_the_file() {
     let empty = dir.join("empty.obj");
     std::fs::write(&empty, "# nothing here\n").unwrap();
     let err = mesh::load_obj(&empty, 1.0).expect_err("an empty OBJ has no cloth");
-    println!("empty.obj: {err}");
     assert!(err.to_string().contains("empty.obj"), "{err}");
     std::fs::remove_dir_all(&dir).ok();
 }
@@ -350,7 +348,6 @@ fn check_obj_scene(fixture: &str) -> (Option<i32>, String, String) {
     std::fs::remove_dir_all(&dir).ok();
     let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
     let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
-    println!("{fixture}: exit {:?}\n{stdout}{stderr}", out.status.code());
     (out.status.code(), stdout, stderr)
 }
 
@@ -501,10 +498,6 @@ fn disk_triangles_have_no_angle_below_30_degrees() {
             worst = (smallest, res);
         }
     }
-    println!(
-        "disk res 4..=32: smallest angle {:.15} deg (res {})",
-        worst.0, worst.1
-    );
     assert!(
         worst.0 > 30.0 - 1e-9,
         "smallest angle {} deg at res {}",

@@ -66,7 +66,6 @@ fn a_rigid_offset_gives_exactly_that_offset() {
     );
     // All of it is offset: nothing is left once the translation is taken out.
     let offset = relative_offset(&b, &a, diag);
-    println!("rigid 5 cm shift: error {err:.6e}, offset {offset:.6e}");
     assert!((offset - err).abs() < 1e-14, "{offset} vs {err}");
 }
 
@@ -89,7 +88,6 @@ fn the_offset_is_the_translation_part_of_the_error() {
     let shape = relative_rms(&b, &a, diag);
     let mean_z = b.iter().zip(&a).map(|(p, q)| p.z - q.z).sum::<Scalar>() / a.len() as Scalar;
     let offset = relative_offset(&b, &a, diag);
-    println!("deeper wave: error {shape:.6e}, offset {offset:.3e} (mean z {mean_z:.3e} m)");
     assert!(shape > 1e-3, "the wave changed: {shape}");
     assert!((offset - mean_z.abs() / diag).abs() < 1e-15);
     assert!(offset < 1e-3 * shape, "{offset} vs {shape}");
@@ -98,7 +96,6 @@ fn the_offset_is_the_translation_part_of_the_error() {
     let total = relative_rms(&c, &a, diag);
     let moved = relative_offset(&c, &a, diag);
     let expected = (mean_z + 0.02).abs() / diag;
-    println!("deeper wave raised 2 cm: error {total:.6e}, offset {moved:.6e}");
     assert!((moved - expected).abs() < 1e-14, "{moved} vs {expected}");
     let rest = (total * total - moved * moved).sqrt();
     assert!(

@@ -170,15 +170,20 @@ fn three_frames_decode_to_three_mesh_rows() {
     assert_eq!(&bytes[bytes.len() - 12..bytes.len() - 4], b"RRF2FOOT");
 
     let d = decode(&path);
-    println!("three frames: {size} bytes, rows {:?}", d.rows);
-    println!(
-        "mesh timelines {:?}, blueprint messages {}",
-        d.mesh_timelines, d.blueprint_msgs
+    assert_eq!(d.rows.get("/cloth/mesh"), Some(&3), "rows {:?}", d.rows);
+    assert_eq!(d.rows.get("/cloth/pins"), Some(&3), "rows {:?}", d.rows);
+    assert_eq!(
+        d.rows.get("/plots/energy/kinetic"),
+        Some(&3),
+        "rows {:?}",
+        d.rows
     );
-    assert_eq!(d.rows.get("/cloth/mesh"), Some(&3));
-    assert_eq!(d.rows.get("/cloth/pins"), Some(&3));
-    assert_eq!(d.rows.get("/plots/energy/kinetic"), Some(&3));
-    assert_eq!(d.rows.get("/plots/mesh/vertices"), Some(&3));
+    assert_eq!(
+        d.rows.get("/plots/mesh/vertices"),
+        Some(&3),
+        "rows {:?}",
+        d.rows
+    );
     assert!(d.mesh_timelines.contains("frame"), "{:?}", d.mesh_timelines);
     assert!(
         d.mesh_timelines.contains("sim_time"),
@@ -220,31 +225,27 @@ fn recording_is_forced_on_with_rerun_off() {
         .expect("run child test");
     let stdout = String::from_utf8_lossy(&out.stdout);
     let stderr = String::from_utf8_lossy(&out.stderr);
-    println!("child with RERUN=off:\n{stdout}{stderr}");
-    assert!(out.status.success(), "child failed");
-    assert!(stdout.contains("1 passed"), "child ran the test");
+    assert!(
+        out.status.success(),
+        "child with RERUN=off failed:\n{stdout}{stderr}"
+    );
+    assert!(
+        stdout.contains("1 passed"),
+        "child ran the test:\n{stdout}{stderr}"
+    );
 }
 
 #[test]
-fn size_and_time_per_frame() {
+fn frames_share_chunks_and_cost_at_most_16_bytes_per_triangle() {
     let one = temp_path("one.rrd");
     let many = temp_path("many.rrd");
     let s1 = record_square(&one, 1).expect("recording");
     let s101 = record_square(&many, 101).expect("recording");
-    println!(
-        "2-triangle mesh, frames batched into one chunk: 1 frame {s1} B, 101 frames {s101} B, \
-         {:.0} B/frame",
-        (s101 - s1) as f64 / 100.0
-    );
     // Pauses longer than rerun's default 200 ms batching tick, which a recording without a
     // live viewer does without: the frames still share their chunks (one per entity, not one
     // per entity and frame).
     let pause = std::time::Duration::from_millis(250);
     let (s4, _) = record_mesh(&many, &square(), 4, pause).expect("recording");
-    println!(
-        "2-triangle mesh, 250 ms between frames: 4 frames {s4} B, {:.0} B/frame",
-        (s4 - s1) as f64 / 3.0
-    );
     let chunks = decode(&many).chunks;
     assert!(
         chunks <= 16,
@@ -252,14 +253,8 @@ fn size_and_time_per_frame() {
     );
     let big = grid(100);
     let (b1, _) = record_mesh(&one, &big, 1, std::time::Duration::ZERO).expect("recording");
-    let (b11, t) = record_mesh(&many, &big, 11, std::time::Duration::ZERO).expect("recording");
+    let (b11, _) = record_mesh(&many, &big, 11, std::time::Duration::ZERO).expect("recording");
     let per_triangle = (b11 - b1) as f64 / 10.0 / big.triangles.len() as f64;
-    println!(
-        "{} triangles: {:.0} kB/frame ({per_triangle:.2} B per triangle per frame), record_frame {:.2} ms/frame",
-        big.triangles.len(),
-        (b11 - b1) as f64 / 10.0 / 1000.0,
-        t.as_secs_f64() * 1e3
-    );
     // Every frame adds bytes (positions change), and batching frames into one chunk
     // costs less per frame than a chunk per frame.
     assert!(s101 > s1 && s4 > s1, "frames add bytes: {s1} {s101} {s4}");
@@ -268,8 +263,8 @@ fn size_and_time_per_frame() {
         "batched frames cost less per frame"
     );
     // Topology constant, no edges: positions only after the first frame (shared
-    // vertices, triangles logged once). Budget of issue 15: 16 B per triangle per
-    // frame for a uniform scene without edges.
+    // vertices, triangles logged once). The budget: 16 B per triangle per frame
+    // for a uniform scene without edges.
     assert!(
         per_triangle <= 16.0,
         "{per_triangle:.2} B per triangle per frame on a constant topology"
@@ -314,8 +309,10 @@ fn dropped_recorder_leaves_valid_file() {
         Ok(())
     })();
     let err = result.expect_err("index 7 of 4 vertices is invalid");
-    println!("invalid frame error: {err}");
-    assert!(matches!(err, RecordError::InvalidFrame { frame: 1, .. }));
+    assert!(
+        matches!(err, RecordError::InvalidFrame { frame: 1, .. }),
+        "{err}"
+    );
     let bytes = std::fs::read(&path).expect("read rrd");
     assert_eq!(&bytes[bytes.len() - 12..bytes.len() - 4], b"RRF2FOOT");
     assert_eq!(decode(&path).rows.get("/cloth/mesh"), Some(&1));
@@ -326,9 +323,8 @@ fn dropped_recorder_leaves_valid_file() {
 fn unwritable_path_is_an_error() {
     let err = Recorder::create(std::path::Path::new("/nonexistent-dir/x.rrd"), "unwritable")
         .expect_err("missing directory");
-    println!("unwritable path error: {err}");
-    assert!(matches!(err, RecordError::Create { .. }));
-    assert!(err.to_string().contains("/nonexistent-dir/x.rrd"));
+    assert!(matches!(err, RecordError::Create { .. }), "{err}");
+    assert!(err.to_string().contains("/nonexistent-dir/x.rrd"), "{err}");
 }
 
 #[test]
@@ -416,13 +412,6 @@ fn decoded_frame_rebuilds_the_triangle_list_with_levels() {
     }
     for (f, (m, positions)) in meshes.iter().zip(&recorded).enumerate() {
         let d = cloth_mesh_at(&path, f as i64).expect("decodes");
-        println!(
-            "frame {f}: {} triangles, {} vertices recorded as {} (topology from frame {})",
-            d.triangles.len(),
-            d.positions.len(),
-            d.recorded_vertices,
-            d.topology_frame
-        );
         assert_eq!(d.triangles, m.triangles, "frame {f}");
         assert_eq!(d.levels, m.levels, "frame {f}");
         let f32s: Vec<[f32; 3]> = positions
@@ -436,8 +425,7 @@ fn decoded_frame_rebuilds_the_triangle_list_with_levels() {
             "levels meet: copies"
         );
     }
-    let err = cloth_mesh_at(&path, 9).map(|_| ()).expect_err("no frame 9");
-    println!("{err}");
+    cloth_mesh_at(&path, 9).map(|_| ()).expect_err("no frame 9");
     let ins = drape::record::inspect::inspect(&path).expect("inspect");
     let flags: Vec<bool> = ins.frames.values().map(|f| f.topology).collect();
     assert_eq!(flags, [true, false, true, false]);

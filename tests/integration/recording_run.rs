@@ -1,4 +1,4 @@
-//! Recordings of whole runs (SPEC 7, issue 5): the schema decoded back with rerun's decoder,
+//! Recordings of whole runs (SPEC 7): the schema decoded back with rerun's decoder,
 //! event counts against the engine's counters, completeness after an error and after Ctrl-C,
 //! reproducibility, `--record-every` and the edge options.
 
@@ -62,11 +62,11 @@ const REVIEW_DEG: (f64, f64) = (15.0 / REVIEW_BAND, 15.0 * REVIEW_BAND);
 /// recorded as `f32`).
 fn check_frames(ins: &Inspection, all_edges: bool) {
     let topology = ins.frames.values().filter(|f| f.topology).count();
-    println!(
-        "topology logged on {topology} of {} frames",
+    assert!(
+        ins.frames.values().next().is_some_and(|f| f.topology),
+        "topology logged on {topology} of {} frames, not the first",
         ins.frames.len()
     );
-    assert!(ins.frames.values().next().is_some_and(|f| f.topology));
     for (n, f) in &ins.frames {
         assert_eq!(f.mesh_rows, 1, "frame {n}: one mesh row");
         let tris = f.triangles.expect("mesh topology");
@@ -109,8 +109,11 @@ fn check_event_counts(ins: &Inspection, summary: &Summary) {
     let counts = ins.event_counts();
     let n = |k: &str| counts.get(k).copied().unwrap_or(0) as u64;
     let a = summary.adapt.expect("adaptive run");
-    println!("events in the file {counts:?}; engine {a:?}");
-    assert_eq!(n("split") + n("closure_split") + n("bounce"), a.splits);
+    assert_eq!(
+        n("split") + n("closure_split") + n("bounce"),
+        a.splits,
+        "events in the file {counts:?}; engine {a:?}"
+    );
     assert_eq!(n("bounce"), a.bounces);
     assert_eq!(n("merge") + n("collapse"), a.merges);
     assert_eq!(n("rollback"), a.rollbacks);
@@ -122,7 +125,6 @@ fn adaptive_run_holds_the_whole_schema() {
     let out = temp_path("schema.rrd");
     let summary = record(&tablecloth_short(), &out, RunOptions::default()).expect("run");
     let ins = inspect(&out).expect("decodes");
-    print!("{}", ins.report());
     assert!(ins.footer);
     let mut expected: BTreeSet<String> = [
         "/",
@@ -204,7 +206,6 @@ fn every_frame_decodes_to_the_engine_mesh() {
     .expect("run");
     assert_eq!(seen.len() as u64, summary.frames);
     let ins = inspect(&out).expect("decodes");
-    let (mut copies, mut recorded) = (0, 0);
     for (n, (positions, triangles)) in seen.iter().enumerate() {
         let f = cloth_mesh_at(&out, n as i64).expect("frame decodes");
         assert_eq!(&f.positions, positions, "frame {n}: positions");
@@ -212,14 +213,7 @@ fn every_frame_decodes_to_the_engine_mesh() {
         assert_eq!(f.levels, ins.frames[&(n as i64)].levels, "frame {n}");
         assert_eq!(f.levels.len(), triangles.len());
         assert_eq!(f.normals.len(), positions.len());
-        copies += f.recorded_vertices - positions.len();
-        recorded += f.recorded_vertices;
     }
-    println!(
-        "{} frames decoded; copies per level: {copies} of {recorded} recorded vertices ({:.1} %)",
-        seen.len(),
-        100.0 * copies as f64 / recorded as f64
-    );
     std::fs::remove_file(&out).ok();
 }
 
@@ -243,9 +237,12 @@ fn record_every_thins_frames_and_keeps_every_event() {
         .map(|f| f as i64)
         .collect();
     let got: Vec<i64> = ins.frames.keys().copied().collect();
-    println!("{} frames simulated, recorded {got:?}", summary.frames);
     assert_eq!(got, expected);
-    assert!(got.len() < summary.frames as usize);
+    assert!(
+        got.len() < summary.frames as usize,
+        "{} frames simulated, recorded {got:?}",
+        summary.frames
+    );
     assert_eq!(
         summary.recording.as_ref().map(|r| r.frames),
         Some(got.len() as u64)
@@ -315,18 +312,6 @@ fn edge_options_filter_or_drop_cloth_edges() {
         }
     }
     assert!(kept_some, "the run bends past {threshold} deg somewhere");
-    println!(
-        "bytes: all edges {} ({} edges), above {threshold} deg {}, default ({:.1} to {:.1} \
-         deg) {} ({} edges), no edges {}",
-        all_i.bytes,
-        kept(&all_i),
-        above_i.bytes,
-        REVIEW_DEG.0,
-        REVIEW_DEG.1,
-        review_i.bytes,
-        kept(&review_i),
-        none_i.bytes
-    );
     for p in [all, above, none, review] {
         std::fs::remove_file(p).ok();
     }
@@ -346,7 +331,6 @@ fn numerical_failure_leaves_a_complete_recording() {
     .expect("scene");
     let out = temp_path("numerical.rrd");
     let err = record(&scene, &out, RunOptions::default()).expect_err("numerical failure");
-    println!("{err}");
     let RunError::Numerical { frame, summary, .. } = err else {
         panic!("not a numerical failure: {err}");
     };
@@ -379,7 +363,6 @@ fn numerical_failure_leaves_a_complete_recording() {
     let expected: Vec<i64> = (0..frame as i64)
         .filter(|f| f % 4 == 0 || *f == frame as i64 - 1)
         .collect();
-    println!("record_every 4, failure at frame {frame}: recorded {got:?}");
     assert_eq!(got, expected);
     std::fs::remove_file(&out).ok();
 }
@@ -391,13 +374,6 @@ fn same_scene_twice_gives_identical_decoded_contents() {
     let (a, b) = (temp_path("a.rrd"), temp_path("b.rrd"));
     record(&scene, &a, RunOptions::default()).expect("run a");
     record(&scene, &b, RunOptions::default()).expect("run b");
-    let (ba, bb) = (std::fs::read(&a).expect("a"), std::fs::read(&b).expect("b"));
-    println!(
-        "sizes {} and {} bytes; byte-identical: {}",
-        ba.len(),
-        bb.len(),
-        ba == bb
-    );
     let (ra, rb) = (
         crate::canonical::rows(&a, crate::canonical::WALL_CLOCK),
         crate::canonical::rows(&b, crate::canonical::WALL_CLOCK),
@@ -444,14 +420,12 @@ fn sigint_leaves_a_complete_recording() {
         assert!(Instant::now() < deadline, "drape did not stop after SIGINT");
         std::thread::sleep(Duration::from_millis(50));
     };
-    println!("interrupted after {:?}, exit {code:?}", started.elapsed());
-    assert_eq!(code, Some(130));
+    assert_eq!(code, Some(130), "interrupted after {:?}", started.elapsed());
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("s.json")).expect("summary"))
             .expect("json");
     assert_eq!(summary["interrupted"], true);
     let ins = inspect(&rrd).expect("decodes completely");
-    print!("{}", ins.report());
     assert!(ins.footer, "footer written");
     let frames = summary["frames"].as_u64().expect("frames");
     assert!(frames < 121, "stopped early");
@@ -483,14 +457,7 @@ fn step_plot_shows_the_step_taken_not_the_target() {
         .values()
         .filter_map(|f| f.scalars.get("time/dt_ms").copied())
         .collect();
-    println!(
-        "{} steps in {:.3} s: {taken_ms:.4} ms a step; plotted {:?} ms over {} frames",
-        summary.steps,
-        summary.sim_time,
-        plotted.first(),
-        plotted.len()
-    );
-    assert_eq!(plotted.len() as u64, summary.frames);
+    assert_eq!(plotted.len() as u64, summary.frames, "plotted {plotted:?}");
     for (n, ms) in plotted.iter().enumerate() {
         assert!(
             (ms - taken_ms).abs() <= 1e-9 * taken_ms,
@@ -514,7 +481,6 @@ fn bounces_are_recorded_as_their_own_events() {
     let summary = record(&scene, &out, RunOptions::default()).expect("run");
     let ins = inspect(&out).expect("decodes");
     let bounces = ins.event_counts().get("bounce").copied().unwrap_or(0);
-    println!("bounce events in the file: {bounces}");
     assert!(bounces > 0, "the case bounces");
     check_event_counts(&ins, &summary);
     let _ = std::fs::remove_file(&out);

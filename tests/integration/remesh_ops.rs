@@ -1,4 +1,4 @@
-//! Remeshing operations as values (issue 13, item 4): atomic edge splits,
+//! Remeshing operations as values: atomic edge splits,
 //! exact inverses for both methods, incrementally kept tables equal to
 //! rebuilt ones.
 
@@ -21,13 +21,12 @@ fn short_interior_edge(m: &mesh::Mesh) -> (u32, u32) {
     (a, b)
 }
 
-/// Issue 13: `Soup::split` committed the prerequisite (longest-edge) splits of
-/// the neighbours before the requested split was refused. On a 4x4 grid with
+/// `Soup::split` takes back the prerequisite (longest-edge) splits of the
+/// neighbours when the requested split is refused. On a 4x4 grid with
 /// `max_level = 1`, splitting a grid leg first bisects the two diagonals next to
-/// it (level 0 -> 1, allowed) and then refuses the leg itself (level 2). Measured
-/// before the fix: `split` returned false but the soup held 36 live triangles
-/// instead of 32 and reported 2 splits. Now it holds the same 32 triangles, in
-/// the same order, and reports none.
+/// it (level 0 -> 1, allowed) and then refuses the leg itself (level 2): the
+/// soup must hold the same 32 triangles, in the same order, and report no
+/// split.
 #[test]
 fn refused_edge_split_leaves_no_partial_work() {
     let m = mesh::rectangle(1.0, 1.0, 4, DiagonalPattern::Regular).unwrap();
@@ -43,12 +42,6 @@ fn refused_edge_split_leaves_no_partial_work() {
     let mut ops = Vec::new();
     let done = soup.split(a, b, &limits, &mut ops, 0);
     let after = soup.live();
-    println!(
-        "refused split of ({a}, {b}): returned {done}, {} -> {} live triangles, {} operations reported",
-        before.0.len(),
-        after.0.len(),
-        ops.len()
-    );
     assert!(
         !done,
         "the leg's triangles would reach level 2 > max_level 1"
@@ -143,11 +136,11 @@ fn refined_everywhere(res: u32, splits: usize, alternate: bool) -> Vec<[(u64, u6
     by_position(rg.material(), &tris)
 }
 
-/// Issue 14: a red-green mesh refined everywhere was a worse discretisation
-/// than the uniform grid of its edge length, because inside each split grid
-/// square every diagonal ran the same way while the uniform grid alternates
-/// them (at rest on `hanging_sheet_rest`, base 16 refined everywhere to 64 had
-/// 0.163 % error against uniform 64's 0.114 %; the uniform grid with its
+/// A red-green mesh refined everywhere with its children as split is a worse
+/// discretisation than the uniform grid of its edge length, because inside each
+/// split grid square every diagonal runs the same way while the uniform grid
+/// alternates them (at rest on `hanging_sheet_rest`, base 16 refined everywhere
+/// to 64 has 0.163 % error against uniform 64's 0.114 %; the uniform grid with its
 /// diagonals all one way 0.912 %). With alternating diagonals (the default) a
 /// grid refined everywhere is the uniform alternating grid, triangle for
 /// triangle; as split, it is not.
@@ -159,17 +152,6 @@ fn red_green_refined_everywhere_is_the_uniform_grid() {
         let uniform = by_position(&m.material, &m.triangles);
         let alternating = refined_everywhere(res, splits, true);
         let as_split = refined_everywhere(res, splits, false);
-        let differ = |a: &[[(u64, u64); 3]]| {
-            a.iter()
-                .filter(|t| uniform.binary_search(t).is_err())
-                .count()
-        };
-        println!(
-            "base {res}, {splits} red splits everywhere: {} triangles; not in uniform {fine}: alternating {}, as split {}",
-            uniform.len(),
-            differ(&alternating),
-            differ(&as_split)
-        );
         assert_eq!(alternating, uniform, "base {res}, {splits} splits");
         assert_ne!(as_split, uniform, "base {res}, {splits} splits, as split");
     }
@@ -277,13 +259,9 @@ fn incremental_tables_equal_a_rebuild_over_draping_passes() {
             }
         }
         let s = ad.stats;
-        println!(
-            "{method:?}: {changed} of 30 passes changed the mesh; {} splits, {} merges",
-            s.splits, s.merges
-        );
         assert!(
             s.splits > 0 && s.merges > 0,
-            "{method:?} should refine and coarsen"
+            "{method:?} should refine and coarsen ({changed} of 30 passes changed the mesh)"
         );
     }
 }
@@ -309,7 +287,7 @@ fn by_position(material: &[drape::math::Vector2], tris: &[[u32; 3]]) -> Vec<[(u6
 proptest! {
     #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
 
-    /// Property (issue 14: incremental updates against a full rebuild, at any
+    /// Property (incremental updates against a full rebuild, at any
     /// adaptation cadence). A sheet is draped into a random sequence of folds
     /// (each a `adapt_cost::drape` shape of random radius) and adapted after
     /// every `cadence`-th shape, by either method and either criterion (the

@@ -755,7 +755,6 @@ fn bending_length_is_an_alternative_to_bending() {
     // Converted with the density and |gravity| (the default 9.81 m/s^2).
     let scene = load_scene_str(&with("bending_length = 0.02\n"), "test.toml", &[]).unwrap();
     let b = scene.material.rigidity(scene.simulation.gravity);
-    println!("bending_length 0.02 m -> rigidity {b:.6e} N m");
     assert!((b - 0.15 * 9.81 * 0.02f64.powi(3)).abs() < 1e-15, "{b}");
     // Both given: located at bending_length, caused by bending.
     let e = error_at(

@@ -1,4 +1,4 @@
-//! The simulation state and the public pipeline (issue 13): a rollback leaves no
+//! The simulation state and the public pipeline: a rollback leaves no
 //! trace in the work ledger, a frame retry restores the whole state, and a state
 //! saved and restored replays bit for bit.
 
@@ -61,8 +61,8 @@ fn until_rollback(
     panic!("no step rolled back in 400 steps");
 }
 
-/// Regression (issue 13): the wind work of a rolled-back attempt stayed in
-/// `external_work` (the rollback restored only positions, velocities and time).
+/// The wind work of a rolled-back attempt does not stay in `external_work` (a
+/// rollback that restored only positions, velocities and time would leave it).
 /// A step with one rollback must add exactly the work of its accepted attempt,
 /// which is replayed here on a twin simulation: the trial step finds the same
 /// marks, then the refined mesh is stepped from the restored start.
@@ -111,10 +111,6 @@ fn rollback_keeps_only_the_accepted_attempts_work() {
     let real = state.ledger.external_work - work0;
     let accepted = twin_state.ledger.external_work - work0;
     let rejected = trial.ledger.external_work - work0;
-    println!(
-        "step {}: work of the step {real:.9e} J, of its accepted attempt {accepted:.9e} J, of the rejected trial {rejected:.9e} J",
-        saved.ledger.steps_done + 1
-    );
     assert!(
         rejected.abs() > 0.0,
         "the trial does work, so the test can fail"
@@ -171,29 +167,21 @@ fn a_restored_state_replays_bit_for_bit_on_a_fresh_pipeline() {
     ];
     let scene = load_scene_file(Path::new("scenes/hard/thrash.toml"), &overrides).expect("scene");
     let (state, replay, moved) = replay_on_a_fresh_pipeline(&scene, 50);
-    println!(
-        "after 100 steps: {} vertices, largest move over the last 50 steps {moved:.3e} m, work {:.6e} J",
-        state.world.x.len(),
-        state.ledger.work()
-    );
-    assert!(moved > 0.0);
+    assert!(moved > 0.0, "the sheet moved {moved} m");
     assert_eq!(state.world.mesh.triangles, replay.world.mesh.triangles);
     assert_eq!(state.world.x, replay.world.x);
     assert_eq!(state.world.v, replay.world.v);
     assert_eq!(state.ledger.work(), replay.ledger.work());
 }
 
-/// Regression (issue 13): the implicit solver's warm start (its first guess, the
-/// last step's velocity change) lived in the pipeline, so a pipeline rebuilt
-/// mid-run started its next solve cold and the run drifted by up to the CG
-/// tolerance. It is now part of the state: with `solver = "cg"` (no stored
-/// factorization) a fresh pipeline continues bit for bit, on a flapping adaptive
-/// sheet (wind, rollback) and on a sheet draped on a ball (contacts). Measured with
-/// the warm start dropped on attaching (what a pipeline-owned one did): the draped
-/// sheet's replay deviated by 2.3e-7 m and this test failed.
-/// The direct solver's stored factorization is a cache (a preconditioner): a
-/// fresh pipeline factors afresh and agrees within the solve's tolerance; the
-/// deviation is printed.
+/// The implicit solver's warm start (its first guess, the last step's velocity
+/// change) is part of the state, not the pipeline: with `solver = "cg"` (no
+/// stored factorization) a fresh pipeline continues bit for bit, on a flapping
+/// adaptive sheet (wind, rollback) and on a sheet draped on a ball (contacts).
+/// A pipeline-owned warm start would start the next solve cold and drift by up
+/// to the CG tolerance (2.3e-7 m on the draped sheet). The direct solver's
+/// stored factorization is a cache (a preconditioner): a fresh pipeline factors
+/// afresh and agrees within the solve's tolerance.
 #[test]
 fn a_rebuilt_pipeline_continues_a_run_bit_identically() {
     // The draped sheet starts just above the ball, so it touches from the start.
@@ -219,18 +207,17 @@ fn a_rebuilt_pipeline_continues_a_run_bit_identically() {
             .zip(&replay.world.x)
             .map(|(a, b)| (*a - *b).length())
             .fold(0.0, f64::max);
-        println!(
-            "{file}, solver {solver}: {} vertices, largest move over the last {steps} steps {moved:.3e} m, replay deviation {deviation:.3e} m, {} contacts in all",
-            state.world.x.len(),
-            state.ledger.collision.contacts
+        assert!(
+            moved > 0.0 && !state.warm_start.is_empty(),
+            "{file}, solver {solver}: moved {moved} m, warm start of {} vertices",
+            state.warm_start.len()
         );
-        assert!(moved > 0.0 && !state.warm_start.is_empty());
         if file.contains("drape_sphere") {
             assert!(state.ledger.collision.contacts > 0, "it touches the ball");
         }
         assert_eq!(state.world.mesh.triangles, replay.world.mesh.triangles);
         if solver == "cg" {
-            // Compared whole (not printed: thousands of vectors); the deviation is above.
+            // Compared whole; the message names what differs, not thousands of vectors.
             assert!(state.world.x == replay.world.x, "{file}: positions");
             assert!(state.world.v == replay.world.v, "{file}: velocities");
             assert!(state.warm_start == replay.warm_start, "{file}: warm start");
@@ -301,16 +288,6 @@ thickness = 0.003
             (frames, summary)
         };
         let (one, s1) = run(1);
-        let last = &one.last().expect("frames").1;
-        println!(
-            "{method}: {} frames, {} vertices at the end (max {}), {} splits, {:.0} contacts/step, {:.0} self-collision pairs/step",
-            one.len(),
-            last.len(),
-            s1.vertices.max,
-            s1.splits,
-            s1.contacts,
-            s1.self_pairs_tested
-        );
         assert!(s1.splits > 0 && s1.contacts > 0.0, "it adapts and touches");
         for threads in [2, 4] {
             let (other, _) = run(threads);

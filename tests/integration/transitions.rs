@@ -1,5 +1,5 @@
-//! Transition triangles two refinement levels deep (issue 14, bending across
-//! adaptive meshes): each interior triangle's shape-operator energy under a
+//! Transition triangles two refinement levels deep (bending across adaptive
+//! meshes): each interior triangle's shape-operator energy under a
 //! constant curvature, against the continuum's.
 
 use drape::adapt::{AdaptConfig, Adapter};
@@ -52,13 +52,13 @@ fn two_levels(
 /// continuum's twist energy (only pairs add up), so a triangle's twist ratio
 /// says nothing about transitions.
 ///
-/// Measured (2026-11-23): on the sheet refined over `x < 0` then `x < -0.3`
+/// On the sheet refined over `x < 0` then `x < -0.3`
 /// (the second level's rim a line of greens along y), six level-3 green
 /// triangles next to a level-4 neighbour carry 0.905 / 1.000 / 0.953 / 0.953
 /// (the others within 5 %); after the same first band the second one over
 /// `x < -0.3, |y| < 0.25` gives four such; bands along x and disks give none;
 /// the same with red-green's children as split and with alternating
-/// diagonals. Their transition operators' `Theta` (a scratch print) is
+/// diagonals. Their transition operators' `Theta` is
 /// singular: singular values 0.0563 m, 0.0469 m and 0, null direction
 /// 0.555 xx - 0.832 xy, the direction the pseudo-inverse leaves blind
 /// (`shape.rs`, "What is given up"). The test fails if any triangle gets
@@ -132,12 +132,9 @@ fn second_level_transitions_bend_within_ten_percent_of_the_continuum() {
                     );
                 }
             }
-            println!(
-                "{name}, alternating diagonals {alternate}: {over5} triangles more than 5 % off, worst |ratio - 1| {worst:.4}"
-            );
             assert!(
                 worst < 0.10,
-                "{name} (alternate {alternate}): worst {worst:.4}"
+                "{name} (alternate {alternate}): worst {worst:.4}, {over5} triangles more than 5 % off"
             );
         }
     }
@@ -153,8 +150,7 @@ fn second_level_transitions_bend_within_ten_percent_of_the_continuum() {
 /// 1.88 % more. The differences halve with the green closure triangles'
 /// area (0.080 and 0.038 of the sheet), so they sit in the greens: 9 to 10 %
 /// softer along an axis and 48 to 50 % stiffer in shear there. Nothing is tuned
-/// away here; this pins what a red-green mesh gives up
-/// (`docs/speed-vs-error-history.md`, "Strain thresholds": a graded sheet hangs
+/// away here; this pins what a red-green mesh gives up (a graded sheet hangs
 /// lower than the grid's would).
 #[test]
 fn green_closures_stretch_unlike_the_grid() {
@@ -219,14 +215,10 @@ fn green_closures_stretch_unlike_the_grid() {
         let mut ratios = Vec::new();
         for (name, f) in cases {
             let (g, u, r) = (energy(&world.mesh, f), energy(&grid, f), energy(&fine, f));
-            println!(
-                "resolution {res}, {name}: graded / grid {:.5}, grid {res} x 4 / grid {:.6} (green area {green:.4})",
-                g / u,
-                r / u
-            );
             assert!(
                 (r / u - 1.0).abs() < 1e-5,
-                "the grid's energy depends on its resolution"
+                "the grid's energy depends on its resolution: {name}, grid {res} x 4 / grid {}",
+                r / u
             );
             ratios.push(g / u);
         }
@@ -241,7 +233,6 @@ fn green_closures_stretch_unlike_the_grid() {
         );
         deficits.push(((1.0 - ratios[0]) / green, (ratios[3] - 1.0) / green));
     }
-    println!("per green area (along x, shear): {deficits:?}");
     // The same per green area at both resolutions: the error is the greens'.
     for k in 0..2 {
         let (a, b) = (

@@ -32,11 +32,6 @@ impl RedGreen {
             .copied()
     }
 
-    /// True when `n` can merge on its own (see [`RedGreen::merge_batch`]).
-    pub fn can_merge(&self, n: u32) -> bool {
-        self.children_mergeable(n) && self.persisting_uses(n, &[]) <= 1
-    }
-
     /// Midpoints of `n`'s edges that stay in use by neighbours after merging `n`
     /// together with the nodes in `merging` (sorted).
     fn persisting_uses(&self, n: u32, merging: &[u32]) -> usize {

@@ -1,17 +1,17 @@
 //! The red forest as a mesh: the conforming simulation mesh built from the
 //! leaves, and the renumbering that follows the world's vertex compaction.
 //!
-//! # Alternating diagonals (`adapt.diagonals`, issue 14)
+//! # Alternating diagonals (`adapt.diagonals`)
 //! A red split of a grid square's two triangles gives four sub-squares whose
 //! diagonals all run the way the square's did, where the uniform grid of the
 //! same edge length alternates them in a checkerboard. The mass-spring
 //! membrane is not isotropic on either triangulation, and the difference
-//! showed: on `hanging_sheet_rest` at rest (error against uniform 96, relative
+//! shows: on `hanging_sheet_rest` at rest (error against uniform 96, relative
 //! to the diagonal) uniform 64 has 0.114 %, uniform 64 with its diagonals all
 //! one way 0.912 %, and base 16 refined everywhere to the same edges 0.163 %.
-//! Node by node the red-green family was the worse discretisation against a
-//! red-green reference too, so this was a floor under every adaptive run, not
-//! a bias of the reference (`docs/speed-vs-error-history.md`).
+//! Against a red-green reference the red-green family is the worse
+//! discretisation too, so all-one-way diagonals put a floor under every
+//! adaptive run's error rather than biasing the reference.
 //!
 //! So the mesh is emitted with one flip per red split: in a split triangle
 //! with a corner of at least 90 degrees (a grid triangle's right angle), the
@@ -173,11 +173,10 @@ impl RedGreen {
     /// Follows the world's vertex compaction: `map[old]` is the new index of
     /// every surviving vertex (`u32::MAX` for removed ones).
     ///
-    /// Incremental (issue 13, item 5): compaction keeps the surviving vertices
+    /// Incremental: compaction keeps the surviving vertices
     /// in order, so every id below the first removed one keeps its index. Only
     /// the table entries and nodes that name a later vertex are rekeyed, in
-    /// place; after a pass that only refined, nothing is. (Before, all three
-    /// maps were rebuilt from scratch after every remesh.) Rekeying in place
+    /// place; after a pass that only refined, nothing is. Rekeying in place
     /// cannot collide: the map is one to one on the surviving vertices, so a
     /// rekeyed entry never lands on an entry that kept its key.
     pub fn remap(&mut self, map: &[u32], material: &[Vector2]) {

@@ -42,7 +42,7 @@ impl BlockPattern {
 
     /// The block-level (one row and column per vertex) CSC structure of the factored
     /// lower triangle, diagonal included, rows ascending within each column: the
-    /// graph that the fill-reducing ordering reads ([`super::super::direct`],
+    /// graph that the fill-reducing ordering reads ([`super::super::cholesky`],
     /// "Ordering by vertex"), as column starts and row indices.
     pub fn vertex_structure(&self) -> (Vec<u32>, Vec<u32>) {
         let n = self.vertices();

@@ -1,6 +1,6 @@
 //! The pattern's derived tables against the searches they replaced: mirrors by
 //! per-row cursors, and the shape triangles' dropped blocks from one lookup per
-//! pair of slots (the "cheaper block pattern" of docs/performance.md).
+//! pair of slots.
 
 use super::BlockPattern;
 use crate::adapt::{AdaptConfig, Adapter};

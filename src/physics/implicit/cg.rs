@@ -8,7 +8,7 @@
 
 use rayon::prelude::*;
 
-use super::{SolveFailure, without};
+use super::{ImplicitScratch, SolveFailure, without};
 use crate::math::{Scalar, Vector, deterministic_sum, deterministic_sum2};
 use crate::physics::forces::PAR_MIN;
 use crate::physics::shape::{SHAPE_SLOTS, rates, spread};
@@ -33,6 +33,51 @@ pub(super) fn solve(
     contact_push: bool,
 ) -> Result<(), SolveFailure> {
     let started = std::time::Instant::now();
+    let (mut rz, mut rr) = start(st, held);
+    let tolerance = model.cg_tolerance;
+    let goal = tolerance * reference;
+    let mut iterations = 0;
+    let outcome = loop {
+        if rr.sqrt() <= goal {
+            break Ok(());
+        }
+        if iterations >= model.cg_max_iterations {
+            break Err(SolveFailure::not_converged(
+                iterations,
+                rr.sqrt(),
+                reference,
+                tolerance,
+            ));
+        }
+        apply_operator(st, Which::Direction, held, true);
+        let s = &mut st.implicit;
+        let pap = dot(&s.cg.p, &s.cg.ap);
+        if pap <= 0.0 || !pap.is_finite() {
+            break Err(SolveFailure::NotPositiveDefinite);
+        }
+        let rz_new;
+        (rz_new, rr) = step(s, rz / pap);
+        let beta = rz_new / rz;
+        rz = rz_new;
+        let c = &mut s.cg;
+        c.p.par_iter_mut()
+            .zip(c.z.par_iter())
+            .with_min_len(PAR_MIN)
+            .for_each(|(p, z)| *p = *z + *p * beta);
+        iterations += 1;
+    };
+    st.stats.cg_iterations += iterations as u64;
+    if outcome.is_ok() && contact_push {
+        contact_pressure(st, held);
+    }
+    st.stats.solve_s += started.elapsed().as_secs_f64();
+    outcome
+}
+
+/// Starts the iteration from the first guess `dv`: `r = b - A dv` (filtered,
+/// zero on held vertices), `z` the preconditioned `r`, `p = z`. Returns `r.z`
+/// and `r.r`.
+fn start(st: &mut Stepper, held: &[bool]) -> (Scalar, Scalar) {
     let n = st.implicit.dv.len();
     {
         let c = &mut st.implicit.cg;
@@ -40,7 +85,6 @@ pub(super) fn solve(
             buf.resize(n, Vector::ZERO);
         }
     }
-    // r = b - A dv, filtered.
     apply_operator(st, Which::Solution, held, true);
     let s = &mut st.implicit;
     let c = &mut s.cg;
@@ -57,59 +101,27 @@ pub(super) fn solve(
         });
     precondition(&mut c.z, &c.r, &s.inv_diag, &s.filter);
     c.p.copy_from_slice(&c.z);
-    let (mut rz, mut rr) = dot2(&c.r, &c.z);
-    let tolerance = model.cg_tolerance;
-    let goal = tolerance * reference;
-    let mut iterations = 0;
-    let outcome = loop {
-        if rr.sqrt() <= goal {
-            break Ok(());
-        }
-        if iterations >= model.cg_max_iterations {
-            break Err(SolveFailure::NotConverged {
-                iterations,
-                residual: rr.sqrt() / reference.max(Scalar::MIN_POSITIVE),
-                tolerance,
-            });
-        }
-        apply_operator(st, Which::Direction, held, true);
-        let s = &mut st.implicit;
-        let c = &mut s.cg;
-        let pap = dot(&c.p, &c.ap);
-        if pap <= 0.0 || !pap.is_finite() {
-            break Err(SolveFailure::NotPositiveDefinite);
-        }
-        let alpha = rz / pap;
-        // One pass: step the solution and the residual, precondition.
-        s.dv.par_iter_mut()
-            .zip(c.r.par_iter_mut().zip(c.z.par_iter_mut()))
-            .zip(
-                c.p.par_iter()
-                    .zip(c.ap.par_iter().zip(s.inv_diag.par_iter())),
-            )
-            .zip(s.filter.par_iter())
-            .with_min_len(PAR_MIN)
-            .for_each(|(((d, (r, z)), (p, (ap, inv))), n)| {
-                *d += *p * alpha;
-                *r -= *ap * alpha;
-                *z = without(*n, *r * *inv);
-            });
-        let rz_new;
-        (rz_new, rr) = dot2(&c.r, &c.z);
-        let beta = rz_new / rz;
-        rz = rz_new;
-        c.p.par_iter_mut()
-            .zip(c.z.par_iter())
-            .with_min_len(PAR_MIN)
-            .for_each(|(p, z)| *p = *z + *p * beta);
-        iterations += 1;
-    };
-    st.stats.cg_iterations += iterations as u64;
-    if outcome.is_ok() && contact_push {
-        contact_pressure(st, held);
-    }
-    st.stats.solve_s += started.elapsed().as_secs_f64();
-    outcome
+    dot2(&c.r, &c.z)
+}
+
+/// One pass with step `alpha`: `dv += alpha p`, `r -= alpha A p`, `z` the
+/// preconditioned `r`. Returns the new `r.z` and `r.r`.
+fn step(s: &mut ImplicitScratch, alpha: Scalar) -> (Scalar, Scalar) {
+    let c = &mut s.cg;
+    s.dv.par_iter_mut()
+        .zip(c.r.par_iter_mut().zip(c.z.par_iter_mut()))
+        .zip(
+            c.p.par_iter()
+                .zip(c.ap.par_iter().zip(s.inv_diag.par_iter())),
+        )
+        .zip(s.filter.par_iter())
+        .with_min_len(PAR_MIN)
+        .for_each(|(((d, (r, z)), (p, (ap, inv))), n)| {
+            *d += *p * alpha;
+            *r -= *ap * alpha;
+            *z = without(*n, *r * *inv);
+        });
+    dot2(&c.r, &c.z)
 }
 
 /// Which vector the operator is applied to.

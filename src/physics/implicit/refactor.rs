@@ -3,9 +3,9 @@
 //!
 //! # The costs
 //! `F`, the cost of one factorization counted in conjugate-gradient iterations, is the
-//! scene's `refactor_iterations`. Measured on the 2-core machine (build `98e9477`,
-//! `drape run ... --summary`, factorization time per factorization against solve
-//! time per factor solve): 14.7 ms against 2.16 ms on `hanging_sheet_rest` at
+//! scene's `refactor_iterations`. Measured on a 2-core machine (`drape run ...
+//! --summary`, factorization time per factorization against solve time per
+//! factor solve): 14.7 ms against 2.16 ms on `hanging_sheet_rest` at
 //! uniform 64 (6.8 iterations), 2.7 ms against 0.37 ms on its red-green run of
 //! about 1,200 vertices (7.2); the default is 7.
 //!
@@ -34,13 +34,12 @@
 //! Everything here counts iterations and compares residual norms, never clock
 //! time, so a run gives the same results on every machine and thread count.
 //!
-//! # What it replaced and why
-//! Before, a solve refactored after a fixed `refactor_iterations` (4) iterations with
-//! an older factor. Even a fresh factor needs about 5 iterations on
-//! `hanging_sheet_rest` at uniform 64, so that rule refactored at 528 of its 600
-//! steps while the sheet hung at rest; 8 was faster there (206 factorizations), but
-//! on `drape_sphere` 1 was faster than 4 or 8 (docs/performance.md,
-//! docs/speed-vs-error-history.md). The fixed count cannot suit both; the costs above do.
+//! # Why not a fixed iteration count
+//! Refactoring after a fixed number of iterations with an older factor cannot suit
+//! every scene: even a fresh factor needs about 5 iterations on
+//! `hanging_sheet_rest` at uniform 64, so a count of 4 refactors at almost every
+//! step while the sheet hangs at rest, yet on `drape_sphere` a count of 1 is faster
+//! than 4 or 8. Weighing the costs as above suits both.
 
 use crate::math::Scalar;
 

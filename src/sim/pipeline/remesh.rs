@@ -128,7 +128,7 @@ impl Pipeline {
         self.angles_fresh = false;
         if changed {
             // The contacts the last step ended in, carried onto the new mesh:
-            // the next implicit step filters them as it would have (issue 14,
+            // the next implicit step filters them as it would have (see
             // `crate::adapt::transfer::carry_contacts`).
             let carried = carry_contacts(&state.contacts, old_vertices, ad.last_origins());
             let had_contacts = !state.contacts.is_empty();

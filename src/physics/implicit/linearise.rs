@@ -1,7 +1,7 @@
-//! Assembly of the implicit step: per-element blocks and slots (springs, hinges,
-//! shape triangles, wind), then the per-vertex gather of the right-hand side `b`,
-//! the mass diagonal and the Jacobi diagonal, in a fixed order per vertex so the
-//! result is identical at any thread count.
+//! Linearisation of the implicit step, shared by both solvers: per-element blocks
+//! and slots (springs, hinges, shape triangles, wind), then the per-vertex gather
+//! of the right-hand side `b`, the mass diagonal and the Jacobi diagonal, in a
+//! fixed order per vertex so the result is identical at any thread count.
 
 use rayon::prelude::*;
 
@@ -18,7 +18,7 @@ use crate::world::World;
 /// Builds the per-element blocks, the right-hand side `b` and the diagonal. With
 /// `newton`, `b` is the residual `h f(x, v) - M (v - v0)` at the current iterate
 /// instead of Baraff and Witkin's `h f(x0, v0) - h^2 K v0`.
-pub(super) fn assemble(st: &mut Stepper, model: &Model, w: &World, h: Scalar, newton: bool) {
+pub(super) fn linearise(st: &mut Stepper, model: &Model, w: &World, h: Scalar, newton: bool) {
     let started = std::time::Instant::now();
     let (el, ext) = (&st.elements, &model.external);
     let (x, v) = (&w.x, &w.v);
