@@ -205,7 +205,19 @@ pub fn bench(
     log: &mut dyn FnMut(&str),
 ) -> Result<(BenchResult, Vec<PathBuf>), BenchError> {
     let (plan, points) = make_plan(opts)?;
-    let plan = write_plan(plan, &points, &opts.scene, dir, opts.cache)?;
+    bench_planned(opts, (plan, &points), dir, interrupt, log)
+}
+
+/// [`bench`] of a plan already made from `opts` by [`make_plan`] (with its
+/// sample points): writes it into `dir`, runs every job and collects.
+pub fn bench_planned(
+    opts: &BenchOptions,
+    (plan, points): (Plan, &SamplePoints),
+    dir: &Path,
+    interrupt: &AtomicBool,
+    log: &mut dyn FnMut(&str),
+) -> Result<(BenchResult, Vec<PathBuf>), BenchError> {
+    let plan = write_plan(plan, points, &opts.scene, dir, opts.cache)?;
     if let Some((dt, origin)) = &plan.common_dt {
         log(&format!("time step: {dt:.4e} s ({origin}) for every run"));
     }

@@ -463,7 +463,13 @@ fn copy_scene(scene_path: &Path, dir: &Path) -> Result<(String, String), BenchEr
     }
     let mut relative = Vec::new();
     for s in &sources {
-        let rel = Path::new("scene").join(s.strip_prefix(&root).unwrap_or(s));
+        let inside = s.strip_prefix(&root).map_err(|_| {
+            BenchError::Plan(format!(
+                "{} and the scene file have no common folder to copy them from",
+                s.display()
+            ))
+        })?;
+        let rel = Path::new("scene").join(inside);
         let to = dir.join(&rel);
         if let Some(parent) = to.parent() {
             std::fs::create_dir_all(parent).map_err(|e| BenchError::io(parent, e))?;

@@ -193,10 +193,11 @@ fn cmd_local(scene: &Path, args: &LadderArgs) -> Result<ExitCode> {
     let flag = interrupt.clone();
     ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed))
         .context("installing the Ctrl-C handler")?;
-    let (plan, _) = drape::bench::make_plan(&opts)?;
+    let (plan, points) = drape::bench::make_plan(&opts)?;
     let dir = args.dir(&plan.stem);
-    let (result, files) =
-        drape::bench::bench(&opts, &dir, &interrupt, &mut |line| eprintln!("{line}"))?;
+    let mut log = |line: &str| eprintln!("{line}");
+    let planned = (plan, &points);
+    let (result, files) = drape::bench::bench_planned(&opts, planned, &dir, &interrupt, &mut log)?;
     finish(&result, &files)
 }
 

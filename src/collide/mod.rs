@@ -200,12 +200,14 @@ impl Obstacles {
         out
     }
 
-    /// Every obstacle triangulated at time `t`, in world coordinates; planes
-    /// as a square of half side `plane.1` around `plane.0` (see
+    /// The obstacles triangulated at time `t`, in world coordinates: every
+    /// one with `fixed_too`, else only those that move; planes as a square of
+    /// half side `plane.1` around `plane.0` (see
     /// [`obstacle::Body::world_triangles`]).
-    pub fn meshes(&self, t: Scalar, plane: (Vector, Scalar)) -> Vec<ObstacleMesh> {
+    pub fn meshes(&self, t: Scalar, plane: (Vector, Scalar), fixed_too: bool) -> Vec<ObstacleMesh> {
         self.bodies
             .iter()
+            .filter(|b| fixed_too || b.is_moving())
             .map(|b| {
                 let (positions, triangles) = b.world_triangles(t, plane);
                 ObstacleMesh {

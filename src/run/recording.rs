@@ -103,10 +103,16 @@ pub(super) fn record_state(
         scalars: &scalars,
         events: &marks,
     })?;
-    for m in setup.obstacles.meshes(world.time, plane_display(world)) {
-        if m.moving || snap.frame == 0 {
-            rec.record_obstacle(&m.name, &m.positions, &m.triangles, !m.moving)?;
-        }
+    if setup.obstacles.is_empty() {
+        return Ok(());
+    }
+    // Fixed obstacles are logged once, as static data, at the first frame.
+    let first = snap.frame == 0;
+    for m in setup
+        .obstacles
+        .meshes(world.time, plane_display(world), first)
+    {
+        rec.record_obstacle(&m.name, &m.positions, &m.triangles, !m.moving)?;
     }
     Ok(())
 }
