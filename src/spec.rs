@@ -324,13 +324,13 @@ pub struct Adapt {
     pub hysteresis: Option<f64>,
     /// Sizing criterion with red-green only: also split a leaf where the
     /// membrane (Green) strain jumps across one of its edges by more than this
-    /// (dimensionless); absent: curvature alone. See `src/adapt/sizing.rs`,
+    /// (dimensionless); absent or 0: curvature alone. See `src/adapt/sizing.rs`,
     /// "Strain jumps".
     #[serde(default)]
     pub refine_strain: Option<f64>,
     /// Sizing criterion with red-green only: also split a leaf where one of its
     /// edges leans towards the nearest obstacle by more than this fraction of
-    /// its height above it (dimensionless); absent: no obstacle term. See
+    /// its height above it (dimensionless); absent or 0: no obstacle term. See
     /// `src/adapt/proximity.rs`.
     #[serde(default)]
     pub refine_obstacle: Option<f64>,

@@ -182,8 +182,8 @@ impl AdaptConfig {
             max_rollbacks: a.max_rollbacks,
             criterion: a.criterion,
             hysteresis: a.hysteresis.unwrap_or(DEFAULT_HYSTERESIS),
-            refine_strain: a.refine_strain,
-            refine_obstacle: a.refine_obstacle,
+            refine_strain: a.refine_strain.filter(|s| *s != 0.0),
+            refine_obstacle: a.refine_obstacle.filter(|r| *r != 0.0),
             alternate_diagonals: a.diagonals.unwrap_or_default() == RedDiagonals::Alternating,
         })
     }

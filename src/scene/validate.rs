@@ -46,7 +46,7 @@ pub(crate) fn validate(scene: &Scene, doc: &Table) -> Result<(), Issue> {
             scene.cloth.shape,
             scene.material.stiffness_rule,
         )?;
-        if a.refine_obstacle.is_some() && scene.obstacle.is_empty() {
+        if a.refine_obstacle.is_some_and(|r| r != 0.0) && scene.obstacle.is_empty() {
             let path = keys(&["adapt", "refine_obstacle"]);
             let why = "refine_obstacle refines where the cloth leans towards an obstacle, and this scene has no [[obstacle]]";
             return Err(Issue::new(path, Kind::NotApplicable, why));

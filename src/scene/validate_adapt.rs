@@ -106,14 +106,15 @@ fn tensor(a: &Adapt, shape: ClothShape, stiffness: StiffnessRule) -> Result<(), 
 
 /// The sizing criterion's own keys: `hysteresis` > 1, and only with `criterion =
 /// "sizing"`; `refine_strain` and `refine_obstacle` > 0, and only with the sizing
-/// criterion on red-green.
+/// criterion on red-green (0 turns either off, so that one `--set` line can
+/// undo a scene's value).
 fn criterion(a: &Adapt) -> Result<(), Issue> {
     if a.diagonals.is_some() && a.method != AdaptMethod::RedGreen {
         let path = keys(&["adapt", "diagonals"]);
         let why = "diagonals belongs to method = \"red_green\" (the edge method splits edges one at a time; the tensor method keeps the cloth's own `diagonals`)";
         return Err(Issue::new(path, Kind::NotApplicable, why));
     }
-    if let Some(s) = a.refine_strain {
+    if let Some(s) = a.refine_strain.filter(|s| *s != 0.0) {
         let path = keys(&["adapt", "refine_strain"]);
         if a.criterion != AdaptCriterion::Sizing || a.method != AdaptMethod::RedGreen {
             let why = "refine_strain belongs to criterion = \"sizing\" with method = \"red_green\"";
@@ -121,7 +122,7 @@ fn criterion(a: &Adapt) -> Result<(), Issue> {
         }
         positive(path, s)?;
     }
-    if let Some(r) = a.refine_obstacle {
+    if let Some(r) = a.refine_obstacle.filter(|r| *r != 0.0) {
         let path = keys(&["adapt", "refine_obstacle"]);
         if a.criterion != AdaptCriterion::Sizing || a.method != AdaptMethod::RedGreen {
             let why =
