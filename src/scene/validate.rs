@@ -39,7 +39,11 @@ pub(crate) fn validate(scene: &Scene, doc: &Table) -> Result<(), Issue> {
     if let Some(s) = &scene.self_collision {
         super::validate_collide::self_collision(s)?;
     }
-    if let Some(a) = &scene.adapt {
+    // `method = "none"` is the same as leaving `[adapt]` out: its other keys
+    // are not used, so a `--set adapt.method=none` on an adaptive scene is
+    // never refused for them.
+    let adaptive = scene.adapt.as_ref();
+    if let Some(a) = adaptive.filter(|a| a.method != crate::scene::AdaptMethod::None) {
         super::validate_adapt::adapt(
             a,
             scene.simulation.integrator,

@@ -1,7 +1,7 @@
 //! Checks of the `[adapt]` table; each check names the key path, which
 //! `parse.rs` turns into a line of the file or a `--set`.
 
-use super::error::{Issue, SceneErrorKind as Kind, keys, num};
+use super::error::{Issue, KeyPath, SceneErrorKind as Kind, keys, num};
 use super::validate::{finite, non_negative, out_of_range, positive};
 use super::{
     Adapt, AdaptCriterion, AdaptEvery, AdaptMethod, ClothShape, Integrator, StiffnessRule,
@@ -120,7 +120,7 @@ fn criterion(a: &Adapt) -> Result<(), Issue> {
             let why = "refine_strain belongs to criterion = \"sizing\" with method = \"red_green\"";
             return Err(Issue::new(path, Kind::NotApplicable, why));
         }
-        positive(path, s)?;
+        positive_or_off(path, s)?;
     }
     if let Some(r) = a.refine_obstacle.filter(|r| *r != 0.0) {
         let path = keys(&["adapt", "refine_obstacle"]);
@@ -129,7 +129,7 @@ fn criterion(a: &Adapt) -> Result<(), Issue> {
                 "refine_obstacle belongs to criterion = \"sizing\" with method = \"red_green\"";
             return Err(Issue::new(path, Kind::NotApplicable, why));
         }
-        positive(path, r)?;
+        positive_or_off(path, r)?;
     }
     let Some(h) = a.hysteresis else {
         return Ok(());
@@ -151,4 +151,14 @@ fn criterion(a: &Adapt) -> Result<(), Issue> {
         ));
     }
     Ok(())
+}
+
+/// A threshold that is > 0, or 0 (handled by the caller) to turn its term off.
+fn positive_or_off(path: KeyPath, x: f64) -> Result<(), Issue> {
+    finite(&path, x)?;
+    if x > 0.0 {
+        return Ok(());
+    }
+    let why = format!("{} is out of range: must be > 0 (or 0: off)", num(x));
+    Err(out_of_range(path, why))
 }

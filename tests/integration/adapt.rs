@@ -501,11 +501,17 @@ fn adaptation_runs_once_per_frame_or_every_n_steps() {
 fn hanging_sheet_run_refines_rolls_back_and_reports_counts() {
     use std::sync::atomic::AtomicBool;
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/hanging_sheet.toml");
-    // Paper A's behaviour: its criterion, adapting every step.
+    // Paper A's behaviour: its criterion, thresholds and rollback, adapting
+    // every step.
     let sets: Vec<String> = [
         "simulation.duration=0.5",
         "cloth.resolution=8",
+        "adapt.max_level=4",
         "adapt.criterion=angle",
+        "adapt.refine_angle=15",
+        "adapt.coarsen_angle=1.5",
+        "adapt.refine_strain=0",
+        "adapt.rollback=true",
         "adapt.every=1",
     ]
     .iter()

@@ -241,19 +241,20 @@ fn strain_jumps_refine_the_mesh_at_point_pins() {
     use std::sync::atomic::AtomicBool;
     let path =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/hanging_sheet_rest.toml");
-    let corner_area = |strain: Option<&str>| {
+    let corner_area = |strain: &str| {
         let mut sets: Vec<String> = [
             "simulation.duration=1.0",
             "cloth.resolution=8",
             "adapt.max_level=4",
+            "adapt.refine_angle=15",
+            "adapt.coarsen_angle=1.5",
             "adapt.rollback=false",
         ]
         .iter()
         .map(|s| s.to_string())
         .collect();
-        if let Some(s) = strain {
-            sets.push(format!("adapt.refine_strain={s}"));
-        }
+        // 0 turns the term off whatever the scene sets.
+        sets.push(format!("adapt.refine_strain={strain}"));
         let scene = drape::scene::load_scene_file(&path, &sets).expect("scene");
         let mut last: Option<(Vec<drape::math::Vector2>, Vec<[u32; 3]>)> = None;
         drape::run::run_observed(
@@ -281,8 +282,8 @@ fn strain_jumps_refine_the_mesh_at_point_pins() {
                 .fold(Scalar::INFINITY, Scalar::min)
         })
     };
-    let coarse = corner_area(None);
-    let graded = corner_area(Some("0.02"));
+    let coarse = corner_area("0");
+    let graded = corner_area("0.02");
     // Base cells are 1/8 m: a base triangle has 1/128 m^2, the finest (level 4,
     // two red splits) 1/2048 m^2.
     for k in 0..2 {

@@ -147,6 +147,18 @@ fn accepted_sets(name: &str, sets: &[&str]) {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// `drape check full.toml` with all of `sets` at once: accepted.
+fn accepted_together(name: &str, sets: &[&str]) {
+    let dir = scene_dir(name);
+    let mut args = vec!["check", "full.toml"];
+    for set in sets {
+        args.extend(["--set", set]);
+    }
+    let out = drape(&dir, &args);
+    assert_eq!(out.status.code(), Some(0), "{sets:?}: {out:?}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 /// `drape check full.toml` with `set` and then `other`: refused, naming the
 /// file, `set`'s key and `why` (a key valid alone that does not apply to the
 /// settings `other` makes).
@@ -341,8 +353,13 @@ fn a_lower_threshold_above_the_upper_is_refused() {
 
 #[test]
 fn refine_strain_needs_the_sizing_rule_on_red_green_and_a_positive_value() {
-    // With the full scene's red_green and the default sizing rule it is valid.
+    // With the full scene's red_green and the default sizing rule it is valid;
+    // 0 is "off" and valid with any method, so that one `--set` undoes it.
     accepted_sets("strain", &["adapt.refine_strain=0.01"]);
+    accepted_together(
+        "strain-off",
+        &["adapt.refine_strain=0", "adapt.method=\"edge\""],
+    );
     for other in ["adapt.criterion=\"angle\"", "adapt.method=\"edge\""] {
         refused_with(
             "strain",
@@ -353,11 +370,8 @@ fn refine_strain_needs_the_sizing_rule_on_red_green_and_a_positive_value() {
     }
     refused_sets(
         "strain-range",
-        &[
-            ("adapt.refine_strain", "0"),
-            ("adapt.refine_strain", "-0.1"),
-        ],
-        "must be > 0",
+        &[("adapt.refine_strain", "-0.1")],
+        "must be > 0 (or 0: off)",
     );
 }
 
@@ -381,6 +395,10 @@ fn flipped_diagonals_are_a_pattern_but_not_for_the_tensor_method() {
 #[test]
 fn refine_obstacle_needs_the_sizing_rule_on_red_green_and_a_positive_value() {
     accepted_sets("obstacle", &["adapt.refine_obstacle=1.0"]);
+    accepted_together(
+        "obstacle-off",
+        &["adapt.refine_obstacle=0", "adapt.criterion=\"angle\""],
+    );
     for other in ["adapt.criterion=\"angle\"", "adapt.method=\"edge\""] {
         refused_with(
             "obstacle",
@@ -391,11 +409,8 @@ fn refine_obstacle_needs_the_sizing_rule_on_red_green_and_a_positive_value() {
     }
     refused_sets(
         "obstacle-range",
-        &[
-            ("adapt.refine_obstacle", "0"),
-            ("adapt.refine_obstacle", "-1"),
-        ],
-        "must be > 0",
+        &[("adapt.refine_obstacle", "-1")],
+        "must be > 0 (or 0: off)",
     );
 }
 

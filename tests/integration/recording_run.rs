@@ -51,8 +51,15 @@ fn tablecloth_short() -> Scene {
 }
 
 /// The band of angles the default edge choice keeps: within a factor `REVIEW_BAND` of the
-/// scenes' refine threshold (15 deg).
-const REVIEW_DEG: (f64, f64) = (15.0 / REVIEW_BAND, 15.0 * REVIEW_BAND);
+/// scene's refine threshold.
+fn review_band(scene: &Scene) -> (f64, f64) {
+    let refine = scene
+        .adapt
+        .as_ref()
+        .expect("an adaptive scene")
+        .refine_angle;
+    (refine / REVIEW_BAND, refine * REVIEW_BAND)
+}
 
 /// Every frame has one mesh row, one `triangle_level` per triangle, the triangle count of the
 /// `mesh/triangles` plot, and the edges: with `all_edges` (a disk-like sheet) `V + T - 1` of
@@ -60,7 +67,7 @@ const REVIEW_DEG: (f64, f64) = (15.0 / REVIEW_BAND, 15.0 * REVIEW_BAND);
 /// at most that many, every one in the band near the refine threshold, none when the largest
 /// angle is below the band, and the largest one whenever it is in the band (the angles are
 /// recorded as `f32`).
-fn check_frames(ins: &Inspection, all_edges: bool) {
+fn check_frames(ins: &Inspection, all_edges: bool, (low, high): (f64, f64)) {
     let topology = ins.frames.values().filter(|f| f.topology).count();
     assert!(
         ins.frames.values().next().is_some_and(|f| f.topology),
@@ -75,7 +82,6 @@ fn check_frames(ins: &Inspection, all_edges: bool) {
         let verts = f.vertices().expect("vertex plot") as usize;
         let edges = f.edges.expect("edges row");
         let plotted = f.scalars["angle/max_deg"];
-        let (low, high) = REVIEW_DEG;
         // The f32 angle of an edge at exactly a bound may round to either side of it.
         let slack = 1e-6;
         if all_edges {
@@ -123,7 +129,8 @@ fn check_event_counts(ins: &Inspection, summary: &Summary) {
 #[test]
 fn adaptive_run_holds_the_whole_schema() {
     let out = temp_path("schema.rrd");
-    let summary = record(&tablecloth_short(), &out, RunOptions::default()).expect("run");
+    let scene = tablecloth_short();
+    let summary = record(&scene, &out, RunOptions::default()).expect("run");
     let ins = inspect(&out).expect("decodes");
     assert!(ins.footer);
     let mut expected: BTreeSet<String> = [
@@ -174,7 +181,7 @@ fn adaptive_run_holds_the_whole_schema() {
     assert_eq!(rec.frames, summary.frames);
     assert_eq!(rec.bytes, ins.bytes);
     assert!(summary.splits > 0, "the short run refines");
-    check_frames(&ins, false);
+    check_frames(&ins, false, review_band(&scene));
     check_event_counts(&ins, &summary);
     std::fs::remove_file(&out).ok();
 }
@@ -247,7 +254,7 @@ fn record_every_thins_frames_and_keeps_every_event() {
         summary.recording.as_ref().map(|r| r.frames),
         Some(got.len() as u64)
     );
-    check_frames(&ins, false);
+    check_frames(&ins, false, review_band(&scene));
     check_event_counts(&ins, &summary);
     std::fs::remove_file(&out).ok();
 }
@@ -284,8 +291,8 @@ fn edge_options_filter_or_drop_cloth_edges() {
         inspect(&review).expect("review"),
     );
     assert!(!none_i.entities.contains_key("/cloth/edges"));
-    check_frames(&all_i, true);
-    check_frames(&review_i, false);
+    check_frames(&all_i, true, review_band(&scene));
+    check_frames(&review_i, false, review_band(&scene));
     let kept = |i: &Inspection| i.frames.values().filter_map(|f| f.edges).sum::<usize>();
     assert!(
         kept(&review_i) < kept(&all_i),
