@@ -643,7 +643,7 @@ fn shipped_scenes_are_valid() {
     let s = default_scene(&[]).expect("default scene");
     assert_eq!(
         (s.name.as_str(), s.cloth.resolution, s.pin.len()),
-        ("default", Some(16), 2)
+        ("default", Some(8), 2)
     );
     let adapt = s.adapt.as_ref().expect("the default scene adapts");
     assert_eq!(adapt.method, drape::scene::AdaptMethod::RedGreen);
