@@ -234,8 +234,11 @@ pub fn default_ladder(scene: &Scene) -> Ladder {
             format!("adapt.max_level={level}"),
         ];
         if m != "red_green" {
-            // Rollback is paper A's, on red-green's hierarchy only.
+            // Rollback is paper A's, on red-green's hierarchy only, and the
+            // strain and obstacle terms are red-green's sizing rule's: off.
             set.push("adapt.rollback=false".into());
+            set.push("adapt.refine_strain=0".into());
+            set.push("adapt.refine_obstacle=0".into());
         }
         Rung::new(format!("{m} {res} L{level}"), set)
     };

@@ -529,3 +529,27 @@ fn bench_cli_plans_collects_and_rejects_unknown_rungs() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// The default ladder's rungs of the other method turn the red-green sizing
+/// rule's strain and obstacle terms off, so that it plans on every shipped
+/// scene, including those that set them (the tablecloth, the hanging sheets).
+#[test]
+fn the_default_ladder_plans_on_every_shipped_adaptive_scene() {
+    let dir = temp_dir("default-ladder");
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    for name in ["tablecloth", "hanging_sheet", "hanging_sheet_rest", "flag"] {
+        let scene = root.join("scenes").join(format!("{name}.toml"));
+        let out = Command::new(env!("CARGO_BIN_EXE_drape"))
+            .args(["bench", "plan", scene.to_str().expect("utf-8")])
+            .args(["--duration", "0.1", "--out", name])
+            .current_dir(&dir)
+            .output()
+            .expect("drape runs");
+        assert!(
+            out.status.success(),
+            "{name}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

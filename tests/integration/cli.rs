@@ -304,6 +304,8 @@ fn set_cloth_resolution_changes_the_vertex_count() {
             SHORT,
             "--set",
             "cloth.resolution=8",
+            "--set",
+            "adapt.method=none",
             "--no-record",
             "--summary",
             "s.json",

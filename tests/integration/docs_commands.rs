@@ -144,14 +144,14 @@ fn drape(args: &[String], dir: &Path) -> Output {
         .expect("drape runs")
 }
 
-/// A working directory that looks like the repository root (`scenes/` and
-/// `docs/` linked), holding the docs' example scenes under their names and a
+/// A working directory that looks like the repository root (`scenes/`,
+/// `docs/` and `src/`, which holds the default scene's file, linked), holding the docs' example scenes under their names and a
 /// short recording `default.rrd` for the `inspect` examples.
 fn workdir() -> PathBuf {
     let dir = std::env::temp_dir().join(format!("drape-docs-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).expect("temp dir");
-    for d in ["scenes", "docs"] {
+    for d in ["scenes", "docs", "src"] {
         std::os::unix::fs::symlink(repo().join(d), dir.join(d)).expect("link");
     }
     for doc in documents() {

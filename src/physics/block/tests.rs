@@ -18,6 +18,7 @@ fn meshes() -> (Vec<Mesh>, MaterialParams) {
         "cloth.resolution=12",
         "adapt.method=red_green",
         "adapt.criterion=angle",
+        "adapt.refine_strain=0",
     ];
     let scene = default_scene(&overrides.map(String::from)).expect("the default scene");
     let grid = World::from_scene(&scene).expect("its sheet").mesh;
