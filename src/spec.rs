@@ -228,6 +228,57 @@ pub struct Obstacle {
     /// Rotation axis in world coordinates (normalised; not zero when `angular_velocity` is set).
     #[serde(default = "default_axis")]
     pub axis: [f64; 3],
+    /// Keyframed motion instead of `velocity` and `angular_velocity`: poses
+    /// relative to the placement at rest, at increasing times (at least two;
+    /// none: no keyframes). See `src/collide/motion.rs`.
+    #[serde(default)]
+    pub keyframes: Vec<Keyframe>,
+    /// How poses between keyframes are interpolated.
+    #[serde(default)]
+    pub easing: KeyframeEasing,
+    /// What the obstacle does after its last keyframe.
+    #[serde(default)]
+    pub after_last: KeyframeAfter,
+}
+
+/// `[[obstacle.keyframes]]`: the obstacle's pose at one time, relative to its
+/// placement at rest (`position`, `rotation`).
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Keyframe {
+    /// Simulated time of the key, s.
+    pub time: f64,
+    /// Displacement of the obstacle's origin, m.
+    #[serde(default)]
+    pub translation: [f64; 3],
+    /// Rotation about the obstacle's origin: Euler angles in degrees (about x,
+    /// then y, then z, as `rotation`).
+    #[serde(default)]
+    pub rotation: [f64; 3],
+}
+
+/// How an obstacle moves between two keyframes.
+#[derive(Debug, Clone, Copy, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum KeyframeEasing {
+    /// At a constant velocity and spin between keys (jumps at the keys).
+    #[default]
+    Linear,
+    /// Easing in and out of every key: the velocity is zero at the keys and
+    /// continuous (C1).
+    Smooth,
+}
+
+/// What a keyframed obstacle does after its last key.
+#[derive(Debug, Clone, Copy, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum KeyframeAfter {
+    /// It stays at the last key.
+    #[default]
+    Hold,
+    /// The keys repeat with the period from the first key to the last (the
+    /// last key's pose must equal the first's).
+    Loop,
 }
 
 /// The shape of an obstacle.

@@ -33,6 +33,7 @@
 
 pub mod cusick;
 pub mod geometry;
+pub mod motion;
 pub mod obstacle;
 mod response;
 pub mod selfcol;
@@ -187,7 +188,7 @@ impl Obstacles {
                     b.thickness,
                     b.mu_static,
                     b.mu_kinetic,
-                    if b.is_moving() { ", moving" } else { "" }
+                    b.motion().describe()
                 )
             })
             .collect();

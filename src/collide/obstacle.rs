@@ -11,6 +11,7 @@ use parry3d_f64::shape::{
 };
 
 use super::CollideError;
+use super::motion::{Motion, Track};
 use crate::adapt::proximity::ObstaclePlane;
 use crate::math::{Scalar, Vector, rotation_from_euler_deg};
 use crate::spec::{Obstacle, ObstacleShape};
@@ -24,11 +25,10 @@ pub struct Body {
     shape: Box<dyn Shape>,
     /// Pose of the shape's local frame at t = 0 (includes the z-up fix of parry's y-axis cylinder).
     pose0: Pose,
-    /// World position of the obstacle's origin at t = 0 (the rotation centre).
+    /// World position of the obstacle's origin at rest (the rotation centre).
     origin: Vector,
-    velocity: Vector,
-    /// Angular velocity vector (axis times rad/s).
-    omega: Vector,
+    /// How it moves from its placement at rest.
+    motion: Motion,
     /// Static friction coefficient.
     pub mu_static: Scalar,
     /// Kinetic friction coefficient.
@@ -106,8 +106,7 @@ impl Body {
             shape,
             pose0,
             origin,
-            velocity: Vector::from_array(o.velocity),
-            omega: axis * o.angular_velocity,
+            motion: motion(o, axis),
             mu_static: o.friction_static,
             mu_kinetic: o.friction_kinetic.unwrap_or(o.friction_static),
             thickness: t,
@@ -117,25 +116,30 @@ impl Body {
 
     /// True when the obstacle moves.
     pub fn is_moving(&self) -> bool {
-        self.velocity != Vector::ZERO || self.omega != Vector::ZERO
+        self.motion.is_moving()
     }
 
-    /// Pose of the local frame at time `t`: translated by `velocity t`, rotated by
-    /// `|omega| t` about the axis through the moving origin.
+    /// How the obstacle moves.
+    pub fn motion(&self) -> &Motion {
+        &self.motion
+    }
+
+    /// Pose of the local frame at time `t`: the placement at rest turned about
+    /// the origin and the origin moved, as the motion says at `t`.
     pub fn pose(&self, t: Scalar) -> Pose {
         if !self.is_moving() {
             return self.pose0;
         }
-        let angle = self.omega.length() * t;
-        let spin = glam::DQuat::from_axis_angle(self.omega.normalize_or(Vector::Z), angle);
-        let centre = self.origin + self.velocity * t;
-        let offset = spin * (self.pose0.translation - self.origin);
-        Pose::from_parts(centre + offset, spin * self.pose0.rotation)
+        let state = self.motion.state(t);
+        let centre = self.origin + state.shift;
+        let offset = state.rotation * (self.pose0.translation - self.origin);
+        Pose::from_parts(centre + offset, state.rotation * self.pose0.rotation)
     }
 
     /// Velocity at time `t` of the obstacle's material point at world position `x`.
     pub fn point_velocity(&self, t: Scalar, x: Vector) -> Vector {
-        self.velocity + self.omega.cross(x - (self.origin + self.velocity * t))
+        let state = self.motion.state(t);
+        state.velocity + state.omega.cross(x - (self.origin + state.shift))
     }
 
     /// True when the local segment `a`-`b` may come within the thickness of the shape.
@@ -307,4 +311,19 @@ fn load_mesh(index: usize, path: &Path, scale: Scalar) -> Result<TriMesh, Collid
         TriMeshFlags::ORIENTED | TriMeshFlags::MERGE_DUPLICATE_VERTICES,
     )
     .map_err(|e| err(format!("{e:?}")))
+}
+
+/// The motion an obstacle's keys ask for: keyframes, else a constant velocity
+/// and spin about `axis` (normalised), else none.
+fn motion(o: &Obstacle, axis: Vector) -> Motion {
+    if !o.keyframes.is_empty() {
+        return Motion::Keyframed(Track::new(&o.keyframes, o.easing, o.after_last));
+    }
+    let velocity = Vector::from_array(o.velocity);
+    let omega = axis * o.angular_velocity;
+    if velocity == Vector::ZERO && omega == Vector::ZERO {
+        Motion::Fixed
+    } else {
+        Motion::Constant { velocity, omega }
+    }
 }

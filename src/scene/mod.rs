@@ -19,6 +19,7 @@ mod validate;
 mod validate_adapt;
 mod validate_collide;
 mod validate_measure;
+mod validate_motion;
 
 use std::path::Path;
 

@@ -9,8 +9,8 @@ use serde::Deserialize;
 // The engine's own types, deserialised straight from the file (see `crate::spec`).
 pub use crate::spec::{
     Adapt, AdaptCriterion, AdaptEvery, AdaptMethod, BendingModel, ClothShape, DEFAULT_THICKNESS,
-    DiagonalPattern, Integrator, Measurement, Obstacle, ObstacleShape, Pin, PinMotion,
-    SelfCollision, Solver, StiffnessRule,
+    DiagonalPattern, Integrator, Keyframe, KeyframeAfter, KeyframeEasing, Measurement, Obstacle,
+    ObstacleShape, Pin, PinMotion, SelfCollision, Solver, StiffnessRule,
 };
 
 /// A whole scene file.

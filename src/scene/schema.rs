@@ -76,6 +76,14 @@ pub(crate) fn allowed(path: &str) -> Option<&'static str> {
         "obstacle.velocity" => "an array of 3 finite numbers (m/s)",
         "obstacle.angular_velocity" => "a finite number (rad/s)",
         "obstacle.axis" => "an array of 3 finite numbers, not all zero",
+        "obstacle.keyframes" => {
+            "an array of at least two tables {time, translation, rotation} with increasing times"
+        }
+        "obstacle.keyframes.time" => "a finite number (s), larger than the key before's",
+        "obstacle.keyframes.translation" => "an array of 3 finite numbers (m)",
+        "obstacle.keyframes.rotation" => "an array of 3 finite numbers (degrees)",
+        "obstacle.easing" => "\"linear\" or \"smooth\"",
+        "obstacle.after_last" => "\"hold\" or \"loop\"",
         "self_collision" => "a table [self_collision]",
         "self_collision.thickness" => "a finite number > 0 (m)",
         "self_collision.iterations" => "an integer >= 1",

@@ -35,6 +35,7 @@ pub(crate) fn validate(scene: &Scene, doc: &Table) -> Result<(), Issue> {
     for (i, o) in scene.obstacle.iter().enumerate() {
         let written = obstacles.and_then(|a| a.get(i)).and_then(Value::as_table);
         super::validate_collide::obstacle(i, o, written)?;
+        super::validate_motion::keyframes(i, o, written)?;
     }
     if let Some(s) = &scene.self_collision {
         super::validate_collide::self_collision(s)?;

@@ -21,6 +21,7 @@ mod energy;
 mod fuzz;
 mod gradient;
 mod inspect_cli;
+mod keyframes;
 mod mesh;
 mod metric;
 mod physics;
