@@ -353,6 +353,16 @@ fn describe_pins(s: &mut String, scene: &Scene, world: &World) {
                     pin.axis, pin.center, pin.angular_velocity
                 )
             }
+            PinMotion::Keyframed => format!(
+                "keyframed: {} keys from {} s to {} s about {:?}, {:?} easing, then {:?}",
+                pin.keyframes.len(),
+                pin.keyframes.first().map_or(0.0, |k| k.time),
+                pin.keyframes.last().map_or(0.0, |k| k.time),
+                pin.center,
+                pin.easing,
+                pin.after_last
+            )
+            .to_lowercase(),
         };
         let release = pin
             .release_time

@@ -1,6 +1,7 @@
 //! Pinned vertices: selected by named region in material space (so a selection
 //! means the same cloth points on any mesh) and moved by a script.
 
+use crate::collide::motion::Track;
 use crate::math::{Matrix3, Scalar, Vector, Vector2};
 use crate::mesh::Mesh;
 use crate::spec::{Pin, PinMotion};
@@ -35,7 +36,7 @@ pub enum PinError {
 }
 
 /// The motion script of one `[[pin]]`.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct PinScript {
     /// Kind of motion.
     pub motion: PinMotion,
@@ -51,6 +52,9 @@ pub struct PinScript {
     pub angular_velocity: Scalar,
     /// Time at which the pin lets go, s.
     pub release_time: Option<Scalar>,
+    /// The keyframes of a `keyframed` pin (validated: at least two); `None`
+    /// for the other motions.
+    pub track: Option<Track>,
 }
 
 impl PinScript {
@@ -69,6 +73,16 @@ impl PinScript {
                     p,
                     (self.axis * self.angular_velocity).cross(p - self.center),
                 )
+            }
+            PinMotion::Keyframed => {
+                // `Pins::select` builds a track for every keyframed pin.
+                let Some(track) = &self.track else {
+                    return (start, Vector::ZERO);
+                };
+                let s = track.state(t);
+                let centre = self.center + s.shift;
+                let p = centre + s.rotation * (start - self.center);
+                (p, s.velocity + s.omega.cross(p - centre))
             }
         }
     }
@@ -130,6 +144,8 @@ impl Pins {
                 axis: Vector::from_array(pin.axis).normalize_or_zero(),
                 angular_velocity: pin.angular_velocity,
                 release_time: pin.release_time,
+                track: (pin.motion == PinMotion::Keyframed)
+                    .then(|| Track::new(&pin.keyframes, pin.easing, pin.after_last)),
             });
         }
         let anchors = owner

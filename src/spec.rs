@@ -166,6 +166,16 @@ pub struct Pin {
     pub angular_velocity: f64,
     /// Time in s at which the pin lets go (absent: never).
     pub release_time: Option<f64>,
+    /// `motion = "keyframed"`: the held cloth's pose at increasing times
+    /// (translation, and rotation about `center`), relative to where it starts.
+    #[serde(default)]
+    pub keyframes: Vec<Keyframe>,
+    /// `motion = "keyframed"`: how poses between keys are interpolated.
+    #[serde(default)]
+    pub easing: KeyframeEasing,
+    /// `motion = "keyframed"`: what the pin does after its last key.
+    #[serde(default)]
+    pub after_last: KeyframeAfter,
 }
 
 /// How a pin moves.
@@ -179,6 +189,9 @@ pub enum PinMotion {
     Linear,
     /// Rotation about `axis` through `center` at `angular_velocity`.
     Circular,
+    /// Along `keyframes`: moved by each key's translation and turned by its
+    /// rotation about `center` (see `src/collide/motion.rs`).
+    Keyframed,
 }
 
 /// `[[obstacle]]`: a rigid obstacle the cloth collides with (a parry3d shape).

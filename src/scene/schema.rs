@@ -48,12 +48,20 @@ pub(crate) fn allowed(path: &str) -> Option<&'static str> {
         "pin.box_min" | "pin.box_max" => {
             "an array of 2 finite numbers (material coordinates, m), box_min < box_max"
         }
-        "pin.motion" => "\"fixed\", \"linear\" or \"circular\"",
+        "pin.motion" => "\"fixed\", \"linear\", \"circular\" or \"keyframed\"",
         "pin.velocity" => "an array of 3 finite numbers (m/s)",
         "pin.acceleration" => "an array of 3 finite numbers (m/s^2)",
         "pin.center" => "an array of 3 finite numbers (m)",
         "pin.axis" => "an array of 3 finite numbers, not all zero",
         "pin.angular_velocity" => "a finite number (rad/s)",
+        "pin.keyframes" => {
+            "an array of at least two tables {time, translation, rotation} with increasing times (motion = \"keyframed\")"
+        }
+        "pin.keyframes.time" => "a finite number (s), larger than the key before's",
+        "pin.keyframes.translation" => "an array of 3 finite numbers (m)",
+        "pin.keyframes.rotation" => "an array of 3 finite numbers (degrees)",
+        "pin.easing" => "\"linear\" or \"smooth\"",
+        "pin.after_last" => "\"hold\" or \"loop\"",
         "pin.release_time" => "a finite number >= 0 (s)",
         "air" => "a table [air]",
         "air.drag" => "a finite number >= 0 (kg/(m^2 s))",

@@ -420,10 +420,14 @@ fn check_pin_motion(
         ),
         PinMotion::Linear => ("linear", &["center", "axis", "angular_velocity"]),
         PinMotion::Circular => ("circular", &["velocity", "acceleration"]),
+        PinMotion::Keyframed => (
+            "keyframed",
+            &["velocity", "acceleration", "axis", "angular_velocity"],
+        ),
     };
     if let Some(k) = foreign.iter().find(|k| has(k)) {
         return Err(Issue::new(at(k), Kind::NotApplicable, format!("`{k}` does not apply to motion = \"{motion}\""))
-            .allowed("velocity and acceleration for \"linear\"; center, axis and angular_velocity for \"circular\"")
+            .allowed("velocity and acceleration for \"linear\"; center, axis and angular_velocity for \"circular\"; keyframes and center for \"keyframed\"")
             .because(at("motion")));
     }
     all_finite(at("velocity"), &p.velocity)?;
@@ -444,7 +448,7 @@ fn check_pin_motion(
     if let Some(t) = p.release_time {
         non_negative(at("release_time"), t)?;
     }
-    Ok(())
+    super::validate_motion::pin_keyframes(p, at, has)
 }
 
 fn air(a: &Air) -> Result<(), Issue> {

@@ -1,12 +1,12 @@
-//! Checks of an obstacle's keyframed motion (`keyframes`, `easing`,
-//! `after_last`); each check names the key path, which `parse.rs` turns into a
+//! Checks of keyframed motion (`keyframes`, `easing`, `after_last`) of
+//! obstacles and pins; each check names the key path, which `parse.rs` turns into a
 //! line of the file or a `--set`.
 
 use toml::Table;
 
 use super::error::{Issue, KeyPath, SceneErrorKind as Kind, Seg};
 use super::validate::{all_finite, finite, out_of_range};
-use super::{KeyframeAfter, Obstacle};
+use super::{Keyframe, KeyframeAfter, Obstacle, Pin, PinMotion};
 use crate::math::rotation_from_euler_deg;
 
 /// Largest difference between the last and the first key of a loop, m or
@@ -24,12 +24,7 @@ pub(super) fn keyframes(i: usize, o: &Obstacle, written: Option<&Table>) -> Resu
     };
     let has = |k: &str| written.is_some_and(|t| t.contains_key(k));
     if o.keyframes.is_empty() {
-        if let Some(k) = ["easing", "after_last"].into_iter().find(|k| has(k)) {
-            let why =
-                format!("`{k}` belongs to keyframed motion, and this obstacle has no `keyframes`");
-            return Err(Issue::new(at(k), Kind::NotApplicable, why));
-        }
-        return Ok(());
+        return unused(&at, &has, "this obstacle has no `keyframes`");
     }
     for k in ["velocity", "angular_velocity"] {
         if has(k) {
@@ -37,12 +32,52 @@ pub(super) fn keyframes(i: usize, o: &Obstacle, written: Option<&Table>) -> Resu
             return Err(Issue::new(at(k), Kind::NotApplicable, why).because(at("keyframes")));
         }
     }
-    if o.keyframes.len() < 2 {
+    track(&at, &o.keyframes, o.after_last)
+}
+
+/// Checks pin `i`'s keyframes: present exactly with `motion = "keyframed"`.
+pub(super) fn pin_keyframes(
+    p: &Pin,
+    at: &dyn Fn(&str) -> KeyPath,
+    has: &dyn Fn(&str) -> bool,
+) -> Result<(), Issue> {
+    if p.motion != PinMotion::Keyframed {
+        if has("keyframes") {
+            let why = "`keyframes` belongs to motion = \"keyframed\"";
+            return Err(Issue::new(at("keyframes"), Kind::NotApplicable, why).because(at("motion")));
+        }
+        return unused(at, has, "this pin's motion is not \"keyframed\"");
+    }
+    track(at, &p.keyframes, p.after_last)
+}
+
+/// `easing` and `after_last` without keyframes: refused, `why` saying so.
+fn unused(
+    at: &dyn Fn(&str) -> KeyPath,
+    has: &dyn Fn(&str) -> bool,
+    why: &str,
+) -> Result<(), Issue> {
+    match ["easing", "after_last"].into_iter().find(|k| has(k)) {
+        Some(k) => {
+            let why = format!("`{k}` belongs to keyframed motion, and {why}");
+            Err(Issue::new(at(k), Kind::NotApplicable, why))
+        }
+        None => Ok(()),
+    }
+}
+
+/// At least two keys, finite, at increasing times; a loop that does not jump.
+fn track(
+    at: &dyn Fn(&str) -> KeyPath,
+    keys: &[Keyframe],
+    after: KeyframeAfter,
+) -> Result<(), Issue> {
+    if keys.len() < 2 {
         return Err(out_of_range(
             at("keyframes"),
             format!(
-                "{} key given: a keyframed motion needs at least two (a still obstacle needs none)",
-                o.keyframes.len()
+                "{} key given: a keyframed motion needs at least two (a still one needs none)",
+                keys.len()
             ),
         ));
     }
@@ -51,31 +86,31 @@ pub(super) fn keyframes(i: usize, o: &Obstacle, written: Option<&Table>) -> Resu
         p.extend([Seg::Index(n), Seg::Key(k.into())]);
         p
     };
-    for (n, k) in o.keyframes.iter().enumerate() {
+    for (n, k) in keys.iter().enumerate() {
         finite(&key(n, "time"), k.time)?;
         all_finite(key(n, "translation"), &k.translation)?;
         all_finite(key(n, "rotation"), &k.rotation)?;
-        if n > 0 && k.time <= o.keyframes[n - 1].time {
+        if n > 0 && k.time <= keys[n - 1].time {
             return Err(out_of_range(
                 key(n, "time"),
                 format!(
                     "{} s is not after the key before it ({} s): key times must increase",
                     k.time,
-                    o.keyframes[n - 1].time
+                    keys[n - 1].time
                 ),
             ));
         }
     }
-    if o.after_last == KeyframeAfter::Loop {
-        looped(o, at("after_last"))?;
+    if after == KeyframeAfter::Loop {
+        looped(keys, at("after_last"))?;
     }
     Ok(())
 }
 
 /// A loop's last key must repeat the first key's pose, or the obstacle jumps
 /// where the loop wraps around.
-fn looped(o: &Obstacle, path: KeyPath) -> Result<(), Issue> {
-    let (first, last) = (&o.keyframes[0], &o.keyframes[o.keyframes.len() - 1]);
+fn looped(keys: &[Keyframe], path: KeyPath) -> Result<(), Issue> {
+    let (first, last) = (&keys[0], &keys[keys.len() - 1]);
     let quat = |r: [f64; 3]| glam::DQuat::from_mat3(&rotation_from_euler_deg(r)).normalize();
     let moved = first
         .translation

@@ -252,3 +252,79 @@ fn keyframe_mistakes_name_the_key() {
         "{e}"
     );
 }
+
+/// A curtain's top edge on keyframed pins: moved 0.5 m along x, then turned a
+/// quarter turn about z through `center` (the origin) as it moves.
+const CURTAIN: &str = r#"
+name = "curtain"
+[simulation]
+duration = 2.0
+[cloth]
+shape = "rectangle"
+width = 1.0
+height = 1.0
+resolution = 12
+position = [0.0, 0.0, 1.0]
+rotation = [90.0, 0.0, 0.0]
+[material]
+density = 0.15
+stretch = 200.0
+bending = 1.0e-5
+damping = 0.001
+[[pin]]
+region = "edge:top"
+motion = "keyframed"
+easing = "smooth"
+keyframes = [
+  { time = 0.0 },
+  { time = 1.0, translation = [0.5, 0.0, 0.0] },
+  { time = 2.0, translation = [0.5, 0.0, 0.0], rotation = [0.0, 0.0, 90.0] },
+]
+"#;
+
+#[test]
+fn keyframed_pins_hold_the_cloth_where_the_keys_say() {
+    let scene = load_scene_str(CURTAIN, "curtain", &[]).expect("scene");
+    let mut worst: f64 = 0.0;
+    let mut checked = 0;
+    drape::run::run_observed(
+        &scene,
+        &drape::run::RunOptions::default(),
+        &AtomicBool::new(false),
+        &mut |_| {},
+        &mut |f| {
+            for (m, p) in f.material.iter().zip(f.positions) {
+                if (m.y - 0.5).abs() > 1e-12 {
+                    continue;
+                }
+                // The top edge starts at (u, 0, 1.5).
+                let expected = if (f.sim_time - 1.0).abs() < 1e-9 {
+                    Some(Vector::new(m.x + 0.5, 0.0, 1.5))
+                } else if (f.sim_time - 2.0).abs() < 1e-9 {
+                    Some(Vector::new(0.5, m.x, 1.5))
+                } else {
+                    None
+                };
+                if let Some(e) = expected {
+                    worst = worst.max((*p - e).length());
+                    checked += 1;
+                }
+            }
+        },
+    )
+    .expect("run");
+    println!("{checked} pinned positions at the keys, largest deviation {worst:.1e} m");
+    assert_eq!(checked, 26, "13 top-edge vertices at two keys");
+    assert!(worst < 1e-9, "{worst} m");
+    let e = load_scene_str(CURTAIN, "curtain", &["pin.0.motion=fixed".into()])
+        .expect_err("keyframes without the motion")
+        .to_string();
+    assert!(
+        e.contains("`keyframes` belongs to motion = \"keyframed\""),
+        "{e}"
+    );
+    let e = load_scene_str(CURTAIN, "curtain", &["pin.0.keyframes=[]".into()])
+        .expect_err("the motion without keyframes")
+        .to_string();
+    assert!(e.contains("needs at least two"), "{e}");
+}
