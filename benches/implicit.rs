@@ -58,6 +58,9 @@ fn corner(region: &str) -> Pin {
         axis: [0.0, 0.0, 1.0],
         angular_velocity: 0.0,
         release_time: None,
+        keyframes: Vec::new(),
+        easing: Default::default(),
+        after_last: Default::default(),
     }
 }
 
