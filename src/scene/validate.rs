@@ -7,7 +7,10 @@ use toml::{Table, Value};
 
 use super::error::{Issue, KeyPath, SceneErrorKind as Kind, Seg, dotted, keys, num};
 use super::schema;
-use super::{Air, Cloth, ClothShape, Material, Pin, PinMotion, Scene, Simulation, TimeStep, Wind};
+use super::{
+    Air, Cloth, ClothShape, Material, MembraneModel, Pin, PinMotion, Scene, Simulation, TimeStep,
+    Wind,
+};
 
 /// The first problem in `scene`, if any. `doc` is the document it came from
 /// (after `--set`), used to tell keys that were written from defaults.
@@ -292,6 +295,7 @@ fn material(m: &Material, written: Option<&Table>, gravity: [f64; 3]) -> Result<
     let at = |k: &str| keys(&["material", k]);
     positive(at("density"), m.density)?;
     positive(at("stretch"), m.stretch)?;
+    moduli(m)?;
     non_negative(at("bending"), m.bending)?;
     if let Some(c) = m.bending_length {
         if written.is_some_and(|t| t.contains_key("bending")) {
@@ -315,6 +319,26 @@ fn material(m: &Material, written: Option<&Table>, gravity: [f64; 3]) -> Result<
         }
     }
     non_negative(at("damping"), m.damping)
+}
+
+/// The triangle membrane's `warp`, `weft` and `shear`: positive, and only with
+/// `membrane = "triangles"` (the springs have one constant, `stretch`).
+fn moduli(m: &Material) -> Result<(), Issue> {
+    let at = |k: &str| keys(&["material", k]);
+    for (key, value) in [("warp", m.warp), ("weft", m.weft), ("shear", m.shear)] {
+        let Some(value) = value else { continue };
+        if m.membrane != MembraneModel::Triangles {
+            return Err(Issue::new(
+                at(key),
+                Kind::NotApplicable,
+                format!("`{key}` is a modulus of the triangle membrane; the springs have one constant, `stretch`"),
+            )
+            .allowed("membrane = \"triangles\" with warp, weft and shear, or `stretch` alone")
+            .because(at("membrane")));
+        }
+        positive(at(key), value)?;
+    }
+    Ok(())
 }
 
 fn check_pin(i: usize, p: &Pin, shape: ClothShape, written: Option<&Table>) -> Result<(), Issue> {

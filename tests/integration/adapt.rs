@@ -52,6 +52,7 @@ fn swinging_stepper(
     let material = MaterialParams {
         density: DENSITY,
         stretch: 200.0,
+        membrane: drape::physics::Membrane::Springs,
         bending: 1e-5,
         damping,
         bending_model: BendingModel::Dihedral,
