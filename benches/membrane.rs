@@ -28,7 +28,10 @@ use drape::world::World;
 fn membranes() -> [(&'static str, Membrane); 2] {
     [
         ("springs", Membrane::Springs),
-        ("triangles", Membrane::Triangles(Orthotropic::isotropic(200.0))),
+        (
+            "triangles",
+            Membrane::Triangles(Orthotropic::isotropic(200.0)),
+        ),
     ]
 }
 
@@ -39,7 +42,13 @@ fn setup(resolution: u32, membrane: Membrane) -> (World, Model) {
     let x = mesh
         .material
         .iter()
-        .map(|p| Vector::new(1.01 * p.x, 1.01 * p.y, 0.01 * (7.0 * p.x).sin() * (5.0 * p.y).cos()))
+        .map(|p| {
+            Vector::new(
+                1.01 * p.x,
+                1.01 * p.y,
+                0.01 * (7.0 * p.x).sin() * (5.0 * p.y).cos(),
+            )
+        })
         .collect();
     let world = World::new(mesh, x);
     let model = Model {
@@ -83,7 +92,14 @@ fn forces(c: &mut Criterion) {
             group.bench_function(BenchmarkId::new(label, n), |b| {
                 b.iter(|| {
                     let ext = &model.external;
-                    element_pass(el, ext, &world.mesh.triangles, &world.x, &world.v, &mut scratch);
+                    element_pass(
+                        el,
+                        ext,
+                        &world.mesh.triangles,
+                        &world.x,
+                        &world.v,
+                        &mut scratch,
+                    );
                     for (i, f) in out.iter_mut().enumerate() {
                         *f = gather(el, ext, &scratch, i, world.v[i]);
                     }

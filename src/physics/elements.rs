@@ -304,9 +304,12 @@ impl Elements {
         );
         self.membrane_slots.fill(
             n,
-            self.membrane_triangles.iter().enumerate().flat_map(|(t, m)| {
-                (0..MEMBRANE_SLOTS).map(move |k| (m.v[k], (MEMBRANE_SLOTS * t + k) as u32))
-            }),
+            self.membrane_triangles
+                .iter()
+                .enumerate()
+                .flat_map(|(t, m)| {
+                    (0..MEMBRANE_SLOTS).map(move |k| (m.v[k], (MEMBRANE_SLOTS * t + k) as u32))
+                }),
         );
         let pairs = &mut self.scratch.shape_pairs;
         pairs.clear();

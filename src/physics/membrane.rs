@@ -178,7 +178,10 @@ impl MembraneTriangle {
         let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
         let det = e1.perp_dot(e2);
         // Rows of the inverse of [e1 e2]: d(barycentric 1, 2)/d(u, v).
-        let (g1, g2) = (Vector2::new(e2.y, -e2.x) / det, Vector2::new(-e1.y, e1.x) / det);
+        let (g1, g2) = (
+            Vector2::new(e2.y, -e2.x) / det,
+            Vector2::new(-e1.y, e1.x) / det,
+        );
         MembraneTriangle {
             v,
             du: [-g1.x - g2.x, g1.x, g2.x],

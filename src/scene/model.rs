@@ -7,12 +7,12 @@
 use serde::Deserialize;
 
 // The engine's own types, deserialised straight from the file (see `crate::spec`).
+use crate::physics::membrane::{Membrane, Orthotropic};
 pub use crate::spec::{
     Adapt, AdaptCriterion, AdaptEvery, AdaptMethod, BendingModel, ClothShape, DEFAULT_THICKNESS,
     DiagonalPattern, Integrator, Measurement, MembraneModel, Obstacle, ObstacleShape, Pin,
     PinMotion, SelfCollision, Solver, StiffnessRule,
 };
-use crate::physics::membrane::{Membrane, Orthotropic};
 
 /// A whole scene file.
 #[derive(Debug, Clone, Deserialize, PartialEq)]

@@ -111,7 +111,12 @@ fn strip_mesh(overhang: Scalar, res: u32, across: Option<u32>) -> Mesh {
 }
 
 /// Solves the clamped strip on `m` (flat in z = 0 at rest) in place.
-pub(crate) fn settle_on(m: &Mesh, x: &mut [Vector], mat: &MaterialParams, overhang: Scalar) -> Settled {
+pub(crate) fn settle_on(
+    m: &Mesh,
+    x: &mut [Vector],
+    mat: &MaterialParams,
+    overhang: Scalar,
+) -> Settled {
     let (lo, hi) = m.material_bounds();
     let clamp = lo.x + overhang / 8.0;
     let fixed: Vec<bool> = m

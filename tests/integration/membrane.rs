@@ -168,7 +168,11 @@ fn patch(m: &Mesh, mat: &MaterialParams, g: [[Scalar; 2]; 2], r: Matrix3) -> Pat
         .material
         .iter()
         .map(|p| {
-            let q = Vector::new(g[0][0] * p.x + g[0][1] * p.y, g[1][0] * p.x + g[1][1] * p.y, 0.0);
+            let q = Vector::new(
+                g[0][0] * p.x + g[0][1] * p.y,
+                g[1][0] * p.x + g[1][1] * p.y,
+                0.0,
+            );
             r * q + t
         })
         .collect();
@@ -222,8 +226,13 @@ fn triangle_membrane_passes_the_patch_test_on_every_mesh() {
     let r = rotation_from_euler_deg([20.0, -35.0, 50.0]);
     let meshes = patch_meshes();
     let springs = membrane_material(Membrane::Springs);
-    println!("patch test: springs (stretch 200 N/m) against the continuum of the triangles' isotropic shorthand (warp = weft = 200, shear = 100 N/m)");
-    println!("{:<18} {:<16} {:>10} {:>11} {:>10} {:>10}", "mesh", "deformation", "E/cont", "E/reg grid", "stress err", "interior");
+    println!(
+        "patch test: springs (stretch 200 N/m) against the continuum of the triangles' isotropic shorthand (warp = weft = 200, shear = 100 N/m)"
+    );
+    println!(
+        "{:<18} {:<16} {:>10} {:>11} {:>10} {:>10}",
+        "mesh", "deformation", "E/cont", "E/reg grid", "stress err", "interior"
+    );
     for (name, g) in DEFORMATIONS {
         let col = |c: usize| r * Vector::new(g[0][c], g[1][c], 0.0);
         let (a, b) = (col(0), col(1));
@@ -233,13 +242,18 @@ fn triangle_membrane_passes_the_patch_test_on_every_mesh() {
             let tri = patch(m, &membrane_material(Membrane::Triangles(moduli)), g, r);
             let (w, p) = (moduli.energy_density(a, b), moduli.first_piola(a, b));
             let scale = p[0].length().max(p[1].length());
-            let stress_err = (tri.stress[0] - p[0]).length().max((tri.stress[1] - p[1]).length());
+            let stress_err = (tri.stress[0] - p[0])
+                .length()
+                .max((tri.stress[1] - p[1]).length());
             assert!(
                 (tri.density / w - 1.0).abs() < 1e-11,
                 "{mesh_name}, {name}: energy {} against the continuum's {w}",
                 tri.density
             );
-            assert!(stress_err < 1e-11 * scale, "{mesh_name}, {name}: stress off by {stress_err:e}");
+            assert!(
+                stress_err < 1e-11 * scale,
+                "{mesh_name}, {name}: stress off by {stress_err:e}"
+            );
             assert!(
                 tri.interior < 1e-11 * scale * h,
                 "{mesh_name}, {name}: {:e} N on an interior vertex",
@@ -248,7 +262,9 @@ fn triangle_membrane_passes_the_patch_test_on_every_mesh() {
             let sp = patch(m, &springs, g, r);
             let (wi, pi) = (iso.energy_density(a, b), iso.first_piola(a, b));
             let iso_scale = pi[0].length().max(pi[1].length());
-            let err = (sp.stress[0] - pi[0]).length().max((sp.stress[1] - pi[1]).length());
+            let err = (sp.stress[0] - pi[0])
+                .length()
+                .max((sp.stress[1] - pi[1]).length());
             println!(
                 "{mesh_name:<18} {name:<16} {:>10.4} {:>11.4} {:>10.4} {:>10.2e}",
                 sp.density / wi,
@@ -367,7 +383,11 @@ fn membrane_stiffness_blocks_match_finite_differences_of_the_forces() {
             compression += 1;
         }
         let exact = gauss_newton.combine(1.0, &exact_geometric, 1.0);
-        let scale = t.block(&exact, 0, 0).to_cols_array().iter().fold(0.0, |a: Scalar, b| a.max(b.abs()));
+        let scale = t
+            .block(&exact, 0, 0)
+            .to_cols_array()
+            .iter()
+            .fold(0.0, |a: Scalar, b| a.max(b.abs()));
         let h = 1e-6;
         for j in 0..3 {
             for d in 0..3 {
@@ -379,11 +399,14 @@ fn membrane_stiffness_blocks_match_finite_differences_of_the_forces() {
                     t.forces(&x, &v, &mut f[k]);
                 }
                 x[vj][d] = x0;
-                for i in 0..3 {
-                    let fd = -(f[0][i] - f[1][i]) / (2.0 * h);
+                for (i, (plus, minus)) in f[0].iter().zip(&f[1]).enumerate() {
+                    let fd = -(*plus - *minus) / (2.0 * h);
                     let column = t.block(&exact, i, j).col(d);
                     let off = (fd - column).length();
-                    assert!(off < 1e-6 * scale, "block ({i}, {j}) column {d}: {fd} against {column}");
+                    assert!(
+                        off < 1e-6 * scale,
+                        "block ({i}, {j}) column {d}: {fd} against {column}"
+                    );
                 }
             }
         }
@@ -393,9 +416,14 @@ fn membrane_stiffness_blocks_match_finite_differences_of_the_forces() {
         let mut product = [Vector::ZERO; 3];
         t.apply(&solver, &p, &mut product);
         for (i, q) in product.iter().enumerate() {
-            let by_blocks: Vector = (0..3).map(|j| t.block(&solver, i, j) * p[t.v[j] as usize]).sum();
+            let by_blocks: Vector = (0..3)
+                .map(|j| t.block(&solver, i, j) * p[t.v[j] as usize])
+                .sum();
             assert!((*q - by_blocks).length() <= 1e-12 * q.length().max(1.0));
         }
     }
-    assert!(tension > 0 && compression > 0, "{tension} in tension, {compression} not");
+    assert!(
+        tension > 0 && compression > 0,
+        "{tension} in tension, {compression} not"
+    );
 }

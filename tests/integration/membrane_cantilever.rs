@@ -19,7 +19,9 @@ fn cantilever_chord_angle_barely_depends_on_the_membrane() {
         membrane: Membrane::Triangles(Orthotropic::isotropic(springs.stretch)),
         ..springs
     };
-    println!("cantilever, overhang 2c, elastica {exact:.4} deg; chord angle minus the elastica's, deg");
+    println!(
+        "cantilever, overhang 2c, elastica {exact:.4} deg; chord angle minus the elastica's, deg"
+    );
     println!("{:<28} {:>9} {:>10}", "strip", "springs", "triangles");
     for (name, jitter, seed, res) in [
         ("regular, 32 along", 0.0, 1, 32),
@@ -32,7 +34,11 @@ fn cantilever_chord_angle_barely_depends_on_the_membrane() {
         for (k, mat) in [springs, triangles].iter().enumerate() {
             let mut x: Vec<Vector> = m.material.iter().map(|p| p.extend(0.0)).collect();
             let s = settle_on(&m, &mut x, mat, 2.0 * c);
-            assert!(s.residual < 1e-9, "{name}: not settled ({:.1e} N)", s.residual);
+            assert!(
+                s.residual < 1e-9,
+                "{name}: not settled ({:.1e} N)",
+                s.residual
+            );
             off[k] = s.chord_deg - exact;
         }
         println!("{name:<22} s{seed} {:>+9.3} {:>+10.3}", off[0], off[1]);

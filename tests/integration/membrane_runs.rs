@@ -13,7 +13,9 @@ use drape::physics::{
     Elements, ExternalForces, Membrane, Model, Orthotropic, Solver, SolverSettings,
 };
 use drape::run::{RunOptions, run};
-use drape::scene::{DiagonalPattern, Integrator, SceneErrorKind as Kind, load_scene_file, load_scene_str};
+use drape::scene::{
+    DiagonalPattern, Integrator, SceneErrorKind as Kind, load_scene_file, load_scene_str,
+};
 use drape::world::World;
 
 use crate::membrane::{membrane_material, uniform};
@@ -54,9 +56,17 @@ fn obj_cloth_with_texture_coordinates_runs_with_both_membranes() {
     for membrane in ["springs", "triangles"] {
         let overrides = [format!("material.membrane=\"{membrane}\"")];
         let scene = load_scene_file(&scene_path, &overrides).expect("the scene loads");
-        let summary = run(&scene, &RunOptions::default(), &AtomicBool::new(false), &mut |_| {})
-            .unwrap_or_else(|e| panic!("{membrane}: {e}"));
-        assert!(summary.frames > 0 && summary.energy.r#final.is_finite(), "{membrane}");
+        let summary = run(
+            &scene,
+            &RunOptions::default(),
+            &AtomicBool::new(false),
+            &mut |_| {},
+        )
+        .unwrap_or_else(|e| panic!("{membrane}: {e}"));
+        assert!(
+            summary.frames > 0 && summary.energy.r#final.is_finite(),
+            "{membrane}"
+        );
         masses.push(summary.mass_final);
         let world = World::from_scene(&scene).expect("the world");
         let model = Model::from_scene(&scene);
@@ -64,14 +74,20 @@ fn obj_cloth_with_texture_coordinates_runs_with_both_membranes() {
         let v = vec![Vector::ZERO; world.x.len()];
         let elastic =
             drape::physics::forces::energy(&el, &ExternalForces::default(), &world.x, &v).elastic;
-        assert!(elastic > 0.0, "{membrane}: the bulge is stretched ({elastic} J)");
+        assert!(
+            elastic > 0.0,
+            "{membrane}: the bulge is stretched ({elastic} J)"
+        );
         if membrane == "triangles" {
             assert_eq!(el.membrane_triangles.len(), world.mesh.triangles.len());
             assert!(el.springs.is_empty(), "no stretch springs with triangles");
         }
     }
     std::fs::remove_dir_all(&dir).ok();
-    assert_eq!(masses[0], masses[1], "the lumped mass does not depend on the membrane");
+    assert_eq!(
+        masses[0], masses[1],
+        "the lumped mass does not depend on the membrane"
+    );
 }
 
 /// Membrane forces (elastic and damping) on a randomly moved, moving sheet sum
@@ -95,7 +111,9 @@ fn triangle_membrane_conserves_momentum_and_keeps_the_lumped_mass() {
         .iter()
         .map(|p| p.extend(0.0) + Vector::new(next(), next(), next()) * 0.02)
         .collect();
-    let v: Vec<Vector> = (0..x.len()).map(|_| Vector::new(next(), next(), next())).collect();
+    let v: Vec<Vector> = (0..x.len())
+        .map(|_| Vector::new(next(), next(), next()))
+        .collect();
     let ext = ExternalForces::default();
     let mut scratch = ForceScratch::default();
     element_pass(&el, &ext, &m.triangles, &x, &v, &mut scratch);
@@ -112,12 +130,22 @@ fn triangle_membrane_conserves_momentum_and_keeps_the_lumped_mass() {
 
 /// A 1 m sheet at resolution 16 held along its four edges, moving, and with
 /// the triangle membrane (woven moduli, bending and damping as given).
-fn held_sheet(stretch: Scalar, bending: Scalar, damping: Scalar) -> (World, drape::physics::MaterialParams) {
+fn held_sheet(
+    stretch: Scalar,
+    bending: Scalar,
+    damping: Scalar,
+) -> (World, drape::physics::MaterialParams) {
     let m = mesh::rectangle(1.0, 1.0, 16, DiagonalPattern::Alternating).unwrap();
     let x: Vec<Vector> = m
         .material
         .iter()
-        .map(|p| Vector::new(stretch * p.x, stretch * p.y, 1.0 + 0.02 * (6.0 * p.x).sin() * (4.0 * p.y).cos()))
+        .map(|p| {
+            Vector::new(
+                stretch * p.x,
+                stretch * p.y,
+                1.0 + 0.02 * (6.0 * p.x).sin() * (4.0 * p.y).cos(),
+            )
+        })
         .collect();
     let mut world = World::new(m, x);
     world.v = world
@@ -180,7 +208,10 @@ fn implicit_steps_with_the_triangle_membrane_converge_with_both_solvers() {
     for solver in [Solver::Direct, Solver::Cg] {
         let (_, newton) = implicit_steps(&world, material, solver, 30);
         println!("{solver:?}: {newton} Newton iterations in 3 steps");
-        assert!(newton <= 3 * 5, "{solver:?}: {newton} Newton iterations in 3 steps");
+        assert!(
+            newton <= 3 * 5,
+            "{solver:?}: {newton} Newton iterations in 3 steps"
+        );
     }
     let (world, material) = held_sheet(1.0, 1e-5, 0.001);
     let (direct, _) = implicit_steps(&world, material, Solver::Direct, 1);
@@ -205,17 +236,26 @@ fn drape_check_prints_the_membrane_and_its_moduli() {
             .args(&args)
             .output()
             .expect("run drape check");
-        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
         String::from_utf8_lossy(&out.stdout).into_owned()
     };
     let springs = check(&[]);
     assert!(springs.contains("membrane \"springs\""), "{springs}");
     let iso = check(&["material.membrane=\"triangles\"", "material.stretch=400"]);
     assert!(
-        iso.contains("membrane \"triangles\"") && iso.contains("warp 400 N/m, weft 400 N/m, shear 200 N/m"),
+        iso.contains("membrane \"triangles\"")
+            && iso.contains("warp 400 N/m, weft 400 N/m, shear 200 N/m"),
         "{iso}"
     );
-    let woven = check(&["material.membrane=\"triangles\"", "material.weft=120", "material.shear=25"]);
+    let woven = check(&[
+        "material.membrane=\"triangles\"",
+        "material.weft=120",
+        "material.shear=25",
+    ]);
     assert!(woven.contains("weft 120 N/m, shear 25 N/m"), "{woven}");
 }
 
@@ -233,12 +273,42 @@ fn with_material(extra: &str) -> String {
 fn bad_membrane_keys_are_errors_naming_the_key() {
     let triangles = "membrane = \"triangles\"";
     for (extra, line, key, kind) in [
-        (format!("{triangles}\nwarp = -300.0"), 13, "material.warp", Kind::OutOfRange),
-        (format!("{triangles}\nweft = nan"), 13, "material.weft", Kind::OutOfRange),
-        (format!("{triangles}\nshear = 0.0"), 13, "material.shear", Kind::OutOfRange),
-        (format!("{triangles}\nwarp = inf"), 13, "material.warp", Kind::OutOfRange),
-        ("shear = 25.0".to_string(), 12, "material.shear", Kind::NotApplicable),
-        ("membrane = \"quads\"".to_string(), 12, "material.membrane", Kind::BadValue),
+        (
+            format!("{triangles}\nwarp = -300.0"),
+            13,
+            "material.warp",
+            Kind::OutOfRange,
+        ),
+        (
+            format!("{triangles}\nweft = nan"),
+            13,
+            "material.weft",
+            Kind::OutOfRange,
+        ),
+        (
+            format!("{triangles}\nshear = 0.0"),
+            13,
+            "material.shear",
+            Kind::OutOfRange,
+        ),
+        (
+            format!("{triangles}\nwarp = inf"),
+            13,
+            "material.warp",
+            Kind::OutOfRange,
+        ),
+        (
+            "shear = 25.0".to_string(),
+            12,
+            "material.shear",
+            Kind::NotApplicable,
+        ),
+        (
+            "membrane = \"quads\"".to_string(),
+            12,
+            "material.membrane",
+            Kind::BadValue,
+        ),
     ] {
         let e = match load_scene_str(&with_material(&extra), "test.toml", &[]) {
             Ok(_) => panic!("{extra}: expected an error at {key}"),
@@ -247,12 +317,23 @@ fn bad_membrane_keys_are_errors_naming_the_key() {
         let msg = e.to_string();
         assert_eq!(e.kind, kind, "{msg}");
         assert_eq!(e.key.as_deref(), Some(key), "{msg}");
-        assert!(msg.starts_with(&format!("test.toml:{line}: key `{key}`: ")), "{msg}");
+        assert!(
+            msg.starts_with(&format!("test.toml:{line}: key `{key}`: ")),
+            "{msg}"
+        );
     }
-    let ok = load_scene_str(&with_material(&format!("{triangles}\nwarp = 300.0")), "test.toml", &[]);
+    let ok = load_scene_str(
+        &with_material(&format!("{triangles}\nwarp = 300.0")),
+        "test.toml",
+        &[],
+    );
     let scene = ok.expect("valid moduli load");
     assert_eq!(
         scene.material.membrane(),
-        Membrane::Triangles(Orthotropic { warp: 300.0, weft: 200.0, shear: 100.0 })
+        Membrane::Triangles(Orthotropic {
+            warp: 300.0,
+            weft: 200.0,
+            shear: 100.0
+        })
     );
 }

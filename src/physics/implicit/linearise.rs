@@ -153,8 +153,7 @@ fn membrane_triangles(
 ) {
     let count = el.membrane_triangles.len();
     s.membrane_block.resize(count, ColumnBlocks::ZERO);
-    s.membrane_slot
-        .resize(MEMBRANE_SLOTS * count, Vector::ZERO);
+    s.membrane_slot.resize(MEMBRANE_SLOTS * count, Vector::ZERO);
     s.membrane_slot
         .par_chunks_exact_mut(MEMBRANE_SLOTS)
         .zip(s.membrane_block.par_iter_mut())
