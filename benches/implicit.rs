@@ -76,6 +76,7 @@ fn setup(resolution: u32, solver: Solver, refactor_iterations: u32) -> Sheet {
         material: MaterialParams {
             density: 0.15,
             stretch: 200.0,
+            membrane: drape::physics::Membrane::Springs,
             bending: 1e-5,
             damping: 0.001,
             bending_model: BendingModel::Dihedral,
@@ -206,6 +207,7 @@ fn remesh_tables(c: &mut Criterion) {
         let material = MaterialParams {
             density: 0.15,
             stretch: 200.0,
+            membrane: drape::physics::Membrane::Springs,
             bending: 1e-5,
             damping: 0.001,
             bending_model: BendingModel::ShapeOperator,

@@ -42,6 +42,7 @@ fn setup(resolution: u32, bending_model: BendingModel) -> Setup {
         material: MaterialParams {
             density: 0.15,
             stretch: 200.0,
+            membrane: drape::physics::Membrane::Springs,
             bending: 1e-5,
             damping: 0.001,
             bending_model,

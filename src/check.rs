@@ -5,7 +5,7 @@ use std::fmt::Write;
 use crate::adapt::AdaptConfig;
 use crate::collide::{Collider, Obstacles};
 use crate::physics::timestep::fit_to_frame;
-use crate::physics::{Elements, ExternalForces, MaterialParams, Model, Stepper};
+use crate::physics::{Elements, ExternalForces, MaterialParams, Membrane, Model, Stepper};
 use crate::run::RunError;
 use crate::scene::{
     AdaptCriterion, AdaptMethod, BendingModel, ClothShape, Integrator, PinMotion, Scene,
@@ -99,20 +99,46 @@ fn describe_forces(
         StiffnessRule::Consistent => "consistent (Van Gelder: k = stretch * sum(A) / L^2)",
         StiffnessRule::PaperA => "paper_a (k = stretch * 2^(level/2) per spring)",
     };
-    let stretch_springs = world.mesh.edges.len();
-    let _ = writeln!(
-        s,
-        "  stretch: {} springs, {} N/m, rule {}",
-        stretch_springs, mat.stretch, rule
-    );
+    let stretch_springs = match mat.membrane {
+        Membrane::Springs => {
+            let _ = writeln!(
+                s,
+                "  stretch: membrane \"springs\", {} springs, {} N/m, rule {}",
+                world.mesh.edges.len(),
+                mat.stretch,
+                rule
+            );
+            world.mesh.edges.len()
+        }
+        Membrane::Triangles(m) => {
+            let _ = writeln!(
+                s,
+                "  stretch: membrane \"triangles\" (constant-strain, orthotropic St. Venant-Kirchhoff), {} triangles, warp {} N/m, weft {} N/m, shear {} N/m",
+                el.membrane_triangles.len(),
+                m.warp,
+                m.weft,
+                m.shear
+            );
+            0
+        }
+    };
     if mat.bending > 0.0 {
         describe_bending(s, el, mat, stretch_springs);
     }
     if mat.damping > 0.0 {
         let _ = writeln!(
             s,
-            "  spring damping: {} s times each spring's stiffness (paper B eq. 2)",
-            mat.damping
+            "  {}",
+            match mat.membrane {
+                Membrane::Springs => format!(
+                    "spring damping: {} s times each spring's stiffness (paper B eq. 2)",
+                    mat.damping
+                ),
+                Membrane::Triangles(_) => format!(
+                    "membrane damping: {} s times the strain rate's stress (stiffness proportional)",
+                    mat.damping
+                ),
+            }
         );
     }
     if let Some(g) = ext.gravity {

@@ -124,6 +124,19 @@ pub enum BendingModel {
     HingeSpring,
 }
 
+/// The in-plane (stretch and shear) force model (`material.membrane`).
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum MembraneModel {
+    /// One spring per edge from `stretch` (the papers' model): its response
+    /// depends on the triangulation.
+    #[default]
+    Springs,
+    /// Constant-strain triangles in material coordinates with orthotropic
+    /// moduli (warp, weft, shear): the continuum on every triangulation.
+    Triangles,
+}
+
 /// How stretch spring constants are derived.
 #[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq, Default)]
 #[serde(rename_all = "snake_case")]

@@ -1,7 +1,7 @@
 //! The implicit system matrix assembled into a fixed 3x3-block sparsity pattern.
 //!
 //! [`BlockPattern`] is built once per mesh topology: one block per vertex pair
-//! coupled by a spring or a hinge (both triangles stored, columns sorted per row),
+//! coupled by a spring, a membrane triangle, a hinge or a shape triangle (both triangles stored, columns sorted per row),
 //! and for every block of the lower triangle the list of element terms that sum
 //! into it, in element order. Assembly ([`BlockPattern::gather`]) then needs no
 //! triplets, no sorting and no atomics: each lower block sums its own sources in a
@@ -13,8 +13,8 @@
 //! with, for every scalar entry, the block and the component it comes from.
 //!
 //! # The factored matrix
-//! The factorization reads only the blocks of vertex pairs joined by a spring (and
-//! the diagonal). The only other blocks are the couplings between the two wing tips
+//! The factorization reads only the blocks of vertex pairs joined by a spring or
+//! a membrane triangle's edge (and the diagonal). The only other blocks are the couplings between the two wing tips
 //! `p`, `q` of a hinge, and keeping them more than doubles the factor: on a 65 x 65
 //! grid its stored values go from 0.80 to 1.99 million and a numerical factorization
 //! from 11 to 45 ms (measured on this machine with a probe that factored a test matrix on the pattern). So the
@@ -34,14 +34,17 @@
 //!
 mod buckets;
 mod csc;
+mod terms;
 #[cfg(test)]
 mod tests;
+
+pub use terms::ElementBlocks;
 
 use rayon::prelude::*;
 
 use super::elements::Elements;
 use super::forces::{PAR_MIN, PAR_MIN_ROWS};
-use super::shape::{SHAPE_SLOTS, ShapeJacobian, ShapeTriangle};
+use super::shape::SHAPE_SLOTS;
 use crate::math::{Matrix3, Scalar, Vector};
 use buckets::{group_by_key, sorted_unique_rows};
 
@@ -56,60 +59,8 @@ enum Source {
     Hinge { hinge: u32, k: u8, l: u8 },
     /// `h^2 sum_ab M_ab J_ak J_bl^T` of shape triangle `tri`, slots `k` and `l`.
     Shape { tri: u32, k: u8, l: u8 },
-}
-
-/// The per-element matrix terms of one implicit step, computed by the caller.
-#[derive(Debug, Clone, Copy)]
-pub struct ElementBlocks<'a> {
-    /// Per spring: `h^2 K_e + h D_e`, acting on `x_a - x_b`.
-    pub springs: &'a [Matrix3],
-    /// Per hinge, four gradients of its angle (one per vertex).
-    pub hinge_gradients: &'a [Vector],
-    /// Per hinge: `h^2 k` (its Gauss-Newton block is `coef g g^T`).
-    pub hinge_coefficients: &'a [Scalar],
-    /// Per vertex: mass plus `h` times its drag coefficient, kg.
-    pub diagonal_mass: &'a [Scalar],
-    /// The shape triangles (constant `M`) and, per triangle, the angle gradients.
-    pub shape_triangles: &'a [ShapeTriangle],
-    /// Per shape triangle: the gradients of its three angles.
-    pub shape_jacobians: &'a [ShapeJacobian],
-    /// `h^2`, the scale of the shape triangles' blocks.
-    pub h2: Scalar,
-}
-
-impl ElementBlocks<'_> {
-    /// Block `(k, l)` of shape triangle `tri`: `h^2 sum_ab M_ab J_ak J_bl^T`.
-    ///
-    /// `M J` is not precomputed per triangle and step: the gather reads blocks
-    /// in pattern order, not triangle order, and a second 432-byte row per
-    /// triangle measured slower than the arithmetic it saves.
-    ///
-    /// A tip slot `3 + a` moves angle `a` only (`shape.rs`, `HINGE_SLOTS`), so
-    /// its gradients by the other two angles are zero and their terms are
-    /// skipped: a block with one tip sums one outer product or one term of
-    /// `M J` instead of three, a tip-tip block one of each. Skipping exact
-    /// zeros leaves every block the same to the last bit.
-    fn shape_block(&self, tri: usize, k: usize, l: usize) -> Matrix3 {
-        let (m, jac) = (&self.shape_triangles[tri].m, &self.shape_jacobians[tri]);
-        let mut out = Matrix3::ZERO;
-        for a in moved_angles(k) {
-            // sum_b M_ab J_bl
-            let row = &m[a];
-            let right = match l {
-                0..3 => jac[0][l] * row[0] + jac[1][l] * row[1] + jac[2][l] * row[2],
-                _ => jac[l - 3][l] * row[l - 3],
-            };
-            out += outer(jac[a][k], right);
-        }
-        out * self.h2
-    }
-}
-
-/// The angles of a shape triangle that slot `k` moves: all three for one of
-/// its own vertices, angle `a` alone for the tip across edge `a` (slot `3 + a`).
-#[inline(always)]
-fn moved_angles(k: usize) -> std::ops::Range<usize> {
-    if k < 3 { 0..3 } else { k - 3..k - 2 }
+    /// Corner block `(k, l)` of membrane triangle `tri`.
+    Membrane { tri: u32, k: u8, l: u8 },
 }
 
 /// A fixed 3x3-block sparsity pattern for one mesh topology (module docs).
@@ -125,7 +76,8 @@ pub struct BlockPattern {
     diagonal: Vec<u32>,
     /// Per block: the block holding its transpose.
     mirror: Vec<u32>,
-    /// Per block: true when the factorization reads it (diagonal or spring pair).
+    /// Per block: true when the factorization reads it (diagonal, spring pair or
+    /// membrane triangle edge).
     factored: Vec<bool>,
     /// Per vertex, CSC-like: the hinge slots `4 h + k` (k a wing tip) whose
     /// dropped tip-tip coupling is compensated on this vertex's diagonal.
@@ -171,6 +123,15 @@ impl BlockPattern {
                 }
             }
         }
+        for t in &elements.membrane_triangles {
+            for i in t.v {
+                for j in t.v {
+                    if i != j {
+                        pairs.push((i, j));
+                    }
+                }
+            }
+        }
         for t in &elements.shape_triangles {
             for (k, i) in t.slots() {
                 for (l, j) in t.slots() {
@@ -205,6 +166,15 @@ impl BlockPattern {
             for (i, j) in [(a, b), (b, a)] {
                 let s = p.slot(i, j) as usize;
                 p.factored[s] = true;
+            }
+        }
+        // A membrane triangle couples the ends of its edges, as the springs do.
+        for t in &elements.membrane_triangles {
+            for i in t.v {
+                for j in t.v {
+                    let s = p.slot(i, j) as usize;
+                    p.factored[s] = true;
+                }
             }
         }
         let mut tips: Vec<(u32, u32)> = Vec::new();
@@ -261,6 +231,17 @@ impl BlockPattern {
                     if j <= i {
                         let hinge = h as u32;
                         tagged.push((self.slot(i, j), Source::Hinge { hinge, k, l }));
+                    }
+                }
+            }
+        }
+        for (ti, t) in elements.membrane_triangles.iter().enumerate() {
+            for k in 0..3u8 {
+                for l in 0..3u8 {
+                    let (i, j) = (t.v[k as usize], t.v[l as usize]);
+                    if j <= i {
+                        let tri = ti as u32;
+                        tagged.push((self.slot(i, j), Source::Membrane { tri, k, l }));
                     }
                 }
             }
@@ -401,6 +382,14 @@ impl BlockPattern {
                         }
                         Source::Shape { tri, k, l } => {
                             terms.shape_block(tri as usize, k as usize, l as usize)
+                        }
+                        Source::Membrane { tri, k, l } => {
+                            let tri = tri as usize;
+                            terms.membrane_triangles[tri].block(
+                                &terms.membrane_blocks[tri],
+                                k as usize,
+                                l as usize,
+                            )
                         }
                     };
                 }

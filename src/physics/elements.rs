@@ -25,6 +25,9 @@
 //!   Fitting per-spring weights on such triangles to the grid's membrane
 //!   tensor cuts that deviation several times but improves no benchmark
 //!   error, so it is not adopted.
+//! * Membrane triangles (`membrane = "triangles"`, module [`super::membrane`]):
+//!   one constant-strain orthotropic element per triangle instead of the stretch
+//!   springs; exact for every homogeneous strain on every triangulation.
 //! * Stretch, `paper_a`: every spring of level n has `k = stretch * 2^(n/2)`
 //!   (paper A, eq. 1, with `k_0 = stretch`). Level 0 springs of a uniform mesh
 //!   all get the same constant, which in 2D is itself resolution independent; the
@@ -52,6 +55,7 @@ mod reuse;
 
 pub use reuse::RebuildCounts;
 
+use super::membrane::{MEMBRANE_SLOTS, Membrane, MembraneTriangle};
 use super::shape::{SHAPE_SLOTS, ShapeScratch, ShapeTriangle, build_shape_triangles_into};
 use crate::math::{Scalar, Vector2};
 use crate::mesh::Mesh;
@@ -63,8 +67,11 @@ use reuse::{Previous, Reuse};
 pub struct MaterialParams {
     /// Area density, kg/m^2.
     pub density: Scalar,
-    /// Stretch stiffness, N/m.
+    /// Stretch stiffness of the springs, N/m (with [`Membrane::Springs`]).
     pub stretch: Scalar,
+    /// The in-plane force model: springs from `stretch`, or the continuum
+    /// membrane with its own moduli.
+    pub membrane: Membrane,
     /// Bending rigidity, N m.
     pub bending: Scalar,
     /// Stiffness-proportional damping, s.
@@ -147,8 +154,11 @@ pub struct Elements {
     pub mass: Vec<Scalar>,
     /// Rest area attributed to each vertex (a third of each adjacent triangle), m^2.
     pub vertex_area: Vec<Scalar>,
-    /// Stretch springs (one per edge) followed by hinge springs when that model is on.
+    /// Stretch springs (one per edge, with [`Membrane::Springs`]) followed by hinge
+    /// springs when that bending model is on.
     pub springs: Vec<Spring>,
+    /// Continuum membrane triangles, one per triangle (with [`Membrane::Triangles`]).
+    pub membrane_triangles: Vec<MembraneTriangle>,
     /// Dihedral hinges (only with the dihedral model and non-zero rigidity).
     pub hinges: Vec<Hinge>,
     /// Shape-operator bending elements, one per triangle (only with that model and
@@ -163,6 +173,8 @@ pub struct Elements {
     /// Shape-triangle slots `SHAPE_SLOTS * element + k` where the vertex is `v[k]`
     /// (used slots only).
     pub shape_slots: Incidence,
+    /// Membrane-triangle slots `MEMBRANE_SLOTS * element + k` where the vertex is `v[k]`.
+    pub membrane_slots: Incidence,
     /// Triangles at each vertex (for per-triangle forces such as wind).
     pub vertex_triangles: Incidence,
     /// What these elements were built from, for the next [`Elements::rebuild`].
@@ -231,6 +243,7 @@ impl Elements {
         self.mass
             .extend(self.vertex_area.iter().map(|a| mat.density * a));
         stretch_springs(mesh, mat, area, &mut self.springs);
+        membrane_triangles(mesh, mat, area, &mut self.membrane_triangles);
         scratch.shapes.clear();
         let mut kept = 0;
         if mat.bending > 0.0 && mat.bending_model == BendingModel::ShapeOperator {
@@ -289,6 +302,15 @@ impl Elements {
                 .enumerate()
                 .flat_map(|(h, hg)| (0..4).map(move |k| (hg.v[k], (4 * h + k) as u32))),
         );
+        self.membrane_slots.fill(
+            n,
+            self.membrane_triangles
+                .iter()
+                .enumerate()
+                .flat_map(|(t, m)| {
+                    (0..MEMBRANE_SLOTS).map(move |k| (m.v[k], (MEMBRANE_SLOTS * t + k) as u32))
+                }),
+        );
         let pairs = &mut self.scratch.shape_pairs;
         pairs.clear();
         pairs.extend(self.shape_triangles.iter().enumerate().flat_map(|(p, st)| {
@@ -315,10 +337,13 @@ fn level_factor(rule: StiffnessRule, level: u8) -> Scalar {
     }
 }
 
-/// One stretch spring per edge (module docs: stiffness derivations); `area` is
-/// each triangle's rest area.
+/// One stretch spring per edge (module docs: stiffness derivations) with the
+/// springs membrane, none with the triangles; `area` is each triangle's rest area.
 fn stretch_springs(mesh: &Mesh, mat: &MaterialParams, area: &[Scalar], springs: &mut Vec<Spring>) {
     springs.clear();
+    if mat.membrane != Membrane::Springs {
+        return;
+    }
     for (e, edge) in mesh.edges.iter().enumerate() {
         let rest = mesh.rest_length(e);
         let tris = edge
@@ -343,6 +368,24 @@ fn stretch_springs(mesh: &Mesh, mat: &MaterialParams, area: &[Scalar], springs: 
             c: mat.damping * k,
         });
     }
+}
+
+/// One membrane triangle per triangle with the triangles membrane (`membrane.rs`),
+/// none with the springs; `area` is each triangle's rest area.
+fn membrane_triangles(
+    mesh: &Mesh,
+    mat: &MaterialParams,
+    area: &[Scalar],
+    out: &mut Vec<MembraneTriangle>,
+) {
+    out.clear();
+    let Membrane::Triangles(moduli) = &mat.membrane else {
+        return;
+    };
+    out.extend(mesh.triangles.iter().zip(area).map(|(tri, &a)| {
+        let p = tri.map(|v| mesh.material[v as usize]);
+        MembraneTriangle::new(*tri, p, a, moduli, mat.damping)
+    }));
 }
 
 /// The bending elements of the edge-based models: dihedral hinges (into

@@ -1,5 +1,5 @@
 //! Force evaluation in two parallel phases without atomics:
-//! 1. **element pass**: each spring, hinge and (wind) triangle computes its forces
+//! 1. **element pass**: each spring, membrane triangle, hinge and (wind) triangle computes its forces
 //!    into its own slots of scratch arrays;
 //! 2. **gather**: each vertex sums its slots in a fixed order (CSR lists), adds its
 //!    own forces (gravity, drag), and the integrator uses the sum at once.
@@ -12,6 +12,7 @@ use rayon::prelude::*;
 
 use super::bending::dihedral_angle_and_gradient;
 use super::elements::Elements;
+use super::membrane::MEMBRANE_SLOTS;
 use super::shape::SHAPE_SLOTS;
 use crate::math::{Scalar, Vector, deterministic_sum};
 
@@ -61,6 +62,8 @@ pub struct ForceScratch {
     pub hinge: Vec<Vector>,
     /// Force on each shape triangle's slots, `SHAPE_SLOTS` per element.
     pub shape: Vec<Vector>,
+    /// Force on each membrane triangle's corners, `MEMBRANE_SLOTS` per element.
+    pub membrane: Vec<Vector>,
     /// A third of each triangle's wind force (the share of each of its vertices).
     pub triangle: Vec<Vector>,
 }
@@ -142,6 +145,15 @@ pub fn element_pass(
         .with_min_len(PAR_MIN / SHAPE_SLOTS)
         .zip(el.shape_triangles.par_iter())
         .for_each(|(f, t)| t.forces(x, f));
+    scratch
+        .membrane
+        .resize(MEMBRANE_SLOTS * el.membrane_triangles.len(), Vector::ZERO);
+    scratch
+        .membrane
+        .par_chunks_exact_mut(MEMBRANE_SLOTS)
+        .with_min_len(PAR_MIN / MEMBRANE_SLOTS)
+        .zip(el.membrane_triangles.par_iter())
+        .for_each(|(f, t)| t.forces(x, v, f));
     if let Some(wind) = &ext.wind {
         scratch.triangle.resize(triangles.len(), Vector::ZERO);
         scratch
@@ -177,6 +189,9 @@ pub fn gather(
     for &s in el.shape_slots.of(i) {
         f += scratch.shape[s as usize];
     }
+    for &s in el.membrane_slots.of(i) {
+        f += scratch.membrane[s as usize];
+    }
     if ext.wind.is_some() {
         for &t in el.vertex_triangles.of(i) {
             f += scratch.triangle[t as usize];
@@ -198,7 +213,7 @@ pub struct Energy {
     pub kinetic: Scalar,
     /// Gravitational potential energy (zero at the world origin).
     pub gravitational: Scalar,
-    /// Elastic energy of springs, hinges and shape triangles.
+    /// Elastic energy of springs, membrane triangles, hinges and shape triangles.
     pub elastic: Scalar,
 }
 
@@ -229,9 +244,12 @@ pub fn energy(el: &Elements, ext: &ExternalForces, x: &[Vector], v: &[Vector]) -
     let shape = deterministic_sum(el.shape_triangles.len(), |t| {
         el.shape_triangles[t].energy(x)
     });
+    let membrane = deterministic_sum(el.membrane_triangles.len(), |t| {
+        el.membrane_triangles[t].energy(x)
+    });
     Energy {
         kinetic,
         gravitational,
-        elastic: stretch + bend + shape,
+        elastic: stretch + membrane + bend + shape,
     }
 }

@@ -13,6 +13,9 @@
 //! * Shape triangle (`shape.rs`), energy `theta^T M theta / 2` over its three edge
 //!   angles with Jacobian `J` (rows: angle gradients): Gauss-Newton `K_t = J^T M J`
 //!   (constant `M`; the curvature term is dropped as for the hinges).
+//! * Membrane triangle (`membrane.rs`): `K_t = J^T C J + S+ (x) I` (the
+//!   Gauss-Newton part plus the positive part of the geometric term, exact in
+//!   tension), `D_t = damping J^T C J`.
 //! * Wind is treated explicitly (only in `b`, evaluated at the start of the step).
 //!
 //! # Newton iterations
@@ -70,6 +73,7 @@ use linearise::linearise;
 use rayon::prelude::*;
 
 use super::forces::PAR_MIN;
+use super::membrane::ColumnBlocks;
 use super::shape::ShapeJacobian;
 use super::{Contact, Model, Stepper};
 use crate::math::{Matrix3, Scalar, Vector, deterministic_sum};
@@ -139,6 +143,10 @@ pub struct ImplicitScratch {
     hinge_slot: Vec<Vector>,
     shape_slot: Vec<Vector>,
     shape_grad: Vec<ShapeJacobian>,
+    /// Per membrane triangle: `h^2 K_t + h D_t` over its deformation gradient's
+    /// columns.
+    membrane_block: Vec<ColumnBlocks>,
+    membrane_slot: Vec<Vector>,
     /// `h^2` of the step being solved (scales the shape triangles' `M`).
     h2: Scalar,
     tri_slot: Vec<Vector>,

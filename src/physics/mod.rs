@@ -13,6 +13,7 @@ pub mod elements;
 pub mod explicit;
 pub mod forces;
 pub mod implicit;
+pub mod membrane;
 pub mod multirate;
 /// Pinned vertices (a top-level module, [`crate::pins`], so that `world` needs nothing
 /// from `physics`); kept reachable here.
@@ -25,6 +26,7 @@ pub use crate::spec::Solver;
 pub use elements::{Elements, Hinge, MaterialParams, Spring};
 pub use forces::{Energy, ExternalForces, WindForce};
 pub use implicit::SolveFailure;
+pub use membrane::{Membrane, MembraneTriangle, Orthotropic};
 pub use shape::{SHAPE_SLOTS, ShapeTriangle};
 
 use crate::math::{Scalar, Vector};

@@ -20,7 +20,7 @@
 //! symplectic Euler exactly. (Holding the other levels still instead was tried
 //! first and is unstable at the level interfaces.)
 //!
-//! A kick computes only the springs, hinges, shape triangles and wind triangles that touch the
+//! A kick computes only the springs, hinges, shape triangles, membrane and wind triangles that touch the
 //! level's vertices. Element forces are computed in parallel and written back
 //! in a fixed order, so results do not depend on the thread count.
 
@@ -32,6 +32,7 @@ pub use rk4::rk4_multirate;
 use super::bending::dihedral_angle_and_gradient;
 use super::elements::Elements;
 use super::forces::{ForceScratch, gather, spring_force, wind_share};
+use super::membrane::MEMBRANE_SLOTS;
 use super::shape::SHAPE_SLOTS;
 use super::timestep::{SAFETY, vertex_limits};
 use super::{Model, Stepper};
@@ -220,6 +221,10 @@ pub fn symplectic_multirate(st: &mut Stepper, model: &Model, w: &mut World, big:
         SHAPE_SLOTS * st.elements.shape_triangles.len(),
         Vector::ZERO,
     );
+    scratch.membrane.resize(
+        MEMBRANE_SLOTS * st.elements.membrane_triangles.len(),
+        Vector::ZERO,
+    );
     if model.external.wind.is_some() {
         scratch
             .triangle
@@ -328,6 +333,22 @@ fn level_forces(
     for (&p, f) in g.shape.iter().zip(&level.shape) {
         scratch.shape[SHAPE_SLOTS * p as usize..SHAPE_SLOTS * (p as usize + 1)].copy_from_slice(f);
     }
+    // Membrane triangle t is mesh triangle t: the group's triangles are its own.
+    if !el.membrane_triangles.is_empty() {
+        g.triangles
+            .par_iter()
+            .with_min_len(256)
+            .map(|&t| {
+                let mut f = [Vector::ZERO; MEMBRANE_SLOTS];
+                el.membrane_triangles[t as usize].forces(x, v, &mut f);
+                f
+            })
+            .collect_into_vec(&mut level.membrane);
+        for (&t, f) in g.triangles.iter().zip(&level.membrane) {
+            let at = MEMBRANE_SLOTS * t as usize;
+            scratch.membrane[at..at + MEMBRANE_SLOTS].copy_from_slice(f);
+        }
+    }
     if let Some(wind) = &ext.wind {
         for &t in &g.triangles {
             let tri = triangles[t as usize];
@@ -364,4 +385,5 @@ struct LevelScratch {
     springs: Vec<Vector>,
     hinges: Vec<[Vector; 4]>,
     shape: Vec<[Vector; SHAPE_SLOTS]>,
+    membrane: Vec<[Vector; MEMBRANE_SLOTS]>,
 }

@@ -18,6 +18,7 @@ mod spans;
 mod validate;
 mod validate_adapt;
 mod validate_collide;
+mod validate_material;
 mod validate_measure;
 mod validate_motion;
 

@@ -7,10 +7,11 @@
 use serde::Deserialize;
 
 // The engine's own types, deserialised straight from the file (see `crate::spec`).
+use crate::physics::membrane::{Membrane, Orthotropic};
 pub use crate::spec::{
     Adapt, AdaptCriterion, AdaptEvery, AdaptMethod, BendingModel, ClothShape, DEFAULT_THICKNESS,
-    DiagonalPattern, Integrator, Keyframe, KeyframeAfter, KeyframeEasing, Measurement, Obstacle,
-    ObstacleShape, Pin, PinMotion, SelfCollision, Solver, StiffnessRule,
+    DiagonalPattern, Integrator, Keyframe, KeyframeAfter, KeyframeEasing, Measurement,
+    MembraneModel, Obstacle, ObstacleShape, Pin, PinMotion, SelfCollision, Solver, StiffnessRule,
 };
 
 /// A whole scene file.
@@ -148,8 +149,22 @@ pub struct Cloth {
 pub struct Material {
     /// Area density in kg/m^2 (> 0).
     pub density: f64,
-    /// Stretch stiffness in N/m (> 0).
+    /// Stretch stiffness in N/m (> 0): the springs' constant, and the
+    /// triangles' isotropic shorthand (`warp = weft = stretch`, `shear =
+    /// stretch / 2`).
     pub stretch: f64,
+    /// The in-plane force model: `"springs"` or `"triangles"`.
+    #[serde(default)]
+    pub membrane: MembraneModel,
+    /// Tensile stiffness along material u in N/m (> 0; triangles only;
+    /// default `stretch`).
+    pub warp: Option<f64>,
+    /// Tensile stiffness along material v in N/m (> 0; triangles only;
+    /// default `stretch`).
+    pub weft: Option<f64>,
+    /// In-plane shear stiffness in N/m (> 0; triangles only; default
+    /// `stretch / 2`).
+    pub shear: Option<f64>,
     /// Bending rigidity in N m (>= 0; 0 turns bending off).
     #[serde(default)]
     pub bending: f64,
@@ -168,6 +183,23 @@ pub struct Material {
 }
 
 impl Material {
+    /// The in-plane model with its moduli: the springs, or the triangles with
+    /// `warp`, `weft` and `shear` where given and the isotropic shorthand of
+    /// `stretch` otherwise.
+    pub fn membrane(&self) -> Membrane {
+        match self.membrane {
+            MembraneModel::Springs => Membrane::Springs,
+            MembraneModel::Triangles => {
+                let iso = Orthotropic::isotropic(self.stretch);
+                Membrane::Triangles(Orthotropic {
+                    warp: self.warp.unwrap_or(iso.warp),
+                    weft: self.weft.unwrap_or(iso.weft),
+                    shear: self.shear.unwrap_or(iso.shear),
+                })
+            }
+        }
+    }
+
     /// The bending rigidity in N m: `bending`, or `density * |gravity| * c^3` when
     /// the bending length `c` is given instead.
     pub fn rigidity(&self, gravity: [f64; 3]) -> f64 {

@@ -114,6 +114,7 @@ impl Model {
             material: MaterialParams {
                 density: m.density,
                 stretch: m.stretch,
+                membrane: m.membrane(),
                 bending: m.rigidity(scene.simulation.gravity),
                 damping: m.damping,
                 bending_model: m.bending_model,

@@ -36,6 +36,10 @@ pub(crate) fn allowed(path: &str) -> Option<&'static str> {
         "material" => "a table [material]",
         "material.density" => "a finite number > 0 (kg/m^2)",
         "material.stretch" => "a finite number > 0 (N/m)",
+        "material.membrane" => "\"springs\" or \"triangles\"",
+        "material.warp" | "material.weft" | "material.shear" => {
+            "a finite number > 0 (N/m), with membrane = \"triangles\""
+        }
         "material.bending" => "a finite number >= 0 (N m)",
         "material.bending_length" => {
             "a finite number > 0 (m), instead of `bending` (not both); needs non-zero gravity"

@@ -7,7 +7,7 @@ use toml::{Table, Value};
 
 use super::error::{Issue, KeyPath, SceneErrorKind as Kind, Seg, dotted, keys, num};
 use super::schema;
-use super::{Air, Cloth, ClothShape, Material, Pin, PinMotion, Scene, Simulation, TimeStep, Wind};
+use super::{Air, Cloth, ClothShape, Pin, PinMotion, Scene, Simulation, TimeStep, Wind};
 
 /// The first problem in `scene`, if any. `doc` is the document it came from
 /// (after `--set`), used to tell keys that were written from defaults.
@@ -15,7 +15,7 @@ pub(crate) fn validate(scene: &Scene, doc: &Table) -> Result<(), Issue> {
     name(&scene.name)?;
     simulation(&scene.simulation)?;
     cloth(&scene.cloth, section(doc, "cloth"))?;
-    material(
+    super::validate_material::material(
         &scene.material,
         section(doc, "material"),
         scene.simulation.gravity,
@@ -291,35 +291,6 @@ fn cloth(c: &Cloth, written: Option<&Table>) -> Result<(), Issue> {
     positive(at("uv_scale"), c.uv_scale)?;
     all_finite(at("position"), &c.position)?;
     all_finite(at("rotation"), &c.rotation)
-}
-
-fn material(m: &Material, written: Option<&Table>, gravity: [f64; 3]) -> Result<(), Issue> {
-    let at = |k: &str| keys(&["material", k]);
-    positive(at("density"), m.density)?;
-    positive(at("stretch"), m.stretch)?;
-    non_negative(at("bending"), m.bending)?;
-    if let Some(c) = m.bending_length {
-        if written.is_some_and(|t| t.contains_key("bending")) {
-            return Err(Issue::new(
-                at("bending_length"),
-                Kind::NotApplicable,
-                "`bending_length` and `bending` both given: they set the same rigidity",
-            )
-            .allowed("exactly one of `bending` (N m) and `bending_length` (m)")
-            .because(at("bending")));
-        }
-        positive(at("bending_length"), c)?;
-        if gravity.iter().all(|&g| g == 0.0) {
-            return Err(Issue::new(
-                at("bending_length"),
-                Kind::NotApplicable,
-                "`bending_length` needs gravity to convert to a rigidity (B = density |g| c^3), and gravity is zero",
-            )
-            .allowed("`bending` (N m) in a scene without gravity")
-            .because(keys(&["simulation", "gravity"])));
-        }
-    }
-    non_negative(at("damping"), m.damping)
 }
 
 fn check_pin(i: usize, p: &Pin, shape: ClothShape, written: Option<&Table>) -> Result<(), Issue> {

@@ -52,6 +52,7 @@ fn cost(method: AdaptMethod) {
     let mat = MaterialParams {
         density: 0.15,
         stretch: 200.0,
+        membrane: drape::physics::Membrane::Springs,
         bending: 1e-5,
         damping: 0.001,
         bending_model: BendingModel::ShapeOperator,

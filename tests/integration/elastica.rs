@@ -75,6 +75,7 @@ pub fn strip_material(bending: Scalar, model: BendingModel, rule: StiffnessRule)
     MaterialParams {
         density: RHO,
         stretch: 1e4,
+        membrane: drape::physics::Membrane::Springs,
         bending,
         damping: 0.0,
         bending_model: model,
@@ -110,7 +111,12 @@ fn strip_mesh(overhang: Scalar, res: u32, across: Option<u32>) -> Mesh {
 }
 
 /// Solves the clamped strip on `m` (flat in z = 0 at rest) in place.
-fn settle_on(m: &Mesh, x: &mut [Vector], mat: &MaterialParams, overhang: Scalar) -> Settled {
+pub(crate) fn settle_on(
+    m: &Mesh,
+    x: &mut [Vector],
+    mat: &MaterialParams,
+    overhang: Scalar,
+) -> Settled {
     let (lo, hi) = m.material_bounds();
     let clamp = lo.x + overhang / 8.0;
     let fixed: Vec<bool> = m
@@ -369,7 +375,7 @@ fn settle_across(overhang: Scalar, res: u32, across: u32, mat: &MaterialParams) 
 /// The large-deflection strip of the shape operator with consistent
 /// stiffness: its bending length `c` (the overhang is `2 c`), its material,
 /// and the exact elastica's chord angle, degrees.
-fn large_strip() -> (Scalar, MaterialParams, Scalar) {
+pub(crate) fn large_strip() -> (Scalar, MaterialParams, Scalar) {
     let bending = 1e-5;
     let c = (bending / (RHO * G)).cbrt();
     let mat = strip_material(
@@ -447,7 +453,7 @@ fn a_tensor_refined_strip_bends_like_the_uniform_one() {
 /// outline, the clamp edge and the tip column stay on the mesh lines; each
 /// cell is split along its shorter diagonal. An irregular triangulation, as
 /// an OBJ cloth from a modeller has.
-fn irregular_strip(
+pub(crate) fn irregular_strip(
     overhang: Scalar,
     res: u32,
     across: u32,

@@ -69,6 +69,7 @@ fn total_force_is_minus_the_energy_gradient() {
                 density: 0.15,
                 // Soft enough that bending forces are as large as the stretch ones.
                 stretch: 0.5,
+                membrane: drape::physics::Membrane::Springs,
                 bending: 1e-3,
                 damping: 0.0,
                 bending_model: model,

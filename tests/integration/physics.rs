@@ -5,7 +5,9 @@ use drape::math::{Scalar, Vector};
 use drape::mesh::{self, Mesh};
 use drape::physics::bending::dihedral_angle_and_gradient;
 use drape::physics::forces::{ForceScratch, element_pass, gather};
-use drape::physics::{Elements, ExternalForces, MaterialParams, Model, SolverSettings, WindForce};
+use drape::physics::{
+    Elements, ExternalForces, MaterialParams, Membrane, Model, SolverSettings, WindForce,
+};
 use drape::scene::{BendingModel, DiagonalPattern, Integrator, StiffnessRule};
 use drape::world::World;
 
@@ -21,6 +23,7 @@ pub(crate) fn material(
     MaterialParams {
         density: 0.15,
         stretch: 200.0,
+        membrane: drape::physics::Membrane::Springs,
         bending: 1e-5,
         damping: 0.001,
         bending_model,
@@ -358,6 +361,7 @@ fn implicit_is_stable_at_a_sixtieth_of_a_second_on_stiff_fabric() {
     let mat = MaterialParams {
         density: 0.1,
         stretch: 1e4,
+        membrane: drape::physics::Membrane::Springs,
         ..material(BendingModel::Dihedral, StiffnessRule::Consistent)
     };
     let ext = ExternalForces {
@@ -397,8 +401,9 @@ fn implicit_is_stable_at_a_sixtieth_of_a_second_on_stiff_fabric() {
     );
 }
 
-/// Runs `steps` steps of a flag-like world (every force on) inside a pool of `threads`.
-fn final_state(threads: usize, integrator: Integrator) -> Vec<Vector> {
+/// Runs `steps` steps of a flag-like world (every force on, with `membrane`)
+/// inside a pool of `threads`.
+fn final_state(threads: usize, integrator: Integrator, membrane: Membrane) -> Vec<Vector> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
@@ -421,7 +426,10 @@ fn final_state(threads: usize, integrator: Integrator) -> Vec<Vector> {
             Model {
                 cg_tolerance: 1e-6,
                 ..model(
-                    material(BendingModel::Dihedral, StiffnessRule::Consistent),
+                    MaterialParams {
+                        membrane,
+                        ..material(BendingModel::Dihedral, StiffnessRule::Consistent)
+                    },
                     ext,
                     integrator,
                 )
@@ -442,22 +450,35 @@ fn final_state(threads: usize, integrator: Integrator) -> Vec<Vector> {
 
 #[test]
 fn results_are_bit_identical_with_one_and_two_threads() {
-    for integrator in [
-        Integrator::SymplecticEuler,
-        Integrator::Rk4,
-        Integrator::Implicit,
+    let woven = Membrane::Triangles(drape::physics::Orthotropic {
+        warp: 300.0,
+        weft: 120.0,
+        shear: 25.0,
+    });
+    for (integrator, membrane) in [
+        (Integrator::SymplecticEuler, Membrane::Springs),
+        (Integrator::Rk4, Membrane::Springs),
+        (Integrator::Implicit, Membrane::Springs),
+        (Integrator::SymplecticEuler, woven),
+        (Integrator::Implicit, woven),
     ] {
-        let (a, b) = (final_state(1, integrator), final_state(2, integrator));
+        let (a, b) = (
+            final_state(1, integrator, membrane),
+            final_state(2, integrator, membrane),
+        );
         let same = a
             .iter()
             .zip(&b)
             .all(|(p, q)| p.to_array().map(f64::to_bits) == q.to_array().map(f64::to_bits));
         assert!(
             same,
-            "{integrator:?}: positions differ between 1 and 2 threads"
+            "{integrator:?}, {membrane:?}: positions differ between 1 and 2 threads"
         );
         let moved = a.iter().map(|p| (p.z - 1.0).abs()).fold(0.0, Scalar::max);
-        assert!(moved > 1e-6, "{integrator:?}: the sheet should have moved");
+        assert!(
+            moved > 1e-6,
+            "{integrator:?}, {membrane:?}: the sheet should have moved"
+        );
     }
 }
 

@@ -7,7 +7,9 @@ use std::sync::atomic::AtomicBool;
 
 use drape::math::{Scalar, Vector};
 use drape::mesh;
-use drape::physics::{ExternalForces, MaterialParams, Model, Solver, SolverSettings, WindForce};
+use drape::physics::{
+    ExternalForces, MaterialParams, Membrane, Model, Solver, SolverSettings, WindForce,
+};
 use drape::record::inspect::inspect;
 use drape::run::{RunError, RunOptions, run};
 use drape::scene::{BendingModel, DiagonalPattern, Integrator, StiffnessRule, default_scene};
@@ -21,6 +23,7 @@ fn fabric(stretch: Scalar) -> MaterialParams {
     MaterialParams {
         density: 0.15,
         stretch,
+        membrane: drape::physics::Membrane::Springs,
         bending: 1e-5,
         damping: 0.001,
         bending_model: BendingModel::Dihedral,
@@ -117,8 +120,9 @@ fn free_fall_matches_the_discrete_trajectory_with_both_solvers() {
     }
 }
 
-/// A flag (wind, drag, pins, every force) stepped `steps` times in a pool of `threads`.
-fn flag_state(threads: usize, solver: Solver, newton: u32) -> Vec<Vector> {
+/// A flag (wind, drag, pins, every force, with `membrane`) stepped `steps`
+/// times in a pool of `threads`.
+fn flag_state(threads: usize, solver: Solver, newton: u32, membrane: Membrane) -> Vec<Vector> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
@@ -138,7 +142,11 @@ fn flag_state(threads: usize, solver: Solver, newton: u32) -> Vec<Vector> {
             air_velocity: wind.velocity,
             wind: Some(wind),
         };
-        let mut model = implicit(fabric(2000.0), ext, solver, 1e-6);
+        let material = MaterialParams {
+            membrane,
+            ..fabric(2000.0)
+        };
+        let mut model = implicit(material, ext, solver, 1e-6);
         model.solver.newton_iterations = newton;
         let mut st = crate::common::BareStepper::new(model, &w);
         for _ in 0..12 {
@@ -150,17 +158,27 @@ fn flag_state(threads: usize, solver: Solver, newton: u32) -> Vec<Vector> {
 
 #[test]
 fn both_solvers_are_bit_identical_at_one_two_and_four_threads() {
-    for (solver, newton) in [(Solver::Direct, 1), (Solver::Cg, 1)] {
-        let a = flag_state(1, solver, newton);
+    let woven = Membrane::Triangles(drape::physics::Orthotropic {
+        warp: 3000.0,
+        weft: 1200.0,
+        shear: 250.0,
+    });
+    for (solver, newton, membrane) in [
+        (Solver::Direct, 1, Membrane::Springs),
+        (Solver::Cg, 1, Membrane::Springs),
+        (Solver::Direct, 1, woven),
+        (Solver::Cg, 1, woven),
+    ] {
+        let a = flag_state(1, solver, newton, membrane);
         for threads in [2, 4] {
-            let b = flag_state(threads, solver, newton);
+            let b = flag_state(threads, solver, newton, membrane);
             let same = a
                 .iter()
                 .zip(&b)
                 .all(|(p, q)| p.to_array().map(f64::to_bits) == q.to_array().map(f64::to_bits));
             assert!(
                 same,
-                "{solver:?}: positions differ between 1 and {threads} threads"
+                "{solver:?}, {membrane:?}: positions differ between 1 and {threads} threads"
             );
         }
     }

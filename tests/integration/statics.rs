@@ -1,7 +1,7 @@
 //! Static equilibrium of the discrete model: Newton's method on the total energy
 //! (elastic + gravitational) with the library's own forces, a positive
-//! semi-definite approximation of the Hessian (exact for springs in tension,
-//! Gauss-Newton for dihedral hinges and shape triangles, springs in compression
+//! semi-definite approximation of the Hessian (exact for springs and membrane
+//! triangles in tension, Gauss-Newton for dihedral hinges and shape triangles, springs in compression
 //! without their negative transverse term), a backtracking line
 //! search and a banded (envelope) Cholesky factorization. It finds the rest state
 //! of a clamped strip in well under a second, where a dynamic run takes minutes;
@@ -127,6 +127,11 @@ pub fn solve(
         .iter()
         .map(|s| s.v.map(|v| v as usize).to_vec())
         .chain(el.hinges.iter().map(|h| h.v.map(|v| v as usize).to_vec()))
+        .chain(
+            el.membrane_triangles
+                .iter()
+                .map(|t| t.v.map(|v| v as usize).to_vec()),
+        )
         .chain(
             el.shape_triangles
                 .iter()
@@ -267,6 +272,15 @@ fn assemble(el: &Elements, x: &[Vector], rank: &[usize], k: &mut Envelope) {
         add_block(b, b, m);
         add_block(a, b, -m);
         add_block(b, a, -m);
+    }
+    for t in &el.membrane_triangles {
+        let (gauss_newton, geometric) = t.stiffness(x);
+        let m = gauss_newton.combine(1.0, &geometric, 1.0);
+        for i in 0..3 {
+            for j in 0..3 {
+                add_block(t.v[i] as usize, t.v[j] as usize, t.block(&m, i, j));
+            }
+        }
     }
     for h in &el.hinges {
         let (_, g) =

@@ -157,6 +157,7 @@ fn green_closures_stretch_unlike_the_grid() {
     let material = MaterialParams {
         density: 0.15,
         stretch: 200.0,
+        membrane: drape::physics::Membrane::Springs,
         bending: 0.0,
         damping: 0.0,
         bending_model: BendingModel::ShapeOperator,

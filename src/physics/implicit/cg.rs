@@ -11,6 +11,7 @@ use rayon::prelude::*;
 use super::{ImplicitScratch, SolveFailure, without};
 use crate::math::{Scalar, Vector, deterministic_sum, deterministic_sum2};
 use crate::physics::forces::PAR_MIN;
+use crate::physics::membrane::MEMBRANE_SLOTS;
 use crate::physics::shape::{SHAPE_SLOTS, rates, spread};
 use crate::physics::{Model, Stepper};
 
@@ -173,6 +174,12 @@ fn apply_operator(st: &mut Stepper, which: Which, held: &[bool], filtered: bool)
             let c = t.times_m(rates(t, jac, input));
             spread(jac, c.map(|c| c * h2), slot);
         });
+    s.membrane_slot
+        .par_chunks_exact_mut(MEMBRANE_SLOTS)
+        .zip(s.membrane_block.par_iter())
+        .zip(el.membrane_triangles.par_iter())
+        .with_min_len(PAR_MIN / MEMBRANE_SLOTS)
+        .for_each(|((slot, block), t)| t.apply(block, input, slot));
     let (spring_slot, hinge_slot, shape_slot, diag_mass, filter) = (
         &s.spring_slot,
         &s.hinge_slot,
@@ -180,6 +187,7 @@ fn apply_operator(st: &mut Stepper, which: Which, held: &[bool], filtered: bool)
         &s.diag_mass,
         &s.filter,
     );
+    let membrane_slot = &s.membrane_slot;
     s.cg.ap
         .par_iter_mut()
         .enumerate()
@@ -202,6 +210,9 @@ fn apply_operator(st: &mut Stepper, which: Which, held: &[bool], filtered: bool)
             }
             for &k in el.shape_slots.of(i) {
                 acc += shape_slot[k as usize];
+            }
+            for &k in el.membrane_slots.of(i) {
+                acc += membrane_slot[k as usize];
             }
             *out = if filtered {
                 without(filter[i], acc)

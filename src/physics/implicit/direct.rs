@@ -149,6 +149,8 @@ pub(super) fn solve(
         shape_triangles: &st.elements.shape_triangles,
         shape_jacobians: &s.shape_grad,
         h2: s.h2,
+        membrane_triangles: &st.elements.membrane_triangles,
+        membrane_blocks: &s.membrane_block,
     };
     let a = &mut s.direct;
     pattern.gather(&terms, &mut a.lower, &mut a.raw);

@@ -1,5 +1,5 @@
 //! Linearisation of the implicit step, shared by both solvers: per-element blocks
-//! and slots (springs, hinges, shape triangles, wind), then the per-vertex gather
+//! and slots (springs, hinges, shape triangles, membrane triangles, wind), then the per-vertex gather
 //! of the right-hand side `b`, the mass diagonal and the Jacobi diagonal, in a
 //! fixed order per vertex so the result is identical at any thread count.
 
@@ -8,6 +8,7 @@ use rayon::prelude::*;
 use super::super::bending::dihedral_angle_and_gradient;
 use super::super::elements::Elements;
 use super::super::forces::{PAR_MIN, spring_force, wind_share};
+use super::super::membrane::{ColumnBlocks, MEMBRANE_SLOTS};
 use super::super::shape::{SHAPE_SLOTS, rates, spread};
 use super::super::{ExternalForces, Model, Stepper};
 use super::ImplicitScratch;
@@ -28,6 +29,7 @@ pub(super) fn linearise(st: &mut Stepper, model: &Model, w: &World, h: Scalar, n
     springs(s, el, x, v, h, k_term);
     hinges(s, el, x, v, h, k_term);
     shape_triangles(s, el, x, v, h, k_term);
+    membrane_triangles(s, el, x, v, h, k_term);
     // Wind is explicit: its force at the start of the step serves every Newton
     // iteration (re-evaluated at each iterate, without its derivative in `A`, the
     // iterations diverged on a flag at 10 ms steps).
@@ -139,6 +141,37 @@ fn shape_triangles(
         });
 }
 
+/// Per membrane triangle: the block `h^2 K_t + h D_t` over the columns and the
+/// slots `h f_t - h^2 K_t v`.
+fn membrane_triangles(
+    s: &mut ImplicitScratch,
+    el: &Elements,
+    x: &[Vector],
+    v: &[Vector],
+    h: Scalar,
+    k_term: Scalar,
+) {
+    let count = el.membrane_triangles.len();
+    s.membrane_block.resize(count, ColumnBlocks::ZERO);
+    s.membrane_slot.resize(MEMBRANE_SLOTS * count, Vector::ZERO);
+    s.membrane_slot
+        .par_chunks_exact_mut(MEMBRANE_SLOTS)
+        .zip(s.membrane_block.par_iter_mut())
+        .zip(el.membrane_triangles.par_iter())
+        .with_min_len(PAR_MIN / MEMBRANE_SLOTS)
+        .for_each(|((slot, block), t)| {
+            let (gauss_newton, geometric) = t.stiffness(x);
+            let stiff = gauss_newton.combine(1.0, &geometric, 1.0);
+            *block = gauss_newton.combine(h * h + h * t.damping, &geometric, h * h);
+            let mut kv = [Vector::ZERO; MEMBRANE_SLOTS];
+            t.apply(&stiff, v, &mut kv);
+            t.forces(x, v, slot);
+            for (f, kv) in slot.iter_mut().zip(kv) {
+                *f = *f * h - kv * (h * h * k_term);
+            }
+        });
+}
+
 /// Per vertex, in a fixed order: `b` (the slots of its elements, gravity, drag,
 /// the Newton residual's inertia), the mass plus drag diagonal, and the inverse
 /// Jacobi diagonal (`jacobi`: the CG solver's preconditioner).
@@ -166,6 +199,7 @@ fn gather(
         &s.shape_slot,
     );
     let shape_grad = &s.shape_grad;
+    let (membrane_slot, membrane_block) = (&s.membrane_slot, &s.membrane_block);
     s.b.par_iter_mut()
         .zip(s.diag_mass.par_iter_mut().zip(s.inv_diag.par_iter_mut()))
         .enumerate()
@@ -197,6 +231,14 @@ fn gather(
                     for b in 0..3 {
                         diag += jac[a][slot] * jac[b][slot] * (h * h * m[a][b]);
                     }
+                }
+            }
+            for &k in el.membrane_slots.of(i) {
+                rhs += membrane_slot[k as usize];
+                if jacobi {
+                    let (t, slot) = (k as usize / MEMBRANE_SLOTS, k as usize % MEMBRANE_SLOTS);
+                    let m = el.membrane_triangles[t].block(&membrane_block[t], slot, slot);
+                    diag += matrix_diagonal(&m);
                 }
             }
             if ext.wind.is_some() {

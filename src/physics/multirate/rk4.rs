@@ -5,6 +5,7 @@ use rayon::prelude::*;
 use super::{Group, Rk4MultirateScratch, level_forces, take_levels};
 use crate::math::{Scalar, Vector};
 use crate::physics::forces::gather;
+use crate::physics::membrane::MEMBRANE_SLOTS;
 use crate::physics::shape::SHAPE_SLOTS;
 use crate::physics::{Model, Stepper};
 use crate::world::World;
@@ -50,6 +51,9 @@ fn size_force_scratch(st: &mut Stepper, model: &Model, w: &World) {
     scratch
         .shape
         .resize(SHAPE_SLOTS * el.shape_triangles.len(), Vector::ZERO);
+    scratch
+        .membrane
+        .resize(MEMBRANE_SLOTS * el.membrane_triangles.len(), Vector::ZERO);
     if model.external.wind.is_some() {
         scratch
             .triangle
