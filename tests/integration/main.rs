@@ -24,6 +24,7 @@ mod inspect_cli;
 mod mesh;
 mod metric;
 mod physics;
+mod pins;
 mod recording;
 mod recording_run;
 mod remesh_ops;
