@@ -100,12 +100,17 @@ fn grid_description(w: f64, h: f64, (us, vs): &(Vec<f64>, Vec<f64>)) -> String {
             h / ny as f64
         )
     } else {
+        let range = |(a, b): (f64, f64)| {
+            if b - a <= 1e-12 * b {
+                format!("{:.3}", b * 1e3)
+            } else {
+                format!("{:.3} to {:.3}", a * 1e3, b * 1e3)
+            }
+        };
         format!(
-            " ({nx} x {ny} cells of {:.3} to {:.3} x {:.3} to {:.3} mm: grid lines on the pin boxes' edges)",
-            u0 * 1e3,
-            u1 * 1e3,
-            v0 * 1e3,
-            v1 * 1e3
+            " ({nx} x {ny} cells of {} x {} mm: grid lines on the pin boxes' edges)",
+            range((u0, u1)),
+            range((v0, v1))
         )
     }
 }
