@@ -64,12 +64,9 @@ fn describe_cloth(s: &mut String, scene: &Scene, world: &World, el: &Elements) {
     let c = &scene.cloth;
     let grid = match (c.shape, c.width, c.height, c.resolution) {
         (ClothShape::Rectangle, Some(w), Some(h), Some(r)) => {
-            let (nx, ny) = crate::mesh::cell_counts(w, h, r, c.short_side_segments);
-            format!(
-                " ({nx} x {ny} cells of {:.4} x {:.4} m)",
-                w / nx as f64,
-                h / ny as f64
-            )
+            let cuts = crate::pins::box_cuts(&scene.pin);
+            let lines = crate::mesh::fitted_lines(w, h, r, c.short_side_segments, &cuts);
+            grid_description(w, h, &lines)
         }
         _ => String::new(),
     };
@@ -84,6 +81,38 @@ fn describe_cloth(s: &mut String, scene: &Scene, world: &World, el: &Elements) {
         world.mesh.total_rest_area(),
         el.total_mass()
     );
+}
+
+/// A rectangle's grid in words: its cells, and their range of sizes where
+/// the lines are fitted to box pin regions.
+fn grid_description(w: f64, h: f64, (us, vs): &(Vec<f64>, Vec<f64>)) -> String {
+    let widths = |l: &[f64]| {
+        l.windows(2)
+            .map(|p| p[1] - p[0])
+            .fold((f64::INFINITY, 0.0_f64), |(a, b), w| (a.min(w), b.max(w)))
+    };
+    let ((u0, u1), (v0, v1)) = (widths(us), widths(vs));
+    let (nx, ny) = (us.len() - 1, vs.len() - 1);
+    if u1 - u0 <= 1e-12 * u1 && v1 - v0 <= 1e-12 * v1 {
+        format!(
+            " ({nx} x {ny} cells of {:.4} x {:.4} m)",
+            w / nx as f64,
+            h / ny as f64
+        )
+    } else {
+        let range = |(a, b): (f64, f64)| {
+            if b - a <= 1e-12 * b {
+                format!("{:.3}", b * 1e3)
+            } else {
+                format!("{:.3} to {:.3}", a * 1e3, b * 1e3)
+            }
+        };
+        format!(
+            " ({nx} x {ny} cells of {} x {} mm: grid lines on the pin boxes' edges)",
+            range((u0, u1)),
+            range((v0, v1))
+        )
+    }
 }
 
 /// The `forces computed:` block: stretch always, then each force the scene declares.
@@ -399,5 +428,8 @@ fn describe_pins(s: &mut String, scene: &Scene, world: &World) {
             "pin {p}: `{}`, {count} vertices, {motion}{release}",
             pin.region
         );
+    }
+    for m in crate::pins::mismatches(&scene.pin, &world.mesh) {
+        let _ = writeln!(s, "  differs from the scene: {}", m.describe());
     }
 }

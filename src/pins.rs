@@ -1,10 +1,28 @@
 //! Pinned vertices: selected by named region in material space (so a selection
 //! means the same cloth points on any mesh) and moved by a script.
 
+mod coverage;
+
+pub use coverage::{PinMismatch, mismatches};
+
 use crate::collide::motion::Track;
 use crate::math::{Matrix3, Scalar, Vector, Vector2};
-use crate::mesh::Mesh;
+use crate::mesh::{GridCuts, Mesh};
 use crate::spec::{Pin, PinMotion};
+
+/// The edges of the `box` regions of `pins`: the lines a generated grid needs
+/// so that each box holds exactly the cloth inside it. Other regions (and
+/// boxes missing a corner, which [`Pins::select`] refuses) add none.
+pub fn box_cuts(pins: &[Pin]) -> GridCuts {
+    let mut cuts = GridCuts::default();
+    for pin in pins.iter().filter(|p| p.region == "box") {
+        if let (Some(a), Some(b)) = (pin.box_min, pin.box_max) {
+            cuts.u.extend([a[0], b[0]]);
+            cuts.v.extend([a[1], b[1]]);
+        }
+    }
+    cuts
+}
 
 /// Why a pin could not be set up.
 #[derive(Debug, thiserror::Error, PartialEq)]

@@ -140,6 +140,11 @@ pub struct Summary {
     /// Cantilever bending test measurements at the end, when the scene is a
     /// rectangle held by fixed pins over one end (see `cantilever`).
     pub cantilever: Option<crate::cantilever::CantileverSummary>,
+    /// Box pin regions whose held vertices are not the cloth inside the box
+    /// (a mesh without lines on the box's edges: a disk, an OBJ); absent
+    /// from the JSON when every pin holds what the scene names.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub pin_mismatches: Vec<crate::pins::PinMismatch>,
     /// True when Ctrl-C ended the run early.
     pub interrupted: bool,
     /// The recording, if one was written.
@@ -166,7 +171,7 @@ impl Summary {
             "{}: {} frames, {} steps of {:.3e} s to t = {:.3} s in {:.2} s wall ({:.2} s stepping, {:.2} s recording); \
              {:.0} vertices, {:.0} triangles; {:.3e} vertex-steps/s. Mass {:.6} -> {:.6} kg; \
              energy {:.4e} -> {:.4e} J (max {:.4e}; external work {:.3e} J; largest excess over initial + work {:.3e} J); \
-             {} recoveries (frame attempts retried with halved steps, {} for energy gain); {}.{}{}{} {}",
+             {} recoveries (frame attempts retried with halved steps, {} for energy gain); {}.{}{}{}{} {}",
             self.scene,
             self.frames,
             self.steps,
@@ -207,6 +212,10 @@ impl Summary {
                 ),
                 None => String::new(),
             },
+            self.pin_mismatches
+                .iter()
+                .map(|m| format!(" Pin region differs from the scene: {}.", m.describe()))
+                .collect::<String>(),
             end,
             rec
         )

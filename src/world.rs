@@ -56,7 +56,8 @@ impl World {
         }
     }
 
-    /// Builds the cloth and resolves its pins.
+    /// Builds the cloth and resolves its pins. A rectangle's grid has lines on
+    /// the edges of the box pin regions ([`mesh::fitted_lines`]).
     pub fn from_spec(cloth: &ClothSpec, pins: &[Pin]) -> Result<World, BuildError> {
         let (mesh, local): (Mesh, Vec<Vector>) = match &cloth.mesh {
             &ClothMesh::Rectangle {
@@ -66,13 +67,10 @@ impl World {
                 short_side_segments,
                 diagonals,
             } => {
-                let m = mesh::rectangle_cells(
-                    width,
-                    height,
-                    resolution,
-                    short_side_segments,
-                    diagonals,
-                )?;
+                let cuts = crate::pins::box_cuts(pins);
+                let (us, vs) =
+                    mesh::fitted_lines(width, height, resolution, short_side_segments, &cuts);
+                let m = mesh::rectangle_on_lines(&us, &vs, diagonals)?;
                 let local = m.material.iter().map(|p| p.extend(0.0)).collect();
                 (m, local)
             }

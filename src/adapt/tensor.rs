@@ -41,8 +41,11 @@
 //! value over the whole sheet. Adjacent columns (rows) differ by at most one
 //! halving: a split that would leave a neighbour two halvings coarser splits
 //! that neighbour too (a forced split), and a removal that would leave one
-//! two halvings finer is refused. So neighbouring cells differ in width by a
-//! factor of two at most. Levels follow paper A's count: a halving adds 2,
+//! two halvings finer is refused. So neighbouring cells differ by one halving
+//! at most, in width by a factor of two at most on a uniform base grid. The
+//! base lines need not be uniform: a rectangle's grid fitted to box pin
+//! regions (`crate::mesh::fitted_lines`) has bands of slightly different
+//! cells, and each base column is halved as a uniform one is. Levels follow paper A's count: a halving adds 2,
 //! and `max_level` (even) allows `max_level / 2` halvings either way; a
 //! triangle's level is that of its finer direction.
 //!
@@ -222,17 +225,18 @@ impl TensorGrid {
     }
 
     /// Whether the cell at columns `i`, rows `j` is split along its diagonal
-    /// from (i, j) to (i + 1, j + 1). Alternating grids alternate among cells
-    /// of the same size: the parity is that of the cell's index among cells of
+    /// from (i, j) to (i + 1, j + 1), given each axis's column indices
+    /// ([`Axis::cell_indices`]). Alternating grids alternate among cells of
+    /// the same size: the parity is that of the cell's index among cells of
     /// its width and height, so a cell keeps its diagonal when lines are
     /// inserted elsewhere.
-    fn along_ac(&self, i: usize, j: usize) -> bool {
-        if !self.alternating {
-            return true;
-        }
-        let index =
-            |a: &Axis, c: usize| ((a.lines[c].at - a.lines[0].at) / a.width(c)).round() as i64;
-        (index(&self.u, i) + index(&self.v, j)) % 2 == 0
+    fn along_ac(&self, index: &(Vec<i64>, Vec<i64>), i: usize, j: usize) -> bool {
+        !self.alternating || (index.0[i] + index.1[j]) % 2 == 0
+    }
+
+    /// The column indices of both axes, for [`TensorGrid::along_ac`].
+    fn cell_indices(&self) -> (Vec<i64>, Vec<i64>) {
+        (self.u.cell_indices(), self.v.cell_indices())
     }
 
     /// The grid's triangles (row order of vertices) and their levels.
@@ -241,10 +245,11 @@ impl TensorGrid {
         let id = |i: usize, j: usize| (j * nu + i) as u32;
         let mut tris = Vec::with_capacity(2 * (nu - 1) * (self.v.n() - 1));
         let mut levels = Vec::with_capacity(tris.capacity());
+        let index = self.cell_indices();
         for j in 0..self.v.n() - 1 {
             for i in 0..nu - 1 {
                 let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
-                if self.along_ac(i, j) {
+                if self.along_ac(&index, i, j) {
                     tris.extend([[a, b, c], [a, c, d]]);
                 } else {
                     tris.extend([[a, b, d], [b, c, d]]);
@@ -327,6 +332,7 @@ impl TensorGrid {
             m
         };
         let (nu_of, nv_of) = (new_of(&su, old_nu), new_of(&sv, old.v.n()));
+        let old_index = old.cell_indices();
         let id = |i: usize, j: usize| (j * nu + i) as u32;
         let mut material = Vec::with_capacity(nu * nv);
         let mut origin = Vec::with_capacity(nu * nv);
@@ -344,7 +350,7 @@ impl TensorGrid {
                     (Source::Between(a), Source::Between(b)) => {
                         // The centre of old cell (a, b): the midpoint of its diagonal.
                         let (l, r, lo, hi) = (nu_of[a], nu_of[a + 1], nv_of[b], nv_of[b + 1]);
-                        if old.along_ac(a, b) {
+                        if old.along_ac(&old_index, a, b) {
                             Origin::Midpoint(id(l, lo), id(r, hi))
                         } else {
                             Origin::Midpoint(id(r, lo), id(l, hi))

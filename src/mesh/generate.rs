@@ -29,14 +29,102 @@ pub fn rectangle_cells(
     pattern: DiagonalPattern,
 ) -> Result<Mesh, MeshError> {
     let (nx, ny) = cell_counts(width, height, resolution, short_side_segments);
-    let mut material = Vec::with_capacity((nx + 1) * (ny + 1));
-    for j in 0..=ny {
-        for i in 0..=nx {
-            material.push(Vector2::new(
-                -0.5 * width + width * i as Scalar / nx as Scalar,
-                -0.5 * height + height * j as Scalar / ny as Scalar,
-            ));
-        }
+    rectangle_on_lines(
+        &uniform_lines(width, nx),
+        &uniform_lines(height, ny),
+        pattern,
+    )
+}
+
+/// Material coordinates at which a generated grid must have lines: the edges
+/// of the box pin regions, so that the vertices a box holds are exactly the
+/// cloth inside it.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct GridCuts {
+    /// u coordinates of lines of constant u, m.
+    pub u: Vec<Scalar>,
+    /// v coordinates of lines of constant v, m.
+    pub v: Vec<Scalar>,
+}
+
+/// The u and v lines of [`rectangle_cells`]'s grid with a line at every cut
+/// of `cuts` that falls strictly inside the sheet.
+///
+/// Where every cut is already on a uniform line (to 1e-9 of the sheet's
+/// size) the uniform lines are returned bit for bit, so a scene whose boxes
+/// sit on the grid keeps its mesh. Otherwise the cuts split the axis into
+/// bands, and each band of length `L` gets `max(1, round(L / h))` equal cells
+/// (`h` the uniform cell): every cell of a band is the same, within 0.5 to 1.5
+/// `h` (0.75 to 1.25 `h` in a band of two cells or more), and a cell is
+/// thinner than half a cell only where the scene's band itself is. Moving the
+/// nearest line onto a cut would make neighbouring cells of 0.5 and 1.5 `h`
+/// beside uniform ones, and splitting the cell at the cut a sliver as thin as
+/// the cut's distance to a line; spreading the change over the band avoids
+/// both. The lines are plain base lines: tensor refinement halves their
+/// columns as it halves uniform ones.
+pub fn fitted_lines(
+    width: Scalar,
+    height: Scalar,
+    resolution: u32,
+    short_side_segments: Option<u32>,
+    cuts: &GridCuts,
+) -> (Vec<Scalar>, Vec<Scalar>) {
+    let (nx, ny) = cell_counts(width, height, resolution, short_side_segments);
+    let tol = 1e-9 * width.max(height);
+    (
+        fit_axis(uniform_lines(width, nx), &cuts.u, tol),
+        fit_axis(uniform_lines(height, ny), &cuts.v, tol),
+    )
+}
+
+/// `n` equal cells over `size`, centred on 0 (the uniform grid's lines).
+fn uniform_lines(size: Scalar, n: usize) -> Vec<Scalar> {
+    (0..=n)
+        .map(|i| -0.5 * size + size * i as Scalar / n as Scalar)
+        .collect()
+}
+
+/// The lines of one axis with a line at every cut inside it ([`fitted_lines`]).
+fn fit_axis(uniform: Vec<Scalar>, cuts: &[Scalar], tol: Scalar) -> Vec<Scalar> {
+    let (lo, hi) = (uniform[0], uniform[uniform.len() - 1]);
+    let mut inner: Vec<Scalar> = cuts
+        .iter()
+        .copied()
+        .filter(|&c| c > lo + tol && c < hi - tol)
+        .collect();
+    inner.sort_by(Scalar::total_cmp);
+    inner.dedup_by(|b, a| *b - *a <= tol);
+    let on_a_line = |c: &Scalar| uniform.iter().any(|l| (l - c).abs() <= tol);
+    if inner.iter().all(on_a_line) {
+        return uniform;
+    }
+    let h = (hi - lo) / (uniform.len() - 1) as Scalar;
+    let knots: Vec<Scalar> = std::iter::once(lo)
+        .chain(inner)
+        .chain(std::iter::once(hi))
+        .collect();
+    let mut lines = Vec::with_capacity(uniform.len() + knots.len());
+    for band in knots.windows(2) {
+        let (a, b) = (band[0], band[1]);
+        let cells = ((b - a) / h).round().max(1.0) as usize;
+        lines.extend((0..cells).map(|k| a + (b - a) * k as Scalar / cells as Scalar));
+    }
+    lines.push(hi);
+    lines
+}
+
+/// A grid over the given u and v lines (each increasing, at least two), each
+/// cell split into two right triangles by `pattern` (alternating by the
+/// cell's column and row); vertices row by row along u.
+pub fn rectangle_on_lines(
+    us: &[Scalar],
+    vs: &[Scalar],
+    pattern: DiagonalPattern,
+) -> Result<Mesh, MeshError> {
+    let (nx, ny) = (us.len().saturating_sub(1), vs.len().saturating_sub(1));
+    let mut material = Vec::with_capacity(us.len() * vs.len());
+    for &v in vs {
+        material.extend(us.iter().map(|&u| Vector2::new(u, v)));
     }
     let id = |i: usize, j: usize| (j * (nx + 1) + i) as u32;
     let mut triangles = Vec::with_capacity(2 * nx * ny);

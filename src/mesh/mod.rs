@@ -10,7 +10,9 @@ mod obj;
 mod pairmap;
 mod topology;
 
-pub use generate::{cell_counts, disk, rectangle, rectangle_cells};
+pub use generate::{
+    GridCuts, cell_counts, disk, fitted_lines, rectangle, rectangle_cells, rectangle_on_lines,
+};
 pub use obj::{ObjCloth, ObjError, load_obj};
 pub use pairmap::{PairHasher, PairMap, PairSet};
 pub use topology::{Edge, NO_TRIANGLE};

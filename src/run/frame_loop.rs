@@ -88,7 +88,7 @@ impl<'a> FrameLoop<'a> {
             state,
             pipeline,
         } = sim;
-        let tally = Tally::new(&setup.model, &state.world, pipeline.stepper());
+        let tally = Tally::new(&setup.model, &state.world, pipeline.stepper(), &scene.pin);
         Ok(FrameLoop {
             scene,
             setup,

@@ -4,6 +4,7 @@ use std::path::PathBuf;
 
 use crate::math::Scalar;
 use crate::physics::{Energy, Model, Stepper};
+use crate::scene::Pin;
 use crate::sim::SimState;
 use crate::summary::{EnergySummary, Range, RecordingSummary, Summary};
 use crate::world::World;
@@ -17,6 +18,7 @@ pub(super) struct Tally {
     energy_max: Scalar,
     mass_initial: Scalar,
     max_level: u8,
+    pin_mismatches: Vec<crate::pins::PinMismatch>,
 }
 
 /// End-of-run facts handed to [`Tally::finish`].
@@ -38,7 +40,9 @@ pub(super) struct TallyEnd<'a> {
 }
 
 impl Tally {
-    pub(super) fn new(model: &Model, world: &World, stepper: &Stepper) -> Tally {
+    /// Starts the tally at the initial state; `pins` are the scene's pins,
+    /// compared with the vertices they hold on the initial mesh.
+    pub(super) fn new(model: &Model, world: &World, stepper: &Stepper, pins: &[Pin]) -> Tally {
         let e = stepper.energy(model, world).total();
         Tally {
             vertices: Range::empty(),
@@ -48,6 +52,7 @@ impl Tally {
             energy_max: e,
             mass_initial: stepper.elements.total_mass(),
             max_level: 0,
+            pin_mismatches: crate::pins::mismatches(pins, &world.mesh),
         }
     }
 
@@ -108,6 +113,7 @@ impl Tally {
             self_collision_wall_s: collision.self_collision_wall_s,
             cusick: end.cusick,
             cantilever: end.cantilever,
+            pin_mismatches: self.pin_mismatches.clone(),
             recording: end.recording.map(|(path, bytes, frames)| RecordingSummary {
                 path,
                 bytes,

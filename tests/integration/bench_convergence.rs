@@ -37,8 +37,8 @@ damping = 0.0005
 drag = 4.0
 [[pin]]
 region = "box"
-box_min = [-0.0041, -0.01]
-box_max = [0.0041, 0.01]
+box_min = [-0.004, -0.01]
+box_max = [0.004, 0.01]
 "#,
     )
     .expect("write scene");

@@ -28,6 +28,7 @@ mod membrane_runs;
 mod mesh;
 mod metric;
 mod physics;
+mod pins;
 mod recording;
 mod recording_run;
 mod remesh_ops;

@@ -63,6 +63,26 @@ impl Axis {
         self.lines[c].level.max(self.lines[c + 1].level)
     }
 
+    /// Each column's index among the columns of its level: a column of level
+    /// `L` that is the `k`-th of its base column `b` (the `b`-th between base
+    /// lines) has index `b 2^L + k`. On a uniform base grid this is its
+    /// offset from the first line over its width; base lines need not be
+    /// uniform (a grid fitted to pin boxes).
+    pub(super) fn cell_indices(&self) -> Vec<i64> {
+        let mut out = Vec::with_capacity(self.n().saturating_sub(1));
+        let (mut base, mut base_at) = (-1i64, self.lines[0].at);
+        for c in 0..self.n().saturating_sub(1) {
+            if self.lines[c].level == 0 {
+                base += 1;
+                base_at = self.lines[c].at;
+            }
+            let level = u32::from(self.column_level(c)).min(62);
+            let k = ((self.lines[c].at - base_at) / self.width(c)).round() as i64;
+            out.push((base << level) + k);
+        }
+        out
+    }
+
     pub(super) fn width(&self, c: usize) -> Scalar {
         self.lines[c + 1].at - self.lines[c].at
     }
