@@ -235,7 +235,10 @@ fn not_modelled(
         absent.push("bending");
     }
     if mat.damping <= 0.0 {
-        absent.push("spring damping");
+        absent.push(match mat.membrane {
+            Membrane::Springs => "spring damping",
+            Membrane::Triangles(_) => "membrane damping",
+        });
     }
     if ext.gravity.is_none() {
         absent.push("gravity");
