@@ -328,3 +328,29 @@ fn keyframed_pins_hold_the_cloth_where_the_keys_say() {
         .to_string();
     assert!(e.contains("needs at least two"), "{e}");
 }
+
+/// The shipped curtain (nine keyframed rings drawn along a rail) runs, and
+/// its last ring has travelled as far as its keys say by 1.5 s (halfway
+/// through its smooth 0.5 to 2.5 s move: half of its 1.6 m).
+#[test]
+fn the_curtain_scene_draws_its_rings_along_the_rail() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/curtain.toml");
+    let sets = vec!["simulation.duration=1.5".to_string()];
+    let scene = drape::scene::load_scene_file(&path, &sets).expect("scene");
+    let mut ring = None;
+    drape::run::run_observed(
+        &scene,
+        &drape::run::RunOptions::default(),
+        &AtomicBool::new(false),
+        &mut |_| {},
+        &mut |f| {
+            let at = drape::math::Vector2::new(1.0, 0.75);
+            let i = f.material.iter().position(|m| m.distance(at) < 1e-9);
+            ring = i.map(|i| f.positions[i]);
+        },
+    )
+    .expect("run");
+    let x = ring.expect("the last ring's corner is a vertex").x;
+    println!("the last ring's vertex at x = {x:.6} m at 1.5 s (keys: 1.0 - 0.8 = 0.2 m)");
+    assert!((x - 0.2).abs() < 1e-9, "{x}");
+}
