@@ -354,3 +354,35 @@ fn the_curtain_scene_draws_its_rings_along_the_rail() {
     println!("the last ring's vertex at x = {x:.6} m at 1.5 s (keys: 1.0 - 0.8 = 0.2 m)");
     assert!((x - 0.2).abs() < 1e-9, "{x}");
 }
+
+/// The shipped turning flag: its clamped second column (its top vertex) orbits the pole's
+/// axis, 120 deg round at 2 s, as the keys say (run at 16 segments, whose
+/// grid gets a line on the clamp's edge).
+#[test]
+fn the_turning_flags_pole_turns_its_clamped_column() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/flag_turning.toml");
+    let sets: Vec<String> = ["simulation.duration=2.0", "cloth.resolution=16"]
+        .map(String::from)
+        .to_vec();
+    let scene = drape::scene::load_scene_file(&path, &sets).expect("scene");
+    let mut column = None;
+    drape::run::run_observed(
+        &scene,
+        &drape::run::RunOptions::default(),
+        &AtomicBool::new(false),
+        &mut |_| {},
+        &mut |f| {
+            let at = drape::math::Vector2::new(-0.703125, 0.5);
+            let i = f.material.iter().position(|m| m.distance(at) < 1e-9);
+            column = i.map(|i| f.positions[i]);
+        },
+    )
+    .expect("run");
+    let p = column.expect("the clamp's edge is a grid line");
+    let r = 0.046875;
+    let a = 120f64.to_radians();
+    let expected = Vector::new(-0.75 + r * a.cos(), r * a.sin(), 2.0);
+    let off = (p - expected).length();
+    println!("clamped column at 2 s: {p:?}, off the keys' pose by {off:.1e} m");
+    assert!(off < 1e-9, "{off} m");
+}
