@@ -93,9 +93,8 @@ impl PinScript {
                 )
             }
             PinMotion::Keyframed => {
-                // `Pins::select` builds a track for every keyframed pin.
                 let Some(track) = &self.track else {
-                    return (start, Vector::ZERO);
+                    unreachable!("`Pins::select` builds a track for every keyframed pin")
                 };
                 let s = track.state(t);
                 let centre = self.center + s.shift;

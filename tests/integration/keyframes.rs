@@ -7,6 +7,33 @@ use drape::collide::motion::{RigidState, Track};
 use drape::math::Vector;
 use drape::scene::{Keyframe, KeyframeAfter, KeyframeEasing, load_scene_str};
 
+/// Runs `scene` without recording, showing every frame to `observe`.
+fn watch(
+    scene: &drape::scene::Scene,
+    observe: &mut (dyn FnMut(&drape::run::FrameState) + Send),
+) -> Result<drape::summary::Summary, drape::run::RunError> {
+    let opts = drape::run::RunOptions::default();
+    drape::run::run_observed(scene, &opts, &AtomicBool::new(false), &mut |_| {}, observe)
+}
+
+/// Where the vertex at material point `uv` of shipped scene `name` (with
+/// `sets`) is at the last frame.
+fn vertex_at_end(name: &str, sets: &[&str], uv: [f64; 2]) -> Vector {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes")
+        .join(format!("{name}.toml"));
+    let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+    let scene = drape::scene::load_scene_file(&path, &sets).expect("scene");
+    let at = drape::math::Vector2::new(uv[0], uv[1]);
+    let mut found = None;
+    watch(&scene, &mut |f| {
+        let i = f.material.iter().position(|m| m.distance(at) < 1e-9);
+        found = i.map(|i| f.positions[i]);
+    })
+    .expect("run");
+    found.unwrap_or_else(|| panic!("{name}: no vertex at {uv:?} (a grid line)"))
+}
+
 fn key(time: f64, translation: [f64; 3], rotation: [f64; 3]) -> Keyframe {
     Keyframe {
         time,
@@ -150,29 +177,23 @@ fn a_cloth_on_a_moving_turning_platform_moves_with_it() {
     let mut at_start = None;
     let mut last = None;
     let mut ends = [0usize; 2];
-    let summary = drape::run::run_observed(
-        &scene,
-        &drape::run::RunOptions::default(),
-        &AtomicBool::new(false),
-        &mut |_| {},
-        &mut |f| {
-            // The sheet's u axis: the centres of its left and right edges.
-            for (end, u) in ends.iter_mut().zip([-0.3, 0.3]) {
-                let at = drape::math::Vector2::new(u, 0.0);
-                *end = f
-                    .material
-                    .iter()
-                    .position(|m| m.distance(at) < 1e-9)
-                    .unwrap_or(0);
-            }
-            let snapshot = f.positions.to_vec();
-            if f.sim_time <= 0.5 + 1e-9 {
-                at_start = Some(snapshot);
-            } else {
-                last = Some(snapshot);
-            }
-        },
-    )
+    let summary = watch(&scene, &mut |f| {
+        // The sheet's u axis: the centres of its left and right edges.
+        for (end, u) in ends.iter_mut().zip([-0.3, 0.3]) {
+            let at = drape::math::Vector2::new(u, 0.0);
+            *end = f
+                .material
+                .iter()
+                .position(|m| m.distance(at) < 1e-9)
+                .unwrap_or(0);
+        }
+        let snapshot = f.positions.to_vec();
+        if f.sim_time <= 0.5 + 1e-9 {
+            at_start = Some(snapshot);
+        } else {
+            last = Some(snapshot);
+        }
+    })
     .expect("run");
     let (p0, p1) = (at_start.expect("frames"), last.expect("frames"));
     let centre = |p: &[Vector]| p.iter().copied().sum::<Vector>() / p.len() as f64;
@@ -287,31 +308,25 @@ fn keyframed_pins_hold_the_cloth_where_the_keys_say() {
     let scene = load_scene_str(CURTAIN, "curtain", &[]).expect("scene");
     let mut worst: f64 = 0.0;
     let mut checked = 0;
-    drape::run::run_observed(
-        &scene,
-        &drape::run::RunOptions::default(),
-        &AtomicBool::new(false),
-        &mut |_| {},
-        &mut |f| {
-            for (m, p) in f.material.iter().zip(f.positions) {
-                if (m.y - 0.5).abs() > 1e-12 {
-                    continue;
-                }
-                // The top edge starts at (u, 0, 1.5).
-                let expected = if (f.sim_time - 1.0).abs() < 1e-9 {
-                    Some(Vector::new(m.x + 0.5, 0.0, 1.5))
-                } else if (f.sim_time - 2.0).abs() < 1e-9 {
-                    Some(Vector::new(0.5, m.x, 1.5))
-                } else {
-                    None
-                };
-                if let Some(e) = expected {
-                    worst = worst.max((*p - e).length());
-                    checked += 1;
-                }
+    watch(&scene, &mut |f| {
+        for (m, p) in f.material.iter().zip(f.positions) {
+            if (m.y - 0.5).abs() > 1e-12 {
+                continue;
             }
-        },
-    )
+            // The top edge starts at (u, 0, 1.5).
+            let expected = if (f.sim_time - 1.0).abs() < 1e-9 {
+                Some(Vector::new(m.x + 0.5, 0.0, 1.5))
+            } else if (f.sim_time - 2.0).abs() < 1e-9 {
+                Some(Vector::new(0.5, m.x, 1.5))
+            } else {
+                None
+            };
+            if let Some(e) = expected {
+                worst = worst.max((*p - e).length());
+                checked += 1;
+            }
+        }
+    })
     .expect("run");
     println!("{checked} pinned positions at the keys, largest deviation {worst:.1e} m");
     assert_eq!(checked, 26, "13 top-edge vertices at two keys");
@@ -334,23 +349,8 @@ fn keyframed_pins_hold_the_cloth_where_the_keys_say() {
 /// through its smooth 0.5 to 2.5 s move: half of its 1.6 m).
 #[test]
 fn the_curtain_scene_draws_its_rings_along_the_rail() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/curtain.toml");
-    let sets = vec!["simulation.duration=1.5".to_string()];
-    let scene = drape::scene::load_scene_file(&path, &sets).expect("scene");
-    let mut ring = None;
-    drape::run::run_observed(
-        &scene,
-        &drape::run::RunOptions::default(),
-        &AtomicBool::new(false),
-        &mut |_| {},
-        &mut |f| {
-            let at = drape::math::Vector2::new(1.0, 0.75);
-            let i = f.material.iter().position(|m| m.distance(at) < 1e-9);
-            ring = i.map(|i| f.positions[i]);
-        },
-    )
-    .expect("run");
-    let x = ring.expect("the last ring's corner is a vertex").x;
+    let ring = vertex_at_end("curtain", &["simulation.duration=1.5"], [1.0, 0.75]);
+    let x = ring.x;
     println!("the last ring's vertex at x = {x:.6} m at 1.5 s (keys: 1.0 - 0.8 = 0.2 m)");
     assert!((x - 0.2).abs() < 1e-9, "{x}");
 }
@@ -360,25 +360,8 @@ fn the_curtain_scene_draws_its_rings_along_the_rail() {
 /// grid gets a line on the clamp's edge).
 #[test]
 fn the_turning_flags_pole_turns_its_clamped_column() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/flag_turning.toml");
-    let sets: Vec<String> = ["simulation.duration=2.0", "cloth.resolution=16"]
-        .map(String::from)
-        .to_vec();
-    let scene = drape::scene::load_scene_file(&path, &sets).expect("scene");
-    let mut column = None;
-    drape::run::run_observed(
-        &scene,
-        &drape::run::RunOptions::default(),
-        &AtomicBool::new(false),
-        &mut |_| {},
-        &mut |f| {
-            let at = drape::math::Vector2::new(-0.703125, 0.5);
-            let i = f.material.iter().position(|m| m.distance(at) < 1e-9);
-            column = i.map(|i| f.positions[i]);
-        },
-    )
-    .expect("run");
-    let p = column.expect("the clamp's edge is a grid line");
+    let sets = ["simulation.duration=2.0", "cloth.resolution=16"];
+    let p = vertex_at_end("flag_turning", &sets, [-0.703125, 0.5]);
     let r = 0.046875;
     let a = 120f64.to_radians();
     let expected = Vector::new(-0.75 + r * a.cos(), r * a.sin(), 2.0);
