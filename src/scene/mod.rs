@@ -1,7 +1,8 @@
 //! Scene files: TOML parsing with located errors, `--set` overrides, validation.
 //!
 //! ```text
-//! TOML text -> toml::Table -> apply --set -> Scene (serde) -> validate -> resolve cloth.path
+//! TOML text -> toml::Table -> apply --set -> fill material.preset -> Scene (serde)
+//!     -> validate -> resolve cloth.path
 //! ```
 //! Every error names the file, the line (or the `--set`) and the key; see
 //! [`SceneError`] and `docs/scenes.md`.
@@ -11,6 +12,7 @@ mod limits;
 pub mod model;
 mod overrides;
 mod parse;
+pub mod presets;
 pub mod resolve;
 mod schema;
 mod serde_errors;

@@ -147,6 +147,9 @@ pub struct Cloth {
 #[derive(Debug, Clone, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct Material {
+    /// The measured fabric whose values fill the keys this table does not
+    /// write ([`super::presets::FABRICS`]; `None`: no preset).
+    pub preset: Option<String>,
     /// Area density in kg/m^2 (> 0).
     pub density: f64,
     /// Stretch stiffness in N/m (> 0): the springs' constant, and the

@@ -1,12 +1,13 @@
-//! Loading: TOML text -> document -> `--set` overrides -> `Scene` -> validation,
-//! with every error located at a line of the file or at the `--set` that caused it.
+//! Loading: TOML text -> document -> `--set` overrides -> fabric preset -> `Scene`
+//! -> validation, with every error located at a line of the file or at the `--set`
+//! that caused it.
 
 use std::path::Path;
 
 use super::error::{Issue, KeyPath, SceneError, SceneErrorKind, Seg, dotted, keys};
 use super::serde_errors::translate;
 use super::spans::{line_at, line_of};
-use super::{Scene, overrides, validate};
+use super::{Scene, overrides, presets, validate};
 
 /// Sections the format names that this version does not implement, with what is planned.
 /// (None at present; the mechanism stays for sections added to the format later.)
@@ -31,7 +32,10 @@ pub(crate) fn load(
         ctx.applied.push((path, arg.clone()));
     }
     unsupported(&doc).map_err(|i| ctx.locate(i))?;
-    let mut scene = deserialize(&doc).map_err(|i| ctx.locate(i))?;
+    // Validation sees the document as written: a preset's values are not keys
+    // the scene wrote.
+    let filled = presets::expand(doc.clone()).map_err(|i| ctx.locate(i))?;
+    let mut scene = deserialize(&filled).map_err(|i| ctx.locate(i))?;
     validate::validate(&scene, &doc).map_err(|i| ctx.locate(i))?;
     if let Some(p) = scene.cloth.path.as_deref() {
         let from_set = ctx.set_for(&keys(&["cloth", "path"])).is_some();

@@ -34,6 +34,7 @@ pub(crate) fn allowed(path: &str) -> Option<&'static str> {
         "cloth.position" => "an array of 3 finite numbers (m)",
         "cloth.rotation" => "an array of 3 finite numbers (degrees)",
         "material" => "a table [material]",
+        "material.preset" => super::presets::ALLOWED,
         "material.density" => "a finite number > 0 (kg/m^2)",
         "material.stretch" => "a finite number > 0 (N/m)",
         "material.membrane" => "\"springs\" or \"triangles\"",
