@@ -25,6 +25,7 @@ pub fn describe(scene: &Scene) -> Result<String, RunError> {
     let mut s = String::new();
     let _ = writeln!(s, "scene `{}`", scene.name);
     describe_cloth(&mut s, scene, &world, &stepper.elements);
+    describe_material(&mut s, scene);
     let (ext, mat) = (&model.external, &model.material);
     describe_forces(&mut s, &world, &stepper.elements, mat, ext);
     let adapt = AdaptConfig::from_scene(scene.adapt.as_ref());
@@ -81,6 +82,17 @@ fn describe_cloth(s: &mut String, scene: &Scene, world: &World, el: &Elements) {
         world.mesh.total_rest_area(),
         el.total_mass()
     );
+}
+
+/// The `material:` line: the area density, and the measured fabric whose
+/// values fill the keys the scene does not write.
+fn describe_material(s: &mut String, scene: &Scene) {
+    let m = &scene.material;
+    let preset = m.preset.as_deref().and_then(crate::scene::presets::find);
+    let preset = preset.map_or(String::new(), |f| {
+        format!(", preset \"{}\" ({}; Wang, O'Brien and Ramamoorthi 2011, linearised at zero strain and curvature)", f.name, f.description)
+    });
+    let _ = writeln!(s, "material: density {} kg/m^2{preset}", m.density);
 }
 
 /// A rectangle's grid in words: its cells, and their range of sizes where

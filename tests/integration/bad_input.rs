@@ -255,6 +255,15 @@ fn wrong_types_are_refused() {
 }
 
 #[test]
+fn an_unknown_fabric_preset_is_refused_with_the_known_names() {
+    refused_sets(
+        "preset",
+        &[("material.preset", "\"satin\"")],
+        "no fabric preset is called \"satin\"; allowed: one of \"tango-red-jet-set\"",
+    );
+}
+
+#[test]
 fn zero_and_negative_physical_values_are_refused() {
     // Every physical parameter: > 0 where zero is meaningless, >= 0 otherwise.
     let positive = [

@@ -29,6 +29,7 @@ mod mesh;
 mod metric;
 mod physics;
 mod pins;
+mod presets;
 mod recording;
 mod recording_run;
 mod remesh_ops;
