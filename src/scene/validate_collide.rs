@@ -16,11 +16,12 @@ fn shape_keys(shape: ObstacleShape) -> (&'static str, &'static [&'static str]) {
         ObstacleShape::Capsule => ("capsule", &["radius", "half_height"]),
         ObstacleShape::Cylinder => ("cylinder", &["radius", "half_height"]),
         ObstacleShape::Mesh => ("mesh", &["path"]),
+        ObstacleShape::Articulated => ("articulated", &["part"]),
     }
 }
 
 /// Keys that only some shapes have; every other shape refuses them.
-const SHAPE_SPECIFIC: [(&str, &[ObstacleShape]); 6] = [
+const SHAPE_SPECIFIC: [(&str, &[ObstacleShape]); 7] = [
     (
         "radius",
         &[
@@ -37,6 +38,7 @@ const SHAPE_SPECIFIC: [(&str, &[ObstacleShape]); 6] = [
     ("normal", &[ObstacleShape::Plane]),
     ("path", &[ObstacleShape::Mesh]),
     ("scale", &[ObstacleShape::Mesh]),
+    ("part", &[ObstacleShape::Articulated]),
 ];
 
 /// Checks obstacle `i`; `written` is its table as written (to tell keys from defaults).
