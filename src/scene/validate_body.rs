@@ -6,7 +6,8 @@
 use toml::{Table, Value};
 
 use super::error::{Issue, KeyPath, SceneErrorKind as Kind, Seg};
-use super::validate::{all_finite, allowed_for, out_of_range, positive};
+use super::validate::{all_finite, allowed_for, out_of_range};
+use super::validate_collide::sizes_positive;
 use super::validate_motion::{track, unused};
 use super::{Obstacle, ObstacleShape, Part};
 
@@ -131,21 +132,7 @@ fn sizes(p: &Part, at: &dyn Fn(&str) -> KeyPath, has: &dyn Fn(&str) -> bool) -> 
             .allowed(allowed_for(&at(k)))
             .because(at("shape")));
     }
-    for (k, v) in [("radius", p.radius), ("half_height", p.half_height)] {
-        if let Some(x) = v {
-            positive(at(k), x)?;
-        }
-    }
-    if let Some(h) = p.half_extents {
-        all_finite(at("half_extents"), &h)?;
-        if h.iter().any(|&x| x <= 0.0) {
-            return Err(out_of_range(
-                at("half_extents"),
-                format!("{h:?} has a size that is not > 0"),
-            ));
-        }
-    }
-    Ok(())
+    sizes_positive(at, p.radius, p.half_height, p.half_extents)
 }
 
 /// Every chain of parents reaches a part without a parent (the parents are
