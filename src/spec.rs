@@ -11,6 +11,9 @@
 
 use serde::Deserialize;
 
+mod part;
+pub use part::Part;
+
 /// The cloth's rest mesh and its placement in the world, resolved from `[cloth]`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ClothSpec {
@@ -265,6 +268,10 @@ pub struct Obstacle {
     /// What the obstacle does after its last keyframe.
     #[serde(default)]
     pub after_last: KeyframeAfter,
+    /// The parts of an `articulated` obstacle (`[[obstacle.part]]`), whose
+    /// root frame is the obstacle's own (placed and keyframed as any obstacle).
+    #[serde(default)]
+    pub part: Vec<Part>,
 }
 
 /// `[[obstacle.keyframes]]`: the obstacle's pose at one time, relative to its
@@ -323,6 +330,8 @@ pub enum ObstacleShape {
     Cylinder,
     /// A triangle mesh from an OBJ file (`path`, `scale`).
     Mesh,
+    /// Primitives in a joint hierarchy (`part`), moved by forward kinematics.
+    Articulated,
 }
 
 /// `[self_collision]`: contacts of the cloth with itself.

@@ -32,11 +32,13 @@
 //! thread count.
 
 pub mod cusick;
+mod display;
 pub mod geometry;
 pub mod motion;
 pub mod obstacle;
 mod response;
 pub mod selfcol;
+pub mod skeleton;
 pub mod volino;
 
 use std::time::Instant;
@@ -54,6 +56,8 @@ use parry3d_f64::math::Pose;
 use response::{depth_below, push_out, respond};
 use selfcol::SelfCollider;
 
+pub use display::{Drawn, ObstacleMesh, ObstaclePose};
+
 /// Why the collision setup of a scene failed.
 #[derive(Debug, thiserror::Error)]
 pub enum CollideError {
@@ -64,6 +68,15 @@ pub enum CollideError {
         index: usize,
         /// The file.
         path: String,
+        /// What is wrong.
+        reason: String,
+    },
+    /// An articulated obstacle's hierarchy is unusable (validation normally
+    /// catches this first).
+    #[error("obstacle {index}: {reason}")]
+    Hierarchy {
+        /// Obstacle index.
+        index: usize,
         /// What is wrong.
         reason: String,
     },
@@ -137,19 +150,6 @@ pub struct StepCloth<'a> {
     pub mass: &'a [Scalar],
 }
 
-/// A triangulated obstacle for display: world positions and triangles.
-#[derive(Debug, Clone)]
-pub struct ObstacleMesh {
-    /// Name, `obstacle N (shape)`.
-    pub name: String,
-    /// Whether it moves (then it must be drawn every frame).
-    pub moving: bool,
-    /// Vertex positions, m.
-    pub positions: Vec<Vector>,
-    /// Triangles.
-    pub triangles: Vec<[u32; 3]>,
-}
-
 /// The rigid obstacles of a scene: their shapes, poses, motions and friction,
 /// fixed for the run (the simulation's [`crate::sim::Setup`] holds them; the
 /// [`Collider`] is given them every step).
@@ -166,7 +166,10 @@ impl Obstacles {
             .iter()
             .enumerate()
             .map(|(i, o)| Body::from_spec(i, o))
-            .collect::<Result<Vec<_>, _>>()?;
+            .collect::<Result<Vec<_>, _>>()?
+            .into_iter()
+            .flatten()
+            .collect();
         Ok(Obstacles { bodies })
     }
 
@@ -199,26 +202,6 @@ impl Obstacles {
             );
         }
         out
-    }
-
-    /// The obstacles triangulated at time `t`, in world coordinates: every
-    /// one with `fixed_too`, else only those that move; planes as a square of
-    /// half side `plane.1` around `plane.0` (see
-    /// [`obstacle::Body::world_triangles`]).
-    pub fn meshes(&self, t: Scalar, plane: (Vector, Scalar), fixed_too: bool) -> Vec<ObstacleMesh> {
-        self.bodies
-            .iter()
-            .filter(|b| fixed_too || b.is_moving())
-            .map(|b| {
-                let (positions, triangles) = b.world_triangles(t, plane);
-                ObstacleMesh {
-                    name: b.name.clone(),
-                    moving: b.is_moving(),
-                    positions,
-                    triangles,
-                }
-            })
-            .collect()
     }
 
     /// Per vertex of `x`, the tangent plane of the nearest obstacle surface

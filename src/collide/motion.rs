@@ -33,7 +33,11 @@
 //! first key to the last (`loop`), which needs the last key's pose to equal the
 //! first's so that nothing jumps where the loop wraps around.
 
+use std::sync::Arc;
+
 use glam::DQuat;
+
+use super::skeleton::Skeleton;
 
 use crate::math::{Scalar, Vector, rotation_from_euler_deg};
 use crate::spec::{Keyframe, KeyframeAfter, KeyframeEasing};
@@ -53,6 +57,13 @@ pub enum Motion {
     },
     /// Along keyframes.
     Keyframed(Track),
+    /// As one part of an articulated body (forward kinematics, `skeleton.rs`).
+    Articulated {
+        /// The body's joint hierarchy and root motion, shared by its parts.
+        skeleton: Arc<Skeleton>,
+        /// Which part.
+        part: usize,
+    },
 }
 
 /// Where the obstacle is at one time, relative to its placement at rest.
@@ -149,6 +160,7 @@ impl Motion {
                 *velocity != Vector::ZERO || *omega != Vector::ZERO
             }
             Motion::Keyframed(_) => true,
+            Motion::Articulated { skeleton, part } => skeleton.is_moving(*part),
         }
     }
 
@@ -166,6 +178,16 @@ impl Motion {
                 track.after
             )
             .to_lowercase(),
+            Motion::Articulated { skeleton, part } => format!(
+                ", part `{}` of {} of an articulated body (forward kinematics){}",
+                skeleton.name(*part),
+                skeleton.len(),
+                if skeleton.is_moving(*part) {
+                    ", moving"
+                } else {
+                    ""
+                }
+            ),
         }
     }
 
@@ -185,6 +207,7 @@ impl Motion {
                 omega: *omega,
             },
             Motion::Keyframed(track) => track.state(t),
+            Motion::Articulated { skeleton, part } => skeleton.state(*part, t),
         }
     }
 }

@@ -2,6 +2,7 @@
 //! friction and the cloth thickness kept against it.
 
 use std::path::Path;
+use std::sync::Arc;
 
 use parry3d_f64::bounding_volume::{Aabb, BoundingVolume};
 use parry3d_f64::math::Pose;
@@ -12,9 +13,10 @@ use parry3d_f64::shape::{
 
 use super::CollideError;
 use super::motion::{Motion, Track};
+use super::skeleton::Skeleton;
 use crate::adapt::proximity::ObstaclePlane;
 use crate::math::{Scalar, Vector, rotation_from_euler_deg};
-use crate::spec::{Obstacle, ObstacleShape};
+use crate::spec::{Obstacle, ObstacleShape, Part};
 
 /// A rigid obstacle the cloth collides with.
 pub struct Body {
@@ -55,31 +57,29 @@ pub struct Probe {
 }
 
 impl Body {
-    /// Builds obstacle `index` of a scene (OBJ paths are already resolved by the loader).
-    pub fn from_spec(index: usize, o: &Obstacle) -> Result<Body, CollideError> {
-        let need =
-            |v: Option<Scalar>, key: &'static str| v.ok_or(CollideError::Missing { index, key });
+    /// Builds obstacle `index` of a scene (OBJ paths are already resolved by
+    /// the loader): one body, or one per part of an articulated obstacle.
+    pub fn from_spec(index: usize, o: &Obstacle) -> Result<Vec<Body>, CollideError> {
+        let axis = Vector::from_array(o.axis).normalize_or_zero();
+        if o.shape == ObstacleShape::Articulated {
+            let skeleton = Arc::new(Skeleton::new(index, o, motion(o, axis))?);
+            return o
+                .part
+                .iter()
+                .enumerate()
+                .map(|(i, p)| Body::part(index, o, &skeleton, i, p))
+                .collect();
+        }
         // parry's cylinder is along local y; ours stand along local z.
         let y_to_z = glam::DQuat::from_rotation_x(std::f64::consts::FRAC_PI_2);
         let mut fix = glam::DQuat::IDENTITY;
         let shape: Box<dyn Shape> = match o.shape {
-            ObstacleShape::Sphere => Box::new(Ball::new(need(o.radius, "radius")?)),
-            ObstacleShape::Box => {
-                let h = o.half_extents.ok_or(CollideError::Missing {
-                    index,
-                    key: "half_extents",
-                })?;
-                Box::new(Cuboid::new(Vector::from_array(h)))
-            }
             ObstacleShape::Plane => Box::new(HalfSpace::new(
                 Vector::from_array(o.normal).normalize_or(Vector::Z),
             )),
-            ObstacleShape::Capsule => Box::new(Capsule::new_z(
-                need(o.half_height, "half_height")?,
-                need(o.radius, "radius")?,
-            )),
             ObstacleShape::Cylinder => {
                 fix = y_to_z;
+                let need = |v: Option<Scalar>, key| v.ok_or(CollideError::Missing { index, key });
                 Box::new(Cylinder::new(
                     need(o.half_height, "half_height")?,
                     need(o.radius, "radius")?,
@@ -92,26 +92,61 @@ impl Body {
                     .ok_or(CollideError::Missing { index, key: "path" })?;
                 Box::new(load_mesh(index, Path::new(path), o.scale)?)
             }
+            _ => primitive(index, o.shape, o.radius, o.half_height, o.half_extents)?,
         };
         let rot = glam::DQuat::from_mat3(&rotation_from_euler_deg(o.rotation));
         let origin = Vector::from_array(o.position);
         let pose0 = Pose::from_parts(origin, rot * fix);
-        let axis = Vector::from_array(o.axis).normalize_or_zero();
+        let name = format!("obstacle {index} ({})", shape_name(o.shape));
+        Ok(vec![Body::rigid(name, o, shape, pose0, motion(o, axis))])
+    }
+
+    /// Part `i` (`p`) of articulated obstacle `index` (`o`), moved by `skeleton`.
+    fn part(
+        index: usize,
+        o: &Obstacle,
+        skeleton: &Arc<Skeleton>,
+        i: usize,
+        p: &Part,
+    ) -> Result<Body, CollideError> {
+        let shape = primitive(index, p.shape, p.radius, p.half_height, p.half_extents)?;
+        let rest = skeleton.rest(i);
+        let centre = rest.position + rest.rotation * Vector::from_array(p.center);
+        let pose0 = Pose::from_parts(centre, rest.rotation);
+        let motion = Motion::Articulated {
+            skeleton: Arc::clone(skeleton),
+            part: i,
+        };
+        let name = format!("obstacle {index} part {}", p.name);
+        let mut body = Body::rigid(name, o, shape, pose0, motion);
+        body.origin = rest.position;
+        Ok(body)
+    }
+
+    /// A body of `shape` placed at rest by `pose0` (rotating about its
+    /// translation), with `o`'s friction and thickness.
+    fn rigid(
+        name: String,
+        o: &Obstacle,
+        shape: Box<dyn Shape>,
+        pose0: Pose,
+        motion: Motion,
+    ) -> Body {
         let t = o.thickness;
         let local = shape.compute_local_aabb();
         let local_box = Aabb::new(local.mins - Vector::splat(t), local.maxs + Vector::splat(t));
-        Ok(Body {
-            name: format!("obstacle {index} ({})", shape_name(o.shape)),
+        Body {
+            name,
             kind: o.shape,
             shape,
+            origin: pose0.translation,
             pose0,
-            origin,
-            motion: motion(o, axis),
+            motion,
             mu_static: o.friction_static,
             mu_kinetic: o.friction_kinetic.unwrap_or(o.friction_static),
             thickness: t,
             local_box,
-        })
+        }
     }
 
     /// True when the obstacle moves.
@@ -140,6 +175,11 @@ impl Body {
     pub fn point_velocity(&self, t: Scalar, x: Vector) -> Vector {
         let state = self.motion.state(t);
         state.velocity + state.omega.cross(x - (self.origin + state.shift))
+    }
+
+    /// True when the shape is a plane (a half-space).
+    pub fn is_plane(&self) -> bool {
+        self.shape.as_shape::<HalfSpace>().is_some()
     }
 
     /// True when the local segment `a`-`b` may come within the thickness of the shape.
@@ -202,7 +242,7 @@ impl Body {
 
     /// A triangulation of the obstacle in its local frame, for display (a plane
     /// has none: [`Body::world_triangles`] draws it around the cloth).
-    fn local_triangles(&self) -> (Vec<Vector>, Vec<[u32; 3]>) {
+    pub fn local_triangles(&self) -> (Vec<Vector>, Vec<[u32; 3]>) {
         if let Some(b) = self.shape.as_shape::<Ball>() {
             return b.to_trimesh(32, 16);
         }
@@ -257,6 +297,41 @@ impl Body {
     }
 }
 
+/// A sphere, box or capsule of the given sizes (the shapes an articulated
+/// body's parts may have); any other shape is refused.
+fn primitive(
+    index: usize,
+    shape: ObstacleShape,
+    radius: Option<Scalar>,
+    half_height: Option<Scalar>,
+    half_extents: Option<[Scalar; 3]>,
+) -> Result<Box<dyn Shape>, CollideError> {
+    let need = |v: Option<Scalar>, key: &'static str| v.ok_or(CollideError::Missing { index, key });
+    Ok(match shape {
+        ObstacleShape::Sphere => Box::new(Ball::new(need(radius, "radius")?)),
+        ObstacleShape::Box => {
+            let h = half_extents.ok_or(CollideError::Missing {
+                index,
+                key: "half_extents",
+            })?;
+            Box::new(Cuboid::new(Vector::from_array(h)))
+        }
+        ObstacleShape::Capsule => Box::new(Capsule::new_z(
+            need(half_height, "half_height")?,
+            need(radius, "radius")?,
+        )),
+        other => {
+            return Err(CollideError::Hierarchy {
+                index,
+                reason: format!(
+                    "a part cannot be a {}: parts are spheres, capsules or boxes",
+                    shape_name(other)
+                ),
+            });
+        }
+    })
+}
+
 fn shape_name(s: ObstacleShape) -> &'static str {
     match s {
         ObstacleShape::Sphere => "sphere",
@@ -265,6 +340,7 @@ fn shape_name(s: ObstacleShape) -> &'static str {
         ObstacleShape::Capsule => "capsule",
         ObstacleShape::Cylinder => "cylinder",
         ObstacleShape::Mesh => "mesh",
+        ObstacleShape::Articulated => "articulated",
     }
 }
 

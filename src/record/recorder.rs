@@ -288,11 +288,7 @@ impl Recorder {
                 reason: format!("obstacle {name}: triangle {t:?} indexes past {n} vertices"),
             });
         }
-        let clean: String = name
-            .chars()
-            .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
-            .collect();
-        let entity = format!("{ENTITY_OBSTACLES}/{clean}");
+        let entity = obstacle_entity(name);
         let [r, g, b] = OBSTACLE_COLOR;
         let mesh = rerun::Mesh3D::new(positions.iter().map(|&p| convert::position(p)))
             .with_triangle_indices(triangles.iter().copied())
@@ -303,6 +299,27 @@ impl Recorder {
             self.stream.log(entity.as_str(), &mesh)
         };
         logged.map_err(|e| self.log_err(&entity, e))
+    }
+
+    /// Logs a moving rigid obstacle's pose at the current frame as the
+    /// `Transform3D` of `obstacles/<name>`, which places the mesh that
+    /// [`Recorder::record_obstacle`] logged once in the obstacle's local frame
+    /// (call it after [`Recorder::record_frame`] every frame).
+    pub fn record_obstacle_pose(
+        &mut self,
+        name: &str,
+        translation: Vector,
+        rotation: glam::DQuat,
+    ) -> Result<(), RecordError> {
+        let entity = obstacle_entity(name);
+        let q = rotation.normalize().to_array().map(|c| c as f32);
+        let transform = rerun::Transform3D::from_translation_rotation(
+            convert::f32x3(translation),
+            rerun::Quaternion::from_xyzw(q),
+        );
+        self.stream
+            .log(entity.as_str(), &transform)
+            .map_err(|e| self.log_err(&entity, e))
     }
 
     /// Flushes and closes the stream (the file's footer included) and returns the size of the
@@ -357,4 +374,14 @@ impl Drop for Recorder {
         }
         drop(stream);
     }
+}
+
+/// `obstacles/<name>`, the characters of `name` other than ASCII letters and
+/// digits replaced by `_`.
+fn obstacle_entity(name: &str) -> String {
+    let clean: String = name
+        .chars()
+        .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
+        .collect();
+    format!("{ENTITY_OBSTACLES}/{clean}")
 }

@@ -2,6 +2,7 @@
 //! events and the plots into a [`FrameView`] for the recorder.
 
 use crate::adapt::{AdaptEvent, Adapter, EventKind, edge_angles};
+use crate::collide::Drawn;
 use crate::math::{Scalar, Vector};
 use crate::physics::Energy;
 use crate::record::{EventMark, FrameView, Recorder};
@@ -34,8 +35,8 @@ pub(super) struct Snapshot {
 }
 
 /// Records the world's current state as frame `snap.frame`, with the events since the previous
-/// recorded frame, the plots, and the obstacles (static ones with frame 0, moving ones every
-/// recorded frame).
+/// recorded frame, the plots, and the obstacles (their meshes with frame 0, the poses of
+/// moving ones, or the mesh of a moving plane, every recorded frame).
 pub(super) fn record_state(
     rec: &mut Recorder,
     setup: &Setup,
@@ -106,13 +107,18 @@ pub(super) fn record_state(
     if setup.obstacles.is_empty() {
         return Ok(());
     }
-    // Fixed obstacles are logged once, as static data, at the first frame.
+    // Every mesh but a moving plane's is logged once, at the first frame;
+    // moving rigid shapes are placed by a transform every frame.
     let first = snap.frame == 0;
     for m in setup
         .obstacles
         .meshes(world.time, plane_display(world), first)
     {
-        rec.record_obstacle(&m.name, &m.positions, &m.triangles, !m.moving)?;
+        let fixed = m.drawn != Drawn::Redrawn;
+        rec.record_obstacle(&m.name, &m.positions, &m.triangles, fixed)?;
+    }
+    for p in setup.obstacles.poses(world.time) {
+        rec.record_obstacle_pose(&p.name, p.translation, p.rotation)?;
     }
     Ok(())
 }

@@ -19,6 +19,7 @@ mod serde_errors;
 mod spans;
 mod validate;
 mod validate_adapt;
+mod validate_body;
 mod validate_collide;
 mod validate_material;
 mod validate_measure;

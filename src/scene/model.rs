@@ -11,7 +11,8 @@ use crate::physics::membrane::{Membrane, Orthotropic};
 pub use crate::spec::{
     Adapt, AdaptCriterion, AdaptEvery, AdaptMethod, BendingModel, ClothShape, DEFAULT_THICKNESS,
     DiagonalPattern, Integrator, Keyframe, KeyframeAfter, KeyframeEasing, Measurement,
-    MembraneModel, Obstacle, ObstacleShape, Pin, PinMotion, SelfCollision, Solver, StiffnessRule,
+    MembraneModel, Obstacle, ObstacleShape, Part, Pin, PinMotion, SelfCollision, Solver,
+    StiffnessRule,
 };
 
 /// A whole scene file.

@@ -75,7 +75,9 @@ pub(crate) fn allowed(path: &str) -> Option<&'static str> {
         "wind.velocity" => "an array of 3 finite numbers (m/s)",
         "wind.coefficient" => "a finite number >= 0",
         "obstacle" => "an array of tables [[obstacle]]",
-        "obstacle.shape" => "\"sphere\", \"box\", \"plane\", \"capsule\", \"cylinder\" or \"mesh\"",
+        "obstacle.shape" => {
+            "\"sphere\", \"box\", \"plane\", \"capsule\", \"cylinder\", \"mesh\" or \"articulated\""
+        }
         "obstacle.radius" | "obstacle.half_height" => "a finite number > 0 (m)",
         "obstacle.half_extents" => "an array of 3 finite numbers > 0 (m)",
         "obstacle.normal" => "an array of 3 finite numbers, not all zero",
@@ -97,6 +99,24 @@ pub(crate) fn allowed(path: &str) -> Option<&'static str> {
         "obstacle.keyframes.rotation" => "an array of 3 finite numbers (degrees)",
         "obstacle.easing" => "\"linear\" or \"smooth\"",
         "obstacle.after_last" => "\"hold\" or \"loop\"",
+        "obstacle.part" => {
+            "an array of at least one table [[obstacle.part]] (shape = \"articulated\" only)"
+        }
+        "obstacle.part.name" => "a non-empty string, unique among the obstacle's parts",
+        "obstacle.part.parent" => "the name of another part of the same obstacle",
+        "obstacle.part.shape" => "\"sphere\", \"capsule\" or \"box\"",
+        "obstacle.part.radius" | "obstacle.part.half_height" => "a finite number > 0 (m)",
+        "obstacle.part.half_extents" => "an array of 3 finite numbers > 0 (m)",
+        "obstacle.part.joint" | "obstacle.part.center" => "an array of 3 finite numbers (m)",
+        "obstacle.part.rotation" => "an array of 3 finite numbers (degrees)",
+        "obstacle.part.keyframes" => {
+            "an array of at least two tables {time, rotation} with increasing times"
+        }
+        "obstacle.part.keyframes.time" => "a finite number (s), larger than the key before's",
+        "obstacle.part.keyframes.translation" => "none: a joint only turns",
+        "obstacle.part.keyframes.rotation" => "an array of 3 finite numbers (degrees)",
+        "obstacle.part.easing" => "\"linear\" or \"smooth\"",
+        "obstacle.part.after_last" => "\"hold\" or \"loop\"",
         "self_collision" => "a table [self_collision]",
         "self_collision.thickness" => "a finite number > 0 (m)",
         "self_collision.iterations" => "an integer >= 1",

@@ -36,6 +36,7 @@ pub(crate) fn validate(scene: &Scene, doc: &Table) -> Result<(), Issue> {
         let written = obstacles.and_then(|a| a.get(i)).and_then(Value::as_table);
         super::validate_collide::obstacle(i, o, written)?;
         super::validate_motion::keyframes(i, o, written)?;
+        super::validate_body::parts(i, o, written)?;
     }
     if let Some(s) = &scene.self_collision {
         super::validate_collide::self_collision(s)?;

@@ -16,11 +16,12 @@ fn shape_keys(shape: ObstacleShape) -> (&'static str, &'static [&'static str]) {
         ObstacleShape::Capsule => ("capsule", &["radius", "half_height"]),
         ObstacleShape::Cylinder => ("cylinder", &["radius", "half_height"]),
         ObstacleShape::Mesh => ("mesh", &["path"]),
+        ObstacleShape::Articulated => ("articulated", &["part"]),
     }
 }
 
 /// Keys that only some shapes have; every other shape refuses them.
-const SHAPE_SPECIFIC: [(&str, &[ObstacleShape]); 6] = [
+const SHAPE_SPECIFIC: [(&str, &[ObstacleShape]); 7] = [
     (
         "radius",
         &[
@@ -37,6 +38,7 @@ const SHAPE_SPECIFIC: [(&str, &[ObstacleShape]); 6] = [
     ("normal", &[ObstacleShape::Plane]),
     ("path", &[ObstacleShape::Mesh]),
     ("scale", &[ObstacleShape::Mesh]),
+    ("part", &[ObstacleShape::Articulated]),
 ];
 
 /// Checks obstacle `i`; `written` is its table as written (to tell keys from defaults).
@@ -76,20 +78,7 @@ pub(super) fn obstacle(i: usize, o: &Obstacle, written: Option<&Table>) -> Resul
         .allowed(allowed_for(&at(k)))
         .because(at("shape")));
     }
-    for (k, v) in [("radius", o.radius), ("half_height", o.half_height)] {
-        if let Some(x) = v {
-            positive(at(k), x)?;
-        }
-    }
-    if let Some(h) = o.half_extents {
-        all_finite(at("half_extents"), &h)?;
-        if h.iter().any(|&x| x <= 0.0) {
-            return Err(out_of_range(
-                at("half_extents"),
-                format!("{h:?} has a size that is not > 0"),
-            ));
-        }
-    }
+    sizes_positive(&at, o.radius, o.half_height, o.half_extents)?;
     direction(at("normal"), o.normal)?;
     if o.path.as_deref().is_some_and(|p| p.trim().is_empty()) {
         return Err(Issue::new(at("path"), Kind::BadValue, "the path is empty")
@@ -117,6 +106,31 @@ pub(super) fn obstacle(i: usize, o: &Obstacle, written: Option<&Table>) -> Resul
     finite(&at("angular_velocity"), o.angular_velocity)?;
     if o.angular_velocity != 0.0 || has("axis") {
         direction(at("axis"), o.axis)?;
+    }
+    Ok(())
+}
+
+/// The size keys given (`radius`, `half_height`, `half_extents`) are all > 0;
+/// `at` gives a key's path. Obstacles and articulated parts share it.
+pub(super) fn sizes_positive(
+    at: &dyn Fn(&str) -> KeyPath,
+    radius: Option<f64>,
+    half_height: Option<f64>,
+    half_extents: Option<[f64; 3]>,
+) -> Result<(), Issue> {
+    for (k, v) in [("radius", radius), ("half_height", half_height)] {
+        if let Some(x) = v {
+            positive(at(k), x)?;
+        }
+    }
+    if let Some(h) = half_extents {
+        all_finite(at("half_extents"), &h)?;
+        if h.iter().any(|&x| x <= 0.0) {
+            return Err(out_of_range(
+                at("half_extents"),
+                format!("{h:?} has a size that is not > 0"),
+            ));
+        }
     }
     Ok(())
 }

@@ -52,7 +52,7 @@ pub(super) fn pin_keyframes(
 }
 
 /// `easing` and `after_last` without keyframes: refused, `why` saying so.
-fn unused(
+pub(super) fn unused(
     at: &dyn Fn(&str) -> KeyPath,
     has: &dyn Fn(&str) -> bool,
     why: &str,
@@ -67,7 +67,7 @@ fn unused(
 }
 
 /// At least two keys, finite, at increasing times; a loop that does not jump.
-fn track(
+pub(super) fn track(
     at: &dyn Fn(&str) -> KeyPath,
     keys: &[Keyframe],
     after: KeyframeAfter,

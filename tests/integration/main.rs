@@ -5,6 +5,7 @@ mod adapt;
 mod adapt_cost;
 mod adapt_sizing;
 mod adapt_tensor;
+mod articulated;
 mod bad_cli;
 mod bad_input;
 mod bad_obj;
