@@ -46,6 +46,23 @@ pub fn dihedral_angle_and_gradient(x: [Vector; 4]) -> (Scalar, [Vector; 4]) {
     (theta, [ga, gb, gp, gq])
 }
 
+/// The signed dihedral angle alone (radians), equal to
+/// [`dihedral_angle_and_gradient`]'s.
+#[inline(always)]
+pub fn dihedral_angle(x: [Vector; 4]) -> Scalar {
+    let [a, b, p, q] = x;
+    let e = b - a;
+    let e_len2 = e.length_squared();
+    let n0 = e.cross(p - a);
+    let n1 = (a - b).cross(q - b);
+    let (n0_len2, n1_len2) = (n0.length_squared(), n1.length_squared());
+    if e_len2 <= 0.0 || n0_len2 <= 1e-300 || n1_len2 <= 1e-300 {
+        return 0.0;
+    }
+    let (u0, u1) = (n0 / n0_len2.sqrt(), n1 / n1_len2.sqrt());
+    u0.cross(u1).dot(e / e_len2.sqrt()).atan2(u0.dot(u1))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -56,7 +56,9 @@ mod reuse;
 pub use reuse::RebuildCounts;
 
 use super::membrane::{MEMBRANE_SLOTS, Membrane, MembraneTriangle};
-use super::shape::{SHAPE_SLOTS, ShapeScratch, ShapeTriangle, build_shape_triangles_into};
+use super::shape::{
+    FoldSplits, SHAPE_SLOTS, ShapeScratch, ShapeTriangle, build_shape_triangles_into,
+};
 use crate::math::{Scalar, Vector2};
 use crate::mesh::Mesh;
 use crate::spec::{BendingModel, StiffnessRule};
@@ -164,6 +166,8 @@ pub struct Elements {
     /// Shape-operator bending elements, one per triangle (only with that model and
     /// non-zero rigidity).
     pub shape_triangles: Vec<ShapeTriangle>,
+    /// The factored system of the shape triangles' fold splits.
+    pub fold_splits: FoldSplits,
     /// Springs where the vertex is the first end (`v[0]`).
     pub spring_first: Incidence,
     /// Springs where the vertex is the second end (`v[1]`).
@@ -246,12 +250,13 @@ impl Elements {
         membrane_triangles(mesh, mat, area, &mut self.membrane_triangles);
         scratch.shapes.clear();
         let mut kept = 0;
+        let mut splits = 0;
         if mat.bending > 0.0 && mat.bending_model == BendingModel::ShapeOperator {
             let (old, previous) = (&self.shape_triangles, &self.previous);
             let reuse = &mut scratch.reuse;
             reuse.match_previous(previous, &self.vertex_triangles, mesh, mat);
             let reuse = &*reuse;
-            build_shape_triangles_into(
+            splits = build_shape_triangles_into(
                 mesh,
                 area,
                 mat.bending,
@@ -270,6 +275,8 @@ impl Elements {
             computed: scratch.shapes.len() - kept,
         };
         std::mem::swap(&mut self.shape_triangles, &mut scratch.shapes);
+        self.fold_splits = FoldSplits::new(&self.shape_triangles, splits)
+            .expect("the plate matrices of a valid mesh are positive definite");
         edge_bending(mesh, mat, area, &mut self.springs, &mut self.hinges);
         self.fill_tables(n, mesh);
         self.previous

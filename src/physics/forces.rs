@@ -66,6 +66,38 @@ pub struct ForceScratch {
     pub membrane: Vec<Vector>,
     /// A third of each triangle's wind force (the share of each of its vertices).
     pub triangle: Vec<Vector>,
+    /// Each shape triangle's three folds.
+    pub folds: Vec<[Scalar; 3]>,
+    /// The fold splits at the current folds.
+    pub splits: Vec<Scalar>,
+}
+
+/// The fold splits that minimise the bending energy at `x` (see
+/// [`solve_splits`]); empty without shape triangles.
+pub fn splits_at(el: &Elements, x: &[Vector]) -> Vec<Scalar> {
+    let (mut folds, mut splits) = (Vec::new(), Vec::new());
+    if !el.shape_triangles.is_empty() {
+        solve_splits(el, x, &mut folds, &mut splits);
+    }
+    splits
+}
+
+/// Into `folds` and `splits`: each shape triangle's folds at `x` and the
+/// splits that minimise the bending energy for them (`shape.rs`, "Splitting
+/// the folds").
+pub fn solve_splits(
+    el: &Elements,
+    x: &[Vector],
+    folds: &mut Vec<[Scalar; 3]>,
+    splits: &mut Vec<Scalar>,
+) {
+    folds.resize(el.shape_triangles.len(), [0.0; 3]);
+    folds
+        .par_iter_mut()
+        .with_min_len(PAR_MIN)
+        .zip(el.shape_triangles.par_iter())
+        .for_each(|(f, t)| *f = t.folds(x));
+    el.fold_splits.solve(&el.shape_triangles, folds, splits);
 }
 
 /// Spring force on the first end `a` (the second end gets the opposite):
@@ -139,12 +171,16 @@ pub fn element_pass(
     scratch
         .shape
         .resize(SHAPE_SLOTS * el.shape_triangles.len(), Vector::ZERO);
+    if !el.shape_triangles.is_empty() {
+        solve_splits(el, x, &mut scratch.folds, &mut scratch.splits);
+    }
+    let splits = &scratch.splits;
     scratch
         .shape
         .par_chunks_exact_mut(SHAPE_SLOTS)
         .with_min_len(PAR_MIN / SHAPE_SLOTS)
         .zip(el.shape_triangles.par_iter())
-        .for_each(|(f, t)| t.forces(x, f));
+        .for_each(|(f, t)| t.forces(x, splits, f));
     scratch
         .membrane
         .resize(MEMBRANE_SLOTS * el.membrane_triangles.len(), Vector::ZERO);
@@ -241,8 +277,9 @@ pub fn energy(el: &Elements, ext: &ExternalForces, x: &[Vector], v: &[Vector]) -
         let (theta, _) = dihedral_angle_and_gradient(hg.v.map(|i| x[i as usize]));
         0.5 * hg.k * theta * theta
     });
+    let splits = splits_at(el, x);
     let shape = deterministic_sum(el.shape_triangles.len(), |t| {
-        el.shape_triangles[t].energy(x)
+        el.shape_triangles[t].energy(x, &splits)
     });
     let membrane = deterministic_sum(el.membrane_triangles.len(), |t| {
         el.membrane_triangles[t].energy(x)

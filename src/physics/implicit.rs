@@ -143,6 +143,10 @@ pub struct ImplicitScratch {
     hinge_slot: Vec<Vector>,
     shape_slot: Vec<Vector>,
     shape_grad: Vec<ShapeJacobian>,
+    /// Per shape triangle: its folds.
+    shape_folds: Vec<[Scalar; 3]>,
+    /// The fold splits at the step's start.
+    shape_splits: Vec<Scalar>,
     /// Per membrane triangle: `h^2 K_t + h D_t` over its deformation gradient's
     /// columns.
     membrane_block: Vec<ColumnBlocks>,

@@ -31,7 +31,7 @@ pub use rk4::rk4_multirate;
 
 use super::bending::dihedral_angle_and_gradient;
 use super::elements::Elements;
-use super::forces::{ForceScratch, gather, spring_force, wind_share};
+use super::forces::{ForceScratch, gather, solve_splits, spring_force, wind_share};
 use super::membrane::MEMBRANE_SLOTS;
 use super::shape::SHAPE_SLOTS;
 use super::timestep::{SAFETY, vertex_limits};
@@ -321,12 +321,17 @@ fn level_forces(
     for (&h, f) in g.hinges.iter().zip(&level.hinges) {
         scratch.hinge[4 * h as usize..4 * h as usize + 4].copy_from_slice(f);
     }
+    if !g.shape.is_empty() {
+        // The splits couple every fold: they are solved over the whole mesh.
+        solve_splits(el, x, &mut scratch.folds, &mut scratch.splits);
+    }
+    let splits = &scratch.splits;
     g.shape
         .par_iter()
         .with_min_len(128)
         .map(|&p| {
             let mut f = [Vector::ZERO; SHAPE_SLOTS];
-            el.shape_triangles[p as usize].forces(x, &mut f);
+            el.shape_triangles[p as usize].forces(x, splits, &mut f);
             f
         })
         .collect_into_vec(&mut level.shape);

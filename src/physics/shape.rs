@@ -13,9 +13,9 @@
 //! and its energy, the Kirchhoff plate with Poisson ratio 0 whose beam rigidity
 //! per width is exactly `B` (the textile cantilever's flexural rigidity):
 //! `E_t = (B A / 2) |S_t|_F^2 = (1/2) theta^T M theta`,
-//! `M_ab = (B / (4 A)) L_a L_b (t_a . t_b)^2` (constant, positive semi-definite).
-//! (Triangles at a refinement transition use another constant `M`, from the
-//! same three angles: "Transitions" below.)
+//! `M_ab = (B / (4 A)) L_a L_b (t_a . t_b)^2` (constant, positive semi-definite),
+//! here with each fold shared equally; "Splitting the folds" below frees the
+//! share.
 //! Forces: `f = -sum_a (M theta)_a grad theta_a`. For the implicit solver the
 //! Gauss-Newton Hessian is `J^T M J (x) ` with `J` the 3 x 18 matrix whose rows are
 //! the angle gradients (each over 4 of the element's 6 vertices: the triangle's
@@ -31,8 +31,6 @@
 //! more cheaply than the continuum. For a strip bent along one grid direction the
 //! three angles of every triangle give `S_t` exactly, so the bound is attained:
 //! the energy is `B/2 kappa^2` per area, at every resolution.
-//! (This identity is given up at refinement transitions, where each triangle is
-//! made exact for constant curvature instead: see "Transitions".)
 //!
 //! The per-edge hinge energy `k_e theta_e^2` (`bending = "dihedral"`) only has the
 //! edges' diagonal terms. On a right-triangle grid the bending of a strip can then
@@ -85,112 +83,72 @@
 //! is worse: on the probe below, green triangles 1.325 and red ones 1.148 for
 //! the cylinder about x, against 1.052 / 1.108 by area.)
 //!
-//! # Transitions
-//! Area shares fix the sizes, not the shapes. Probe (the test
-//! `partly_refined_sheet_bends_like_the_continuum`, and a scratch program, not
-//! kept, doing the same on more meshes): impose `f = x^T H x / 2` for constant `H` on a partly refined sheet,
-//! take the folds of its linear interpolant, and compare each class's energy
-//! with `B/2 |H|^2` over its area (classes: coarse level 0, green 1-2 closure
-//! triangles, red refined ones; triangles with all edges interior). With area
-//! shares, on the 8 x 8 sheet refined one red level over `|y| < 0.2` (a jagged
-//! band), coarse / green / red: cylinder about x (`H = e_y e_y`) 1.000 / 1.052
-//! / 1.108, about y 1.056 / 1.179 / 1.081, sphere 0.861 / 1.056 / 1.152, saddle
-//! 1.194 / 1.175 / 1.038 (single triangles up to 2.1 times); on a straight band
-//! `|y| < 0.15` the green triangles carry 2.56 times for the cylinder bent
-//! along the band and 2.03 times for the sphere (single ones 4.6 times); in a
-//! refined disk 1.74 / 1.88; the level-3 greens of a second red level 2.04 /
-//! 2.14. The uniform sheet is exact for all four. Equal halves are worse
-//! (greens 1.679 for the first cylinder).
+//! # Splitting the folds
+//! Area shares fix the sizes, not the shapes: a triangle whose folds do not
+//! cancel inside it (a green closure, any triangle of an irregular
+//! triangulation: an OBJ cloth, a Delaunay mesh) keeps a residue for a
+//! constant curvature, and by Jensen's inequality above the sheet is too
+//! stiff, by a factor that does not fall with the cell size. Measured with
+//! fixed shares on the cantilever with free vertices moved by up to 0.4 of a
+//! cell: 1.6 to 2.7 deg stiff of the elastica at resolutions 16 to 32; on
+//! transitions of two red-green levels single triangles carried up to 2.1
+//! times the continuum's energy for a constant curvature.
 //!
-//! The cause: the folds are right (their sum is the curvature's integral),
-//! their sharing is not. A green split adds an edge that is not along the
-//! grid (directions like (1, 2)); under a bend along x its fold carries, per
-//! unit of its length, `xy` and `yy` parts as well as `xx`, and on the uniform
-//! grid those parts are cancelled inside every triangle by the folds of its
-//! other edges. At a transition the folds that should cancel them sit on edges
-//! of other sizes and shapes (a hanging-node half edge, a coarse hypotenuse),
-//! so each triangle keeps a residue, the residues cancel only in the sum over
-//! the patch, and by Jensen the energy of the parts exceeds that of the sum.
-//! On the straight band bent along it (`H = kappa e_x e_x`) the two green
-//! halves of a coarse triangle get `S = [[2/3, 1/6], [1/6, 1/4]] kappa` (the
-//! obtuse one) and `[[2, 1/2], [1/2, 1/4]] kappa` (the right-angled one,
-//! 4.56 times the continuum's energy density). No scalar share per edge
-//! can fix this: a triangle has three shares and six conditions (exact `S` for
-//! `H = xx` and `H = yy`).
+//! The fix is Morley's nonconforming plate element, whose degrees of freedom
+//! are the vertex positions and one normal slope per edge midpoint: `S_t` is
+//! the Hessian of the quadratic they define, `1/A sum_a L_a u_a n_a n_a^T`
+//! with `u_a` the jump from the triangle's own slope to the edge's. With the
+//! edge's slope between the two triangles' slopes, the two sides' `u` sum to
+//! the fold, so each interior edge between two free triangles has one
+//! unknown, its split `phi`: the triangle takes `share_a theta_a + phi` and
+//! its neighbour `share_o theta_a - phi` (`split_sign` says which side adds).
+//! `sum_t A_t S_t` is then still the distributional Hessian whatever the
+//! splits, and the energy is
+//! `E(x) = min_phi sum_t (1/2) u_t^T K_t u_t`, `K_ab = (B / A) L_a L_b (n_a . n_b)^2`.
+//! It is quadratic in `phi` with a constant matrix, so the splits solve one
+//! sparse symmetric positive definite system (module [`split`], factored once
+//! per mesh) at every force evaluation, and by the envelope theorem the
+//! forces are those at the optimal splits, per triangle:
+//! `f = -sum_a share_a (K u)_a grad theta_a`. Morley's element converges on
+//! general triangulations (it reproduces every quadratic exactly), where the
+//! fixed shares do not.
 //!
-//! So a transition triangle (all three edges interior, and a free neighbour of
-//! another level, as a green one's red neighbour always is) gets the operator that is exact for every
-//! constant `H`: with `C` the shared-fold operator above (`S = C theta`, as
-//! `[S_xx, S_yy, S_xy]`) and `Theta` the 3 x 3 map from `H` to this triangle's
-//! three folds (from its own and its neighbours' rest corners; a held
-//! neighbour keeps the tangent plane of `f` at the edge's midpoint, which
-//! reproduces the clamp's share of 2),
-//! `S = P theta`, `P = C + (I - C Theta) Theta^+`,
-//! (`Theta^+` a pseudo-inverse: a green triangle whose three folds are all
-//! zero under a twist, which happens, cannot see the twist, and `P` leaves it
-//! as `C` does), and `M = B A P^T W P`, `W = diag(1, 1, 2)`. Where `C` is exact
-//! already the correction is zero; every other triangle keeps `C` bit for bit,
-//! so a mesh of one level is unchanged. Measured on the same probes: every
-//! class 1.000 for both cylinders, the sphere and the saddle, on all the
-//! meshes above (the test: 1.000 / 0.998 / 1.000 with its exact, strongly bent
-//! cylinders). `P` stays well conditioned: `|det P / det C|` 0.44 to 1.9 and
-//! the trace of `P^T W P` 0.41 to 1.47 times `C`'s over the transition
-//! triangles. The cantilever (resolution 10, red-green, 8 splits near the
-//! clamp): chord angle 37.78 -> 41.92 deg (41.97 unrefined, elastica 41.5);
-//! with 40 splits (`refine_angle = 3`) 41.47 -> 41.67.
+//! The implicit solvers keep the fixed-share Hessian `J^T M J`,
+//! `M_ab = share_a share_b K_ab`: the energy at zero splits bounds the
+//! minimised one from above, so it is a positive definite upper bound of the
+//! exact Hessian (which couples every fold through the splits and has no
+//! sparse form). The step's forces are exact; the Newton iterations converge
+//! to the same state.
 //!
-//! What is given up, and what was not done:
-//! * A transition triangle whose three folds cannot tell some constant `H`
-//!   from zero (a singular `Theta`; the pseudo-inverse then leaves that part
-//!   as `C` does) is not exact for it. For example, a first-level green next
-//!   to a flipped corner square (the
-//!   case `adapt/red_green/mesh.rs` now avoids) has `Theta` with singular
-//!   values 0.113 m, 0.094 m and 0 (folds per unit curvature, 1 m sheet),
-//!   null direction 0.555 xx - 0.832 xy, so it is blind to part of a bend
-//!   along x (0.905 of the continuum's energy for the cylinder about y); with
-//!   the square as split its null direction is pure twist. On the 8 x 8
-//!   sheet refined one red level over `x < b1` and a second over `x < b2`,
-//!   for `(b1, b2)` = (-0.15, -0.3), (-0.1, -0.2) and (0.1, -0.05), 6, 8 and
-//!   6 (triangle, shape) pairs were more than 5 % from the continuum over
-//!   the four shapes of `partly_refined_sheet_bends_like_the_continuum`
-//!   (worst |ratio - 1| 0.0947), with red-green's children as split and with
-//!   alternating diagonals alike; (0, -0.25) had none. On the four meshes of
-//!   the test `second_level_transitions_bend_within_ten_percent_of_the_continuum`
-//!   (among them `(b1, b2)` = (0, -0.3)), every triangle more than 5 % off is
-//!   a second-level (level 3) green
-//!   beside a level-4 triangle where the second level's rim runs along y,
-//!   each at 0.905 / 1.000 / 0.953 / 0.953 for the four shapes, and its
-//!   `Theta` is singular the same way (singular values 0.0563 m, 0.0469 m, 0;
-//!   null direction 0.555 xx - 0.832 xy); rims along x and round ones have
-//!   none. Of those meshes' 1,320 transition operators (four meshes, both
-//!   diagonal settings) 116 had a
-//!   singular `Theta`: 96 blind to twist only, these 20 to part of a bend.
-//!   Reading a fourth fold (a neighbour's) where `Theta` is singular might fix
-//!   it; not done (it needs a seventh and eighth slot in the element).
-//! * `sum_t A_t S_t` is no longer exactly the distributional Hessian across a
-//!   transition rim, so the Jensen argument above holds in the uniform parts
-//!   only; in the rim each triangle is instead exact for constant curvature,
-//!   and `P` has full rank (no fold pattern is free there).
-//! * The exact operator everywhere would change uniform meshes: on the
-//!   alternating grid `C` is exact for `H` diagonal in the grid axes but not
-//!   for twist (`xy`: 2.00 times the continuum, a cylinder at 45 deg 1.50),
-//!   which the exact operator would make 1.00. Transition triangles get 1.00
-//!   for those, except greens blind to twist (0.50 on the straight band).
-//! * Triangles with a boundary edge keep `C`: taking the boundary's fold as a
-//!   zero row of `Theta` fixes some (a green on the straight band, bent along
-//!   the band, 1.56 -> 1.00) but makes the operator read curvature across the
-//!   free edge from the other two folds (a red one, cylinder about x, 1.000 ->
-//!   0.965), against the zero-moment condition below.
+//! Boundary edges keep no split (their triangle takes no angle there, as
+//! below), and neither do clamp edges (the free triangle takes the whole
+//! fold, as above).
 //!
-//! * Irregular triangulations (an OBJ cloth, bisection in a metric) are not
-//!   exact: a triangle whose folds do not cancel inside it carries a residue
-//!   for a constant curvature, so by Jensen the sheet is too stiff, by a
-//!   factor that does not fall with the cell size. Measured on the
-//!   cantilever with free vertices moved up to a quarter cell: 1.1 to 1.2 deg
-//!   stiff of the elastica, 1.7 to 1.8 deg at 0.3 cell and 64 cells along;
-//!   `P` on every interior triangle overshoots to 0.3 to 0.9 deg soft (3.5
-//!   to 5.1 deg on thin cells). The test
-//!   `elastica::an_irregular_strip_bends_stiffer_than_the_elastica` pins it.
+//! Measured (`tests/integration/elastica_irregular.rs`, chord angle against
+//! the elastica): free vertices moved by up to 0.4 of a cell -0.27 / -0.43 /
+//! -0.81 deg at resolutions 16 / 32 / 64 (the fixed shares -1.56 / -2.73 /
+//! 64 not measured); half-cell shifted rows -0.52 / -0.18 / -0.08 deg (fixed shares
+//! -1.34 / -0.61 / -0.30); regular grids +0.16 / +0.04 / +0.01 deg (fixed
+//! shares +0.12 / +0.03 / +0.01). Red-green transitions two levels deep store
+//! the unrefined sheet's energy to 0.0006 for constant curvatures (test
+//! `second_level_transitions_bend_like_the_unrefined_sheet`).
+//!
+//! # Thin triangles
+//! A triangle with a small corner has two nearly parallel edges whose
+//! `n n^T` nearly coincide, so `K` is nearly singular in the difference of
+//! their parts, and free splits on those edges let it soak up curvature at
+//! almost no cost: measured, the tensor method's strip (cells of aspect 8:1)
+//! settled 0.93 deg soft of the elastica, against 0.04 with fixed shares, and
+//! a strip of 4:1 cells 0.21 deg soft. Morley's element converges only on
+//! shape-regular meshes. So an edge takes a split only when both its
+//! triangles have every corner at least [`SPLIT_MIN_ANGLE_DEG`] (15 deg):
+//! the 4:1 cells' 14 deg corners keep fixed shares (exact there, for bends
+//! along the cells), red-green's green closures (18.4 deg) take splits. The
+//! limit was chosen between those two measured cases (20 deg left the greens
+//! with fixed shares, 6 to 10 % stiff on transitions); the edge method's
+//! thinner triangles are the known cost: adapted from the irregular strips
+//! it settles 1.8 to 2.9 deg stiff (test
+//! `edge_adapted_irregular_strips_bend_stiffer_than_the_elastica`).
 //!
 //! Boundary edges have no angle, so an imposed curvature across a free edge loses
 //! the outer half row of triangles' share (the `1 - 1/n` of the cylinder test).
@@ -198,10 +156,13 @@
 //! settled sheet has no curvature across it there, and no energy is lost.
 
 mod build;
+mod split;
 
+pub use build::SPLIT_MIN_ANGLE_DEG;
 pub(crate) use build::{ShapeMatrix, ShapeScratch, build_shape_triangles_into};
+pub use split::{FoldSplits, SplitError};
 
-use super::bending::dihedral_angle_and_gradient;
+use super::bending::{dihedral_angle, dihedral_angle_and_gradient};
 use crate::math::{Scalar, Vector};
 
 /// Vertex slots of a shape triangle: its three vertices, then the tips across
@@ -213,6 +174,10 @@ pub const SHAPE_SLOTS: usize = 6;
 /// vertex, the tip across.
 const HINGE_SLOTS: [[usize; 4]; 3] = [[1, 2, 0, 3], [2, 0, 1, 4], [0, 1, 2, 5]];
 
+/// Marks an edge of a shape triangle without a split unknown (module docs,
+/// "Splitting the folds").
+pub const NO_SPLIT: u32 = u32::MAX;
+
 /// One triangle's bending element (module docs).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ShapeTriangle {
@@ -222,8 +187,20 @@ pub struct ShapeTriangle {
     pub v: [u32; SHAPE_SLOTS],
     /// Which edges are interior (have an angle).
     pub interior: [bool; 3],
-    /// The constant matrix `M` of `E = theta^T M theta / 2`, N m.
+    /// The constant matrix `M` of the fixed-share energy `theta^T M theta / 2`,
+    /// N m: the approximate Hessian the implicit solvers use.
     pub m: [[Scalar; 3]; 3],
+    /// The plate matrix `K` of `E = u^T K u / 2` in the triangle's parts `u` of
+    /// its three folds, N m: `K_ab = (B / A) L_a L_b (n_a . n_b)^2`.
+    pub k: [[Scalar; 3]; 3],
+    /// The fixed part of each fold the triangle takes (one half on a uniform
+    /// mesh, all of it next to a clamp, zero on a boundary edge).
+    pub share: [Scalar; 3],
+    /// Per edge, its split unknown ([`NO_SPLIT`]: none).
+    pub split: [u32; 3],
+    /// Per edge, the sign with which the split adds to this side's part (the
+    /// other side subtracts it).
+    pub split_sign: [Scalar; 3],
 }
 
 /// Angles of a shape triangle's edges and their gradients by slot.
@@ -256,24 +233,63 @@ impl ShapeTriangle {
         (theta, jac)
     }
 
+    /// The three edge angles alone (zero on boundary edges).
+    #[inline(always)]
+    pub fn folds(&self, x: &[Vector]) -> [Scalar; 3] {
+        [0, 1, 2].map(|a| {
+            if self.interior[a] {
+                dihedral_angle(HINGE_SLOTS[a].map(|k| x[self.v[k] as usize]))
+            } else {
+                0.0
+            }
+        })
+    }
+
+    /// The triangle's parts `u` of its folds `theta` given the split unknowns.
+    #[inline(always)]
+    pub fn parts(&self, theta: [Scalar; 3], splits: &[Scalar]) -> [Scalar; 3] {
+        [0, 1, 2].map(|a| {
+            let split = match self.split[a] {
+                NO_SPLIT => 0.0,
+                s => self.split_sign[a] * splits[s as usize],
+            };
+            self.share[a] * theta[a] + split
+        })
+    }
+
+    /// `K u`.
+    #[inline(always)]
+    pub fn times_k(&self, u: [Scalar; 3]) -> [Scalar; 3] {
+        [0, 1, 2].map(|a| (0..3).map(|b| self.k[a][b] * u[b]).sum())
+    }
+
+    /// `dE / d theta` at fixed splits: `share_a (K u)_a`, N m.
+    #[inline(always)]
+    pub fn moments(&self, theta: [Scalar; 3], splits: &[Scalar]) -> [Scalar; 3] {
+        let ku = self.times_k(self.parts(theta, splits));
+        [0, 1, 2].map(|a| self.share[a] * ku[a])
+    }
+
     /// `M y`.
     #[inline(always)]
     pub fn times_m(&self, y: [Scalar; 3]) -> [Scalar; 3] {
         [0, 1, 2].map(|a| (0..3).map(|b| self.m[a][b] * y[b]).sum())
     }
 
-    /// Elastic energy at positions `x`, J.
-    pub fn energy(&self, x: &[Vector]) -> Scalar {
-        let (theta, _) = self.angles(x);
-        let mt = self.times_m(theta);
-        0.5 * (0..3).map(|a| theta[a] * mt[a]).sum::<Scalar>()
+    /// Elastic energy at positions `x` with the split unknowns `splits`, J.
+    pub fn energy(&self, x: &[Vector], splits: &[Scalar]) -> Scalar {
+        let u = self.parts(self.folds(x), splits);
+        let ku = self.times_k(u);
+        0.5 * (0..3).map(|a| u[a] * ku[a]).sum::<Scalar>()
     }
 
-    /// Forces `-sum_a (M theta)_a grad theta_a` by slot, into `out[..6]`.
+    /// Forces `-sum_a (dE / d theta_a) grad theta_a` by slot, into `out[..6]`,
+    /// with the split unknowns `splits` (at their optimum these are the forces
+    /// of the energy minimised over the splits).
     #[inline(always)]
-    pub fn forces(&self, x: &[Vector], out: &mut [Vector]) {
+    pub fn forces(&self, x: &[Vector], splits: &[Scalar], out: &mut [Vector]) {
         let (theta, jac) = self.angles(x);
-        spread(&jac, self.times_m(theta).map(|c| -c), out);
+        spread(&jac, self.moments(theta, splits).map(|c| -c), out);
     }
 }
 

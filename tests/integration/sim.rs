@@ -187,7 +187,9 @@ fn a_rebuilt_pipeline_continues_a_run_bit_identically() {
     // The draped sheet starts just above the ball, so it touches from the start.
     let on_the_ball = ["cloth.position=[0.0,0.0,0.504]", "cloth.resolution=24"];
     let cases = [
-        ("scenes/hard/thrash.toml", "cg", &[][..]),
+        // Remeshing every third step, so that the last of the 20 steps keeps
+        // its warm start (a remesh clears it).
+        ("scenes/hard/thrash.toml", "cg", &["adapt.every=3"][..]),
         ("scenes/drape_sphere.toml", "cg", &on_the_ball[..]),
         ("scenes/drape_sphere.toml", "direct", &on_the_ball[..]),
     ];

@@ -40,6 +40,21 @@ impl Envelope {
         }
     }
 
+    /// `y = A x` for the (unfactored) symmetric matrix.
+    fn mul(&self, x: &[Scalar]) -> Vec<Scalar> {
+        let mut y = vec![0.0; x.len()];
+        for i in 0..x.len() {
+            for j in self.first[i]..=i {
+                let a = self.at(i, j);
+                y[i] += a * x[j];
+                if j < i {
+                    y[j] += a * x[i];
+                }
+            }
+        }
+        y
+    }
+
     fn at(&self, i: usize, j: usize) -> Scalar {
         self.val[self.start[i] + j - self.first[i]]
     }
@@ -184,6 +199,11 @@ pub fn solve(
             iterations += 1;
             let mut k = Envelope::new(first.clone());
             assemble(el, x, &rank, &mut k);
+            let unfactored = Envelope {
+                first: k.first.clone(),
+                start: k.start.clone(),
+                val: k.val.clone(),
+            };
             let mut shift = 0.0;
             let mut fac = k.val.clone();
             loop {
@@ -206,8 +226,8 @@ pub fn solve(
                     return Err("Hessian not positive definite".into());
                 }
             }
-            let mut rhs: Vec<Scalar> = order.iter().flat_map(|&i| f[i].to_array()).collect();
-            k.solve(&mut rhs);
+            let rhs: Vec<Scalar> = order.iter().flat_map(|&i| f[i].to_array()).collect();
+            let rhs = newton_direction(el, x, &order, &rank, &unfactored, &k, &rhs);
             let dx: Vec<Vector> = (0..n)
                 .map(|i| match rank[i] {
                     usize::MAX => Vector::ZERO,
@@ -245,6 +265,85 @@ pub fn solve(
         iterations,
         residual,
     })
+}
+
+/// Solves `H dx = f` for the Newton direction by conjugate gradients
+/// preconditioned with the factored `k` (the assembled Hessian `unfactored`,
+/// whose shape triangles hold their folds' fixed split), where `H` takes the
+/// shape triangles' folds with their optimal splits (`shape.rs`): exact for
+/// the bending energy minimised over the splits, which no sparse matrix holds.
+fn newton_direction(
+    el: &Elements,
+    x: &[Vector],
+    order: &[usize],
+    rank: &[usize],
+    unfactored: &Envelope,
+    k: &Envelope,
+    f: &[Scalar],
+) -> Vec<Scalar> {
+    let mut dx = f.to_vec();
+    k.solve(&mut dx);
+    if el.fold_splits.count() == 0 {
+        return dx;
+    }
+    let jac: Vec<_> = el.shape_triangles.iter().map(|t| t.angles(x).1).collect();
+    let apply = |p: &[Scalar]| -> Vec<Scalar> {
+        let mut y = unfactored.mul(p);
+        let at = |v: u32| match rank[v as usize] {
+            usize::MAX => Vector::ZERO,
+            r => Vector::new(p[3 * r], p[3 * r + 1], p[3 * r + 2]),
+        };
+        let rates: Vec<[Scalar; 3]> = el
+            .shape_triangles
+            .iter()
+            .zip(&jac)
+            .map(|(t, j)| [0, 1, 2].map(|a| t.slots().map(|(s, v)| j[a][s].dot(at(v))).sum()))
+            .collect();
+        let mut splits = Vec::new();
+        el.fold_splits
+            .solve(&el.shape_triangles, &rates, &mut splits);
+        for ((t, j), r) in el.shape_triangles.iter().zip(&jac).zip(&rates) {
+            let (exact, fixed) = (t.moments(*r, &splits), t.times_m(*r));
+            for (s, v) in t.slots() {
+                let rv = rank[v as usize];
+                if rv == usize::MAX {
+                    continue;
+                }
+                let g: Vector = (0..3).map(|a| j[a][s] * (exact[a] - fixed[a])).sum();
+                for d in 0..3 {
+                    y[3 * rv + d] += g[d];
+                }
+            }
+        }
+        y
+    };
+    let dot = |a: &[Scalar], b: &[Scalar]| a.iter().zip(b).map(|(x, y)| x * y).sum::<Scalar>();
+    let _ = order;
+    let mut r: Vec<Scalar> = f.iter().zip(apply(&dx)).map(|(b, a)| b - a).collect();
+    let mut z = r.clone();
+    k.solve(&mut z);
+    let mut p = z.clone();
+    let mut rz = dot(&r, &z);
+    let norm_f = dot(f, f).sqrt();
+    for _ in 0..200 {
+        if dot(&r, &r).sqrt() <= 1e-10 * norm_f {
+            break;
+        }
+        let ap = apply(&p);
+        let alpha = rz / dot(&p, &ap);
+        for i in 0..dx.len() {
+            dx[i] += alpha * p[i];
+            r[i] -= alpha * ap[i];
+        }
+        z.copy_from_slice(&r);
+        k.solve(&mut z);
+        let rz_new = dot(&r, &z);
+        for i in 0..p.len() {
+            p[i] = z[i] + rz_new / rz * p[i];
+        }
+        rz = rz_new;
+    }
+    dx
 }
 
 /// Adds the element Hessians (module docs) of the free vertices to `k`.

@@ -45,38 +45,28 @@ fn two_levels(
     world.mesh
 }
 
-/// Each interior triangle's energy over the continuum's `B/2 |H|^2 A` for the
-/// constant curvatures `H = xx`, `yy`, sphere and saddle (height fields of
-/// curvature 1/50, so the folds are the height field's to 1e-4). Twist is left
-/// out: per triangle the alternating grid itself gives 0, 1.5 or 2 times the
-/// continuum's twist energy (only pairs add up), so a triangle's twist ratio
-/// says nothing about transitions.
-///
-/// On the sheet refined over `x < 0` then `x < -0.3`
-/// (the second level's rim a line of greens along y), six level-3 green
-/// triangles next to a level-4 neighbour carry 0.905 / 1.000 / 0.953 / 0.953
-/// (the others within 5 %); after the same first band the second one over
-/// `x < -0.3, |y| < 0.25` gives four such; bands along x and disks give none;
-/// the same with red-green's children as split and with alternating
-/// diagonals. Their transition operators' `Theta` is
-/// singular: singular values 0.0563 m, 0.0469 m and 0, null direction
-/// 0.555 xx - 0.832 xy, the direction the pseudo-inverse leaves blind
-/// (`shape.rs`, "What is given up"). The test fails if any triangle gets
-/// further than 10 % from the continuum, or if a triangle other than a
-/// level-3 one beside level 4 gets further than 5 %.
+/// Two red levels in the middle of the 8 x 8 sheet (1 m): the bending energy
+/// of constant curvatures `H = xx`, `yy`, sphere and saddle (height fields of
+/// curvature 1/50, so the folds are the height field's to 1e-4), minimised
+/// over the fold splits, against the unrefined sheet's under the same shape.
+/// The refined regions stay off the free edges, whose triangles lose the
+/// same part of the energy on both meshes (the cylinder test in
+/// `physics.rs`), so the two agree where the transitions bend like the
+/// grid. Printed per probe (measured: within 0.0006 of the unrefined sheet
+/// on all three, both diagonal settings); the test fails beyond `TOLERANCE`.
 #[test]
-fn second_level_transitions_bend_within_ten_percent_of_the_continuum() {
-    let probes: [(&str, Region, Region); 4] = [
+fn second_level_transitions_bend_like_the_unrefined_sheet() {
+    const TOLERANCE: Scalar = 0.002;
+    let probes: [(&str, Region, Region); 3] = [
         (
-            "|y| < 0.25, then |y| < 0.1",
-            |c| c.y.abs() < 0.25,
-            |c| c.y.abs() < 0.1,
+            "|x|, |y| < 0.3, then |x|, |y| < 0.1",
+            |c| c.x.abs() < 0.3 && c.y.abs() < 0.3,
+            |c| c.x.abs() < 0.1 && c.y.abs() < 0.1,
         ),
-        ("x < 0, then x < -0.3", |c| c.x < 0.0, |c| c.x < -0.3),
         (
-            "|y| < 0.25, then x < -0.3 and |y| < 0.25",
-            |c| c.y.abs() < 0.25,
-            |c| c.x < -0.3 && c.y.abs() < 0.25,
+            "|x|, |y| < 0.3, then x < -0.05 inside it",
+            |c| c.x.abs() < 0.3 && c.y.abs() < 0.3,
+            |c| c.x < -0.05 && c.x > -0.3 && c.y.abs() < 0.3,
         ),
         (
             "disks r < 0.375, then r < 0.15",
@@ -84,60 +74,38 @@ fn second_level_transitions_bend_within_ten_percent_of_the_continuum() {
             |c| c.length() < 0.15,
         ),
     ];
-    let curvatures: [[Scalar; 3]; 4] = [
-        [1.0, 0.0, 0.0],
-        [0.0, 1.0, 0.0],
-        [1.0, 1.0, 0.0],
-        [1.0, -1.0, 0.0],
-    ];
+    let curvatures: [[Scalar; 2]; 4] = [[1.0, 0.0], [0.0, 1.0], [1.0, 1.0], [1.0, -1.0]];
     let rs: Scalar = 50.0;
     let mat = MaterialParams {
         bending: 1e-3,
         ..crate::physics::material(BendingModel::ShapeOperator, StiffnessRule::Consistent)
     };
+    let energy = |m: &Mesh, h: [Scalar; 2]| {
+        let el = Elements::build(m, &mat);
+        let height = |p: &Vector2| (h[0] * p.x * p.x + h[1] * p.y * p.y) / (2.0 * rs);
+        let x: Vec<Vector> = m.material.iter().map(|p| p.extend(height(p))).collect();
+        let splits = drape::physics::forces::splits_at(&el, &x);
+        el.shape_triangles
+            .iter()
+            .map(|t| t.energy(&x, &splits))
+            .sum::<Scalar>()
+    };
+    let base = mesh::rectangle(1.0, 1.0, 8, DiagonalPattern::Alternating).unwrap();
+    let mut failures = Vec::new();
     for alternate in [false, true] {
         for (name, first, second) in probes {
             let m = two_levels(alternate, first, second);
-            let el = Elements::build(&m, &mat);
-            let mut finer_beside = vec![false; m.triangles.len()];
-            for e in m.edges.iter().filter(|e| e.is_interior()) {
-                let [a, b] = e.triangles.map(|t| t as usize);
-                finer_beside[a] |= m.levels[b] > m.levels[a];
-                finer_beside[b] |= m.levels[a] > m.levels[b];
-            }
-            let (mut over5, mut worst) = (0, 0.0 as Scalar);
-            for (t, st) in el.shape_triangles.iter().enumerate() {
-                if !st.interior.iter().all(|&i| i) {
-                    continue;
-                }
-                let ratios = curvatures.map(|h| {
-                    let height = |p: &Vector2| (h[0] * p.x * p.x + h[1] * p.y * p.y) / (2.0 * rs);
-                    let x: Vec<Vector> = m.material.iter().map(|p| p.extend(height(p))).collect();
-                    let continuum = m.rest_area(t) * mat.bending / 2.0
-                        * (h[0] * h[0] + h[1] * h[1])
-                        / (rs * rs);
-                    st.energy(&x) / continuum
-                });
-                let off = ratios
-                    .iter()
-                    .map(|r| (r - 1.0).abs())
-                    .fold(0.0, Scalar::max);
-                worst = worst.max(off);
-                if off > 0.05 {
-                    over5 += 1;
-                    assert!(
-                        m.levels[t] == 3 && finer_beside[t],
-                        "{name} (alternate {alternate}): triangle {t}, level {}, off by {off:.4}: {ratios:.4?}",
-                        m.levels[t]
-                    );
-                }
-            }
-            assert!(
-                worst < 0.10,
-                "{name} (alternate {alternate}): worst {worst:.4}, {over5} triangles more than 5 % off"
+            assert!(m.levels.iter().any(|&l| l >= 3), "{name}: two levels");
+            let ratios = curvatures.map(|h| energy(&m, h) / energy(&base, h));
+            println!(
+                "{name} (alternate {alternate}): xx, yy, sphere, saddle {ratios:.4?} of the unrefined sheet"
             );
+            if ratios.iter().any(|r| (r - 1.0).abs() >= TOLERANCE) {
+                failures.push(format!("{name} (alternate {alternate}): {ratios:.4?}"));
+            }
         }
     }
+    assert!(failures.is_empty(), "{failures:?}");
 }
 
 /// The membrane is not exact on graded meshes (the mass-spring patch test):

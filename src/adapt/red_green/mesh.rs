@@ -34,8 +34,9 @@
 //! whole leaf of its own level. That last condition came from a failure: with
 //! squares flipped next to a level transition, a green triangle across the
 //! flipped square's side had a shape operator blind to a bend (its three
-//! folds no longer determine the curvature tensor, `shape.rs`,
-//! "Transitions"): on a sheet refined over `x < -0.15`, six of its sixteen
+//! folds did not determine the curvature tensor under the per-triangle
+//! transition operator the bending then used; `shape.rs` now splits the
+//! folds instead): on a sheet refined over `x < -0.15`, six of its sixteen
 //! greens carried 0.905 of the continuum's energy for a cylinder about y
 //! (test `partly_refined_sheet_bends_like_the_continuum`), and the
 //! cantilever's partly refined rungs were up to twice as far from the
@@ -120,7 +121,8 @@ impl RedGreen {
     /// Whether the two outer sides of corner child `corner` (at corner `k` of
     /// its parent) each face the mesh boundary or a leaf of its own level that
     /// is emitted whole (module docs: a flipped triangle next to a green one
-    /// leaves that green's transition operator blind to a bend).
+    /// left that green's curvature blind to a bend under the bending model
+    /// this condition was measured with).
     fn level_outside(&self, corner: u32, k: usize) -> bool {
         let c = self.vertices(corner);
         [(c[k], c[(k + 1) % 3]), (c[(k + 2) % 3], c[k])]

@@ -113,7 +113,8 @@ fn hinges(
         });
 }
 
-/// Per shape triangle: slot = J^T (-h M theta - h^2 M J v), and the Jacobian.
+/// Per shape triangle: slot = J^T (-h dE/dtheta - h^2 M J v), and the
+/// Jacobian; the folds' splits are solved first (`shape.rs`).
 fn shape_triangles(
     s: &mut ImplicitScratch,
     el: &Elements,
@@ -127,17 +128,27 @@ fn shape_triangles(
     s.shape_slot.resize(SHAPE_SLOTS * shapes, Vector::ZERO);
     s.shape_grad
         .resize(shapes, [[Vector::ZERO; SHAPE_SLOTS]; 3]);
-    s.shape_slot
-        .par_chunks_exact_mut(SHAPE_SLOTS)
+    s.shape_folds.resize(shapes, [0.0; 3]);
+    s.shape_folds
+        .par_iter_mut()
         .zip(s.shape_grad.par_iter_mut())
         .zip(el.shape_triangles.par_iter())
         .with_min_len(PAR_MIN / SHAPE_SLOTS)
-        .for_each(|((slot, grad), t)| {
-            let (theta, jac) = t.angles(x);
-            let jv = rates(t, &jac, v);
-            let c = t.times_m([0, 1, 2].map(|a| -h * theta[a] - h * h * jv[a] * k_term));
-            spread(&jac, c, slot);
-            *grad = jac;
+        .for_each(|((folds, grad), t)| (*folds, *grad) = t.angles(x));
+    el.fold_splits
+        .solve(&el.shape_triangles, &s.shape_folds, &mut s.shape_splits);
+    let (folds, splits) = (&s.shape_folds, &s.shape_splits);
+    s.shape_slot
+        .par_chunks_exact_mut(SHAPE_SLOTS)
+        .zip(s.shape_grad.par_iter())
+        .zip(folds.par_iter())
+        .zip(el.shape_triangles.par_iter())
+        .with_min_len(PAR_MIN / SHAPE_SLOTS)
+        .for_each(|(((slot, jac), theta), t)| {
+            let jv = t.times_m(rates(t, jac, v));
+            let moment = t.moments(*theta, splits);
+            let c = [0, 1, 2].map(|a| -h * moment[a] - h * h * jv[a] * k_term);
+            spread(jac, c, slot);
         });
 }
 

@@ -1,0 +1,173 @@
+//! The split of each fold between its two triangles (module docs of
+//! [`super`], "Splitting the folds"): one unknown per interior edge, chosen to
+//! minimise the bending energy for the current folds. The energy is quadratic
+//! in the splits with a constant matrix, so they solve one sparse symmetric
+//! positive definite system, factored once per mesh (faer's sparse Cholesky,
+//! sequential: the result does not depend on the thread count).
+
+use std::collections::BTreeMap;
+use std::sync::{Arc, Mutex};
+
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::sparse::linalg::SupernodalThreshold;
+use faer::sparse::linalg::cholesky::{
+    CholeskySymbolicParams, LltRef, SymbolicCholesky, SymmetricOrdering,
+    factorize_symbolic_cholesky,
+};
+use faer::sparse::{SparseColMat, Triplet};
+use faer::{Conj, Par, Side};
+
+use super::{NO_SPLIT, ShapeTriangle};
+use crate::math::Scalar;
+
+/// The factored system of the split unknowns of one mesh's shape triangles.
+#[derive(Clone)]
+pub struct FoldSplits {
+    /// Number of split unknowns.
+    count: usize,
+    /// The system's lower triangle `(row, column, value)`, row-major (what two
+    /// systems are compared by).
+    matrix: Vec<(u32, u32, Scalar)>,
+    /// Its Cholesky factor (none when there are no unknowns).
+    factor: Option<Arc<Factor>>,
+    /// The solve's scratch memory, allocated once.
+    workspace: Arc<Mutex<MemBuffer>>,
+}
+
+/// A simplicial Cholesky factor: the system is small and local (each unknown
+/// couples to the other edges of its two triangles).
+struct Factor {
+    symbolic: SymbolicCholesky<usize>,
+    values: Vec<Scalar>,
+}
+
+impl Default for FoldSplits {
+    fn default() -> FoldSplits {
+        FoldSplits {
+            count: 0,
+            matrix: Vec::new(),
+            factor: None,
+            workspace: Arc::new(Mutex::new(MemBuffer::new(StackReq::EMPTY))),
+        }
+    }
+}
+
+impl std::fmt::Debug for FoldSplits {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("FoldSplits")
+            .field("count", &self.count)
+            .field("stored", &self.matrix.len())
+            .finish()
+    }
+}
+
+/// Two systems are equal when their matrices are (the factor follows from it).
+impl PartialEq for FoldSplits {
+    fn eq(&self, other: &FoldSplits) -> bool {
+        self.count == other.count && self.matrix == other.matrix
+    }
+}
+
+/// The split system could not be factored: a triangle's plate matrix is not
+/// positive definite, which a valid mesh (no zero-area triangle) rules out.
+#[derive(Debug, Clone, thiserror::Error)]
+#[error("the bending elements' fold-split system cannot be factored: {0}")]
+pub struct SplitError(&'static str);
+
+impl FoldSplits {
+    /// Assembles and factors the system of `shapes`, whose split indices run
+    /// over `0..count`.
+    pub fn new(shapes: &[ShapeTriangle], count: usize) -> Result<FoldSplits, SplitError> {
+        if count == 0 {
+            return Ok(FoldSplits::default());
+        }
+        let matrix = assemble(shapes);
+        let triplets: Vec<Triplet<usize, usize, Scalar>> = matrix
+            .iter()
+            .map(|&(i, j, v)| Triplet::new(i as usize, j as usize, v))
+            .collect();
+        let a = SparseColMat::<usize, Scalar>::try_new_from_triplets(count, count, &triplets)
+            .map_err(|_| SplitError("the matrix could not be built"))?;
+        let symbolic = factorize_symbolic_cholesky(
+            a.symbolic(),
+            Side::Lower,
+            SymmetricOrdering::Amd,
+            CholeskySymbolicParams {
+                supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SIMPLICIAL,
+                ..Default::default()
+            },
+        )
+        .map_err(|_| SplitError("the symbolic analysis failed"))?;
+        let req = symbolic
+            .factorize_numeric_llt_scratch::<Scalar>(Par::Seq, Default::default())
+            .or(symbolic.solve_in_place_scratch::<Scalar>(1, Par::Seq));
+        let mut buffer = MemBuffer::new(req);
+        let mut values = vec![0.0; symbolic.len_val()];
+        symbolic
+            .factorize_numeric_llt(
+                &mut values,
+                a.as_ref(),
+                Side::Lower,
+                Default::default(),
+                Par::Seq,
+                MemStack::new(&mut buffer),
+                Default::default(),
+            )
+            .map_err(|_| SplitError("a pivot is not positive"))?;
+        Ok(FoldSplits {
+            count,
+            matrix,
+            factor: Some(Arc::new(Factor { symbolic, values })),
+            workspace: Arc::new(Mutex::new(buffer)),
+        })
+    }
+
+    /// Number of split unknowns.
+    pub fn count(&self) -> usize {
+        self.count
+    }
+
+    /// Into `out`: the splits that minimise the energy of `shapes` (the
+    /// triangles this system was built from) at their folds `theta`.
+    pub fn solve(&self, shapes: &[ShapeTriangle], theta: &[[Scalar; 3]], out: &mut Vec<Scalar>) {
+        out.clear();
+        out.resize(self.count, 0.0);
+        let Some(factor) = &self.factor else {
+            return;
+        };
+        // The energy's gradient at zero splits, negated.
+        for (t, th) in shapes.iter().zip(theta) {
+            let fixed = [0, 1, 2].map(|a| t.share[a] * th[a]);
+            let k_fixed = t.times_k(fixed);
+            for a in (0..3).filter(|&a| t.split[a] != NO_SPLIT) {
+                out[t.split[a] as usize] -= t.split_sign[a] * k_fixed[a];
+            }
+        }
+        let rhs = faer::MatMut::from_column_major_slice_mut(out.as_mut_slice(), self.count, 1);
+        let llt = LltRef::<usize, Scalar>::new(&factor.symbolic, &factor.values);
+        // A poisoned lock only means another solve panicked; the buffer is scratch.
+        let mut buffer = self
+            .workspace
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner());
+        llt.solve_in_place_with_conj(Conj::No, rhs, Par::Seq, MemStack::new(&mut buffer));
+    }
+}
+
+/// The lower triangle of the splits' system, `(row, column, value)` in
+/// row-major order: `sum_t s_a s_b K_ab` over the triangles' split edges.
+fn assemble(shapes: &[ShapeTriangle]) -> Vec<(u32, u32, Scalar)> {
+    let mut sum: BTreeMap<(u32, u32), Scalar> = BTreeMap::new();
+    for t in shapes {
+        for a in (0..3).filter(|&a| t.split[a] != NO_SPLIT) {
+            for b in (0..3).filter(|&b| t.split[b] != NO_SPLIT) {
+                let (i, j) = (t.split[a], t.split[b]);
+                if j <= i {
+                    let v = t.split_sign[a] * t.split_sign[b] * t.k[a][b];
+                    *sum.entry((i, j)).or_insert(0.0) += v;
+                }
+            }
+        }
+    }
+    sum.into_iter().map(|((i, j), v)| (i, j, v)).collect()
+}
