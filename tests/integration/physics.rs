@@ -500,43 +500,27 @@ fn results_are_bit_identical_with_one_and_two_threads() {
     }
 }
 
-/// Regression: the shape operator split each edge's fold equally between its
-/// two triangles, so where a refined region meets a coarse one (red-green's
-/// level transitions and green closure triangles) the small triangles took
-/// half of a fold that mostly lies over the large ones, and a partly refined
-/// strip was stiffer than either mesh (the cantilever's chord angle 36.26 deg
-/// after 8 splits near its clamp, against 41.97 deg unrefined). Sharing by
-/// area fixed the sizes but not the shapes: a green triangle, or a triangle
-/// whose neighbour is, gets folds on edges that are not along the curvature's
-/// directions, and shares cannot make them add up to the imposed tensor. Such
-/// transition triangles now use the operator that reproduces every constant
-/// curvature tensor from their three folds (`shape.rs`, "Transitions").
-///
-/// Here a sheet refined one red level over a band across its middle is bent
-/// to a cylinder about either axis and to a shallow sphere and saddle; per
-/// class (coarse, green 1-2 closure triangles, red refined ones; triangles with
-/// all edges interior) the bending energy is compared with the continuum's
-/// `B / 2 |H|^2` over their area. Measured, coarse / green / red:
-/// * equal split (before aa86c17), cylinder about x: total over the refined
-///   ones 1.366, coarse 0.825;
-/// * area shares (aa86c17): cylinder about x 1.0000 / 1.1368 / 1.1008, about
-///   y 1.0442 / 1.0819 / 1.0756, sphere 0.8888 / 1.1110 / 1.1414, saddle
-///   1.1554 / 1.1110 / 1.0353;
-/// * transition operator (now): both cylinders 1.0000 / 0.9977 / 1.0000,
-///   sphere 0.9999 / 0.9999 / 0.9999, saddle 0.9999 / 0.9999 / 1.0000 (the
-///   cantilever after the same 8 splits: 41.92 deg).
-///
-/// Both red-green diagonal settings, and a second region, the band `x <
-/// -0.15` (refined one red level, its rim a line of green triangles along
-/// y). With alternating diagonals, a corner square facing a coarser leaf is
-/// left as split: flipping it too leaves the neighbouring green's transition
-/// operator blind to the bend, and the greens along that rim carry 0.9594 of
-/// the continuum for the cylinder about y.
 /// How far the bending energy of a partly refined sheet may be from the
 /// unrefined sheet's under the same imposed constant curvature (measured:
 /// within 0.0002 on both regions, all four shapes, both diagonal settings).
 const TRANSITION_TOLERANCE: Scalar = 0.002;
 
+/// Regression: with each edge's fold split equally between its two
+/// triangles, where a refined region meets a coarse one (red-green's level
+/// transitions and green closure triangles) the small triangles took half of
+/// a fold that mostly lies over the large ones, and a partly refined strip
+/// was stiffer than either mesh (the cantilever's chord angle 36.26 deg after
+/// 8 splits near its clamp, against 41.97 deg unrefined); fixed area shares
+/// left single green triangles up to 1.14 times the continuum's energy
+/// density. The splits are now unknowns minimising the energy (`shape.rs`,
+/// "Splitting the folds").
+///
+/// Here a sheet refined one red level over a square or a disk in its middle
+/// (off the free edges, whose triangles lose the same part of the energy on
+/// both meshes) is bent to a cylinder about either axis and to a shallow
+/// sphere and saddle, and its whole bending energy is compared with the
+/// unrefined sheet's under the same shape, with both red-green diagonal
+/// settings.
 #[test]
 fn partly_refined_sheet_bends_like_the_continuum() {
     for alternate in [false, true] {

@@ -1,6 +1,6 @@
-//! Transition triangles two refinement levels deep (bending across adaptive
-//! meshes): each interior triangle's shape-operator energy under a
-//! constant curvature, against the continuum's.
+//! Transitions two refinement levels deep (bending across adaptive meshes):
+//! the sheet's shape-operator energy under a constant curvature, against the
+//! unrefined sheet's; and the springs' membrane on green closures.
 
 use drape::adapt::{AdaptConfig, Adapter};
 use drape::math::{Scalar, Vector, Vector2};
