@@ -125,13 +125,16 @@
 //! fold, as above).
 //!
 //! Measured (`tests/integration/elastica_irregular.rs`, chord angle against
-//! the elastica): free vertices moved by up to 0.4 of a cell -0.27 / -0.43 /
-//! -0.81 deg at resolutions 16 / 32 / 64 (the fixed shares -1.56 / -2.73 /
-//! 64 not measured); half-cell shifted rows -0.52 / -0.18 / -0.08 deg (fixed shares
-//! -1.34 / -0.61 / -0.30); regular grids +0.16 / +0.04 / +0.01 deg (fixed
-//! shares +0.12 / +0.03 / +0.01). Red-green transitions two levels deep store
-//! the unrefined sheet's energy to 0.0006 for constant curvatures (test
-//! `second_level_transitions_bend_like_the_unrefined_sheet`).
+//! the elastica): free vertices moved by up to 0.4 of a cell -0.22 / -0.32 /
+//! -0.26 deg at resolutions 16 / 32 / 64 (fixed shares: -1.56 / -2.73 at 16
+//! / 32); a constrained Delaunay strip -0.22 / -0.10 / -0.05 deg; red-green
+//! refinement from either at resolution 8 -0.53 / -0.47 deg; half-cell
+//! shifted rows -0.52 / -0.18 / -0.08 deg (fixed shares -1.34 / -0.61 /
+//! -0.30); regular grids +0.16 / +0.04 / +0.01 deg (fixed shares +0.12 /
+//! +0.03 / +0.01). Small deflection on the irregular strips: tip drop within
+//! 1.2 % of the elastica at 16 and 32. Red-green transitions two levels deep
+//! store the unrefined sheet's energy to 0.0006 for constant curvatures
+//! (test `second_level_transitions_bend_like_the_unrefined_sheet`).
 //!
 //! # Thin triangles
 //! A triangle with a small corner has two nearly parallel edges whose
