@@ -139,42 +139,69 @@ pub fn load_frames(
     Ok((triangles, frames))
 }
 
-/// Reads one OBJ frame: every object of the file, triangulated, vertices
-/// indexed as the file numbers them (texture coordinates and normals do not
-/// split them), scaled by `scale`.
+/// Reads one OBJ frame: its `v` and `f` lines (every object of the file;
+/// polygons cut into fans of triangles; texture and normal indices ignored),
+/// scaled by `scale`. Vertices keep the file's numbering, so that a frame
+/// whose faces use other vertices is told apart.
 fn read_frame(index: usize, path: &str, scale: Scalar) -> Result<Frame, CollideError> {
     let err = |reason: String| CollideError::Obj {
         index,
         path: path.to_string(),
         reason,
     };
-    let opts = tobj::LoadOptions {
-        triangulate: true,
-        single_index: false,
-        ..Default::default()
-    };
-    let (models, _) = tobj::load_obj(Path::new(path), &opts)
-        .map_err(|e| err(format!("{e} (not a readable Wavefront OBJ file)")))?;
+    let text = std::fs::read_to_string(Path::new(path))
+        .map_err(|e| err(format!("cannot read the file: {e}")))?;
     let mut x = Vec::new();
     let mut tris = Vec::new();
-    for m in &models {
-        let base = x.len() as u32;
-        let count = (m.mesh.positions.len() / 3) as u32;
-        for (n, c) in m.mesh.positions.chunks_exact(3).enumerate() {
-            let v = Vector::new(c[0], c[1], c[2]) * scale;
-            if !v.is_finite() {
-                return Err(err(format!(
-                    "vertex {} has a coordinate that is not a finite number: {c:?}",
-                    base as usize + n + 1
-                )));
+    for (n, line) in text.lines().enumerate() {
+        let at = |what: String| err(format!("line {}: {what}", n + 1));
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("v") => {
+                let c: Vec<f64> = words
+                    .take(3)
+                    .map(str::parse)
+                    .collect::<Result<_, _>>()
+                    .map_err(|e| at(format!("a vertex coordinate is not a number ({e})")))?;
+                let v = match c[..] {
+                    [a, b, c] => Vector::new(a, b, c) * scale,
+                    _ => return Err(at("a vertex needs three coordinates".into())),
+                };
+                if !v.is_finite() {
+                    return Err(at(format!(
+                        "the vertex {c:?} has a coordinate that is not a finite number (after scaling by {scale})"
+                    )));
+                }
+                x.push(v);
             }
-            x.push(v);
-        }
-        for f in m.mesh.indices.chunks_exact(3) {
-            if f.iter().any(|&i| i >= count) {
-                return Err(err("a face references a vertex that does not exist".into()));
+            Some("f") => {
+                let count = x.len() as i64;
+                let corners = words
+                    .map(|w| {
+                        let i: i64 = w
+                            .split('/')
+                            .next()
+                            .unwrap_or("")
+                            .parse()
+                            .map_err(|_| at(format!("`{w}` is not a vertex reference")))?;
+                        let k = if i < 0 { count + i } else { i - 1 };
+                        if (0..count).contains(&k) {
+                            Ok(k as u32)
+                        } else {
+                            Err(at(format!(
+                                "the face refers to vertex {i}, and {count} are defined before it"
+                            )))
+                        }
+                    })
+                    .collect::<Result<Vec<u32>, _>>()?;
+                if corners.len() < 3 {
+                    return Err(at("a face needs at least three vertices".into()));
+                }
+                tris.extend(
+                    (1..corners.len() - 1).map(|j| [corners[0], corners[j], corners[j + 1]]),
+                );
             }
-            tris.push([base + f[0], base + f[1], base + f[2]]);
+            _ => {}
         }
     }
     if tris.is_empty() {
