@@ -76,6 +76,9 @@ impl Sequence {
 /// One OBJ frame: vertex positions (scaled) and triangles.
 type Frame = (Vec<Vector>, Vec<[u32; 3]>);
 
+/// A sequence's triangles and its frames' vertex positions.
+type Frames = (Vec<[u32; 3]>, Vec<Vec<Vector>>);
+
 /// Loads the frames of obstacle `index` from `files` (in order, at least
 /// one), each scaled by `scale` and placed by `place`, and checks that they
 /// share one topology: the same vertex count and the same triangles (the
@@ -86,7 +89,7 @@ pub fn load_frames(
     files: &[String],
     scale: Scalar,
     place: &dyn Fn(Vector) -> Vector,
-) -> Result<(Vec<[u32; 3]>, Vec<Vec<Vector>>), CollideError> {
+) -> Result<Frames, CollideError> {
     let err = |path: &str, reason: String| CollideError::Obj {
         index,
         path: path.to_string(),
