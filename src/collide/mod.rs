@@ -40,6 +40,7 @@ pub mod obstacle;
 mod response;
 pub mod selfcol;
 pub mod sequence;
+mod shapes;
 pub mod skeleton;
 pub mod skin;
 pub mod volino;
