@@ -7,9 +7,8 @@
 //! and skinned to them ([`super::skin`]). The collision passes query its
 //! surface at the two ends of each step, a parry [`TriMesh`] built from the
 //! positions at that time (its bounding volume hierarchy and pseudo-normals
-//! rebuilt, which for a body of a few thousand triangles costs well under a
-//! millisecond), kept in a small cache so that each time is built once: the
-//! end of one step is the start of the next.
+//! rebuilt, not refitted), kept in a small cache so that each time is built
+//! once: the end of one step is the start of the next.
 //!
 //! - The velocity of the surface at a point is the barycentric interpolation
 //!   of the vertex velocities of the triangle under it, so friction acts on
