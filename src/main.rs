@@ -8,6 +8,7 @@ use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
 use cli::bench::{BenchArgs, cmd_bench};
+use cli::body_frames::{BodyFramesArgs, cmd_body_frames};
 use cli::run::cmd_run;
 use drape::record::inspect::inspect;
 use drape::scene::{Scene, default_scene, load_scene_file};
@@ -15,6 +16,7 @@ use drape::scene::{Scene, default_scene, load_scene_file};
 /// The subcommands that have a file of their own.
 mod cli {
     pub mod bench;
+    pub mod body_frames;
     pub mod run;
 }
 
@@ -41,6 +43,10 @@ enum Command {
     Bench(BenchArgs),
     /// Run the hard-case stability suite (scenes/hard/) and print a pass/fail table.
     Stability(StabilityArgs),
+    /// Write a scene's deforming mesh obstacle (an articulated body with
+    /// surface = "skinned_mesh") as one OBJ file per recorded frame,
+    /// DIR/frame_0000.obj, ..., for a `mesh_sequence` obstacle to read back.
+    BodyFrames(BodyFramesArgs),
 }
 
 #[derive(Args)]
@@ -149,6 +155,7 @@ fn main() -> ExitCode {
         Command::Inspect(args) => cmd_inspect(args),
         Command::Bench(args) => cmd_bench(args),
         Command::Stability(args) => cmd_stability(args),
+        Command::BodyFrames(args) => cmd_body_frames(args),
     };
     match result {
         Ok(code) => code,

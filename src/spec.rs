@@ -12,7 +12,9 @@
 use serde::Deserialize;
 
 mod part;
+mod sequence;
 pub use part::Part;
+pub use sequence::{BodySurface, SequenceFiles};
 
 /// The cloth's rest mesh and its placement in the world, resolved from `[cloth]`.
 #[derive(Debug, Clone, PartialEq)]
@@ -272,6 +274,17 @@ pub struct Obstacle {
     /// root frame is the obstacle's own (placed and keyframed as any obstacle).
     #[serde(default)]
     pub part: Vec<Part>,
+    /// How an `articulated` obstacle meets the cloth: rigid parts, or one
+    /// mesh skinned to them.
+    #[serde(default)]
+    pub surface: BodySurface,
+    /// The OBJ frames of a `mesh_sequence`, relative to the scene file (the
+    /// scene loader replaces them by the list of resolved paths).
+    pub files: Option<SequenceFiles>,
+    /// Frames per second of a `mesh_sequence`.
+    pub frame_rate: Option<f64>,
+    /// The number a `files` pattern starts from (default 0).
+    pub first_frame: Option<u64>,
 }
 
 /// `[[obstacle.keyframes]]`: the obstacle's pose at one time, relative to its
@@ -332,6 +345,9 @@ pub enum ObstacleShape {
     Mesh,
     /// Primitives in a joint hierarchy (`part`), moved by forward kinematics.
     Articulated,
+    /// A triangle mesh deformed by a sequence of OBJ files of one topology
+    /// (`files`, `frame_rate`, `scale`), interpolated between frames.
+    MeshSequence,
 }
 
 /// `[self_collision]`: contacts of the cloth with itself.

@@ -1,6 +1,7 @@
 //! The obstacles as the recording draws them: meshes logged once and placed
 //! by a pose each frame when they move rigidly (a moving plane, drawn around
-//! the cloth, is redrawn every frame).
+//! the cloth, is redrawn every frame; a deforming mesh's vertex positions are
+//! logged every frame, its triangles once).
 
 use super::Obstacles;
 use crate::math::{Scalar, Vector};
@@ -16,6 +17,10 @@ pub enum Drawn {
     /// A moving plane, drawn around the cloth: its mesh in world
     /// coordinates, logged every frame.
     Redrawn,
+    /// A deforming mesh: its vertex positions in world coordinates, logged
+    /// every frame, and its triangles, logged once (given with the first
+    /// frame only).
+    Deforming,
 }
 
 /// A triangulated obstacle for display: positions and triangles.
@@ -51,6 +56,15 @@ impl Obstacles {
         self.bodies
             .iter()
             .filter_map(|b| {
+                if b.deforming().is_some() {
+                    let (positions, triangles) = b.world_triangles(t, plane);
+                    return Some(ObstacleMesh {
+                        name: b.name.clone(),
+                        drawn: Drawn::Deforming,
+                        positions,
+                        triangles: if first { triangles } else { Vec::new() },
+                    });
+                }
                 let local = b.local_triangles();
                 let drawn = match (b.is_moving(), local.1.is_empty()) {
                     (false, _) => Drawn::Fixed,
@@ -78,7 +92,7 @@ impl Obstacles {
     pub fn poses(&self, t: Scalar) -> Vec<ObstaclePose> {
         self.bodies
             .iter()
-            .filter(|b| b.is_moving() && !b.is_plane())
+            .filter(|b| b.is_moving() && !b.is_plane() && b.deforming().is_none())
             .map(|b| {
                 let pose = b.pose(t);
                 ObstaclePose {

@@ -32,13 +32,17 @@
 //! thread count.
 
 pub mod cusick;
+pub mod deform;
 mod display;
 pub mod geometry;
 pub mod motion;
 pub mod obstacle;
 mod response;
 pub mod selfcol;
+pub mod sequence;
+mod shapes;
 pub mod skeleton;
+pub mod skin;
 pub mod volino;
 
 use std::time::Instant;
@@ -51,8 +55,8 @@ use crate::math::{Scalar, Vector};
 use crate::physics::Contact;
 use crate::spec::{ClothMesh, ClothSpec, Obstacle, ObstacleShape, SelfCollision};
 use crate::world::World;
+use deform::At;
 use obstacle::Body;
-use parry3d_f64::math::Pose;
 use response::{depth_below, push_out, respond};
 use selfcol::SelfCollider;
 
@@ -191,7 +195,8 @@ impl Obstacles {
                     b.thickness,
                     b.mu_static,
                     b.mu_kinetic,
-                    b.motion().describe()
+                    b.deforming()
+                        .map_or_else(|| b.motion().describe(), |d| d.describe())
                 )
             })
             .collect();
@@ -213,10 +218,12 @@ impl Obstacles {
         if self.bodies.is_empty() {
             return;
         }
+        let ats: Vec<At> = self.bodies.iter().map(|b| b.at(t)).collect();
         out.extend(x.iter().map(|&p| {
             self.bodies
                 .iter()
-                .map(|b| b.nearest_plane(t, p))
+                .zip(&ats)
+                .map(|(b, at)| b.nearest_plane(at, p))
                 .min_by(|a, b| a.0.total_cmp(&b.0))
                 .map(|(_, plane)| plane)
                 .expect("at least one obstacle")
@@ -232,9 +239,9 @@ pub struct Collider {
     x0: Vec<Vector>,
     held: Vec<bool>,
     t0: Scalar,
-    /// Per-step scratch, kept so that a step allocates nothing: each body's pose at the
+    /// Per-step scratch, kept so that a step allocates nothing: each body at the
     /// start and the end of the step.
-    poses: Vec<(Pose, Pose)>,
+    poses: Vec<(At, At)>,
     /// Per-step scratch: per vertex, whether it touched an obstacle and the work done on it.
     hits: Vec<(u64, Scalar)>,
 }
@@ -299,7 +306,7 @@ impl Collider {
         self.poses.clear();
         let bodies = &obstacles.bodies;
         self.poses
-            .extend(bodies.iter().map(|b| (b.pose(t0), b.pose(t1))));
+            .extend(bodies.iter().map(|b| (b.at(t0), b.at(t1))));
         let touching = if bodies.is_empty() {
             0
         } else {
@@ -371,7 +378,7 @@ impl Collider {
                         // A moving surface works on the cloth: impulse . surface velocity
                         // (the filter's impulse included).
                         if moving {
-                            let surface = b.point_velocity(t1, *x);
+                            let surface = b.velocity_at(t1, &pose.1, *x);
                             let m = mass.get(i).copied().unwrap_or(0.0);
                             work += m * ((*v - before).dot(surface) + push * c.normal_speed);
                         }

@@ -7,16 +7,18 @@ use std::sync::Arc;
 use parry3d_f64::bounding_volume::{Aabb, BoundingVolume};
 use parry3d_f64::math::Pose;
 use parry3d_f64::query::Ray;
-use parry3d_f64::shape::{
-    Ball, Capsule, Cuboid, Cylinder, HalfSpace, Shape, TriMesh, TriMeshFlags,
-};
+use parry3d_f64::shape::{Ball, Capsule, Cuboid, Cylinder, HalfSpace, Shape, TriMesh};
 
 use super::CollideError;
+use super::deform::{Animation, At, Deforming};
 use super::motion::{Motion, Track};
+use super::sequence::{Sequence, load_frames};
+use super::shapes::{load_mesh, primitive, shape_name};
 use super::skeleton::Skeleton;
+use super::skin::Skin;
 use crate::adapt::proximity::ObstaclePlane;
 use crate::math::{Scalar, Vector, rotation_from_euler_deg};
-use crate::spec::{Obstacle, ObstacleShape, Part};
+use crate::spec::{BodySurface, Obstacle, ObstacleShape, Part, SequenceFiles};
 
 /// A rigid obstacle the cloth collides with.
 pub struct Body {
@@ -39,6 +41,9 @@ pub struct Body {
     pub thickness: Scalar,
     /// Local bounding box inflated by the thickness (quick rejection).
     local_box: Aabb,
+    /// A deforming mesh's triangles and animation (`shape` is then its mesh
+    /// at rest, the pose the identity and `motion` fixed).
+    deform: Option<Deforming>,
 }
 
 impl std::fmt::Debug for Body {
@@ -63,12 +68,18 @@ impl Body {
         let axis = Vector::from_array(o.axis).normalize_or_zero();
         if o.shape == ObstacleShape::Articulated {
             let skeleton = Arc::new(Skeleton::new(index, o, motion(o, axis))?);
+            if o.surface == BodySurface::SkinnedMesh {
+                return Ok(vec![Body::skinned(index, o, skeleton)?]);
+            }
             return o
                 .part
                 .iter()
                 .enumerate()
                 .map(|(i, p)| Body::part(index, o, &skeleton, i, p))
                 .collect();
+        }
+        if o.shape == ObstacleShape::MeshSequence {
+            return Ok(vec![Body::mesh_sequence(index, o)?]);
         }
         // parry's cylinder is along local y; ours stand along local z.
         let y_to_z = glam::DQuat::from_rotation_x(std::f64::consts::FRAC_PI_2);
@@ -123,6 +134,65 @@ impl Body {
         Ok(body)
     }
 
+    /// Obstacle `index` (`o`), a `mesh_sequence`: its frames loaded, checked
+    /// and placed by `position` and `rotation`.
+    fn mesh_sequence(index: usize, o: &Obstacle) -> Result<Body, CollideError> {
+        let files = match &o.files {
+            Some(SequenceFiles::List(files)) => files.as_slice(),
+            _ => {
+                return Err(CollideError::Missing {
+                    index,
+                    key: "files",
+                });
+            }
+        };
+        let rate = o.frame_rate.ok_or(CollideError::Missing {
+            index,
+            key: "frame_rate",
+        })?;
+        let rot = rotation_from_euler_deg(o.rotation);
+        let origin = Vector::from_array(o.position);
+        let (triangles, frames) = load_frames(index, files, o.scale, &|p| origin + rot * p)?;
+        let animation = Animation::Sequence(Sequence::new(frames, rate, o.after_last));
+        let name = format!("obstacle {index} (mesh sequence)");
+        Ok(Body::with_deform(
+            name,
+            o,
+            Deforming::new(triangles, animation),
+        ))
+    }
+
+    /// Articulated obstacle `index` (`o`) as one mesh skinned to its parts.
+    fn skinned(index: usize, o: &Obstacle, skeleton: Arc<Skeleton>) -> Result<Body, CollideError> {
+        let shapes = o
+            .part
+            .iter()
+            .map(|p| primitive(index, p.shape, p.radius, p.half_height, p.half_extents))
+            .collect::<Result<Vec<_>, _>>()?;
+        let centres: Vec<Vector> = o
+            .part
+            .iter()
+            .map(|p| Vector::from_array(p.center))
+            .collect();
+        let (skin, triangles) = Skin::new(skeleton, &shapes, &centres);
+        let name = format!("obstacle {index} (skinned mesh)");
+        Ok(Body::with_deform(
+            name,
+            o,
+            Deforming::new(triangles, Animation::Skinned(skin)),
+        ))
+    }
+
+    /// A deforming mesh body with `o`'s friction and thickness.
+    fn with_deform(name: String, o: &Obstacle, deform: Deforming) -> Body {
+        let rest = deform.at(0.0);
+        let shape = Box::new(rest.mesh().clone());
+        let mut body = Body::rigid(name, o, shape, Pose::IDENTITY, Motion::Fixed);
+        body.origin = Vector::ZERO;
+        body.deform = Some(deform);
+        body
+    }
+
     /// A body of `shape` placed at rest by `pose0` (rotating about its
     /// translation), with `o`'s friction and thickness.
     fn rigid(
@@ -146,12 +216,36 @@ impl Body {
             mu_kinetic: o.friction_kinetic.unwrap_or(o.friction_static),
             thickness: t,
             local_box,
+            deform: None,
         }
     }
 
     /// True when the obstacle moves.
     pub fn is_moving(&self) -> bool {
-        self.motion.is_moving()
+        self.deform.is_some() || self.motion.is_moving()
+    }
+
+    /// The deforming mesh, when the obstacle is one.
+    pub fn deforming(&self) -> Option<&Deforming> {
+        self.deform.as_ref()
+    }
+
+    /// The obstacle at time `t`: its pose and, for a deforming mesh, its
+    /// surface then.
+    pub fn at(&self, t: Scalar) -> At {
+        At {
+            pose: self.pose(t),
+            surface: self.deform.as_ref().map(|d| d.at(t)),
+        }
+    }
+
+    /// The shape the queries at `at` use: the deforming mesh's surface then,
+    /// else the rigid shape.
+    fn shape_at<'a>(&'a self, at: &'a At) -> &'a dyn Shape {
+        match &at.surface {
+            Some(s) => s.mesh(),
+            None => self.shape.as_ref(),
+        }
     }
 
     /// How the obstacle moves.
@@ -171,8 +265,17 @@ impl Body {
         Pose::from_parts(centre + offset, state.rotation * self.pose0.rotation)
     }
 
-    /// Velocity at time `t` of the obstacle's material point at world position `x`.
+    /// Velocity at time `t` of the obstacle's material point at world position `x`
+    /// (of a deforming mesh: of its surface point nearest to `x`).
     pub fn point_velocity(&self, t: Scalar, x: Vector) -> Vector {
+        self.velocity_at(t, &self.at(t), x)
+    }
+
+    /// As [`Body::point_velocity`], with the obstacle at `t` given as `at`.
+    pub fn velocity_at(&self, t: Scalar, at: &At, x: Vector) -> Vector {
+        if let Some(s) = &at.surface {
+            return s.velocity_at(x);
+        }
         let state = self.motion.state(t);
         state.velocity + state.omega.cross(x - (self.origin + state.shift))
     }
@@ -182,23 +285,28 @@ impl Body {
         self.shape.as_shape::<HalfSpace>().is_some()
     }
 
-    /// True when the local segment `a`-`b` may come within the thickness of the shape.
-    pub fn may_touch(&self, a: Vector, b: Vector) -> bool {
+    /// True when the local segment `a`-`b` may come within the thickness of
+    /// the shape at `at`.
+    pub fn may_touch(&self, at: &At, a: Vector, b: Vector) -> bool {
         let seg = Aabb::new(a.min(b), a.max(b));
-        self.local_box.intersects(&seg)
+        match &at.surface {
+            Some(s) => s.bounds().loosened(self.thickness).intersects(&seg),
+            None => self.local_box.intersects(&seg),
+        }
     }
 
-    /// Signed distance and outward normal of local point `q`.
-    pub fn probe(&self, q: Vector) -> Probe {
-        let proj = self.shape.project_local_point(q, false);
+    /// Signed distance and outward normal of local point `q`, the shape at `at`.
+    pub fn probe(&self, at: &At, q: Vector) -> Probe {
+        let shape = self.shape_at(at);
+        let proj = shape.project_local_point(q, false);
         let d = q - proj.point;
         let dist = d.length();
         let normal = if dist > 1e-12 {
             if proj.is_inside { -d / dist } else { d / dist }
         } else {
             // On the surface: ask parry for the normal of the feature there.
-            let (p, feature) = self.shape.project_local_point_and_get_feature(q);
-            self.shape
+            let (p, feature) = shape.project_local_point_and_get_feature(q);
+            shape
                 .feature_normal_at_point(p.subshape, feature, q)
                 .unwrap_or(Vector::Z)
         };
@@ -212,10 +320,10 @@ impl Body {
     /// distance from `x` (m, unsigned) and the tangent plane there, in world
     /// coordinates (for the sizing criterion's obstacle term,
     /// `crate::adapt::proximity`).
-    pub fn nearest_plane(&self, t: Scalar, x: Vector) -> (Scalar, ObstaclePlane) {
-        let pose = self.pose(t);
+    pub fn nearest_plane(&self, at: &At, x: Vector) -> (Scalar, ObstaclePlane) {
+        let pose = at.pose;
         let q = pose.inverse_transform_point(x);
-        let probe = self.probe(q);
+        let probe = self.probe(at, q);
         let local_point = q - probe.normal * probe.signed;
         (
             probe.signed.abs(),
@@ -228,14 +336,14 @@ impl Body {
     }
 
     /// Where the local segment `a` -> `b` first enters the solid from outside:
-    /// `(fraction of the segment, outward normal)`.
-    pub fn first_entry(&self, a: Vector, b: Vector) -> Option<(Scalar, Vector)> {
+    /// `(fraction of the segment, outward normal)`, the shape at `at`.
+    pub fn first_entry(&self, at: &At, a: Vector, b: Vector) -> Option<(Scalar, Vector)> {
         let dir = b - a;
         if dir.length_squared() == 0.0 {
             return None;
         }
         let hit = self
-            .shape
+            .shape_at(at)
             .cast_local_ray_and_get_normal(&Ray::new(a, dir), 1.0, false)?;
         (hit.normal.dot(dir) < 0.0).then_some((hit.time_of_impact, hit.normal))
     }
@@ -270,6 +378,10 @@ impl Body {
         t: Scalar,
         plane: (Vector, Scalar),
     ) -> (Vec<Vector>, Vec<[u32; 3]>) {
+        if let Some(d) = &self.deform {
+            let s = d.at(t);
+            return (s.mesh().vertices().to_vec(), d.triangles().to_vec());
+        }
         let pose = self.pose(t);
         if let Some(h) = self.shape.as_shape::<HalfSpace>() {
             let n = pose.rotation * h.normal;
@@ -295,98 +407,6 @@ impl Body {
         (axis.z.abs() > 1.0 - 1e-9)
             .then(|| (pose.translation + Vector::Z * c.half_height, c.radius))
     }
-}
-
-/// A sphere, box or capsule of the given sizes (the shapes an articulated
-/// body's parts may have); any other shape is refused.
-fn primitive(
-    index: usize,
-    shape: ObstacleShape,
-    radius: Option<Scalar>,
-    half_height: Option<Scalar>,
-    half_extents: Option<[Scalar; 3]>,
-) -> Result<Box<dyn Shape>, CollideError> {
-    let need = |v: Option<Scalar>, key: &'static str| v.ok_or(CollideError::Missing { index, key });
-    Ok(match shape {
-        ObstacleShape::Sphere => Box::new(Ball::new(need(radius, "radius")?)),
-        ObstacleShape::Box => {
-            let h = half_extents.ok_or(CollideError::Missing {
-                index,
-                key: "half_extents",
-            })?;
-            Box::new(Cuboid::new(Vector::from_array(h)))
-        }
-        ObstacleShape::Capsule => Box::new(Capsule::new_z(
-            need(half_height, "half_height")?,
-            need(radius, "radius")?,
-        )),
-        other => {
-            return Err(CollideError::Hierarchy {
-                index,
-                reason: format!(
-                    "a part cannot be a {}: parts are spheres, capsules or boxes",
-                    shape_name(other)
-                ),
-            });
-        }
-    })
-}
-
-fn shape_name(s: ObstacleShape) -> &'static str {
-    match s {
-        ObstacleShape::Sphere => "sphere",
-        ObstacleShape::Box => "box",
-        ObstacleShape::Plane => "plane",
-        ObstacleShape::Capsule => "capsule",
-        ObstacleShape::Cylinder => "cylinder",
-        ObstacleShape::Mesh => "mesh",
-        ObstacleShape::Articulated => "articulated",
-    }
-}
-
-/// Loads an obstacle mesh from OBJ (every object of the file, triangulated), scaled.
-fn load_mesh(index: usize, path: &Path, scale: Scalar) -> Result<TriMesh, CollideError> {
-    let err = |reason: String| CollideError::Obj {
-        index,
-        path: path.display().to_string(),
-        reason,
-    };
-    let opts = tobj::LoadOptions {
-        triangulate: true,
-        single_index: true,
-        ..Default::default()
-    };
-    let (models, _) = tobj::load_obj(path, &opts)
-        .map_err(|e| err(format!("{e} (not a readable Wavefront OBJ file)")))?;
-    let mut vertices = Vec::new();
-    let mut indices = Vec::new();
-    for m in &models {
-        let base = vertices.len() as u32;
-        let p = &m.mesh.positions;
-        for c in p.chunks_exact(3) {
-            let v = Vector::new(c[0], c[1], c[2]) * scale;
-            if !v.is_finite() {
-                return Err(err("a vertex coordinate is not a finite number".into()));
-            }
-            vertices.push(v);
-        }
-        let count = (p.len() / 3) as u32;
-        for f in m.mesh.indices.chunks_exact(3) {
-            if f.iter().any(|&i| i >= count) {
-                return Err(err("a face references a vertex that does not exist".into()));
-            }
-            indices.push([base + f[0], base + f[1], base + f[2]]);
-        }
-    }
-    if indices.is_empty() {
-        return Err(err("the file has no triangles".into()));
-    }
-    TriMesh::with_flags(
-        vertices,
-        indices,
-        TriMeshFlags::ORIENTED | TriMeshFlags::MERGE_DUPLICATE_VERTICES,
-    )
-    .map_err(|e| err(format!("{e:?}")))
 }
 
 /// The motion an obstacle's keys ask for: keyframes, else a constant velocity

@@ -2,8 +2,7 @@
 //! docs of [`super`]): continuous detection, proximity, placement and friction; and the
 //! push-out and depth measurement of the pass after self-collision.
 
-use parry3d_f64::math::Pose;
-
+use super::deform::At;
 use super::obstacle::Body;
 use crate::math::{Scalar, Vector};
 use crate::physics::Contact;
@@ -14,12 +13,15 @@ use crate::physics::Contact;
 const CONTACT_MARGIN: Scalar = 1.0 + 1e-6;
 
 /// Contact response of one vertex against one obstacle (module docs, steps 1-3).
-/// `p0` is the start-of-step position, `x`/`v` the state after the integrator.
+/// `p0` is the start-of-step position, `x`/`v` the state after the integrator;
+/// `start` and `end` are the obstacle at the two ends of the step. The path
+/// is taken relative to the obstacle: from `p0` carried with it over the step
+/// ([`At::carried`]) to `x`, against its shape at the end of the step.
 /// Returns the contact when the vertex touched the obstacle.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn respond(
     b: &Body,
-    (pose0, pose1): &(Pose, Pose),
+    (start, end): &(At, At),
     t1: Scalar,
     h: Scalar,
     pushed: Scalar,
@@ -27,18 +29,24 @@ pub(super) fn respond(
     x: &mut Vector,
     v: &mut Vector,
 ) -> Option<Contact> {
-    let q0 = pose0.inverse_transform_point(p0);
+    let pose1 = &end.pose;
     let q1 = pose1.inverse_transform_point(*x);
-    if !b.may_touch(q0, q1) {
+    let rough = if end.surface.is_some() {
+        p0
+    } else {
+        start.pose.inverse_transform_point(p0)
+    };
+    if !b.may_touch(end, rough, q1) {
         return None;
     }
+    let q0 = start.carried(end, p0);
     let thick = b.thickness;
     // Signed distance of the start of the step from the surface.
-    let start = b.probe(q0).signed;
-    let (n, offset) = contact_plane(b, q0, q1, start)?;
+    let start = b.probe(end, q0).signed;
+    let (n, offset) = contact_plane(b, end, q0, q1, start)?;
     let mut q = q1 + n * (offset + thick - n.dot(q1));
     let rot = pose1.rotation;
-    let mut u = rot.inverse() * (*v - b.point_velocity(t1, pose1.transform_point(q)));
+    let mut u = rot.inverse() * (*v - b.velocity_at(t1, end, pose1.transform_point(q)));
     let un = u.dot(n);
     // Normal impulse per mass of the step: the approach removed here, plus what the
     // implicit solve's contact filter already removed.
@@ -70,12 +78,12 @@ pub(super) fn respond(
         u = ut_new + n * un.max(0.0);
     }
     // Curved surfaces and corners: make sure the final point is a thickness outside.
-    let f = b.probe(q);
+    let f = b.probe(end, q);
     if f.signed < thick {
         q += f.normal * (thick - f.signed);
     }
     *x = pose1.transform_point(q);
-    let surface = b.point_velocity(t1, *x);
+    let surface = b.velocity_at(t1, end, *x);
     *v = rot * u + surface;
     let normal = rot * n;
     Some(Contact {
@@ -88,13 +96,19 @@ pub(super) fn respond(
 /// in the body's frame: outward normal and its offset `n . s` at the surface point
 /// `s`. The plane where the step first enters the surface, else the one under `q1`
 /// when it ends within the contact margin; `None` when the vertex stays clear.
-fn contact_plane(b: &Body, q0: Vector, q1: Vector, start: Scalar) -> Option<(Vector, Scalar)> {
+fn contact_plane(
+    b: &Body,
+    end: &At,
+    q0: Vector,
+    q1: Vector,
+    start: Scalar,
+) -> Option<(Vector, Scalar)> {
     if start >= 0.0
-        && let Some((toi, n)) = b.first_entry(q0, q1)
+        && let Some((toi, n)) = b.first_entry(end, q0, q1)
     {
         return Some((n, n.dot(q0 + (q1 - q0) * toi)));
     }
-    let p = b.probe(q1);
+    let p = b.probe(end, q1);
     if p.signed < b.thickness * CONTACT_MARGIN {
         return Some((p.normal, p.normal.dot(q1) - p.signed));
     }
@@ -114,18 +128,19 @@ fn before_contact(gap0: Scalar, gap1: Scalar) -> Scalar {
 
 /// Pushes a vertex that came within the thickness back out along the normal and removes
 /// its approaching normal velocity (the pass after self-collision).
-pub(super) fn push_out(b: &Body, pose: &Pose, t: Scalar, x: &mut Vector, v: &mut Vector) {
+pub(super) fn push_out(b: &Body, at: &At, t: Scalar, x: &mut Vector, v: &mut Vector) {
+    let pose = &at.pose;
     let q = pose.inverse_transform_point(*x);
-    if !b.may_touch(q, q) {
+    if !b.may_touch(at, q, q) {
         return;
     }
-    let p = b.probe(q);
+    let p = b.probe(at, q);
     if p.signed >= b.thickness {
         return;
     }
     *x = pose.transform_point(q + p.normal * (b.thickness - p.signed));
     let n = pose.rotation * p.normal;
-    let rel = *v - b.point_velocity(t, *x);
+    let rel = *v - b.velocity_at(t, at, *x);
     let vn = rel.dot(n);
     if vn < 0.0 {
         *v -= n * vn;
@@ -133,10 +148,10 @@ pub(super) fn push_out(b: &Body, pose: &Pose, t: Scalar, x: &mut Vector, v: &mut
 }
 
 /// Depth of `x` below the obstacle's surface, m (0 outside).
-pub(super) fn depth_below(b: &Body, pose: &Pose, x: Vector) -> Scalar {
-    let q = pose.inverse_transform_point(x);
-    if !b.may_touch(q, q) {
+pub(super) fn depth_below(b: &Body, at: &At, x: Vector) -> Scalar {
+    let q = at.pose.inverse_transform_point(x);
+    if !b.may_touch(at, q, q) {
         return 0.0;
     }
-    (-b.probe(q).signed).max(0.0)
+    (-b.probe(at, q).signed).max(0.0)
 }

@@ -301,6 +301,44 @@ impl Recorder {
         logged.map_err(|e| self.log_err(&entity, e))
     }
 
+    /// Logs a deforming obstacle mesh at `obstacles/<name>`: its vertex
+    /// positions at the current frame and, when `triangles` is not empty (the
+    /// first frame), its triangles and colour as static data, which every
+    /// frame's positions share (call it after [`Recorder::record_frame`]
+    /// every frame).
+    pub fn record_deforming_obstacle(
+        &mut self,
+        name: &str,
+        positions: &[Vector],
+        triangles: &[[u32; 3]],
+    ) -> Result<(), RecordError> {
+        let n = positions.len();
+        if let Some(t) = triangles
+            .iter()
+            .find(|t| t.iter().any(|&i| i as usize >= n))
+        {
+            return Err(RecordError::InvalidFrame {
+                frame: 0,
+                reason: format!("obstacle {name}: triangle {t:?} indexes past {n} vertices"),
+            });
+        }
+        let entity = obstacle_entity(name);
+        if !triangles.is_empty() {
+            let [r, g, b] = OBSTACLE_COLOR;
+            let topology = rerun::Mesh3D::update_fields()
+                .with_triangle_indices(triangles.iter().copied())
+                .with_albedo_factor(rerun::Rgba32::from_rgb(r, g, b));
+            self.stream
+                .log_static(entity.as_str(), &topology)
+                .map_err(|e| self.log_err(&entity, e))?;
+        }
+        let moved = rerun::Mesh3D::update_fields()
+            .with_vertex_positions(positions.iter().map(|&p| convert::position(p)));
+        self.stream
+            .log(entity.as_str(), &moved)
+            .map_err(|e| self.log_err(&entity, e))
+    }
+
     /// Logs a moving rigid obstacle's pose at the current frame as the
     /// `Transform3D` of `obstacles/<name>`, which places the mesh that
     /// [`Recorder::record_obstacle`] logged once in the obstacle's local frame

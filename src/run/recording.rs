@@ -108,12 +108,17 @@ pub(super) fn record_state(
         return Ok(());
     }
     // Every mesh but a moving plane's is logged once, at the first frame;
-    // moving rigid shapes are placed by a transform every frame.
+    // moving rigid shapes are placed by a transform every frame, deforming
+    // meshes get their vertex positions every frame.
     let first = snap.frame == 0;
     for m in setup
         .obstacles
         .meshes(world.time, plane_display(world), first)
     {
+        if m.drawn == Drawn::Deforming {
+            rec.record_deforming_obstacle(&m.name, &m.positions, &m.triangles)?;
+            continue;
+        }
         let fixed = m.drawn != Drawn::Redrawn;
         rec.record_obstacle(&m.name, &m.positions, &m.triangles, fixed)?;
     }

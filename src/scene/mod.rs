@@ -15,6 +15,7 @@ mod parse;
 pub mod presets;
 pub mod resolve;
 mod schema;
+mod sequence_files;
 mod serde_errors;
 mod spans;
 mod validate;

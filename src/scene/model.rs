@@ -9,10 +9,10 @@ use serde::Deserialize;
 // The engine's own types, deserialised straight from the file (see `crate::spec`).
 use crate::physics::membrane::{Membrane, Orthotropic};
 pub use crate::spec::{
-    Adapt, AdaptCriterion, AdaptEvery, AdaptMethod, BendingModel, ClothShape, DEFAULT_THICKNESS,
-    DiagonalPattern, Integrator, Keyframe, KeyframeAfter, KeyframeEasing, Measurement,
-    MembraneModel, Obstacle, ObstacleShape, Part, Pin, PinMotion, SelfCollision, Solver,
-    StiffnessRule,
+    Adapt, AdaptCriterion, AdaptEvery, AdaptMethod, BendingModel, BodySurface, ClothShape,
+    DEFAULT_THICKNESS, DiagonalPattern, Integrator, Keyframe, KeyframeAfter, KeyframeEasing,
+    Measurement, MembraneModel, Obstacle, ObstacleShape, Part, Pin, PinMotion, SelfCollision,
+    SequenceFiles, Solver, StiffnessRule,
 };
 
 /// A whole scene file.

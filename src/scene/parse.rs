@@ -7,7 +7,7 @@ use std::path::Path;
 use super::error::{Issue, KeyPath, SceneError, SceneErrorKind, Seg, dotted, keys};
 use super::serde_errors::translate;
 use super::spans::{line_at, line_of};
-use super::{Scene, overrides, presets, validate};
+use super::{Scene, SequenceFiles, overrides, presets, validate};
 
 /// Sections the format names that this version does not implement, with what is planned.
 /// (None at present; the mechanism stays for sections added to the format later.)
@@ -49,6 +49,22 @@ pub(crate) fn load(
         scene.cloth.path = Some(resolved.to_string_lossy().into_owned());
     }
     for i in 0..scene.obstacle.len() {
+        if let Some(files) = &scene.obstacle[i].files {
+            let key = vec![
+                Seg::Key("obstacle".into()),
+                Seg::Index(i),
+                Seg::Key("files".into()),
+            ];
+            let dir = if ctx.set_for(&key).is_some() {
+                None
+            } else {
+                base
+            };
+            let first = scene.obstacle[i].first_frame.unwrap_or(0);
+            let list = super::sequence_files::resolve(i, files, first, dir)
+                .map_err(|issue| ctx.locate(issue))?;
+            scene.obstacle[i].files = Some(SequenceFiles::List(list));
+        }
         let Some(p) = scene.obstacle[i].path.as_deref() else {
             continue;
         };

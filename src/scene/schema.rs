@@ -76,13 +76,19 @@ pub(crate) fn allowed(path: &str) -> Option<&'static str> {
         "wind.coefficient" => "a finite number >= 0",
         "obstacle" => "an array of tables [[obstacle]]",
         "obstacle.shape" => {
-            "\"sphere\", \"box\", \"plane\", \"capsule\", \"cylinder\", \"mesh\" or \"articulated\""
+            "\"sphere\", \"box\", \"plane\", \"capsule\", \"cylinder\", \"mesh\", \"mesh_sequence\" or \"articulated\""
         }
         "obstacle.radius" | "obstacle.half_height" => "a finite number > 0 (m)",
         "obstacle.half_extents" => "an array of 3 finite numbers > 0 (m)",
         "obstacle.normal" => "an array of 3 finite numbers, not all zero",
         "obstacle.path" => "a non-empty path to an OBJ file, relative to the scene file",
         "obstacle.scale" => "a finite number > 0",
+        "obstacle.files" => {
+            "a path pattern with one `{}` or `{:0N}` placeholder for the frame number, or a non-empty array of paths to OBJ files (relative to the scene file)"
+        }
+        "obstacle.frame_rate" => "a finite number > 0 (frames per second)",
+        "obstacle.first_frame" => "an integer >= 0 (with a `files` pattern)",
+        "obstacle.surface" => "\"parts\" or \"skinned_mesh\" (shape = \"articulated\" only)",
         "obstacle.position" => "an array of 3 finite numbers (m)",
         "obstacle.rotation" => "an array of 3 finite numbers (degrees)",
         "obstacle.friction_static" => "a finite number >= 0",
@@ -98,7 +104,9 @@ pub(crate) fn allowed(path: &str) -> Option<&'static str> {
         "obstacle.keyframes.translation" => "an array of 3 finite numbers (m)",
         "obstacle.keyframes.rotation" => "an array of 3 finite numbers (degrees)",
         "obstacle.easing" => "\"linear\" or \"smooth\"",
-        "obstacle.after_last" => "\"hold\" or \"loop\"",
+        "obstacle.after_last" => {
+            "\"hold\" or \"loop\" (with keyframes or shape = \"mesh_sequence\")"
+        }
         "obstacle.part" => {
             "an array of at least one table [[obstacle.part]] (shape = \"articulated\" only)"
         }

@@ -5,7 +5,7 @@ use toml::Table;
 
 use super::error::{Issue, KeyPath, SceneErrorKind as Kind, Seg, keys};
 use super::validate::{all_finite, allowed_for, finite, non_negative, out_of_range, positive};
-use super::{Obstacle, ObstacleShape, SelfCollision};
+use super::{Obstacle, ObstacleShape, SelfCollision, SequenceFiles};
 
 /// Keys each obstacle shape needs, and the shape-specific keys that do not apply to it.
 fn shape_keys(shape: ObstacleShape) -> (&'static str, &'static [&'static str]) {
@@ -17,11 +17,12 @@ fn shape_keys(shape: ObstacleShape) -> (&'static str, &'static [&'static str]) {
         ObstacleShape::Cylinder => ("cylinder", &["radius", "half_height"]),
         ObstacleShape::Mesh => ("mesh", &["path"]),
         ObstacleShape::Articulated => ("articulated", &["part"]),
+        ObstacleShape::MeshSequence => ("mesh_sequence", &["files", "frame_rate"]),
     }
 }
 
 /// Keys that only some shapes have; every other shape refuses them.
-const SHAPE_SPECIFIC: [(&str, &[ObstacleShape]); 7] = [
+const SHAPE_SPECIFIC: [(&str, &[ObstacleShape]); 11] = [
     (
         "radius",
         &[
@@ -37,8 +38,12 @@ const SHAPE_SPECIFIC: [(&str, &[ObstacleShape]); 7] = [
     ("half_extents", &[ObstacleShape::Box]),
     ("normal", &[ObstacleShape::Plane]),
     ("path", &[ObstacleShape::Mesh]),
-    ("scale", &[ObstacleShape::Mesh]),
+    ("scale", &[ObstacleShape::Mesh, ObstacleShape::MeshSequence]),
     ("part", &[ObstacleShape::Articulated]),
+    ("surface", &[ObstacleShape::Articulated]),
+    ("files", &[ObstacleShape::MeshSequence]),
+    ("frame_rate", &[ObstacleShape::MeshSequence]),
+    ("first_frame", &[ObstacleShape::MeshSequence]),
 ];
 
 /// Checks obstacle `i`; `written` is its table as written (to tell keys from defaults).
@@ -85,6 +90,7 @@ pub(super) fn obstacle(i: usize, o: &Obstacle, written: Option<&Table>) -> Resul
             .allowed(allowed_for(&at("path"))));
     }
     positive(at("scale"), o.scale)?;
+    sequence(&at, o)?;
     all_finite(at("position"), &o.position)?;
     all_finite(at("rotation"), &o.rotation)?;
     non_negative(at("friction_static"), o.friction_static)?;
@@ -131,6 +137,41 @@ pub(super) fn sizes_positive(
                 format!("{h:?} has a size that is not > 0"),
             ));
         }
+    }
+    Ok(())
+}
+
+/// A `mesh_sequence`'s keys: a positive frame rate, files that are a pattern
+/// with one placeholder or a non-empty list; no motion keys (the frames move it).
+fn sequence(at: &dyn Fn(&str) -> KeyPath, o: &Obstacle) -> Result<(), Issue> {
+    if let Some(r) = o.frame_rate {
+        positive(at("frame_rate"), r)?;
+    }
+    match &o.files {
+        Some(SequenceFiles::Pattern(p)) => {
+            if let Err(why) = super::sequence_files::placeholder(p) {
+                return Err(
+                    Issue::new(at("files"), Kind::BadValue, why).allowed(allowed_for(&at("files")))
+                );
+            }
+        }
+        Some(SequenceFiles::List(l)) if l.is_empty() || l.iter().any(|f| f.trim().is_empty()) => {
+            return Err(Issue::new(
+                at("files"),
+                Kind::BadValue,
+                "the list of files is empty or names an empty path",
+            )
+            .allowed(allowed_for(&at("files"))));
+        }
+        _ => {}
+    }
+    if o.first_frame.is_some() && !matches!(o.files, Some(SequenceFiles::Pattern(_))) {
+        return Err(Issue::new(
+            at("first_frame"),
+            Kind::NotApplicable,
+            "`first_frame` numbers the frames of a `files` pattern, and `files` is a list",
+        )
+        .because(at("files")));
     }
     Ok(())
 }

@@ -6,7 +6,7 @@ use toml::Table;
 
 use super::error::{Issue, KeyPath, SceneErrorKind as Kind, Seg};
 use super::validate::{all_finite, finite, out_of_range};
-use super::{Keyframe, KeyframeAfter, Obstacle, Pin, PinMotion};
+use super::{Keyframe, KeyframeAfter, Obstacle, ObstacleShape, Pin, PinMotion};
 use crate::math::rotation_from_euler_deg;
 
 /// Largest difference between the last and the first key of a loop, m or
@@ -23,6 +23,22 @@ pub(super) fn keyframes(i: usize, o: &Obstacle, written: Option<&Table>) -> Resu
         ]
     };
     let has = |k: &str| written.is_some_and(|t| t.contains_key(k));
+    if o.shape == ObstacleShape::MeshSequence {
+        let moves = [
+            "keyframes",
+            "velocity",
+            "angular_velocity",
+            "axis",
+            "easing",
+        ];
+        if let Some(k) = moves.into_iter().find(|k| has(k)) {
+            let why = format!(
+                "`{k}` does not apply to shape = \"mesh_sequence\": its frames move it (`after_last` says what it does after the last frame)"
+            );
+            return Err(Issue::new(at(k), Kind::NotApplicable, why).because(at("shape")));
+        }
+        return Ok(());
+    }
     if o.keyframes.is_empty() {
         return unused(&at, &has, "this obstacle has no `keyframes`");
     }

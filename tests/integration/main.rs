@@ -28,6 +28,7 @@ mod membrane;
 mod membrane_cantilever;
 mod membrane_runs;
 mod mesh;
+mod meshbody;
 mod metric;
 mod physics;
 mod pins;

@@ -1,0 +1,104 @@
+//! The rigid shapes of obstacles: the primitives of parts, the OBJ mesh
+//! loader and the shapes' names.
+
+use std::path::Path;
+
+use parry3d_f64::shape::{Ball, Capsule, Cuboid, Shape, TriMesh, TriMeshFlags};
+
+use super::CollideError;
+use crate::math::{Scalar, Vector};
+use crate::spec::ObstacleShape;
+
+/// A sphere, box or capsule of the given sizes (the shapes an articulated
+/// body's parts may have); any other shape is refused.
+pub(super) fn primitive(
+    index: usize,
+    shape: ObstacleShape,
+    radius: Option<Scalar>,
+    half_height: Option<Scalar>,
+    half_extents: Option<[Scalar; 3]>,
+) -> Result<Box<dyn Shape>, CollideError> {
+    let need = |v: Option<Scalar>, key: &'static str| v.ok_or(CollideError::Missing { index, key });
+    Ok(match shape {
+        ObstacleShape::Sphere => Box::new(Ball::new(need(radius, "radius")?)),
+        ObstacleShape::Box => {
+            let h = half_extents.ok_or(CollideError::Missing {
+                index,
+                key: "half_extents",
+            })?;
+            Box::new(Cuboid::new(Vector::from_array(h)))
+        }
+        ObstacleShape::Capsule => Box::new(Capsule::new_z(
+            need(half_height, "half_height")?,
+            need(radius, "radius")?,
+        )),
+        other => {
+            return Err(CollideError::Hierarchy {
+                index,
+                reason: format!(
+                    "a part cannot be a {}: parts are spheres, capsules or boxes",
+                    shape_name(other)
+                ),
+            });
+        }
+    })
+}
+
+/// The scene's word for a shape, for names and messages.
+pub(super) fn shape_name(s: ObstacleShape) -> &'static str {
+    match s {
+        ObstacleShape::Sphere => "sphere",
+        ObstacleShape::Box => "box",
+        ObstacleShape::Plane => "plane",
+        ObstacleShape::Capsule => "capsule",
+        ObstacleShape::Cylinder => "cylinder",
+        ObstacleShape::Mesh => "mesh",
+        ObstacleShape::Articulated => "articulated",
+        ObstacleShape::MeshSequence => "mesh sequence",
+    }
+}
+
+/// Loads an obstacle mesh from OBJ (every object of the file, triangulated), scaled.
+pub(super) fn load_mesh(index: usize, path: &Path, scale: Scalar) -> Result<TriMesh, CollideError> {
+    let err = |reason: String| CollideError::Obj {
+        index,
+        path: path.display().to_string(),
+        reason,
+    };
+    let opts = tobj::LoadOptions {
+        triangulate: true,
+        single_index: true,
+        ..Default::default()
+    };
+    let (models, _) = tobj::load_obj(path, &opts)
+        .map_err(|e| err(format!("{e} (not a readable Wavefront OBJ file)")))?;
+    let mut vertices = Vec::new();
+    let mut indices = Vec::new();
+    for m in &models {
+        let base = vertices.len() as u32;
+        let p = &m.mesh.positions;
+        for c in p.chunks_exact(3) {
+            let v = Vector::new(c[0], c[1], c[2]) * scale;
+            if !v.is_finite() {
+                return Err(err("a vertex coordinate is not a finite number".into()));
+            }
+            vertices.push(v);
+        }
+        let count = (p.len() / 3) as u32;
+        for f in m.mesh.indices.chunks_exact(3) {
+            if f.iter().any(|&i| i >= count) {
+                return Err(err("a face references a vertex that does not exist".into()));
+            }
+            indices.push([base + f[0], base + f[1], base + f[2]]);
+        }
+    }
+    if indices.is_empty() {
+        return Err(err("the file has no triangles".into()));
+    }
+    TriMesh::with_flags(
+        vertices,
+        indices,
+        TriMeshFlags::ORIENTED | TriMeshFlags::MERGE_DUPLICATE_VERTICES,
+    )
+    .map_err(|e| err(format!("{e:?}")))
+}
