@@ -19,6 +19,7 @@ mod docs_commands;
 mod elastica;
 mod elements;
 mod energy;
+mod fast_contact;
 mod fuzz;
 mod gradient;
 mod inspect_cli;
