@@ -361,7 +361,7 @@ fn refinement_near_an_obstacle_follows_it_and_coarsens_behind() {
 /// 0.1 s): the pulled edge is where its keys say, the whole cloth has slid
 /// off the top, and no vertex ever went below an obstacle's surface.
 #[test]
-fn the_tablecloth_pull_scene_pulls_the_cloth_across_the_table() {
+fn the_tablecloth_pull_scene_pulls_the_cloth_off_the_table() {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/tablecloth_pull.toml");
     let sets = ["simulation.duration=0.3".to_string()];
     let scene = drape::scene::load_scene_file(&path, &sets).expect("scene");
