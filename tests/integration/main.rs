@@ -20,6 +20,7 @@ mod elastica;
 mod elastica_irregular;
 mod elements;
 mod energy;
+mod fast_contact;
 mod fuzz;
 mod gradient;
 mod inspect_cli;
