@@ -13,7 +13,7 @@ use rayon::prelude::*;
 use super::bending::dihedral_angle_and_gradient;
 use super::elements::Elements;
 use super::membrane::MEMBRANE_SLOTS;
-use super::shape::SHAPE_SLOTS;
+use super::shape::{SHAPE_SLOTS, ShapeJacobian, spread};
 use crate::math::{Scalar, Vector, deterministic_sum};
 
 /// Element count below which a pass runs on one thread (splitting costs more).
@@ -68,6 +68,8 @@ pub struct ForceScratch {
     pub triangle: Vec<Vector>,
     /// Each shape triangle's three folds.
     pub folds: Vec<[Scalar; 3]>,
+    /// Each shape triangle's fold gradients by slot.
+    pub fold_gradients: Vec<ShapeJacobian>,
     /// The fold splits at the current folds.
     pub splits: Vec<Scalar>,
 }
@@ -171,16 +173,31 @@ pub fn element_pass(
     scratch
         .shape
         .resize(SHAPE_SLOTS * el.shape_triangles.len(), Vector::ZERO);
-    if !el.shape_triangles.is_empty() {
-        solve_splits(el, x, &mut scratch.folds, &mut scratch.splits);
-    }
-    let splits = &scratch.splits;
+    let shapes = el.shape_triangles.len();
+    scratch.folds.resize(shapes, [0.0; 3]);
+    scratch
+        .fold_gradients
+        .resize(shapes, [[Vector::ZERO; SHAPE_SLOTS]; 3]);
+    scratch
+        .folds
+        .par_iter_mut()
+        .zip(scratch.fold_gradients.par_iter_mut())
+        .zip(el.shape_triangles.par_iter())
+        .with_min_len(PAR_MIN / SHAPE_SLOTS)
+        .for_each(|((folds, jac), t)| (*folds, *jac) = t.angles(x));
+    el.fold_splits
+        .solve(&el.shape_triangles, &scratch.folds, &mut scratch.splits);
+    let (folds, jacs, splits) = (&scratch.folds, &scratch.fold_gradients, &scratch.splits);
     scratch
         .shape
         .par_chunks_exact_mut(SHAPE_SLOTS)
         .with_min_len(PAR_MIN / SHAPE_SLOTS)
-        .zip(el.shape_triangles.par_iter())
-        .for_each(|(f, t)| t.forces(x, splits, f));
+        .zip(
+            el.shape_triangles
+                .par_iter()
+                .zip(folds.par_iter().zip(jacs.par_iter())),
+        )
+        .for_each(|(f, (t, (theta, jac)))| spread(jac, t.moments(*theta, splits).map(|c| -c), f));
     scratch
         .membrane
         .resize(MEMBRANE_SLOTS * el.membrane_triangles.len(), Vector::ZERO);

@@ -124,12 +124,14 @@
 //! below), and neither do clamp edges (the free triangle takes the whole
 //! fold, as above).
 //!
-//! The cost is one more pass over the triangles' angles and the sparse
-//! solve at every force evaluation, which weighs most on explicit
-//! integrators (four evaluations per RK4 step): `scenes/flag.toml` for 1 s
-//! (RK4, 2,760 steps, 1,344 triangles) took 12.0 and 13.0 s against 7.5 and
-//! 7.8 s with fixed shares (the two builds interleaved in one sitting, with
-//! another build running alongside).
+//! The cost is the sparse solve between the angles and the forces at every
+//! force evaluation (the angles and their gradients are computed once and
+//! kept for the forces), which weighs most on explicit integrators (four
+//! evaluations per RK4 step): `scenes/flag.toml` for 1 s (RK4, 2,760 steps,
+//! 1,344 triangles) took 11.0 and 10.0 s against 7.5 and 7.8 s with fixed
+//! shares (measured in two sittings with another build running alongside;
+//! the fixed shares' pair and this pair each interleaved with the same
+//! third build, which took 12.0 / 13.0 and 13.8 / 14.9 s in them).
 //!
 //! Measured (`tests/integration/elastica_irregular.rs`, chord angle against
 //! the elastica): free vertices moved by up to 0.4 of a cell -0.22 / -0.32 /
