@@ -84,6 +84,28 @@ pub fn splits_at(el: &Elements, x: &[Vector]) -> Vec<Scalar> {
     splits
 }
 
+/// Into `folds`, `gradients` and `splits`: each shape triangle's folds at
+/// `x` and their gradients by slot, then the splits that minimise the
+/// bending energy for them (`shape.rs`, "Splitting the folds").
+pub fn fold_angles_and_splits(
+    el: &Elements,
+    x: &[Vector],
+    folds: &mut Vec<[Scalar; 3]>,
+    gradients: &mut Vec<ShapeJacobian>,
+    splits: &mut Vec<Scalar>,
+) {
+    let shapes = el.shape_triangles.len();
+    folds.resize(shapes, [0.0; 3]);
+    gradients.resize(shapes, [[Vector::ZERO; SHAPE_SLOTS]; 3]);
+    folds
+        .par_iter_mut()
+        .zip(gradients.par_iter_mut())
+        .zip(el.shape_triangles.par_iter())
+        .with_min_len(PAR_MIN / SHAPE_SLOTS)
+        .for_each(|((folds, jac), t)| (*folds, *jac) = t.angles(x));
+    el.fold_splits.solve(&el.shape_triangles, folds, splits);
+}
+
 /// Into `folds` and `splits`: each shape triangle's folds at `x` and the
 /// splits that minimise the bending energy for them (`shape.rs`, "Splitting
 /// the folds").
@@ -173,20 +195,13 @@ pub fn element_pass(
     scratch
         .shape
         .resize(SHAPE_SLOTS * el.shape_triangles.len(), Vector::ZERO);
-    let shapes = el.shape_triangles.len();
-    scratch.folds.resize(shapes, [0.0; 3]);
-    scratch
-        .fold_gradients
-        .resize(shapes, [[Vector::ZERO; SHAPE_SLOTS]; 3]);
-    scratch
-        .folds
-        .par_iter_mut()
-        .zip(scratch.fold_gradients.par_iter_mut())
-        .zip(el.shape_triangles.par_iter())
-        .with_min_len(PAR_MIN / SHAPE_SLOTS)
-        .for_each(|((folds, jac), t)| (*folds, *jac) = t.angles(x));
-    el.fold_splits
-        .solve(&el.shape_triangles, &scratch.folds, &mut scratch.splits);
+    fold_angles_and_splits(
+        el,
+        x,
+        &mut scratch.folds,
+        &mut scratch.fold_gradients,
+        &mut scratch.splits,
+    );
     let (folds, jacs, splits) = (&scratch.folds, &scratch.fold_gradients, &scratch.splits);
     scratch
         .shape

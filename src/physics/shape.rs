@@ -127,11 +127,7 @@
 //! The cost is the sparse solve between the angles and the forces at every
 //! force evaluation (the angles and their gradients are computed once and
 //! kept for the forces), which weighs most on explicit integrators (four
-//! evaluations per RK4 step): `scenes/flag.toml` for 1 s (RK4, 2,760 steps,
-//! 1,344 triangles) took 11.0 and 10.0 s against 7.5 and 7.8 s with fixed
-//! shares (measured in two sittings with another build running alongside;
-//! the fixed shares' pair and this pair each interleaved with the same
-//! third build, which took 12.0 / 13.0 and 13.8 / 14.9 s in them).
+//! evaluations per RK4 step). It has not been timed on a quiet machine.
 //!
 //! Measured (`tests/integration/elastica_irregular.rs`, chord angle against
 //! the elastica): free vertices moved by up to 0.4 of a cell -0.22 / -0.32 /

@@ -227,7 +227,7 @@ pub fn solve(
                 }
             }
             let rhs: Vec<Scalar> = order.iter().flat_map(|&i| f[i].to_array()).collect();
-            let rhs = newton_direction(el, x, &order, &rank, &unfactored, &k, &rhs);
+            let rhs = newton_direction(el, x, &rank, &unfactored, &k, &rhs);
             let dx: Vec<Vector> = (0..n)
                 .map(|i| match rank[i] {
                     usize::MAX => Vector::ZERO,
@@ -275,7 +275,6 @@ pub fn solve(
 fn newton_direction(
     el: &Elements,
     x: &[Vector],
-    order: &[usize],
     rank: &[usize],
     unfactored: &Envelope,
     k: &Envelope,
@@ -318,7 +317,6 @@ fn newton_direction(
         y
     };
     let dot = |a: &[Scalar], b: &[Scalar]| a.iter().zip(b).map(|(x, y)| x * y).sum::<Scalar>();
-    let _ = order;
     let mut r: Vec<Scalar> = f.iter().zip(apply(&dx)).map(|(b, a)| b - a).collect();
     let mut z = r.clone();
     k.solve(&mut z);

@@ -7,7 +7,7 @@ use rayon::prelude::*;
 
 use super::super::bending::dihedral_angle_and_gradient;
 use super::super::elements::Elements;
-use super::super::forces::{PAR_MIN, spring_force, wind_share};
+use super::super::forces::{PAR_MIN, fold_angles_and_splits, spring_force, wind_share};
 use super::super::membrane::{ColumnBlocks, MEMBRANE_SLOTS};
 use super::super::shape::{SHAPE_SLOTS, rates, spread};
 use super::super::{ExternalForces, Model, Stepper};
@@ -126,17 +126,13 @@ fn shape_triangles(
     s.h2 = h * h;
     let shapes = el.shape_triangles.len();
     s.shape_slot.resize(SHAPE_SLOTS * shapes, Vector::ZERO);
-    s.shape_grad
-        .resize(shapes, [[Vector::ZERO; SHAPE_SLOTS]; 3]);
-    s.shape_folds.resize(shapes, [0.0; 3]);
-    s.shape_folds
-        .par_iter_mut()
-        .zip(s.shape_grad.par_iter_mut())
-        .zip(el.shape_triangles.par_iter())
-        .with_min_len(PAR_MIN / SHAPE_SLOTS)
-        .for_each(|((folds, grad), t)| (*folds, *grad) = t.angles(x));
-    el.fold_splits
-        .solve(&el.shape_triangles, &s.shape_folds, &mut s.shape_splits);
+    fold_angles_and_splits(
+        el,
+        x,
+        &mut s.shape_folds,
+        &mut s.shape_grad,
+        &mut s.shape_splits,
+    );
     let (folds, splits) = (&s.shape_folds, &s.shape_splits);
     s.shape_slot
         .par_chunks_exact_mut(SHAPE_SLOTS)
