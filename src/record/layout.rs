@@ -1,17 +1,15 @@
 //! The default blueprint sent with every recording: two 3D views (refinement levels, dihedral
 //! angles) above the event log, beside a column of plots.
 
-use rerun::blueprint::components::PanelState;
 use std::fmt::Write as _;
 
-use rerun::blueprint::{
-    Blueprint, BlueprintActivation, BlueprintPanel, ContainerLike, Horizontal, SelectionPanel,
-    Spatial3DView, TextDocumentView, TextLogView, TimePanel, TimeSeriesView, Vertical,
-};
 use rerun::{RecordingStream, RecordingStreamError};
 
+use super::blueprint::{self, Node, ViewSpec};
 use super::edges::ANGLE_STOPS;
-use super::{ENTITY_EDGES, ENTITY_EVENT_LOG, ENTITY_LEGEND, ENTITY_PLOTS, LEVEL_PALETTE};
+use super::{
+    ENTITY_EDGES, ENTITY_EVENT_LOG, ENTITY_LEGEND, ENTITY_MESH, ENTITY_PLOTS, LEVEL_PALETTE,
+};
 
 /// Names of the palette colours, in [`LEVEL_PALETTE`] order.
 const LEVEL_NAMES: [&str; 8] = [
@@ -57,70 +55,76 @@ pub(super) fn legend_markdown() -> String {
 /// - right: one time-series view per top-level plot group (the first segment of the scalar
 ///   names, alphabetically).
 ///
+/// The eyes of both 3D views follow the cloth (`cloth/mesh` and `cloth/edges`), so the cloth
+/// stays framed while a body carries it or a pin drags it away; the user can still orbit and
+/// zoom, and untrack in the view's settings.
+///
 /// The blueprint and selection panels start collapsed and the time panel collapsed to its
 /// play controls, so the views get the window; all can be reopened in the viewer.
-///
-/// rerun 0.36.3's `Blueprint::send` builds an internal stream that honours `RERUN=off` and then
-/// panics on its empty output, so the blueprint is skipped in that case.
 pub(super) fn send_blueprint(
     stream: &RecordingStream,
     scalar_names: &[&str],
 ) -> Result<(), RecordingStreamError> {
-    if !rerun::decide_logging_enabled(true) {
-        return Ok(());
-    }
     let mut groups: Vec<&str> = scalar_names
         .iter()
         .filter_map(|name| name.split('/').find(|s| !s.is_empty()))
         .collect();
     groups.sort_unstable();
     groups.dedup();
-    let cloth: ContainerLike = Spatial3DView::new("cloth")
-        .with_origin("/")
-        .with_contents([
+    let view = |class, name: &str, origin: &str, contents: Vec<String>, tracking: Option<&str>| {
+        Node::View(ViewSpec {
+            class,
+            name: name.to_owned(),
+            origin: origin.to_owned(),
+            contents,
+            tracking: tracking.map(|t| format!("/{t}")),
+        })
+    };
+    let cloth = view(
+        "3D",
+        "cloth",
+        "/",
+        vec![
             "+ /**".to_owned(),
             format!("- /{ENTITY_EDGES}"),
             format!("- /{ENTITY_LEGEND}"),
-        ])
-        .into();
-    let angles: ContainerLike = Spatial3DView::new("angles")
-        .with_origin("/")
-        .with_contents([
+        ],
+        Some(ENTITY_MESH),
+    );
+    let angles = view(
+        "3D",
+        "angles",
+        "/",
+        vec![
             format!("+ /{ENTITY_EDGES}"),
             "+ /events/points".to_owned(),
             "+ /obstacles/**".to_owned(),
-        ])
-        .into();
-    let log: ContainerLike = TextLogView::new("events")
-        .with_origin(ENTITY_EVENT_LOG)
-        .into();
-    let legend: ContainerLike = TextDocumentView::new("legend")
-        .with_origin(ENTITY_LEGEND)
-        .into();
-    let bottom: ContainerLike = Horizontal::new([log, legend])
-        .with_column_shares([3.0_f32, 1.0])
-        .into();
-    let scenes: ContainerLike = Vertical::new([Horizontal::new([cloth, angles]).into(), bottom])
-        .with_row_shares([3.0_f32, 1.0])
-        .into();
-    let plots = groups.iter().map(|g| {
-        TimeSeriesView::new(*g)
-            .with_origin(format!("{ENTITY_PLOTS}/{g}"))
-            .into()
-    });
-    let root: ContainerLike = Horizontal::new([scenes, Vertical::new(plots).into()])
-        .with_column_shares([2.0_f32, 1.0])
-        .into();
-    Blueprint::new(root)
-        .with_auto_views(false)
-        .with_blueprint_panel(BlueprintPanel::from_state(PanelState::Collapsed))
-        .with_selection_panel(SelectionPanel::from_state(PanelState::Collapsed))
-        .with_time_panel(TimePanel::new().with_state(PanelState::Collapsed))
-        .send(
-            stream,
-            BlueprintActivation {
-                make_active: true,
-                make_default: true,
-            },
-        )
+        ],
+        Some(ENTITY_EDGES),
+    );
+    let log = view("TextLog", "events", ENTITY_EVENT_LOG, Vec::new(), None);
+    let legend = view("TextDocument", "legend", ENTITY_LEGEND, Vec::new(), None);
+    let bottom = Node::Horizontal(vec![log, legend], vec![3.0, 1.0]);
+    let scenes = Node::Vertical(
+        vec![
+            Node::Horizontal(vec![cloth, angles], vec![1.0, 1.0]),
+            bottom,
+        ],
+        vec![3.0, 1.0],
+    );
+    let plots = groups
+        .iter()
+        .map(|g| {
+            view(
+                "TimeSeries",
+                g,
+                &format!("{ENTITY_PLOTS}/{g}"),
+                Vec::new(),
+                None,
+            )
+        })
+        .collect::<Vec<_>>();
+    let shares = vec![1.0; plots.len()];
+    let root = Node::Horizontal(vec![scenes, Node::Vertical(plots, shares)], vec![2.0, 1.0]);
+    blueprint::send(stream, &root)
 }

@@ -30,13 +30,12 @@
 //! - a default blueprint, sent with the first frame once the plot names are known (`layout.rs`).
 //!
 //! The recording is forced on: `RERUN=off` in the environment does not disable it (the builder
-//! uses `enabled(true)`, which rerun documents as ignoring the `RERUN` variable). One
-//! exception, a rerun 0.36.3 limitation: rerun builds the blueprint in a second, internal
-//! stream that does honour `RERUN=off` (and then panics on the empty result), so under
-//! `RERUN=off` the blueprint is left out and the viewer falls back to its automatic layout.
+//! uses `enabled(true)`, which rerun documents as ignoring the `RERUN` variable), and so is
+//! the blueprint's own in-memory stream (`blueprint.rs`).
 //! Rerun's private test variable `_RERUN_TEST_FORCE_SAVE` redirects every stream to its own
 //! path; do not set it.
 
+mod blueprint;
 mod convert;
 pub mod decode;
 pub mod edges;

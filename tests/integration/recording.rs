@@ -130,6 +130,9 @@ pub(crate) struct Decoded {
     mesh_timelines: std::collections::BTreeSet<String>,
     recording_ids: std::collections::BTreeSet<String>,
     blueprint_msgs: usize,
+    /// The entity paths the blueprint's 3D eyes track (the arrow text of each
+    /// `EyeControls3D:tracking_entity` column).
+    tracked: Vec<String>,
 }
 
 /// Decodes a `.rrd` file (panics if it does not decode); also used by the CLI tests.
@@ -142,6 +145,13 @@ pub(crate) fn decode(path: &std::path::Path) -> Decoded {
         let store = msg.store_id().clone();
         if store.kind() != rerun::StoreKind::Recording {
             out.blueprint_msgs += 1;
+            if let LogMsg::ArrowMsg(_, arrow) = &msg {
+                let chunk = Chunk::from_arrow_msg(arrow).expect("blueprint chunk");
+                let id = "EyeControls3D:tracking_entity".into();
+                if let Some(array) = chunk.raw_component_array(id) {
+                    out.tracked.push(format!("{array:?}"));
+                }
+            }
             continue;
         }
         out.recording_ids.insert(store.recording_id().to_string());
@@ -193,9 +203,14 @@ fn three_frames_decode_to_three_mesh_rows() {
     assert!(d.rows.contains_key("/cloth"), "annotation context");
     let id = drape::record::recording_id("two-triangles");
     assert_eq!(d.recording_ids.iter().collect::<Vec<_>>(), vec![&id]);
-    if rerun::decide_logging_enabled(true) {
-        assert!(d.blueprint_msgs > 0, "default blueprint sent");
-    }
+    // The blueprint is sent even under `RERUN=off` (see the test below), and both 3D
+    // views' eyes follow the cloth.
+    assert!(d.blueprint_msgs > 0, "default blueprint sent");
+    let mut tracked = d.tracked.clone();
+    tracked.sort();
+    assert_eq!(tracked.len(), 2, "tracked {tracked:?}");
+    assert!(tracked[0].contains("\"/cloth/edges\""), "{tracked:?}");
+    assert!(tracked[1].contains("\"/cloth/mesh\""), "{tracked:?}");
     std::fs::remove_file(&path).ok();
 }
 
