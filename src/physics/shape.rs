@@ -120,9 +120,8 @@
 //! sparse form). The step's forces are exact; the Newton iterations converge
 //! to the same state.
 //!
-//! Boundary edges keep no split (their triangle takes no angle there, as
-//! below), and neither do clamp edges (the free triangle takes the whole
-//! fold, as above).
+//! Clamp edges keep no split (the free triangle takes the whole fold, as
+//! above); free edges of the cloth have one of their own (below).
 //!
 //! The cost is the sparse solve between the angles and the forces at every
 //! force evaluation (the angles and their gradients are computed once and
@@ -130,14 +129,13 @@
 //! evaluations per RK4 step). It has not been timed on a quiet machine.
 //!
 //! Measured (`tests/integration/elastica_irregular.rs`, chord angle against
-//! the elastica): free vertices moved by up to 0.4 of a cell -0.22 / -0.32 /
-//! -0.26 deg at resolutions 16 / 32 / 64 (fixed shares: -1.56 / -2.73 at 16
-//! / 32); a constrained Delaunay strip -0.22 / -0.10 / -0.05 deg; red-green
-//! refinement from either at resolution 8 -0.53 / -0.47 deg; half-cell
-//! shifted rows -0.52 / -0.18 / -0.08 deg (fixed shares -1.34 / -0.61 /
-//! -0.30); regular grids +0.16 / +0.04 / +0.01 deg (fixed shares +0.12 /
-//! +0.03 / +0.01). Small deflection on the irregular strips: tip drop within
-//! 1.2 % of the elastica at 16 and 32. Red-green transitions two levels deep
+//! the elastica, free edges' parts free, below): free vertices moved by up
+//! to 0.4 of a cell +0.12 / -0.07 / -0.13 deg at resolutions 16 / 32 / 64
+//! (fixed shares: -1.56 / -2.73 at 16 / 32); a constrained Delaunay strip
+//! -0.07 / +0.01 / +0.01 deg; adapted from either at resolution 8,
+//! red-green +0.10 / +0.08 deg and the edge method -0.41 / -0.14 deg. Small
+//! deflection on the irregular strips: tip drop within 0.5 % of the
+//! elastica at 16 and 32. Red-green transitions two levels deep
 //! store the unrefined sheet's energy to 0.0006 for constant curvatures
 //! (test `second_level_transitions_bend_like_the_unrefined_sheet`).
 //!
@@ -149,24 +147,25 @@
 //! settled 0.93 deg soft of the elastica, against 0.04 with fixed shares, and
 //! a strip of 4:1 cells 0.21 deg soft. Morley's element converges only on
 //! shape-regular meshes. So an edge takes a split only when both its
-//! triangles have every corner at least [`SPLIT_MIN_ANGLE_DEG`] (15 deg):
+//! triangles (a free edge: its one) have every corner at least
+//! [`SPLIT_MIN_ANGLE_DEG`] (15 deg):
 //! the 4:1 cells' 14 deg corners keep fixed shares (exact there, for bends
 //! along the cells), red-green's green closures (18.4 deg) take splits. The
 //! limit was chosen between those two measured cases (20 deg left the greens
 //! with fixed shares, 6 to 10 % stiff on transitions).
 //!
-//! The edge method adapted from the irregular strips settles 1.8 to 2.9 deg
-//! stiff of the elastica (test
-//! `edge_adapted_irregular_strips_bend_stiffer_than_the_elastica`), and the
-//! cause is not this limit: any limit from 5 to 15 deg gives the same angle
-//! to 1e-4 deg, a constant curvature on those adapted strips stores the
-//! continuum's energy to 1 %, and a softer or stiffer membrane (stretch
-//! 10 to 1e5 N/m) moves the angle only between -2.6 and -4.0 deg.
-//!
-//! Boundary edges have no angle, so an imposed curvature across a free edge loses
-//! the outer half row of triangles' share (the `1 - 1/n` of the cylinder test).
-//! At a free edge the plate's natural boundary condition is zero moment, so a
-//! settled sheet has no curvature across it there, and no energy is lost.
+//! # Free edges
+//! A free edge of the cloth has no fold, and Morley's element leaves its
+//! midpoint slope free: the edge has a split unknown of its own, the one
+//! triangle's whole part (`share` zero), which the minimisation sets to the
+//! plate's natural boundary condition. Held at zero instead, it forces the
+//! triangle's curvature into the span of its other two edges' `n n^T`: a
+//! triangle whose longest edge lies on a free side (the edge method's
+//! bisections make them) cannot then bend along that side without bending
+//! across it as much, and the strip is too stiff. Measured on the
+//! cantilever adapted by the edge method from resolution 8: -2.31 deg from
+//! a regular grid, -2.93 / -1.79 deg from the jittered / Delaunay strips
+//! with the part held at zero; -0.65 / -0.41 / -0.14 deg with it free.
 
 mod build;
 mod split;

@@ -90,8 +90,11 @@ pub(crate) fn build_shape_triangles_into(
             .filter(|(t, _)| **t != crate::mesh::NO_TRIANGLE && !held(**t as usize))
             .map(|(t, sign)| (*t as usize, sign))
             .collect();
-        // Both sides free and neither triangle thin (module docs, "Thin triangles").
-        let split = free.len() == 2
+        // Both sides free, or a free edge of the cloth (its one triangle's part is
+        // a free unknown: module docs, "Free edges"), and no triangle thin
+        // (module docs, "Thin triangles").
+        let free_edge = free.len() == 1 && e.triangles.contains(&crate::mesh::NO_TRIANGLE);
+        let split = (free.len() == 2 || free_edge)
             && free
                 .iter()
                 .all(|&(t, _)| min_angle(mesh, t) >= SPLIT_MIN_ANGLE_DEG);
