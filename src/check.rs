@@ -5,8 +5,8 @@ use std::fmt::Write;
 use crate::adapt::AdaptConfig;
 use crate::collide::{Collider, Obstacles};
 use crate::physics::timestep::fit_to_frame;
-use crate::pins::PinPath;
 use crate::physics::{Elements, ExternalForces, MaterialParams, Membrane, Model, Stepper};
+use crate::pins::PinPath;
 use crate::run::RunError;
 use crate::scene::{
     AdaptCriterion, AdaptMethod, BendingModel, ClothShape, Integrator, PinMotion, Scene,

@@ -112,10 +112,8 @@ impl PinScript {
         let v = Vector::from_array;
         let path = match (&pin.attach, pin.motion) {
             (Some(attach), _) => PinPath::Attached(
-                Carrier::new(obstacles, attach).map_err(|source| PinError::Attach {
-                    pin: p,
-                    source,
-                })?,
+                Carrier::new(obstacles, attach)
+                    .map_err(|source| PinError::Attach { pin: p, source })?,
             ),
             (None, PinMotion::Fixed) => PinPath::Fixed,
             (None, PinMotion::Linear) => PinPath::Linear {

@@ -53,9 +53,7 @@ pub(crate) fn allowed(path: &str) -> Option<&'static str> {
         "pin.box_min" | "pin.box_max" => {
             "an array of 2 finite numbers (material coordinates, m), box_min < box_max"
         }
-        "pin.motion" => {
-            "\"fixed\", \"linear\", \"circular\" or \"keyframed\" (not with `attach`)"
-        }
+        "pin.motion" => "\"fixed\", \"linear\", \"circular\" or \"keyframed\" (not with `attach`)",
         "pin.attach" => {
             "the `name` of an [[obstacle]] that is not a mesh_sequence (\"NAME\"), or \"NAME/PART\" for a part of an articulated one"
         }

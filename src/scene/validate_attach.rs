@@ -34,7 +34,9 @@ pub(super) fn obstacle_names(obstacles: &[Obstacle]) -> Result<(), Issue> {
         let why = if name.trim().is_empty() {
             "the obstacle's name is empty".to_owned()
         } else if name.contains('/') {
-            format!("`{name}` contains `/`, which separates an obstacle from its part in a pin's `attach`")
+            format!(
+                "`{name}` contains `/`, which separates an obstacle from its part in a pin's `attach`"
+            )
         } else if let Some(m) = obstacles[..i]
             .iter()
             .position(|q| q.name.as_deref() == Some(name))
@@ -60,7 +62,9 @@ pub(super) fn pin_keys(
         let why = if k == "motion" {
             "`motion` and `attach` both say how the pin moves: give one of them".to_owned()
         } else {
-            format!("`{k}` does not apply to a pin with `attach`: the body it is attached to moves it")
+            format!(
+                "`{k}` does not apply to a pin with `attach`: the body it is attached to moves it"
+            )
         };
         return Err(Issue::new(at(k), Kind::NotApplicable, why)
             .allowed("remove it, or remove `attach` and give the pin its own motion")

@@ -156,7 +156,8 @@ fn a_generated_grid_has_vertices_on_the_edges_of_a_box_pin() {
 fn a_grid_fitted_to_a_pin_box_refines_by_tensor_lines() {
     let edge = -0.0713;
     let cloth = rectangle(1.0, 0.5, 8);
-    let mut w = World::from_spec(&cloth, &[box_pin([-1.0, -1.0], [edge, 1.0])], &[]).expect("world");
+    let mut w =
+        World::from_spec(&cloth, &[box_pin([-1.0, -1.0], [edge, 1.0])], &[]).expect("world");
     // Bent about the v axis beyond the clamp's edge.
     let r = 0.2;
     w.x = w
