@@ -15,7 +15,7 @@ pub struct Pin {
     pub box_min: Option<[f64; 2]>,
     /// Upper corner of a `box` region in material coordinates (m).
     pub box_max: Option<[f64; 2]>,
-    /// How the pinned vertices move.
+    /// How the pinned vertices move (without `attach`).
     #[serde(default)]
     pub motion: PinMotion,
     /// Velocity in m/s for `linear` motion.
