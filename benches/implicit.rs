@@ -61,6 +61,7 @@ fn corner(region: &str) -> Pin {
         keyframes: Vec::new(),
         easing: Default::default(),
         after_last: Default::default(),
+        attach: None,
     }
 }
 

@@ -6,6 +6,7 @@ use crate::adapt::AdaptConfig;
 use crate::collide::{Collider, Obstacles};
 use crate::physics::timestep::fit_to_frame;
 use crate::physics::{Elements, ExternalForces, MaterialParams, Membrane, Model, Stepper};
+use crate::pins::PinPath;
 use crate::run::RunError;
 use crate::scene::{
     AdaptCriterion, AdaptMethod, BendingModel, ClothShape, Integrator, PinMotion, Scene,
@@ -411,29 +412,11 @@ fn describe_pins(s: &mut String, scene: &Scene, world: &World) {
             .iter()
             .filter(|a| a.pin as usize == p)
             .count();
-        let motion = match pin.motion {
-            PinMotion::Fixed => "fixed".to_string(),
-            PinMotion::Linear => format!(
-                "linear, v {:?} m/s, a {:?} m/s^2",
-                pin.velocity, pin.acceleration
-            ),
-            PinMotion::Circular => {
-                format!(
-                    "circular about {:?} through {:?} at {} rad/s",
-                    pin.axis, pin.center, pin.angular_velocity
-                )
-            }
-            PinMotion::Keyframed => format!(
-                "keyframed: {} keys from {} s to {} s about {:?}, {:?} easing, then {:?}",
-                pin.keyframes.len(),
-                pin.keyframes.first().map_or(0.0, |k| k.time),
-                pin.keyframes.last().map_or(0.0, |k| k.time),
-                pin.center,
-                pin.easing,
-                pin.after_last
-            )
-            .to_lowercase(),
-        };
+        let carrier = world.pins.scripts.get(p).and_then(|s| match &s.path {
+            PinPath::Attached(c) => Some(c.describe()),
+            _ => None,
+        });
+        let motion = carrier.unwrap_or_else(|| pin_motion(pin));
         let release = pin
             .release_time
             .map(|t| format!(", released at {t} s"))
@@ -446,5 +429,32 @@ fn describe_pins(s: &mut String, scene: &Scene, world: &World) {
     }
     for m in crate::pins::mismatches(&scene.pin, &world.mesh) {
         let _ = writeln!(s, "  differs from the scene: {}", m.describe());
+    }
+}
+
+/// A pin's own `motion`, in words.
+fn pin_motion(pin: &crate::scene::Pin) -> String {
+    match pin.motion {
+        PinMotion::Fixed => "fixed".to_string(),
+        PinMotion::Linear => format!(
+            "linear, v {:?} m/s, a {:?} m/s^2",
+            pin.velocity, pin.acceleration
+        ),
+        PinMotion::Circular => {
+            format!(
+                "circular about {:?} through {:?} at {} rad/s",
+                pin.axis, pin.center, pin.angular_velocity
+            )
+        }
+        PinMotion::Keyframed => format!(
+            "keyframed: {} keys from {} s to {} s about {:?}, {:?} easing, then {:?}",
+            pin.keyframes.len(),
+            pin.keyframes.first().map_or(0.0, |k| k.time),
+            pin.keyframes.last().map_or(0.0, |k| k.time),
+            pin.center,
+            pin.easing,
+            pin.after_last
+        )
+        .to_lowercase(),
     }
 }

@@ -1,14 +1,16 @@
 //! Pinned vertices: selected by named region in material space (so a selection
-//! means the same cloth points on any mesh) and moved by a script.
+//! means the same cloth points on any mesh) and moved by a script, or carried
+//! by an obstacle or a part of one (`attach`, `crate::collide::carrier`).
 
 mod coverage;
 
 pub use coverage::{PinMismatch, mismatches};
 
+use crate::collide::carrier::{AttachError, Carrier};
 use crate::collide::motion::Track;
 use crate::math::{Matrix3, Scalar, Vector, Vector2};
 use crate::mesh::{GridCuts, Mesh};
-use crate::spec::{Pin, PinMotion};
+use crate::spec::{Obstacle, Pin, PinMotion};
 
 /// The edges of the `box` regions of `pins`: the lines a generated grid needs
 /// so that each box holds exactly the cloth inside it. Other regions (and
@@ -43,6 +45,15 @@ pub enum PinError {
         /// Pin index.
         pin: usize,
     },
+    /// `attach` names nothing that can carry pins (validation normally
+    /// catches this first, with the line).
+    #[error("pin {pin}: attach: {source}")]
+    Attach {
+        /// Pin index.
+        pin: usize,
+        /// What is wrong.
+        source: AttachError,
+    },
     /// The region contains no vertex of the mesh.
     #[error("pin {pin}: region `{region}` contains no vertex of the cloth")]
     Empty {
@@ -53,54 +64,114 @@ pub enum PinError {
     },
 }
 
+/// How the vertices of one `[[pin]]` move.
+#[derive(Debug, Clone, PartialEq)]
+pub enum PinPath {
+    /// Held in place.
+    Fixed,
+    /// `x(t) = x0 + velocity t + acceleration t^2 / 2`.
+    Linear {
+        /// m/s.
+        velocity: Vector,
+        /// m/s^2.
+        acceleration: Vector,
+    },
+    /// Turned about `axis` through `center` at `angular_velocity`.
+    Circular {
+        /// A point on the rotation axis, m.
+        center: Vector,
+        /// Unit rotation axis.
+        axis: Vector,
+        /// rad/s, right-handed about `axis`.
+        angular_velocity: Scalar,
+    },
+    /// Moved by the keys' translations and turned by their rotations about
+    /// `center` (which moves with the translation).
+    Keyframed {
+        /// The point the rotations turn about at t = 0, m.
+        center: Vector,
+        /// The keys (validated: at least two).
+        track: Track,
+    },
+    /// Carried by an obstacle or a part of one (`attach`).
+    Attached(Carrier),
+}
+
 /// The motion script of one `[[pin]]`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PinScript {
-    /// Kind of motion.
-    pub motion: PinMotion,
-    /// Linear velocity, m/s.
-    pub velocity: Vector,
-    /// Linear acceleration, m/s^2.
-    pub acceleration: Vector,
-    /// Point on the rotation axis, m.
-    pub center: Vector,
-    /// Unit rotation axis.
-    pub axis: Vector,
-    /// Angular velocity, rad/s.
-    pub angular_velocity: Scalar,
+    /// How the held vertices move.
+    pub path: PinPath,
     /// Time at which the pin lets go, s.
     pub release_time: Option<Scalar>,
-    /// The keyframes of a `keyframed` pin (validated: at least two); `None`
-    /// for the other motions.
-    pub track: Option<Track>,
 }
 
 impl PinScript {
+    /// The script of `pin`, whose `attach` (if any) names one of `obstacles`.
+    fn new(p: usize, pin: &Pin, obstacles: &[Obstacle]) -> Result<PinScript, PinError> {
+        let v = Vector::from_array;
+        let path = match (&pin.attach, pin.motion) {
+            (Some(attach), _) => PinPath::Attached(
+                Carrier::new(obstacles, attach)
+                    .map_err(|source| PinError::Attach { pin: p, source })?,
+            ),
+            (None, PinMotion::Fixed) => PinPath::Fixed,
+            (None, PinMotion::Linear) => PinPath::Linear {
+                velocity: v(pin.velocity),
+                acceleration: v(pin.acceleration),
+            },
+            (None, PinMotion::Circular) => PinPath::Circular {
+                center: v(pin.center),
+                axis: v(pin.axis).normalize_or_zero(),
+                angular_velocity: pin.angular_velocity,
+            },
+            (None, PinMotion::Keyframed) => PinPath::Keyframed {
+                center: v(pin.center),
+                track: Track::new(&pin.keyframes, pin.easing, pin.after_last),
+            },
+        };
+        Ok(PinScript {
+            path,
+            release_time: pin.release_time,
+        })
+    }
+
     /// Position and velocity at time `t` of a point that was at `start` at t = 0.
     pub fn at(&self, start: Vector, t: Scalar) -> (Vector, Vector) {
-        match self.motion {
-            PinMotion::Fixed => (start, Vector::ZERO),
-            PinMotion::Linear => (
-                start + self.velocity * t + self.acceleration * (0.5 * t * t),
-                self.velocity + self.acceleration * t,
+        match &self.path {
+            PinPath::Fixed => (start, Vector::ZERO),
+            PinPath::Linear {
+                velocity,
+                acceleration,
+            } => (
+                start + *velocity * t + *acceleration * (0.5 * t * t),
+                *velocity + *acceleration * t,
             ),
-            PinMotion::Circular => {
-                let r = Matrix3::from_axis_angle(self.axis, self.angular_velocity * t);
-                let p = self.center + r * (start - self.center);
-                (
-                    p,
-                    (self.axis * self.angular_velocity).cross(p - self.center),
-                )
+            &PinPath::Circular {
+                center,
+                axis,
+                angular_velocity,
+            } => {
+                let r = Matrix3::from_axis_angle(axis, angular_velocity * t);
+                let p = center + r * (start - center);
+                (p, (axis * angular_velocity).cross(p - center))
             }
-            PinMotion::Keyframed => {
-                let Some(track) = &self.track else {
-                    unreachable!("`Pins::select` builds a track for every keyframed pin")
-                };
+            PinPath::Keyframed { center, track } => {
                 let s = track.state(t);
-                let centre = self.center + s.shift;
-                let p = centre + s.rotation * (start - self.center);
+                let centre = *center + s.shift;
+                let p = centre + s.rotation * (start - *center);
                 (p, s.velocity + s.omega.cross(p - centre))
             }
+            PinPath::Attached(carrier) => carrier.follow(start, t),
+        }
+    }
+
+    /// True when the held vertices move at some time.
+    pub fn moves(&self) -> bool {
+        match &self.path {
+            PinPath::Fixed => false,
+            PinPath::Attached(carrier) => carrier.is_moving(),
+            _ => true,
         }
     }
 
@@ -131,8 +202,20 @@ pub struct Pins {
 }
 
 impl Pins {
-    /// Selects each pin's vertices on `mesh` (world positions `x` at t = 0).
+    /// Selects each pin's vertices on `mesh` (world positions `x` at t = 0),
+    /// for a scene without obstacles (a pin with `attach` is refused).
     pub fn select(pins: &[Pin], mesh: &Mesh, x: &[Vector]) -> Result<Pins, PinError> {
+        Pins::select_among(pins, &[], mesh, x)
+    }
+
+    /// Selects each pin's vertices on `mesh` (world positions `x` at t = 0);
+    /// a pin's `attach` names one of `obstacles`.
+    pub fn select_among(
+        pins: &[Pin],
+        obstacles: &[Obstacle],
+        mesh: &Mesh,
+        x: &[Vector],
+    ) -> Result<Pins, PinError> {
         let (lo, hi) = mesh.material_bounds();
         let tol = 1e-9 * (hi - lo).max_element().max(Scalar::MIN_POSITIVE);
         let mut owner: Vec<Option<u32>> = vec![None; mesh.vertex_count()];
@@ -153,17 +236,7 @@ impl Pins {
             for i in chosen {
                 owner[i].get_or_insert(p as u32);
             }
-            scripts.push(PinScript {
-                motion: pin.motion,
-                velocity: Vector::from_array(pin.velocity),
-                acceleration: Vector::from_array(pin.acceleration),
-                center: Vector::from_array(pin.center),
-                axis: Vector::from_array(pin.axis).normalize_or_zero(),
-                angular_velocity: pin.angular_velocity,
-                release_time: pin.release_time,
-                track: (pin.motion == PinMotion::Keyframed)
-                    .then(|| Track::new(&pin.keyframes, pin.easing, pin.after_last)),
-            });
+            scripts.push(PinScript::new(p, pin, obstacles)?);
         }
         let anchors = owner
             .iter()

@@ -95,7 +95,7 @@ pub struct SimParts {
 /// is where a bad OBJ file or a pin that selects nothing is found, before any
 /// output is opened.
 pub fn build(spec: &SimSpec) -> Result<SimParts, SimBuildError> {
-    let world = World::from_spec(&spec.cloth, &spec.pins)?;
+    let world = World::from_spec(&spec.cloth, &spec.pins, &spec.obstacles)?;
     let adapter = spec
         .settings
         .adapt

@@ -9,7 +9,7 @@ use std::path::Path;
 use crate::math::{Scalar, Vector, rotation_from_euler_deg};
 use crate::mesh::{self, Mesh, MeshError, ObjError};
 use crate::pins::{PinError, Pins};
-use crate::spec::{ClothMesh, ClothSpec, Pin};
+use crate::spec::{ClothMesh, ClothSpec, Obstacle, Pin};
 
 /// Why a world could not be built from a scene.
 #[derive(Debug, thiserror::Error)]
@@ -56,9 +56,14 @@ impl World {
         }
     }
 
-    /// Builds the cloth and resolves its pins. A rectangle's grid has lines on
-    /// the edges of the box pin regions ([`mesh::fitted_lines`]).
-    pub fn from_spec(cloth: &ClothSpec, pins: &[Pin]) -> Result<World, BuildError> {
+    /// Builds the cloth and resolves its pins, whose `attach` names one of
+    /// `obstacles`. A rectangle's grid has lines on the edges of the box pin
+    /// regions ([`mesh::fitted_lines`]).
+    pub fn from_spec(
+        cloth: &ClothSpec,
+        pins: &[Pin],
+        obstacles: &[Obstacle],
+    ) -> Result<World, BuildError> {
         let (mesh, local): (Mesh, Vec<Vector>) = match &cloth.mesh {
             &ClothMesh::Rectangle {
                 width,
@@ -87,7 +92,7 @@ impl World {
         let rot = rotation_from_euler_deg(cloth.rotation);
         let origin = Vector::from_array(cloth.position);
         let x: Vec<Vector> = local.iter().map(|p| origin + rot * *p).collect();
-        let pins = Pins::select(pins, &mesh, &x)?;
+        let pins = Pins::select_among(pins, obstacles, &mesh, &x)?;
         let mut world = World::new(mesh, x);
         world.pins = pins;
         Ok(world)

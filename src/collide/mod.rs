@@ -31,6 +31,7 @@
 //! and every reduction is exact (integer sums, maxima), so results are the same at any
 //! thread count.
 
+pub mod carrier;
 pub mod cusick;
 pub mod deform;
 mod display;

@@ -79,6 +79,21 @@ pub struct RigidState {
     pub omega: Vector,
 }
 
+impl RigidState {
+    /// Where the body point at `rest` (world position with the body at rest)
+    /// is in this state, the body turning about its origin `origin` at rest.
+    pub fn place(&self, origin: Vector, rest: Vector) -> Vector {
+        origin + self.shift + self.rotation * (rest - origin)
+    }
+
+    /// Velocity of the body's material point at world position `x` in this
+    /// state (`origin`: the body's origin at rest): the same for contact,
+    /// friction and attached pins.
+    pub fn point_velocity(&self, origin: Vector, x: Vector) -> Vector {
+        self.velocity + self.omega.cross(x - (origin + self.shift))
+    }
+}
+
 /// Keyframes ready to interpolate.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Track {

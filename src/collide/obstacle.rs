@@ -276,8 +276,7 @@ impl Body {
         if let Some(s) = &at.surface {
             return s.velocity_at(x);
         }
-        let state = self.motion.state(t);
-        state.velocity + state.omega.cross(x - (self.origin + state.shift))
+        self.motion.state(t).point_velocity(self.origin, x)
     }
 
     /// True when the shape is a plane (a half-space).
@@ -411,7 +410,7 @@ impl Body {
 
 /// The motion an obstacle's keys ask for: keyframes, else a constant velocity
 /// and spin about `axis` (normalised), else none.
-fn motion(o: &Obstacle, axis: Vector) -> Motion {
+pub(super) fn motion(o: &Obstacle, axis: Vector) -> Motion {
     if !o.keyframes.is_empty() {
         return Motion::Keyframed(Track::new(&o.keyframes, o.easing, o.after_last));
     }

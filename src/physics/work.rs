@@ -18,7 +18,6 @@ use rayon::prelude::*;
 use super::forces::{PAR_MIN, element_pass, gather, wind_share};
 use super::{Model, Stepper};
 use crate::math::{Scalar, Vector, deterministic_sum};
-use crate::spec::PinMotion;
 use crate::world::World;
 
 /// A held vertex of a moving pin at the start of a step.
@@ -64,7 +63,7 @@ impl Stepper {
             .iter()
             .filter(|a| {
                 let s = &pins.scripts[a.pin as usize];
-                s.motion != PinMotion::Fixed && s.holds_at(world.time)
+                s.moves() && s.holds_at(world.time)
             })
             .map(|a| a.vertex)
             .collect();

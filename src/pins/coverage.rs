@@ -285,6 +285,7 @@ mod tests {
             keyframes: Vec::new(),
             easing: Default::default(),
             after_last: Default::default(),
+            attach: None,
         }
     }
 

@@ -20,6 +20,7 @@ mod serde_errors;
 mod spans;
 mod validate;
 mod validate_adapt;
+mod validate_attach;
 mod validate_body;
 mod validate_collide;
 mod validate_material;

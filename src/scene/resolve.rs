@@ -74,7 +74,7 @@ pub fn cloth_spec(c: &Cloth) -> Result<ClothSpec, BuildError> {
 impl World {
     /// Builds the cloth of `scene` and resolves its pins.
     pub fn from_scene(scene: &Scene) -> Result<World, BuildError> {
-        World::from_spec(&cloth_spec(&scene.cloth)?, &scene.pin)
+        World::from_spec(&cloth_spec(&scene.cloth)?, &scene.pin, &scene.obstacle)
     }
 }
 

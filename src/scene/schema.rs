@@ -53,7 +53,10 @@ pub(crate) fn allowed(path: &str) -> Option<&'static str> {
         "pin.box_min" | "pin.box_max" => {
             "an array of 2 finite numbers (material coordinates, m), box_min < box_max"
         }
-        "pin.motion" => "\"fixed\", \"linear\", \"circular\" or \"keyframed\"",
+        "pin.motion" => "\"fixed\", \"linear\", \"circular\" or \"keyframed\" (not with `attach`)",
+        "pin.attach" => {
+            "the `name` of an [[obstacle]] that is not a mesh_sequence (\"NAME\"), or \"NAME/PART\" for a part of an articulated one"
+        }
         "pin.velocity" => "an array of 3 finite numbers (m/s)",
         "pin.acceleration" => "an array of 3 finite numbers (m/s^2)",
         "pin.center" => "an array of 3 finite numbers (m)",
@@ -75,6 +78,7 @@ pub(crate) fn allowed(path: &str) -> Option<&'static str> {
         "wind.velocity" => "an array of 3 finite numbers (m/s)",
         "wind.coefficient" => "a finite number >= 0",
         "obstacle" => "an array of tables [[obstacle]]",
+        "obstacle.name" => "a non-empty string without `/`, unique among the obstacles",
         "obstacle.shape" => {
             "\"sphere\", \"box\", \"plane\", \"capsule\", \"cylinder\", \"mesh\", \"mesh_sequence\" or \"articulated\""
         }

@@ -38,6 +38,10 @@ pub(crate) fn validate(scene: &Scene, doc: &Table) -> Result<(), Issue> {
         super::validate_motion::keyframes(i, o, written)?;
         super::validate_body::parts(i, o, written)?;
     }
+    super::validate_attach::obstacle_names(&scene.obstacle)?;
+    for (i, pin) in scene.pin.iter().enumerate() {
+        super::validate_attach::pin_target(i, pin, &scene.obstacle)?;
+    }
     if let Some(s) = &scene.self_collision {
         super::validate_collide::self_collision(s)?;
     }
@@ -298,6 +302,9 @@ fn check_pin(i: usize, p: &Pin, shape: ClothShape, written: Option<&Table>) -> R
     let at = |k: &str| vec![Seg::Key("pin".into()), Seg::Index(i), Seg::Key(k.into())];
     let has = |k: &str| written.is_some_and(|t| t.contains_key(k));
     check_pin_region(p, shape, &at, &has)?;
+    if p.attach.is_some() {
+        return super::validate_attach::pin_keys(p, &at, &has);
+    }
     check_pin_motion(p, &at, &has)
 }
 

@@ -29,7 +29,9 @@ pub(super) fn measure(scene: &Scene) -> Result<(), Issue> {
 /// Why the cantilever test cannot apply to `scene`: it needs a rectangle held
 /// over one end by fixed pins, under gravity alone.
 fn cantilever(scene: &Scene) -> Option<String> {
-    let fixed = |p: &super::Pin| p.motion == PinMotion::Fixed && p.release_time.is_none();
+    let fixed = |p: &super::Pin| {
+        p.motion == PinMotion::Fixed && p.attach.is_none() && p.release_time.is_none()
+    };
     let why = if scene.cloth.shape != ClothShape::Rectangle {
         "needs a rectangular strip (cloth.shape = \"rectangle\")"
     } else if scene.pin.is_empty() {

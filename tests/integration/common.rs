@@ -35,6 +35,7 @@ pub fn pin(region: &str) -> Pin {
         keyframes: Vec::new(),
         easing: Default::default(),
         after_last: Default::default(),
+        attach: None,
     }
 }
 

@@ -33,6 +33,7 @@ mod meshbody;
 mod metric;
 mod physics;
 mod pins;
+mod pins_attached;
 mod presets;
 mod recording;
 mod recording_run;

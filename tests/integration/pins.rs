@@ -109,7 +109,7 @@ fn a_clamp_box_between_grid_lines_clamps_at_its_edge_and_the_strip_follows_the_e
 #[test]
 fn a_generated_grid_has_vertices_on_the_edges_of_a_box_pin() {
     let (lo, hi) = ([-0.31, -0.2], [0.137, 0.6]);
-    let w = World::from_spec(&rectangle(1.0, 0.5, 16), &[box_pin(lo, hi)]).expect("world");
+    let w = World::from_spec(&rectangle(1.0, 0.5, 16), &[box_pin(lo, hi)], &[]).expect("world");
     let m = &w.mesh;
     let mut vs: Vec<Scalar> = m.material.iter().map(|p| p.y).collect();
     vs.sort_by(Scalar::total_cmp);
@@ -158,7 +158,8 @@ fn a_generated_grid_has_vertices_on_the_edges_of_a_box_pin() {
 fn a_grid_fitted_to_a_pin_box_refines_by_tensor_lines() {
     let edge = -0.0713;
     let cloth = rectangle(1.0, 0.5, 8);
-    let mut w = World::from_spec(&cloth, &[box_pin([-1.0, -1.0], [edge, 1.0])]).expect("world");
+    let mut w =
+        World::from_spec(&cloth, &[box_pin([-1.0, -1.0], [edge, 1.0])], &[]).expect("world");
     // Bent about the v axis beyond the clamp's edge.
     let r = 0.2;
     w.x = w
@@ -206,7 +207,7 @@ fn a_scene_whose_pins_are_on_grid_lines_keeps_its_uniform_mesh() {
         box_pin([-0.5, 0.125], [0.0, 0.25]),
         crate::common::pin("corner:top_left"),
     ];
-    let w = World::from_spec(&rectangle(1.0, 0.5, 16), &pins).expect("world");
+    let w = World::from_spec(&rectangle(1.0, 0.5, 16), &pins, &[]).expect("world");
     let uniform =
         mesh::rectangle(1.0, 0.5, 16, DiagonalPattern::Alternating).expect("uniform grid");
     assert_eq!(w.mesh.material, uniform.material);
