@@ -16,8 +16,41 @@
 
 use serde::Serialize;
 
+use super::Obstacles;
+use super::obstacle::Body;
 use crate::math::{Scalar, Vector};
 use crate::mesh::Mesh;
+use crate::spec::{ClothMesh, ClothSpec, ObstacleShape};
+use crate::world::World;
+
+impl Obstacles {
+    /// The Cusick drape measurements, when the cloth is a disk specimen lying on a
+    /// vertical cylinder (the support disk) centred under it.
+    pub fn cusick_of(&self, cloth: &ClothSpec, world: &World) -> Option<CusickSummary> {
+        let (top, specimen, disk) = self.cusick_support(cloth)?;
+        Some(measure(&world.mesh, &world.x, top, specimen, disk))
+    }
+
+    /// The support of a Cusick test: the top centre of the vertical cylinder
+    /// centred under the disk specimen `cloth`, the specimen's radius and the
+    /// support's (smaller) radius; `None` when the cloth is not such a specimen.
+    pub fn cusick_support(&self, cloth: &ClothSpec) -> Option<(Vector, Scalar, Scalar)> {
+        let ClothMesh::Disk {
+            radius: specimen, ..
+        } = cloth.mesh
+        else {
+            return None;
+        };
+        let centre = Vector::from_array(cloth.position);
+        let (top, disk) = self
+            .bodies
+            .iter()
+            .filter(|b| b.kind == ObstacleShape::Cylinder)
+            .find_map(Body::vertical_cylinder_top)?;
+        let off = (top - centre).truncate().length();
+        (off < 0.25 * disk && disk < specimen).then_some((top, specimen, disk))
+    }
+}
 
 /// Raster cells across the specimen's diameter.
 pub const GRID: usize = 600;

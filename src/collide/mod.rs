@@ -54,11 +54,11 @@ use serde::Serialize;
 use crate::adapt::proximity::ObstaclePlane;
 use crate::math::{Scalar, Vector};
 use crate::physics::Contact;
-use crate::spec::{ClothMesh, ClothSpec, Obstacle, ObstacleShape, SelfCollision};
+use crate::spec::{Obstacle, SelfCollision};
 use crate::world::World;
 use deform::At;
 use obstacle::Body;
-use response::{depth_below, push_out, respond};
+use response::{contact_work, depth_below, push_out, respond};
 use selfcol::SelfCollider;
 
 pub use display::{Drawn, ObstacleMesh, ObstaclePose};
@@ -245,6 +245,9 @@ pub struct Collider {
     poses: Vec<(At, At)>,
     /// Per-step scratch: per vertex, whether it touched an obstacle and the work done on it.
     hits: Vec<(u64, Scalar)>,
+    /// Per-step scratch of the last pass: per vertex, its depth below an obstacle
+    /// surface and the work done on it.
+    pushes: Vec<(Scalar, Scalar)>,
 }
 
 impl Collider {
@@ -261,6 +264,7 @@ impl Collider {
             t0: 0.0,
             poses: Vec::new(),
             hits: Vec::new(),
+            pushes: Vec::new(),
         })
     }
 
@@ -330,7 +334,7 @@ impl Collider {
         }
         let started = Instant::now();
         if !bodies.is_empty() {
-            let depth = self.final_obstacle_pass(bodies, world);
+            let depth = self.final_obstacle_pass(bodies, world, h, cloth.mass, stats);
             stats.max_penetration = stats.max_penetration.max(depth);
             stats.last_penetration = depth;
         }
@@ -374,14 +378,16 @@ impl Collider {
                 let push = pushed.get(i).copied().unwrap_or(0.0);
                 let mut work = 0.0;
                 for (b, pose) in bodies.iter().zip(poses) {
-                    let before = *v;
+                    let (xb, vb) = (*x, *v);
                     if let Some(c) = respond(b, pose, t1, h, push, x0[i], x, v) {
-                        // A moving surface works on the cloth: impulse . surface velocity
-                        // (the filter's impulse included).
+                        // A moving surface works on the cloth: its impulses, those of
+                        // the velocity change, the displacement and the filter, dotted
+                        // with the surface velocity (`contact_work`).
                         if moving {
                             let surface = b.velocity_at(t1, &pose.1, *x);
                             let m = mass.get(i).copied().unwrap_or(0.0);
-                            work += m * ((*v - before).dot(surface) + push * c.normal_speed);
+                            work += contact_work(m, h, *x - xb, *v - vb, surface)
+                                + m * push * c.normal_speed;
                         }
                         *contact = c;
                         hit = true;
@@ -401,11 +407,21 @@ impl Collider {
 
     /// The last proximity pass: when self-collision ran (it may have moved vertices
     /// into an obstacle), pushes unpinned vertices back out of every obstacle at its
-    /// end-of-step pose. Returns the largest depth of a vertex below an obstacle surface.
-    fn final_obstacle_pass(&self, bodies: &[Body], world: &mut World) -> Scalar {
+    /// end-of-step pose, adding the work moving obstacles do so (`contact_work`) to
+    /// `stats.obstacle_work`. Returns the largest depth of a vertex below an obstacle
+    /// surface.
+    fn final_obstacle_pass(
+        &mut self,
+        bodies: &[Body],
+        world: &mut World,
+        h: Scalar,
+        mass: &[Scalar],
+        stats: &mut CollisionStats,
+    ) -> Scalar {
         let t1 = world.time;
         let (held, poses) = (&self.held, &self.poses);
         let after_self = self.self_collider.is_some();
+        let moving = bodies.iter().any(Body::is_moving);
         world
             .x
             .par_iter_mut()
@@ -413,44 +429,30 @@ impl Collider {
             .enumerate()
             .with_min_len(256)
             .map(|(i, (x, v))| {
-                let mut deepest: Scalar = 0.0;
+                let (mut deepest, mut work): (Scalar, Scalar) = (0.0, 0.0);
                 for (b, pose) in bodies.iter().zip(poses) {
                     if after_self && !held[i] {
+                        let (xb, vb) = (*x, *v);
                         push_out(b, &pose.1, t1, x, v);
+                        if moving && (*x != xb || *v != vb) {
+                            let surface = b.velocity_at(t1, &pose.1, *x);
+                            let m = mass.get(i).copied().unwrap_or(0.0);
+                            work += contact_work(m, h, *x - xb, *v - vb, surface);
+                        }
                     }
                     deepest = deepest.max(depth_below(b, &pose.1, *x));
                 }
-                deepest
+                (deepest, work)
             })
-            .reduce(|| 0.0, Scalar::max)
-    }
-}
-
-impl Obstacles {
-    /// The Cusick drape measurements, when the cloth is a disk specimen lying on a
-    /// vertical cylinder (the support disk) centred under it.
-    pub fn cusick_of(&self, cloth: &ClothSpec, world: &World) -> Option<cusick::CusickSummary> {
-        let (top, specimen, disk) = self.cusick_support(cloth)?;
-        Some(cusick::measure(&world.mesh, &world.x, top, specimen, disk))
-    }
-
-    /// The support of a Cusick test: the top centre of the vertical cylinder
-    /// centred under the disk specimen `cloth`, the specimen's radius and the
-    /// support's (smaller) radius; `None` when the cloth is not such a specimen.
-    pub fn cusick_support(&self, cloth: &ClothSpec) -> Option<(Vector, Scalar, Scalar)> {
-        let ClothMesh::Disk {
-            radius: specimen, ..
-        } = cloth.mesh
-        else {
-            return None;
-        };
-        let centre = Vector::from_array(cloth.position);
-        let (top, disk) = self
-            .bodies
+            .collect_into_vec(&mut self.pushes);
+        // Summed in vertex order, so the work is the same at any thread count.
+        let (deepest, work) = self
+            .pushes
             .iter()
-            .filter(|b| b.kind == ObstacleShape::Cylinder)
-            .find_map(Body::vertical_cylinder_top)?;
-        let off = (top - centre).truncate().length();
-        (off < 0.25 * disk && disk < specimen).then_some((top, specimen, disk))
+            .fold((0.0, 0.0), |(d, w): (Scalar, Scalar), &(a, b)| {
+                (d.max(a), w + b)
+            });
+        stats.obstacle_work += work;
+        deepest
     }
 }
