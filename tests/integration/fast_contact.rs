@@ -1,6 +1,6 @@
 //! Contact with fast obstacles: a limb sweeping at 5 m/s through a stretched
-//! sheet kept at 1 mm (translating, and turning about a joint), checked at
-//! every step; and the obstacle term of the sizing rule following a moving
+//! sheet kept at 1 mm (translating, and turning about a joint), with the
+//! implicit and the symplectic Euler integrators, checked at every step; and the obstacle term of the sizing rule following a moving
 //! ball; and the shipped tablecloth pull, briefly.
 //!
 //! Contact is per cloth vertex: the limbs here are thicker than the cloth's
@@ -29,12 +29,17 @@ const THICK: Scalar = 0.001;
 /// A 0.4 m sheet of 20 x 20 cells at z = 0, held along its left and right
 /// edges (u = -0.2 m and +0.2 m), with `obstacle` appended.
 fn stretched_sheet(obstacle: &str) -> Scene {
+    stretched_sheet_with(obstacle, "implicit")
+}
+
+/// [`stretched_sheet`] with the time integrator `integrator`.
+fn stretched_sheet_with(obstacle: &str, integrator: &str) -> Scene {
     let text = format!(
         r#"
 name = "limb"
 [simulation]
 duration = 0.1
-integrator = "implicit"
+integrator = "{integrator}"
 [cloth]
 shape = "rectangle"
 width = 0.4
@@ -193,7 +198,10 @@ fn step_checked(
             limb.measure(state.world.time, &state.world.x, out);
             out.steps += 1;
         }
-        Err(_) if h > 1e-5 => {
+        Err(e) if h > 1e-5 => {
+            if out.halved == 0 {
+                println!("first rejected step, at {:.5} s: {e}", state.world.time);
+            }
             state.restore(&saved);
             out.halved += 1;
             for _ in 0..2 {
@@ -210,11 +218,21 @@ fn step_checked(
 /// check counts the work the limb does by moving vertices out to its
 /// surface).
 fn sweeps_keep_the_sheet_ahead(what: &str, limb: &str, duration: Scalar) {
-    let scene = stretched_sheet(limb);
-    let body = Body::from_spec(0, &scene.obstacle[0])
-        .expect("body")
-        .remove(0);
-    for h in [1.0 / 500.0, 1.0 / 100.0, 1.0 / 50.0] {
+    // The implicit integrator at 2, 10 and 20 ms; symplectic Euler at 0.25 ms,
+    // inside its stability limit for these 2 cm cells (about 0.5 ms). Both
+    // keep every vertex out of the limb and ahead of it.
+    let runs = [
+        ("implicit", 1.0 / 500.0),
+        ("implicit", 1.0 / 100.0),
+        ("implicit", 1.0 / 50.0),
+        ("symplectic_euler", 1.0 / 4000.0),
+    ];
+    for (integrator, h) in runs {
+        let scene = stretched_sheet_with(limb, integrator);
+        let body = Body::from_spec(0, &scene.obstacle[0])
+            .expect("body")
+            .remove(0);
+        let what = format!("{what}, {integrator}");
         let s = sweep(
             &scene,
             &Limb {
@@ -225,7 +243,7 @@ fn sweeps_keep_the_sheet_ahead(what: &str, limb: &str, duration: Scalar) {
             duration,
         );
         println!(
-            "{what}, step {:.1} ms: {} steps ({} halved), smallest clearance from the limb {:.3} mm \
+            "{what}, step {:.2} ms: {} steps ({} halved), smallest clearance from the limb {:.3} mm \
              (thickness {:.1} mm), {} vertex-steps behind it, sheet lifted to {:.3} m",
             h * 1e3,
             s.steps,
@@ -241,7 +259,13 @@ fn sweeps_keep_the_sheet_ahead(what: &str, limb: &str, duration: Scalar) {
             -s.clearance * 1e3
         );
         assert_eq!(s.behind, 0, "{what} at {h} s steps: vertices went through");
-        assert_eq!(s.halved, 0, "{what} at {h} s steps: steps rejected");
+        // Symplectic Euler has rejected steps, redone as halves: the limb's
+        // pushes stretch the sheet, and the elastic energy they store (which
+        // the ledger does not count as the limb's work) comes back as kinetic
+        // energy above the explosion bound. The implicit steps have none.
+        if integrator == "implicit" {
+            assert_eq!(s.halved, 0, "{what} at {h} s steps: steps rejected");
+        }
         assert!(s.lifted > 0.1, "{what}: the limb lifts the sheet");
     }
 }
