@@ -56,8 +56,7 @@ pub(super) fn legend_markdown() -> String {
 ///   names, alphabetically).
 ///
 /// The eyes of both 3D views follow the cloth (`cloth/mesh` and `cloth/edges`), so the cloth
-/// stays framed while a body carries it or a pin drags it away; the user can still orbit and
-/// zoom, and untrack in the view's settings.
+/// stays framed while a body carries it or a pin drags it away.
 ///
 /// The blueprint and selection panels start collapsed and the time panel collapsed to its
 /// play controls, so the views get the window; all can be reopened in the viewer.
