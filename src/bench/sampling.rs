@@ -220,6 +220,7 @@ pub fn sample_frame(f: &FrameState, points: &[Vector2]) -> FrameSamples {
         triangles: f.triangles.to_vec(),
         levels: Vec::new(),
         edges: Vec::new(),
+        pattern: crate::mesh::Pattern::PerVertex,
     };
     let positions = locate(&mesh, points)
         .iter()

@@ -202,7 +202,7 @@ impl SelfCollider {
         s.prims.par_sort_unstable();
         s.prims.dedup();
         // Parts that are close in the rest state cannot be held a thickness apart.
-        let rest = |i: u32| mesh.material[i as usize].extend(0.0);
+        let rest = |i: u32| mesh.rest_point(i);
         s.prims.retain(|p| {
             let (ids, w) = weights(p, tris, &rest);
             let r: Vector = (0..4).map(|k| rest(ids[k]) * w[k]).sum();

@@ -52,7 +52,7 @@ impl Patches {
         let mean_area = mesh.total_rest_area() / n.max(1) as Scalar;
         let side = size.unwrap_or(AUTO_PATCH_TRIANGLES * (2.0 * mean_area).sqrt());
         let cell = |t: usize| {
-            let [a, b, c] = mesh.triangles[t].map(|v| mesh.material[v as usize]);
+            let [a, b, c] = mesh.corners(t);
             let m = (a + b + c) / 3.0;
             ((m.x / side).floor() as i64, (m.y / side).floor() as i64)
         };

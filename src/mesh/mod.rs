@@ -8,6 +8,7 @@
 mod generate;
 mod obj;
 mod pairmap;
+mod panels;
 mod topology;
 
 pub use generate::{
@@ -15,6 +16,7 @@ pub use generate::{
 };
 pub use obj::{ObjCloth, ObjError, load_obj};
 pub use pairmap::{PairHasher, PairMap, PairSet};
+pub use panels::{Panels, Pattern, Seam, SeamState, Sewing, Weld};
 pub use topology::{Edge, NO_TRIANGLE};
 
 use crate::math::{Scalar, Vector2};
@@ -104,12 +106,41 @@ pub enum MeshError {
         /// The vertex.
         vertex: u32,
     },
+    /// Two panels joined at a seam would face opposite ways (one is turned over).
+    #[error(
+        "the seam between panels {a} and {b} joins them twisted: the panels' outlines must \
+         both run counter-clockwise seen from the same side of the garment"
+    )]
+    SeamTwisted {
+        /// One panel's name.
+        a: String,
+        /// The other's.
+        b: String,
+    },
+    /// A seam cannot be sewn as given.
+    #[error("seam `{seam}`: {reason}")]
+    BadSeam {
+        /// The seam's name.
+        seam: String,
+        /// What is wrong with it.
+        reason: String,
+    },
+    /// A seam index past the mesh's seams (or a mesh without panels).
+    #[error("the mesh has no seam {seam}")]
+    NoSuchSeam {
+        /// The index asked for.
+        seam: usize,
+    },
+    /// The panel tables do not match the mesh (an internal inconsistency).
+    #[error("the panel tables do not match the mesh's vertices and triangles")]
+    PanelTables,
 }
 
 /// The cloth mesh: material coordinates, triangles, edges and per-triangle levels.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Mesh {
-    /// Material (rest) coordinates of each vertex, m.
+    /// Material (rest) coordinates of each vertex, m (for a garment, in the
+    /// vertex's home panel: see [`Pattern`]).
     pub material: Vec<Vector2>,
     /// Triangles, counter-clockwise in material space.
     pub triangles: Vec<[u32; 3]>,
@@ -117,6 +148,8 @@ pub struct Mesh {
     pub levels: Vec<u8>,
     /// Unique edges with their adjacent triangles.
     pub edges: Vec<Edge>,
+    /// Where the triangles' corners lie in material space (garment panels).
+    pub pattern: Pattern,
 }
 
 impl Mesh {
@@ -164,18 +197,7 @@ impl Mesh {
             }
         }
         let edges = topology::build_edges(&triangles, n)?;
-        // Unfolded neighbours run their shared edge in opposite directions; if both
-        // run it the same way, their tips lie on the same side: the rest shape folds.
-        for e in &edges {
-            if e.is_interior() {
-                let (a, b) = (e.triangles[0] as usize, e.triangles[1] as usize);
-                if runs_forward(&triangles[a], e.vertices)
-                    == runs_forward(&triangles[b], e.vertices)
-                {
-                    return Err(MeshError::Folded { a, b });
-                }
-            }
-        }
+        check_unfolded(&triangles, &edges)?;
         topology::check_vertices(&triangles, n)?;
         let levels = vec![0; triangles.len()];
         Ok(Mesh {
@@ -183,6 +205,7 @@ impl Mesh {
             triangles,
             levels,
             edges,
+            pattern: Pattern::PerVertex,
         })
     }
 
@@ -200,6 +223,7 @@ impl Mesh {
             triangles,
             levels,
             edges,
+            pattern: Pattern::PerVertex,
         })
     }
 
@@ -210,7 +234,8 @@ impl Mesh {
 
     /// Rest (material-space) area of triangle `t`, m^2.
     pub fn rest_area(&self, t: usize) -> Scalar {
-        signed_area(&self.material, &self.triangles[t])
+        let [a, b, c] = self.corners(t);
+        0.5 * (b - a).perp_dot(c - a)
     }
 
     /// Total rest area, m^2.
@@ -220,8 +245,15 @@ impl Mesh {
 
     /// Rest length of edge `e`, m.
     pub fn rest_length(&self, e: usize) -> Scalar {
-        let [a, b] = self.edges[e].vertices;
-        self.material[a as usize].distance(self.material[b as usize])
+        let edge = &self.edges[e];
+        let [a, b] = edge.vertices;
+        match self.pattern {
+            Pattern::PerVertex => self.material[a as usize].distance(self.material[b as usize]),
+            Pattern::Panels(_) => {
+                let t = edge.triangles[0] as usize;
+                self.corner_at(t, a).distance(self.corner_at(t, b))
+            }
+        }
     }
 
     /// The vertex of triangle `t` that is not on edge `e` (the hinge's wing tip).
@@ -252,6 +284,21 @@ fn bounds(points: &[Vector2]) -> (Vector2, Vector2) {
 pub fn signed_area(material: &[Vector2], tri: &[u32; 3]) -> Scalar {
     let [a, b, c] = tri.map(|v| material[v as usize]);
     0.5 * (b - a).perp_dot(c - a)
+}
+
+/// Unfolded neighbours run their shared edge in opposite directions; if both run
+/// it the same way, their tips lie on the same side: the rest shape folds (or, at
+/// a seam, one panel is turned over).
+fn check_unfolded(triangles: &[[u32; 3]], edges: &[Edge]) -> Result<(), MeshError> {
+    for e in edges {
+        if e.is_interior() {
+            let (a, b) = (e.triangles[0] as usize, e.triangles[1] as usize);
+            if runs_forward(&triangles[a], e.vertices) == runs_forward(&triangles[b], e.vertices) {
+                return Err(MeshError::Folded { a, b });
+            }
+        }
+    }
+    Ok(())
 }
 
 /// True when triangle `tri` runs from `v[0]` to `v[1]` along one of its sides.

@@ -63,6 +63,16 @@ pub(super) fn build_edges(
 /// Checks that every vertex is used, that the triangles around each vertex form a
 /// single fan, and that the whole mesh is connected.
 pub(super) fn check_vertices(triangles: &[[u32; 3]], vertex_count: usize) -> Result<(), MeshError> {
+    let components = check_fans(triangles, vertex_count)?;
+    if components > 1 {
+        return Err(MeshError::Disconnected { components });
+    }
+    Ok(())
+}
+
+/// Checks that every vertex is used and that the triangles around each vertex
+/// form a single fan; returns the number of connected pieces.
+pub(super) fn check_fans(triangles: &[[u32; 3]], vertex_count: usize) -> Result<usize, MeshError> {
     // Union-find over triangles, joined through shared edges (whole mesh) and,
     // per vertex, through edges incident to that vertex (fans).
     let mut at_vertex: Vec<Vec<u32>> = vec![Vec::new(); vertex_count];
@@ -93,11 +103,7 @@ pub(super) fn check_vertices(triangles: &[[u32; 3]], vertex_count: usize) -> Res
             });
         }
     }
-    let components = global.count();
-    if components > 1 {
-        return Err(MeshError::Disconnected { components });
-    }
-    Ok(())
+    Ok(global.count())
 }
 
 /// True when triangles `a` and `b` share an edge that has `v` as an endpoint.

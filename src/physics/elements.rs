@@ -278,6 +278,7 @@ impl Elements {
         self.fold_splits = FoldSplits::new(&self.shape_triangles, splits)
             .expect("the plate matrices of a valid mesh are positive definite");
         edge_bending(mesh, mat, area, &mut self.springs, &mut self.hinges);
+        sewing_springs(mesh, mat, &mut self.springs);
         self.fill_tables(n, mesh);
         self.previous
             .record(mesh, mat, clamped, &self.shape_triangles);
@@ -377,6 +378,27 @@ fn stretch_springs(mesh: &Mesh, mat: &MaterialParams, area: &[Scalar], springs: 
     }
 }
 
+/// A zero-length spring between the two vertices of each pair of every open seam,
+/// appended to `springs`: stiffness the seam's (per metre) times the pair's share
+/// of the seam's length, so the pull per metre of seam does not depend on how
+/// finely it is sampled; damped like the stretch springs.
+fn sewing_springs(mesh: &Mesh, mat: &MaterialParams, springs: &mut Vec<Spring>) {
+    let Some(panels) = mesh.panels() else {
+        return;
+    };
+    for seam in panels.seams.iter().filter(|s| s.is_open()) {
+        for (pair, share) in seam.pairs.iter().zip(seam.pair_lengths(mesh)) {
+            let k = seam.sewing.stiffness * share;
+            springs.push(Spring {
+                v: *pair,
+                rest: 0.0,
+                k,
+                c: mat.damping * k,
+            });
+        }
+    }
+}
+
 /// One membrane triangle per triangle with the triangles membrane (`membrane.rs`),
 /// none with the springs; `area` is each triangle's rest area.
 fn membrane_triangles(
@@ -389,10 +411,15 @@ fn membrane_triangles(
     let Membrane::Triangles(moduli) = &mat.membrane else {
         return;
     };
-    out.extend(mesh.triangles.iter().zip(area).map(|(tri, &a)| {
-        let p = tri.map(|v| mesh.material[v as usize]);
-        MembraneTriangle::new(*tri, p, a, moduli, mat.damping)
-    }));
+    out.extend(
+        mesh.triangles
+            .iter()
+            .zip(area)
+            .enumerate()
+            .map(|(t, (tri, &a))| {
+                MembraneTriangle::new(*tri, mesh.corners(t), a, moduli, mat.damping)
+            }),
+    );
 }
 
 /// The bending elements of the edge-based models: dihedral hinges (into
@@ -432,7 +459,7 @@ fn edge_bending(
             }
             BendingModel::ShapeOperator => unreachable!("returned above"),
             BendingModel::HingeSpring => {
-                let rest = material_distance(&mesh.material, p, q);
+                let rest = tip_distance(mesh, e);
                 let k = mat.bending / (rest * rest) * level_factor(mat.stiffness_rule, level);
                 springs.push(Spring {
                     v: [p, q],
@@ -457,4 +484,31 @@ fn oriented_in(tri: &[u32; 3], [a, b]: [u32; 2]) -> [u32; 2] {
 
 fn material_distance(material: &[Vector2], p: u32, q: u32) -> Scalar {
     material[p as usize].distance(material[q as usize])
+}
+
+/// The rest distance between the wing tips of interior edge `e`. On a garment the
+/// second wing may lie in another panel's pattern: it is unfolded into the first
+/// wing's pattern about their shared edge (both wind counter-clockwise, so a
+/// rotation does it).
+fn tip_distance(mesh: &Mesh, e: usize) -> Scalar {
+    let edge = &mesh.edges[e];
+    let [t0, t1] = edge.triangles;
+    let (p, q) = (
+        mesh.opposite_vertex(t0, edge),
+        mesh.opposite_vertex(t1, edge),
+    );
+    if mesh.panels().is_none() {
+        return material_distance(&mesh.material, p, q);
+    }
+    let [a, b] = edge.vertices;
+    let (t0, t1) = (t0 as usize, t1 as usize);
+    let frame = |t: usize| {
+        let (pa, pb) = (mesh.corner_at(t, a), mesh.corner_at(t, b));
+        (pa, (pb - pa).normalize())
+    };
+    let ((a0, u0), (a1, u1)) = (frame(t0), frame(t1));
+    let d = mesh.corner_at(t1, q) - a1;
+    let (along, across) = (d.dot(u1), u1.perp_dot(d));
+    let unfolded = a0 + u0 * along + u0.perp() * across;
+    mesh.corner_at(t0, p).distance(unfolded)
 }

@@ -80,8 +80,13 @@ fn gershgorin_rows(
             damp[v as usize] += 2.0 * s.c;
         }
     }
-    let flat: Vec<Vector> = mesh.material.iter().map(|m| m.extend(0.0)).collect();
+    // A garment's stencils are laid flat one by one (`Mesh::lay_flat`).
+    let mut flat: Vec<Vector> = mesh.material.iter().map(|m| m.extend(0.0)).collect();
+    let garment = mesh.panels().is_some();
     for hg in &el.hinges {
+        if garment {
+            mesh.lay_flat(&hg.v, &mut flat);
+        }
         let (_, g) = dihedral_angle_and_gradient(hg.v.map(|i| flat[i as usize]));
         let sum: Scalar = g.iter().map(|gi| gi.length()).sum();
         for k in 0..4 {
@@ -90,6 +95,10 @@ fn gershgorin_rows(
     }
     for t in &el.shape_triangles {
         // Gershgorin bound of J^T M J at the flat rest state.
+        if garment {
+            let ids: Vec<u32> = t.slots().map(|(_, v)| v).collect();
+            mesh.lay_flat(&ids, &mut flat);
+        }
         let (_, jac) = t.angles(&flat);
         let row: [Scalar; 3] = [0, 1, 2].map(|a| jac[a].iter().map(|g| g.length()).sum());
         for (k, v) in t.slots() {
@@ -102,6 +111,9 @@ fn gershgorin_rows(
     }
     for t in &el.membrane_triangles {
         // Gershgorin bound of the rest stiffness (Gauss-Newton; no stress at rest).
+        if garment {
+            mesh.lay_flat(&t.v, &mut flat);
+        }
         let (gauss_newton, _) = t.stiffness(&flat);
         for i in 0..3 {
             let mut rows = Vector::ZERO;

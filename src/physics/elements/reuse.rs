@@ -119,7 +119,9 @@ impl Reuse {
         mat: &MaterialParams,
     ) {
         self.nothing_to_keep();
-        if previous.params != Some(*mat) {
+        // A garment's panels may overlap in pattern space: a material point does
+        // not name one vertex there, so nothing is matched.
+        if previous.params != Some(*mat) || mesh.panels().is_some() {
             return;
         }
         self.by_point.clear();

@@ -138,7 +138,7 @@ pub const SPLIT_MIN_ANGLE_DEG: Scalar = 15.0;
 
 /// The smallest corner angle of triangle `t` in material space, degrees.
 fn min_angle(mesh: &Mesh, t: usize) -> Scalar {
-    let p = mesh.triangles[t].map(|v| mesh.material[v as usize]);
+    let p = mesh.corners(t);
     (0..3)
         .map(|a| {
             let (u, w) = (p[(a + 1) % 3] - p[a], p[(a + 2) % 3] - p[a]);
@@ -151,7 +151,7 @@ fn min_angle(mesh: &Mesh, t: usize) -> Scalar {
 /// (edge `a` runs from its vertex `a + 1` to `a + 2`; `(n_a . n_b)^2 =
 /// (e_a . e_b)^2 / (L_a L_b)^2`).
 fn plate_k(mesh: &Mesh, t: usize, area: Scalar, bending: Scalar) -> ShapeMatrix {
-    let p = mesh.triangles[t].map(|v| mesh.material[v as usize]);
+    let p = mesh.corners(t);
     let e: [Vector2; 3] = [0, 1, 2].map(|a| p[(a + 2) % 3] - p[(a + 1) % 3]);
     let len = e.map(|v| v.length());
     let mut k = [[0.0; 3]; 3];
