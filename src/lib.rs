@@ -16,6 +16,7 @@ pub mod bench;
 pub mod cantilever;
 pub mod check;
 pub mod collide;
+pub mod garment;
 pub mod math;
 pub mod mesh;
 pub mod physics;

@@ -36,7 +36,7 @@ mod state;
 pub use bound::{EXPLOSION_FACTOR, EnergyBound, StepFailure};
 pub use pipeline::{
     ENERGY_GAIN_TOLERANCE, FrameFailed, FrameFailure, MAX_ENERGY_HALVINGS, MAX_STEP_HALVINGS,
-    Pipeline, StepError, StepOutcome,
+    Pipeline, StepError, StepOutcome, WeldEvent,
 };
 pub use setup::{Settings, Setup, StepSize};
 pub use state::{Effort, Ledger, SimState};
@@ -75,9 +75,50 @@ pub enum SimBuildError {
     /// The obstacles could not be built.
     #[error("{0}")]
     Collide(#[from] CollideError),
+    /// A garment panel starts inside an obstacle.
+    #[error(
+        "panel `{panel}` starts inside {obstacle}: a vertex at [{x:.3}, {y:.3}, {z:.3}] m is \
+         {depth_mm:.1} mm below its surface; place the panels around the body"
+    )]
+    PanelInsideBody {
+        /// The panel.
+        panel: String,
+        /// The obstacle (and part).
+        obstacle: String,
+        /// The vertex's position, m.
+        x: Scalar,
+        /// y, m.
+        y: Scalar,
+        /// z, m.
+        z: Scalar,
+        /// How deep inside, mm.
+        depth_mm: Scalar,
+    },
     /// The adaptive method cannot work on this mesh.
     #[error("{0}")]
-    Adapt(#[from] crate::adapt::tensor::NotAGrid),
+    Adapt(#[from] crate::adapt::AdaptSetupError),
+}
+
+/// A garment must start outside every body: one starting inside would be
+/// thrown out by the first collision pass.
+fn garment_outside_bodies(world: &World, obstacles: &Obstacles) -> Result<(), SimBuildError> {
+    let Some(panels) = world.mesh.panels() else {
+        return Ok(());
+    };
+    match obstacles.deepest_inside(&world.x, world.time) {
+        None => Ok(()),
+        Some((v, obstacle, depth)) => {
+            let p = world.x[v];
+            Err(SimBuildError::PanelInsideBody {
+                panel: panels.names[panels.of_vertex[v] as usize].clone(),
+                obstacle,
+                x: p.x,
+                y: p.y,
+                z: p.z,
+                depth_mm: 1e3 * depth,
+            })
+        }
+    }
 }
 
 /// A simulation ready to run: what it holds fixed, its initial state and the
@@ -107,6 +148,7 @@ pub fn build(spec: &SimSpec) -> Result<SimParts, SimBuildError> {
         obstacles: Obstacles::new(&spec.obstacles)?,
         settings: spec.settings.clone(),
     };
+    garment_outside_bodies(&world, &setup.obstacles)?;
     let pipeline = Pipeline::new(&setup, &world);
     let state = SimState::new(&setup, world, adapter, &pipeline);
     Ok(SimParts {

@@ -58,8 +58,86 @@ pub enum ClothMesh {
         path: String,
         /// Metres per texture-coordinate unit (the `vt` become material coordinates).
         uv_scale: f64,
+        /// How seams read from the file's `l` elements are sewn.
+        sewing: Sewing,
+    },
+    /// A garment: panels cut from outlines and sewn at seams.
+    Panels(Garment),
+}
+
+/// A garment made from sewing-pattern panels.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Garment {
+    /// The panels, in scene order.
+    pub panels: Vec<PanelSpec>,
+    /// The seams, in scene order.
+    pub seams: Vec<SeamSpec>,
+    /// The target edge length of the panels' triangles, m.
+    pub max_edge: f64,
+    /// How every seam is sewn and welded.
+    pub sewing: Sewing,
+}
+
+/// One panel: its outline in pattern coordinates and where it starts.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PanelSpec {
+    /// The panel's name (what seams name).
+    pub name: String,
+    /// The outline's corners in pattern coordinates, m; side k runs from corner
+    /// k to corner k + 1 (1-based), the last side back to the first corner.
+    pub outline: Vec<[f64; 2]>,
+    /// How the flat pattern is placed in the garment's frame.
+    pub placement: Placement,
+}
+
+/// How a panel's pattern (u, v) is placed in the garment's frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Placement {
+    /// Flat: the pattern's plane rotated (Euler angles in degrees, about x,
+    /// then y, then z) and moved to `position`, m.
+    Flat {
+        /// Where the pattern's origin goes, m.
+        position: [f64; 3],
+        /// Euler angles, degrees.
+        rotation: [f64; 3],
+    },
+    /// Wrapped around the garment's vertical (z) axis: u becomes arc length on
+    /// a cylinder of `radius` (u = 0 at `angle` degrees from -y, counter-clockwise
+    /// seen from above), v becomes height; the pattern's front faces outwards.
+    Cylinder {
+        /// Cylinder radius, m.
+        radius: f64,
+        /// Where u = 0 lies, degrees about z from the -y direction.
+        angle: f64,
+        /// Added to every point, m.
+        position: [f64; 3],
     },
 }
+
+/// A seam: two panel sides sewn together, the first side's start to the
+/// second side's end (two counter-clockwise outlines run a shared seam in
+/// opposite directions).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SeamSpec {
+    /// The seam's name.
+    pub name: String,
+    /// The first side.
+    pub a: SeamSide,
+    /// The second side.
+    pub b: SeamSide,
+}
+
+/// One side of a seam: a panel and one of its outline's sides.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SeamSide {
+    /// The panel's name.
+    pub panel: String,
+    /// The side, 1-based: side k runs from outline corner k to corner k + 1.
+    pub side: usize,
+}
+
+pub use crate::mesh::Sewing;
 
 /// The linear solver of the implicit integrator.
 #[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq, Default)]
@@ -97,6 +175,8 @@ pub enum ClothShape {
     Disk,
     /// A triangle mesh read from an OBJ file.
     Obj,
+    /// Garment panels from `[[panel]]` outlines, sewn at `[[seam]]`s.
+    Panels,
 }
 
 /// Which diagonal splits each grid square of a rectangle.

@@ -145,10 +145,61 @@ pub struct Summary {
     /// from the JSON when every pin holds what the scene names.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub pin_mismatches: Vec<crate::pins::PinMismatch>,
+    /// A garment's seams at the end: welded (and when) or still open (and how
+    /// wide); absent from the JSON for a cloth without seams.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub seams: Vec<SeamSummary>,
     /// True when Ctrl-C ended the run early.
     pub interrupted: bool,
     /// The recording, if one was written.
     pub recording: Option<RecordingSummary>,
+}
+
+fn seams_sentence(seams: &[SeamSummary]) -> String {
+    if seams.is_empty() {
+        return String::new();
+    }
+    let parts: Vec<String> = seams.iter().map(SeamSummary::describe).collect();
+    format!(" Seams: {}.", parts.join(", "))
+}
+
+/// One seam of a garment at the end of a run.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SeamSummary {
+    /// The seam's name.
+    pub name: String,
+    /// When it was welded, s (`None`: still open).
+    pub welded_at: Option<Scalar>,
+    /// Its largest pair gap at the end, m (0 once welded).
+    pub gap: Scalar,
+}
+
+impl SeamSummary {
+    /// The seams of `mesh` at positions `x`.
+    pub fn of(mesh: &crate::mesh::Mesh, x: &[crate::math::Vector]) -> Vec<SeamSummary> {
+        let Some(panels) = mesh.panels() else {
+            return Vec::new();
+        };
+        panels
+            .seams
+            .iter()
+            .map(|s| SeamSummary {
+                name: s.name.clone(),
+                welded_at: match s.state {
+                    crate::mesh::SeamState::Open => None,
+                    crate::mesh::SeamState::Welded { time } => Some(time),
+                },
+                gap: s.gap(x),
+            })
+            .collect()
+    }
+
+    fn describe(&self) -> String {
+        match self.welded_at {
+            Some(t) => format!("`{}` welded at {t:.3} s", self.name),
+            None => format!("`{}` open, gap {:.1} mm", self.name, 1e3 * self.gap),
+        }
+    }
 }
 
 impl Summary {
@@ -215,7 +266,8 @@ impl Summary {
             self.pin_mismatches
                 .iter()
                 .map(|m| format!(" Pin region differs from the scene: {}.", m.describe()))
-                .collect::<String>(),
+                .collect::<String>()
+                + &seams_sentence(&self.seams),
             end,
             rec
         )

@@ -23,6 +23,9 @@ pub enum BuildError {
     /// A pin region could not be resolved.
     #[error("{0}")]
     Pin(#[from] PinError),
+    /// The garment's panels or seams could not be built.
+    #[error("garment: {0}")]
+    Garment(#[from] crate::garment::GarmentError),
     /// A key the shape needs is missing (validation normally catches this first).
     #[error("cloth: `{0}` is required for this shape")]
     Missing(&'static str),
@@ -84,9 +87,17 @@ impl World {
                 let local = m.material.iter().map(|p| p.extend(0.0)).collect();
                 (m, local)
             }
-            ClothMesh::Obj { path, uv_scale } => {
+            ClothMesh::Obj {
+                path,
+                uv_scale,
+                sewing: _,
+            } => {
                 let obj = mesh::load_obj(Path::new(path), *uv_scale)?;
                 (obj.mesh, obj.positions)
+            }
+            ClothMesh::Panels(garment) => {
+                let built = crate::garment::build(garment)?;
+                (built.mesh, built.positions)
             }
         };
         let rot = rotation_from_euler_deg(cloth.rotation);
@@ -96,6 +107,34 @@ impl World {
         let mut world = World::new(mesh, x);
         world.pins = pins;
         Ok(world)
+    }
+
+    /// Welds seam `s` of the garment (see [`Mesh::weld`]) at the current time:
+    /// each pair becomes one vertex at the pair's centre of mass, moving with
+    /// its mean momentum (`mass`: the vertex masses before the weld), so mass
+    /// and momentum are conserved. Pins follow their vertices. Returns the
+    /// number of vertices merged away.
+    pub fn weld_seam(&mut self, s: usize, mass: &[Scalar]) -> Result<usize, MeshError> {
+        let weld = self.mesh.weld(s, self.time)?;
+        let n = weld.mesh.vertex_count();
+        let mut m = vec![0.0; n];
+        let mut p = vec![Vector::ZERO; n];
+        let mut q = vec![Vector::ZERO; n];
+        for (old, &new) in weld.new_index.iter().enumerate() {
+            let (i, mi) = (new as usize, mass[old]);
+            m[i] += mi;
+            p[i] += self.x[old] * mi;
+            q[i] += self.v[old] * mi;
+        }
+        self.x = p.iter().zip(&m).map(|(p, m)| *p / *m).collect();
+        self.v = q.iter().zip(&m).map(|(q, m)| *q / *m).collect();
+        for a in &mut self.pins.anchors {
+            a.vertex = weld.new_index[a.vertex as usize];
+        }
+        self.pins.anchors.sort_by_key(|a| a.vertex);
+        self.pins.anchors.dedup_by_key(|a| a.vertex);
+        self.mesh = weld.mesh;
+        Ok(weld.merged)
     }
 
     /// Centre of mass for the given vertex masses.

@@ -235,6 +235,21 @@ pub struct Measured<'a> {
     pub obstacle_planes: &'a [proximity::ObstaclePlane],
 }
 
+/// Why adaptive remeshing cannot start on a world's mesh.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum AdaptSetupError {
+    /// The tensor method needs a generated rectangle's grid.
+    #[error("{0}")]
+    NotAGrid(#[from] tensor::NotAGrid),
+    /// The cloth is a garment: a remesh would have to split and merge across
+    /// seams, which neither method does yet.
+    #[error(
+        "adaptive remeshing does not work on garments (a cloth with panels or seams) yet; \
+         run it without [adapt]"
+    )]
+    Garment,
+}
+
 impl Adapter {
     /// Starts adapting `world`'s mesh with `config`'s method (its current
     /// triangles become level 0; `AdaptMethod::None`, which a scene never
@@ -245,8 +260,11 @@ impl Adapter {
         config: &AdaptConfig,
         world: &World,
         density: Scalar,
-    ) -> Result<Adapter, tensor::NotAGrid> {
+    ) -> Result<Adapter, AdaptSetupError> {
         let m = &world.mesh;
+        if m.panels().is_some() {
+            return Err(AdaptSetupError::Garment);
+        }
         let method = match config.method {
             AdaptMethod::Edge => MethodState::Edge(edge::Limits::for_mesh(
                 &m.material,

@@ -210,6 +210,23 @@ impl Obstacles {
         out
     }
 
+    /// The vertex of `x` deepest inside an obstacle at time `t`, with the
+    /// obstacle's name and the depth below its surface, m; `None` when no vertex
+    /// is inside one.
+    pub fn deepest_inside(&self, x: &[Vector], t: Scalar) -> Option<(usize, String, Scalar)> {
+        let mut deepest: Option<(usize, usize, Scalar)> = None;
+        for (k, body) in self.bodies.iter().enumerate() {
+            let at = body.at(t);
+            for (i, &p) in x.iter().enumerate() {
+                let depth = -body.probe(&at, at.pose.inverse_transform_point(p)).signed;
+                if depth > 0.0 && deepest.is_none_or(|d| depth > d.2) {
+                    deepest = Some((i, k, depth));
+                }
+            }
+        }
+        deepest.map(|(i, k, depth)| (i, self.bodies[k].name.clone(), depth))
+    }
+
     /// Per vertex of `x`, the tangent plane of the nearest obstacle surface
     /// point at time `t` (over every obstacle), into `out`; `out` is left empty
     /// when there are no obstacles. For the sizing criterion's obstacle term

@@ -80,6 +80,8 @@ struct Scratch {
     dx: Vec<Vector>,
     dv: Vec<Vector>,
     count: Vec<u32>,
+    /// Every vertex's rest point (`Mesh::rest_points`).
+    rest: Vec<Vector>,
 }
 
 impl SelfCollider {
@@ -202,7 +204,9 @@ impl SelfCollider {
         s.prims.par_sort_unstable();
         s.prims.dedup();
         // Parts that are close in the rest state cannot be held a thickness apart.
-        let rest = |i: u32| mesh.rest_point(i);
+        mesh.rest_points(&mut s.rest);
+        let rest_points = &s.rest;
+        let rest = |i: u32| rest_points[i as usize];
         s.prims.retain(|p| {
             let (ids, w) = weights(p, tris, &rest);
             let r: Vector = (0..4).map(|k| rest(ids[k]) * w[k]).sum();

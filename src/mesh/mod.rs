@@ -7,6 +7,7 @@
 
 mod generate;
 mod obj;
+mod outline;
 mod pairmap;
 mod panels;
 mod topology;
@@ -15,8 +16,14 @@ pub use generate::{
     GridCuts, cell_counts, disk, fitted_lines, rectangle, rectangle_cells, rectangle_on_lines,
 };
 pub use obj::{ObjCloth, ObjError, load_obj};
+pub use outline::{
+    MAX_OUTLINE_POINTS, OUTLINE_ANGLE_LIMIT_DEG, OutlineError, OutlineMesh, mesh_outline,
+    segments_for,
+};
 pub use pairmap::{PairHasher, PairMap, PairSet};
-pub use panels::{Panels, Pattern, Seam, SeamState, Sewing, Weld};
+pub use panels::{
+    DEFAULT_SEWING_STIFFNESS, DEFAULT_WELD_GAP, Panels, Pattern, Seam, SeamState, Sewing, Weld,
+};
 pub use topology::{Edge, NO_TRIANGLE};
 
 use crate::math::{Scalar, Vector2};
@@ -108,8 +115,9 @@ pub enum MeshError {
     },
     /// Two panels joined at a seam would face opposite ways (one is turned over).
     #[error(
-        "the seam between panels {a} and {b} joins them twisted: the panels' outlines must \
-         both run counter-clockwise seen from the same side of the garment"
+        "the seam between panels {a} and {b} joins them twisted: a seam sews its sides end to \
+         start, which joins two outlines that run the same way round (both counter-clockwise, \
+         say); these run opposite ways"
     )]
     SeamTwisted {
         /// One panel's name.

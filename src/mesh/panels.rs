@@ -59,6 +59,13 @@ pub struct Seam {
     pub sewing: Sewing,
 }
 
+/// The default sewing stiffness per metre of seam, N/m per m: a 2 cm gap
+/// pulls with 1 N per metre of seam.
+pub const DEFAULT_SEWING_STIFFNESS: Scalar = 50.0;
+
+/// The default weld gap, m: a seam whose pairs are all within 5 mm is welded.
+pub const DEFAULT_WELD_GAP: Scalar = 0.005;
+
 /// How a seam is sewn: the pull of its springs and the gap at which it is welded.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Sewing {
@@ -201,13 +208,28 @@ impl Mesh {
     }
 
     /// A point per vertex in rest space, for telling apart parts that are close in
-    /// the rest state: the home material coordinate, with each panel lifted to
-    /// its own plane far from the others' (panels' patterns may overlap).
-    pub fn rest_point(&self, v: u32) -> Vector {
-        let lift = self
-            .panels()
-            .map_or(0.0, |p| p.of_vertex[v as usize] as Scalar);
-        self.material[v as usize].extend(lift * PANEL_PLANE_SPACING)
+    /// the rest state (self-collision leaves those alone): the home material
+    /// coordinate, with each panel lifted to its own plane far from the others'
+    /// (panels' patterns may overlap), and the second vertex of every open seam
+    /// pair at its partner's point, so the two sides of a seam being sewn are
+    /// close in rest and free to meet.
+    pub fn rest_points(&self, out: &mut Vec<Vector>) {
+        out.clear();
+        let Some(panels) = self.panels() else {
+            out.extend(self.material.iter().map(|m| m.extend(0.0)));
+            return;
+        };
+        out.extend(
+            self.material
+                .iter()
+                .zip(&panels.of_vertex)
+                .map(|(m, &p)| m.extend(p as Scalar * PANEL_PLANE_SPACING)),
+        );
+        for seam in panels.seams.iter().filter(|s| s.is_open()) {
+            for &[a, b] in &seam.pairs {
+                out[b as usize] = out[a as usize];
+            }
+        }
     }
 
     /// Writes a flat rest embedding of a stencil into `flat` (z = 0): `ids[..3]` is

@@ -114,6 +114,7 @@ impl Tally {
             cusick: end.cusick,
             cantilever: end.cantilever,
             pin_mismatches: self.pin_mismatches.clone(),
+            seams: crate::summary::SeamSummary::of(&end.state.world.mesh, &end.state.world.x),
             recording: end.recording.map(|(path, bytes, frames)| RecordingSummary {
                 path,
                 bytes,

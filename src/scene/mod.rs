@@ -23,6 +23,7 @@ mod validate_adapt;
 mod validate_attach;
 mod validate_body;
 mod validate_collide;
+mod validate_garment;
 mod validate_material;
 mod validate_measure;
 mod validate_motion;

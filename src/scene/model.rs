@@ -45,6 +45,82 @@ pub struct Scene {
     /// default; each must apply to the scene (`validate_measure.rs`).
     #[serde(default)]
     pub measure: Vec<Measurement>,
+    /// Garment panels (`[[panel]]`, with `shape = "panels"`).
+    #[serde(default)]
+    pub panel: Vec<PanelTable>,
+    /// Garment seams (`[[seam]]`, with `shape = "panels"`).
+    #[serde(default)]
+    pub seam: Vec<SeamTable>,
+}
+
+/// `[[panel]]`: one garment panel.
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct PanelTable {
+    /// The panel's name (unique; seams name it).
+    pub name: String,
+    /// The outline's corners in pattern coordinates `[u, v]`, m (at least 3).
+    pub outline: Vec<[f64; 2]>,
+    /// Where the pattern's origin goes in the garment's frame, m (flat
+    /// placement), or what is added to every wrapped point (with `wrap`).
+    #[serde(default)]
+    pub position: [f64; 3],
+    /// Euler angles in degrees of the flat pattern (not with `wrap`).
+    pub rotation: Option<[f64; 3]>,
+    /// Wraps the pattern around the garment's vertical axis instead.
+    pub wrap: Option<WrapTable>,
+}
+
+/// `wrap = { radius, angle }` of a panel: around a cylinder about z.
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct WrapTable {
+    /// Cylinder radius, m (> 0).
+    pub radius: f64,
+    /// Where the pattern's u = 0 lies, degrees about z from the -y direction.
+    #[serde(default)]
+    pub angle: f64,
+}
+
+/// `[[seam]]`: two panel sides sewn together.
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct SeamTable {
+    /// The seam's name (unique).
+    pub name: String,
+    /// The first side: `{ panel = "front", side = 2 }`.
+    pub a: crate::spec::SeamSide,
+    /// The second side, sewn end to start against the first.
+    pub b: crate::spec::SeamSide,
+}
+
+/// `[cloth.sewing]`: how seams are sewn and welded.
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct SewingTable {
+    /// Sewing stiffness per metre of seam, N/m per m (> 0).
+    #[serde(default = "default_sewing_stiffness")]
+    pub stiffness: f64,
+    /// A seam is welded once every sewn pair is closer than this, m (> 0).
+    #[serde(default = "default_weld_gap")]
+    pub weld_gap: f64,
+}
+
+impl Default for SewingTable {
+    fn default() -> SewingTable {
+        SewingTable {
+            stiffness: default_sewing_stiffness(),
+            weld_gap: default_weld_gap(),
+        }
+    }
+}
+
+fn default_sewing_stiffness() -> f64 {
+    crate::mesh::DEFAULT_SEWING_STIFFNESS
+}
+
+fn default_weld_gap() -> f64 {
+    crate::mesh::DEFAULT_WELD_GAP
 }
 
 /// `[simulation]`: time span, integrator and global forces.
@@ -142,6 +218,11 @@ pub struct Cloth {
     /// Euler angles in degrees (about x, then y, then z); the generated sheet lies in xy.
     #[serde(default)]
     pub rotation: [f64; 3],
+    /// Panels: the target edge length of their triangles, m.
+    pub max_edge: Option<f64>,
+    /// How seams (from `[[seam]]` or an OBJ's `l` elements) are sewn and welded.
+    #[serde(default)]
+    pub sewing: SewingTable,
 }
 
 /// `[material]`: physical fabric parameters, per area, independent of the mesh.

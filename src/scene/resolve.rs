@@ -8,9 +8,10 @@ use crate::adapt::AdaptConfig;
 use crate::collide::{CollideError, Obstacles, cusick::CusickSummary};
 use crate::math::Vector;
 use crate::physics::{ExternalForces, MaterialParams, Model, SolverSettings, WindForce};
-use crate::spec::{ClothMesh, ClothSpec};
+use crate::spec::{ClothMesh, ClothSpec, Garment, PanelSpec, Placement, SeamSpec, Sewing};
 use crate::world::{BuildError, World};
 
+use super::model::{PanelTable, SeamTable};
 use super::{Cloth, ClothShape, DEFAULT_AIR_DENSITY, Scene, TimeStep};
 use crate::sim::{Settings, SimSpec, StepSize};
 
@@ -19,7 +20,7 @@ impl Scene {
     /// [`crate::sim::build`].
     pub fn resolve(&self) -> Result<SimSpec, BuildError> {
         Ok(SimSpec {
-            cloth: cloth_spec(&self.cloth)?,
+            cloth: cloth_spec(&self.cloth, &self.panel, &self.seam)?,
             pins: self.pin.clone(),
             model: Model::from_scene(self),
             obstacles: self.obstacle.clone(),
@@ -39,7 +40,11 @@ impl Scene {
 
 /// `[cloth]` with the keys its shape needs checked present (validation normally
 /// reports a missing one first, with its line).
-pub fn cloth_spec(c: &Cloth) -> Result<ClothSpec, BuildError> {
+pub fn cloth_spec(
+    c: &Cloth,
+    panels: &[PanelTable],
+    seams: &[SeamTable],
+) -> Result<ClothSpec, BuildError> {
     let need = |v: Option<f64>, name| v.ok_or(BuildError::Missing(name));
     let mesh = match c.shape {
         ClothShape::Rectangle => {
@@ -62,7 +67,21 @@ pub fn cloth_spec(c: &Cloth) -> Result<ClothSpec, BuildError> {
         ClothShape::Obj => ClothMesh::Obj {
             path: c.path.clone().ok_or(BuildError::Missing("path"))?,
             uv_scale: c.uv_scale,
+            sewing: sewing(c),
         },
+        ClothShape::Panels => ClothMesh::Panels(Garment {
+            panels: panels.iter().map(panel_spec).collect(),
+            seams: seams
+                .iter()
+                .map(|s| SeamSpec {
+                    name: s.name.clone(),
+                    a: s.a.clone(),
+                    b: s.b.clone(),
+                })
+                .collect(),
+            max_edge: need(c.max_edge, "max_edge")?,
+            sewing: sewing(c),
+        }),
     };
     Ok(ClothSpec {
         mesh,
@@ -71,10 +90,42 @@ pub fn cloth_spec(c: &Cloth) -> Result<ClothSpec, BuildError> {
     })
 }
 
+/// The sewing of `[cloth.sewing]`.
+fn sewing(c: &Cloth) -> Sewing {
+    Sewing {
+        stiffness: c.sewing.stiffness,
+        weld_gap: c.sewing.weld_gap,
+    }
+}
+
+/// A `[[panel]]` table resolved: flat unless it wraps.
+fn panel_spec(p: &PanelTable) -> PanelSpec {
+    let placement = match p.wrap {
+        Some(w) => Placement::Cylinder {
+            radius: w.radius,
+            angle: w.angle,
+            position: p.position,
+        },
+        None => Placement::Flat {
+            position: p.position,
+            rotation: p.rotation.unwrap_or([0.0; 3]),
+        },
+    };
+    PanelSpec {
+        name: p.name.clone(),
+        outline: p.outline.clone(),
+        placement,
+    }
+}
+
 impl World {
     /// Builds the cloth of `scene` and resolves its pins.
     pub fn from_scene(scene: &Scene) -> Result<World, BuildError> {
-        World::from_spec(&cloth_spec(&scene.cloth)?, &scene.pin, &scene.obstacle)
+        World::from_spec(
+            &cloth_spec(&scene.cloth, &scene.panel, &scene.seam)?,
+            &scene.pin,
+            &scene.obstacle,
+        )
     }
 }
 
@@ -87,7 +138,10 @@ impl Obstacles {
     /// The Cusick drape measurements, when the scene is a disk specimen lying on a
     /// vertical cylinder (the support disk) centred under it.
     pub fn cusick(&self, scene: &Scene, world: &World) -> Option<CusickSummary> {
-        self.cusick_of(&cloth_spec(&scene.cloth).ok()?, world)
+        self.cusick_of(
+            &cloth_spec(&scene.cloth, &scene.panel, &scene.seam).ok()?,
+            world,
+        )
     }
 }
 

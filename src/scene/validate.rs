@@ -15,6 +15,7 @@ pub(crate) fn validate(scene: &Scene, doc: &Table) -> Result<(), Issue> {
     name(&scene.name)?;
     simulation(&scene.simulation)?;
     cloth(&scene.cloth, section(doc, "cloth"))?;
+    super::validate_garment::garment(scene)?;
     super::validate_material::material(
         &scene.material,
         section(doc, "material"),
@@ -220,7 +221,7 @@ fn shape_keys(
         ClothShape::Rectangle => (
             "rectangle",
             &["width", "height", "resolution"],
-            &["radius", "path", "uv_scale"],
+            &["radius", "path", "uv_scale", "max_edge", "sewing"],
         ),
         ClothShape::Disk => (
             "disk",
@@ -232,6 +233,8 @@ fn shape_keys(
                 "short_side_segments",
                 "path",
                 "uv_scale",
+                "max_edge",
+                "sewing",
             ],
         ),
         ClothShape::Obj => (
@@ -244,6 +247,21 @@ fn shape_keys(
                 "resolution",
                 "short_side_segments",
                 "diagonals",
+                "max_edge",
+            ],
+        ),
+        ClothShape::Panels => (
+            "panels",
+            &["max_edge"],
+            &[
+                "width",
+                "height",
+                "radius",
+                "resolution",
+                "short_side_segments",
+                "diagonals",
+                "path",
+                "uv_scale",
             ],
         ),
     }
@@ -294,6 +312,11 @@ fn cloth(c: &Cloth, written: Option<&Table>) -> Result<(), Issue> {
         return Err(Issue::new(at("path"), Kind::BadValue, "the path is empty").allowed(allowed));
     }
     positive(at("uv_scale"), c.uv_scale)?;
+    if let Some(e) = c.max_edge {
+        positive(at("max_edge"), e)?;
+    }
+    positive(keys(&["cloth", "sewing", "stiffness"]), c.sewing.stiffness)?;
+    positive(keys(&["cloth", "sewing", "weld_gap"]), c.sewing.weld_gap)?;
     all_finite(at("position"), &c.position)?;
     all_finite(at("rotation"), &c.rotation)
 }

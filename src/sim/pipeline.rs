@@ -9,7 +9,10 @@ use crate::physics::{Energy, Model, StepStats, Stepper};
 use crate::world::World;
 
 mod remesh;
+mod sew;
+
 use remesh::StepStart;
+pub use sew::WeldEvent;
 
 /// How often a failing frame is retried with half the step before giving up.
 pub const MAX_STEP_HALVINGS: u32 = 4;
@@ -30,7 +33,7 @@ pub struct StepOutcome {
     /// Times the step was undone and redone on a refined mesh (paper A's
     /// rollback).
     pub rollbacks: u32,
-    /// True when the adaptation pass after the step changed the mesh.
+    /// True when the adaptation pass or a weld after the step changed the mesh.
     pub remeshed: bool,
 }
 
@@ -334,6 +337,7 @@ impl Pipeline {
         }
         state.ledger.steps_done += 1;
         let remeshed = self.adapt(setup, state)?;
+        let remeshed = self.weld_closed_seams(setup, state)? || remeshed;
         Ok(StepOutcome {
             rollbacks,
             remeshed,

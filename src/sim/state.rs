@@ -6,7 +6,7 @@ use crate::math::{Scalar, Vector};
 use crate::physics::{Contact, StepStats};
 use crate::world::World;
 
-use super::{EnergyBound, Pipeline, Setup};
+use super::{EnergyBound, Pipeline, Setup, WeldEvent};
 
 /// The simulation state: one cloneable value (see the [module docs](super)).
 ///
@@ -34,6 +34,8 @@ pub struct SimState {
     pub ledger: Ledger,
     /// What the computer did, retried work included.
     pub effort: Effort,
+    /// Seams welded since the recording last took them.
+    pub welds: Vec<WeldEvent>,
 }
 
 /// The energy accounting of a run: the work done on the cloth from outside, the
@@ -107,6 +109,7 @@ impl SimState {
                 excess_max: 0.0,
             },
             effort: Effort::default(),
+            welds: Vec::new(),
         }
     }
 
@@ -128,6 +131,7 @@ impl Clone for SimState {
             warm_start: self.warm_start.clone(),
             ledger: self.ledger,
             effort: self.effort,
+            welds: self.welds.clone(),
         }
     }
 
@@ -142,6 +146,7 @@ impl Clone for SimState {
             warm_start,
             ledger,
             effort,
+            welds,
         } = source;
         let World {
             mesh,
@@ -160,5 +165,6 @@ impl Clone for SimState {
         self.warm_start.clone_from(warm_start);
         self.ledger = *ledger;
         self.effort = *effort;
+        self.welds.clone_from(welds);
     }
 }

@@ -1,0 +1,198 @@
+//! Checks of a garment's `[[panel]]` and `[[seam]]` tables: names, outlines,
+//! placements, and seams that name existing panel sides of matching length.
+//! Each check names the key path, which `parse.rs` turns into a line of the
+//! file or a `--set`.
+
+use super::error::{Issue, KeyPath, SceneErrorKind as Kind, Seg, keys};
+use super::model::{PanelTable, SeamTable};
+use super::validate::{all_finite, positive};
+use super::{ClothShape, Scene};
+use crate::garment::SEAM_LENGTH_TOLERANCE;
+
+fn at(table: &str, i: usize, key: &str) -> KeyPath {
+    vec![Seg::Key(table.into()), Seg::Index(i), Seg::Key(key.into())]
+}
+
+/// The garment tables: present exactly when `shape = "panels"`, and sound.
+pub(super) fn garment(scene: &Scene) -> Result<(), Issue> {
+    let panels_shape = scene.cloth.shape == ClothShape::Panels;
+    if !panels_shape {
+        for (table, count) in [("panel", scene.panel.len()), ("seam", scene.seam.len())] {
+            if count > 0 {
+                return Err(Issue::new(
+                    at(table, 0, "name"),
+                    Kind::NotApplicable,
+                    format!("[[{table}]] applies to shape = \"panels\" only"),
+                )
+                .because(keys(&["cloth", "shape"])));
+            }
+        }
+        return Ok(());
+    }
+    if scene.panel.is_empty() {
+        return Err(Issue::new(
+            keys(&["panel"]),
+            Kind::MissingKey,
+            "shape = \"panels\" needs at least one [[panel]]",
+        )
+        .because(keys(&["cloth", "shape"])));
+    }
+    if scene
+        .adapt
+        .as_ref()
+        .is_some_and(|a| a.method != crate::spec::AdaptMethod::None)
+    {
+        return Err(Issue::new(
+            keys(&["adapt", "method"]),
+            Kind::Unsupported,
+            "adaptive remeshing does not work on garments (shape = \"panels\") yet: \
+             a remesh would have to split and merge across seams",
+        )
+        .allowed("method = \"none\", or no [adapt] table")
+        .because(keys(&["cloth", "shape"])));
+    }
+    for (i, p) in scene.panel.iter().enumerate() {
+        panel(i, p, &scene.panel[..i])?;
+    }
+    for (i, s) in scene.seam.iter().enumerate() {
+        seam(i, s, &scene.seam[..i], &scene.panel)?;
+    }
+    Ok(())
+}
+
+fn unique_name(
+    path: KeyPath,
+    name: &str,
+    earlier: impl Iterator<Item = String>,
+) -> Result<(), Issue> {
+    if name.trim().is_empty() {
+        return Err(Issue::new(path, Kind::BadValue, "the name is empty"));
+    }
+    for other in earlier {
+        if other == name {
+            return Err(Issue::new(
+                path,
+                Kind::BadValue,
+                format!("the name `{name}` is used twice"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn panel(i: usize, p: &PanelTable, earlier: &[PanelTable]) -> Result<(), Issue> {
+    unique_name(
+        at("panel", i, "name"),
+        &p.name,
+        earlier.iter().map(|e| e.name.clone()),
+    )?;
+    if p.outline.len() < 3 {
+        return Err(Issue::new(
+            at("panel", i, "outline"),
+            Kind::BadValue,
+            format!(
+                "an outline needs at least 3 corners, this one has {}",
+                p.outline.len()
+            ),
+        ));
+    }
+    let flat: Vec<f64> = p.outline.iter().flatten().copied().collect();
+    all_finite(at("panel", i, "outline"), &flat)?;
+    all_finite(at("panel", i, "position"), &p.position)?;
+    match (&p.wrap, &p.rotation) {
+        (Some(_), Some(_)) => Err(Issue::new(
+            at("panel", i, "rotation"),
+            Kind::NotApplicable,
+            "`rotation` does not apply to a wrapped panel (the cylinder places it)",
+        )
+        .because(at("panel", i, "wrap"))),
+        (Some(w), None) => {
+            let mut path = at("panel", i, "wrap");
+            path.push(Seg::Key("radius".into()));
+            positive(path, w.radius)?;
+            let mut path = at("panel", i, "wrap");
+            path.push(Seg::Key("angle".into()));
+            all_finite(path, &[w.angle])
+        }
+        (None, Some(r)) => all_finite(at("panel", i, "rotation"), r),
+        (None, None) => Ok(()),
+    }
+}
+
+fn seam(
+    i: usize,
+    s: &SeamTable,
+    earlier: &[SeamTable],
+    panels: &[PanelTable],
+) -> Result<(), Issue> {
+    unique_name(
+        at("seam", i, "name"),
+        &s.name,
+        earlier.iter().map(|e| e.name.clone()),
+    )?;
+    let mut length = [0.0; 2];
+    for (k, (key, side)) in [("a", &s.a), ("b", &s.b)].into_iter().enumerate() {
+        let Some(p) = panels.iter().find(|p| p.name == side.panel) else {
+            let names: Vec<&str> = panels.iter().map(|p| p.name.as_str()).collect();
+            return Err(Issue::new(
+                at("seam", i, key),
+                Kind::BadValue,
+                format!("there is no panel `{}`", side.panel),
+            )
+            .allowed(format!("one of: {}", names.join(", "))));
+        };
+        let n = p.outline.len();
+        if side.side == 0 || side.side > n {
+            return Err(Issue::new(
+                at("seam", i, key),
+                Kind::OutOfRange,
+                format!("panel `{}` has sides 1 to {n}, not {}", p.name, side.side),
+            )
+            .allowed(format!(
+                "1 to {n}: side k runs from outline corner k to corner k + 1"
+            )));
+        }
+        let (u, w) = (p.outline[side.side - 1], p.outline[side.side % n]);
+        length[k] = (u[0] - w[0]).hypot(u[1] - w[1]);
+    }
+    if s.a == s.b {
+        return Err(Issue::new(
+            at("seam", i, "b"),
+            Kind::BadValue,
+            "both sides of the seam are the same panel side",
+        ));
+    }
+    for (j, e) in earlier.iter().enumerate() {
+        for (key, side) in [("a", &s.a), ("b", &s.b)] {
+            if *side == e.a || *side == e.b {
+                return Err(Issue::new(
+                    at("seam", i, key),
+                    Kind::BadValue,
+                    format!(
+                        "side {} of panel `{}` is already sewn by seam `{}` ([[seam]] {})",
+                        side.side,
+                        side.panel,
+                        e.name,
+                        j + 1
+                    ),
+                ));
+            }
+        }
+    }
+    let (la, lb) = (length[0], length[1]);
+    if (la - lb).abs() > SEAM_LENGTH_TOLERANCE * la.max(lb) {
+        return Err(Issue::new(
+            at("seam", i, "b"),
+            Kind::BadValue,
+            format!(
+                "the sides are {la:.4} m and {lb:.4} m long, {:.1} % apart",
+                100.0 * (la - lb).abs() / la.max(lb)
+            ),
+        )
+        .allowed(format!(
+            "sides within {:.0} % of each other's length (they are sewn point to point)",
+            100.0 * SEAM_LENGTH_TOLERANCE
+        )));
+    }
+    Ok(())
+}

@@ -1,0 +1,69 @@
+//! The pipeline's sewing phase: an open seam whose every pair has closed to
+//! within its weld gap becomes one surface ([`crate::world::World::weld_seam`]).
+
+use super::Pipeline;
+use crate::math::{Scalar, Vector};
+use crate::mesh::MeshError;
+use crate::sim::{Setup, SimState};
+
+/// A seam welded during the run, for the recording's events.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WeldEvent {
+    /// The seam's name.
+    pub seam: String,
+    /// Where: the centre of the seam's welded vertices, m.
+    pub position: Vector,
+    /// The largest gap between a pair just before the weld, m.
+    pub gap: Scalar,
+    /// The step after which it happened.
+    pub step: u64,
+}
+
+impl Pipeline {
+    /// Sew: welds every open seam that has closed. True when the mesh changed
+    /// (the force elements are then rebuilt).
+    pub(super) fn weld_closed_seams(
+        &mut self,
+        setup: &Setup,
+        state: &mut SimState,
+    ) -> Result<bool, MeshError> {
+        let mut welded = false;
+        loop {
+            let Some(panels) = state.world.mesh.panels() else {
+                return Ok(welded);
+            };
+            let x = &state.world.x;
+            let closed = panels.seams.iter().enumerate().find_map(|(s, seam)| {
+                let gap = seam.gap(x);
+                (seam.is_open() && gap < seam.sewing.weld_gap).then_some((s, gap))
+            });
+            let Some((s, gap)) = closed else {
+                return Ok(welded);
+            };
+            let seam = &panels.seams[s];
+            let centre = seam
+                .pairs
+                .iter()
+                .map(|&[a, b]| (x[a as usize] + x[b as usize]) * 0.5)
+                .sum::<Vector>()
+                / seam.pairs.len() as Scalar;
+            let name = seam.name.clone();
+            let mass = self.stepper.elements.mass.clone();
+            let before = self.stepper.energy(&setup.model, &state.world).total();
+            state.world.weld_seam(s, &mass)?;
+            state.welds.push(WeldEvent {
+                seam: name,
+                position: centre,
+                gap,
+                step: state.ledger.steps_done,
+            });
+            self.mesh_changed(setup, state);
+            // Merging moves each pair to its centre of mass (storing a little
+            // elastic energy), loses the pair's relative motion and the sewing
+            // springs' energy: that change is the sewing's work on the cloth.
+            let after = self.stepper.energy(&setup.model, &state.world).total();
+            state.ledger.external_work += after - before;
+            welded = true;
+        }
+    }
+}
