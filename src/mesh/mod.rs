@@ -7,6 +7,7 @@
 
 mod generate;
 mod obj;
+mod outline;
 mod pairmap;
 mod topology;
 
@@ -14,6 +15,10 @@ pub use generate::{
     GridCuts, cell_counts, disk, fitted_lines, rectangle, rectangle_cells, rectangle_on_lines,
 };
 pub use obj::{ObjCloth, ObjError, load_obj};
+pub use outline::{
+    MAX_OUTLINE_POINTS, OUTLINE_ANGLE_LIMIT_DEG, OutlineError, OutlineMesh, mesh_outline,
+    segments_for,
+};
 pub use pairmap::{PairHasher, PairMap, PairSet};
 pub use topology::{Edge, NO_TRIANGLE};
 

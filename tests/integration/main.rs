@@ -31,6 +31,7 @@ mod membrane_runs;
 mod mesh;
 mod meshbody;
 mod metric;
+mod outline;
 mod physics;
 mod pins;
 mod pins_attached;
