@@ -32,6 +32,7 @@ mod membrane_runs;
 mod mesh;
 mod meshbody;
 mod metric;
+mod outline;
 mod physics;
 mod pins;
 mod pins_attached;
