@@ -18,7 +18,7 @@ pub const SEAM_LENGTH_TOLERANCE: Scalar = 0.05;
 #[derive(Debug, thiserror::Error)]
 pub enum GarmentError {
     /// A panel's outline could not be meshed.
-    #[error("panel `{panel}`: {source}")]
+    #[error("panel `{panel}`: {}", scene_words(source))]
     Outline {
         /// The panel.
         panel: String,
@@ -36,6 +36,30 @@ pub enum GarmentError {
     /// The panels do not form a valid mesh, or a seam would weld them twisted.
     #[error("{0}")]
     Mesh(#[from] MeshError),
+}
+
+/// An outline error in the scene's words: sides and corners numbered from 1,
+/// as `[[panel]] outline` and `[[seam]]` number them.
+fn scene_words(e: &OutlineError) -> String {
+    match *e {
+        OutlineError::SelfIntersecting { a, b } => format!(
+            "the outline crosses itself: sides {} and {} cross or touch; an outline must be a \
+             simple polygon",
+            a + 1,
+            b + 1
+        ),
+        OutlineError::ZeroLengthSide { side, next, .. } => format!(
+            "side {} has no length: corners {} and {} are the same point",
+            side + 1,
+            side + 1,
+            next + 1
+        ),
+        OutlineError::NearlyTouching { side } => format!(
+            "side {}, divided into its segments, touches or crosses another side",
+            side + 1
+        ),
+        ref other => other.to_string(),
+    }
 }
 
 /// A garment's mesh and its start positions in the garment's frame.

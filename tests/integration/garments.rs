@@ -398,7 +398,10 @@ fn twisted_seams_self_crossing_outlines_and_panels_inside_a_body_are_refused() {
     );
     for (text, want) in [
         (&twisted, "seam `middle`: it cannot be welded"),
-        (&crossing, "panel `left`:"),
+        (
+            &crossing,
+            "panel `left`: the outline crosses itself: sides 1 and 3 cross or touch",
+        ),
         (&inside, "panel `right` starts inside obstacle 0"),
     ] {
         let err = build_err(text);
