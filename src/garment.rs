@@ -18,12 +18,12 @@ pub const SEAM_LENGTH_TOLERANCE: Scalar = 0.05;
 #[derive(Debug, thiserror::Error)]
 pub enum GarmentError {
     /// A panel's outline could not be meshed.
-    #[error("panel `{panel}`: {}", scene_words(source))]
+    #[error("panel `{panel}`: {}", scene_words(why))]
     Outline {
         /// The panel.
         panel: String,
-        /// Why.
-        source: OutlineError,
+        /// Why (its sides numbered from 0; the message numbers them from 1).
+        why: OutlineError,
     },
     /// A seam names a panel or side that does not exist, or sides that cannot be sewn.
     #[error("seam `{seam}`: {reason}")]
@@ -86,10 +86,10 @@ pub fn build(garment: &Garment) -> Result<BuiltGarment, GarmentError> {
             .iter()
             .map(|c| Vector2::from_array(*c))
             .collect();
-        let meshed = mesh_outline(&outline, &segments[p], garment.max_edge).map_err(|source| {
+        let meshed = mesh_outline(&outline, &segments[p], garment.max_edge).map_err(|why| {
             GarmentError::Outline {
                 panel: panel.name.clone(),
-                source,
+                why,
             }
         })?;
         let base = material.len() as u32;
