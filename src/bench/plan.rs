@@ -268,6 +268,14 @@ pub fn make_plan(opts: &BenchOptions) -> Result<(Plan, SamplePoints), BenchError
         base_set.push(format!("simulation.duration={d:e}"));
     }
     let base = load(&opts.scene, &base_set, "scene")?;
+    if base.cloth.shape == crate::scene::ClothShape::Panels {
+        return Err(BenchError::Plan(
+            "drape bench compares runs point by point in material coordinates, and a garment's \
+             panels share their pattern coordinates; garments (shape = \"panels\") cannot be \
+             benched yet"
+                .into(),
+        ));
+    }
     let ladder = resolve_ladder(opts, &base_set)?;
     let step = match opts.time_ladder {
         true => StepPolicy::Own,
