@@ -123,6 +123,12 @@ struct RunArgs {
     #[arg(long, value_name = "DEG", value_parser = non_negative_degrees,
           conflicts_with = "edges")]
     edge_threshold: Option<f64>,
+    /// What colours the cloth's triangles: `level` (default) the refinement level, `panel`
+    /// the garment panel (each panel in its own colour, named in the legend; a cloth without
+    /// panels is one panel, `cloth`).
+    #[arg(long = "colour-by", alias = "color-by", value_enum, value_name = "WHAT",
+          default_value_t = ColourChoice::Level)]
+    colour_by: ColourChoice,
     /// Also start a Rerun viewer (`rerun` 0.36.3 on PATH) and stream the run to it live.
     #[arg(long, conflicts_with = "connect")]
     spawn: bool,
@@ -208,6 +214,15 @@ enum EdgeChoice {
     Review,
     /// Every edge.
     All,
+}
+
+/// The values of `--colour-by`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum ColourChoice {
+    /// The refinement level.
+    Level,
+    /// The garment panel.
+    Panel,
 }
 
 fn cmd_check(args: SceneArgs) -> Result<ExitCode> {

@@ -18,7 +18,7 @@ pub use crate::sim::{
 };
 
 use crate::math::{Scalar, Vector};
-use crate::record::{EdgeDisplay, LiveViewer, RecordError};
+use crate::record::{ColourBy, EdgeDisplay, LiveViewer, RecordError};
 use crate::scene::Scene;
 use crate::sim::{SimBuildError, SimParts};
 use crate::summary::Summary;
@@ -42,6 +42,9 @@ pub struct RunOptions {
     /// Which edges `cloth/edges` shows; [`EdgeDisplay::Review`] (the default) is resolved
     /// against the scene's refine threshold.
     pub edges: EdgeDisplay,
+    /// What the triangles of `cloth/mesh` are coloured by: refinement level (the default)
+    /// or garment panel.
+    pub colour_by: ColourBy,
 }
 
 /// Progress report after each frame.

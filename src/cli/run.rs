@@ -9,9 +9,9 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 
-use crate::{EdgeChoice, RunArgs, load};
+use crate::{ColourChoice, EdgeChoice, RunArgs, load};
 use drape::bench::sampling::{SamplePoints, Sampler};
-use drape::record::{EdgeDisplay, LiveViewer};
+use drape::record::{ColourBy, EdgeDisplay, LiveViewer};
 use drape::run::{FrameState, Progress, RunError, RunOptions, run_built};
 use drape::scene::Scene;
 use drape::summary::Summary;
@@ -110,7 +110,8 @@ fn report_outcome(
 }
 
 /// The run's options from the command line: where to record (by default `<scene name>.rrd`),
-/// OBJ export, threads, live viewer, frame stride and which edges to record.
+/// OBJ export, threads, live viewer, frame stride, which edges to record and what colours the
+/// triangles.
 fn run_options(args: &RunArgs, scene: &Scene) -> RunOptions {
     let record = (!args.no_record).then(|| {
         args.out
@@ -132,6 +133,10 @@ fn run_options(args: &RunArgs, scene: &Scene) -> RunOptions {
             (false, Some(deg), _) => EdgeDisplay::Above(deg),
             (false, None, EdgeChoice::Review) => EdgeDisplay::Review,
             (false, None, EdgeChoice::All) => EdgeDisplay::All,
+        },
+        colour_by: match args.colour_by {
+            ColourChoice::Level => ColourBy::Level,
+            ColourChoice::Panel => ColourBy::Panel,
         },
     }
 }

@@ -4,7 +4,7 @@
 //! `f32` and uses glam 0.30. Vectors cross the boundary as plain arrays (`to_array()`), cast
 //! to `f32` here and nowhere else, so no glam type of either version leaks across.
 
-use rerun::components::{ClassId, Color, Position3D, Vector3D};
+use rerun::components::{Position3D, Vector3D};
 use rerun::datatypes::Rgba32;
 
 use crate::math::Vector;
@@ -16,20 +16,6 @@ use crate::math::Vector;
 pub(crate) fn level_rgb(level: u8) -> [u8; 3] {
     let last = super::LEVEL_PALETTE.len() - 1;
     super::LEVEL_PALETTE[usize::from(level).min(last)]
-}
-
-/// [`level_rgb`] as a rerun colour (opaque).
-#[inline]
-pub(crate) fn level_color(level: u8) -> Color {
-    let [r, g, b] = level_rgb(level);
-    Color::from(Rgba32::from_rgb(r, g, b))
-}
-
-/// The refinement level as a class id: the level itself, so the annotation context gives it a
-/// label (`level N`) and the exact level is kept as data in the recording.
-#[inline]
-pub(crate) fn level_class_id(level: u8) -> ClassId {
-    ClassId::from(u16::from(level))
 }
 
 /// An engine vector as three `f32`s (metres stay metres).

@@ -1,6 +1,6 @@
 //! The cloth mesh of one frame, decoded back from a recording: what the viewer shows at that
 //! frame (the latest value of each `cloth/mesh` component at or before it), mapped back onto
-//! the simulated mesh (vertices, triangles and their levels).
+//! the simulated mesh (vertices, triangles, their levels and their classes).
 
 use std::path::Path;
 
@@ -9,7 +9,7 @@ use super::mesh::{DUPLICATE_COMPONENT, LEVEL_COMPONENT, simulated_triangles};
 use super::{ENTITY_MESH, TIMELINE_FRAME};
 use rerun::external::arrow::array::{
     Array, ArrayRef, AsArray, FixedSizeListArray,
-    types::{Float32Type, UInt8Type, UInt32Type},
+    types::{Float32Type, UInt8Type, UInt16Type, UInt32Type},
 };
 use rerun::log::Chunk;
 
@@ -26,6 +26,10 @@ pub struct ClothFrame {
     pub triangles: Vec<[u32; 3]>,
     /// Refinement level per triangle.
     pub levels: Vec<u8>,
+    /// Class id per triangle (its level, or its panel index with `--colour-by panel`): the
+    /// class id of its recorded corners, which share one; empty when the recording has no
+    /// class ids.
+    pub classes: Vec<u16>,
     /// Vertices of the recorded `Mesh3D` (the simulated ones and their copies per level).
     pub recorded_vertices: usize,
     /// The frame whose row last logged the topology (at or before `frame`).
@@ -36,19 +40,20 @@ pub struct ClothFrame {
 type Latest = Option<(i64, ArrayRef)>;
 
 /// The `cloth/mesh` components [`cloth_mesh_at`] reads, in the order of [`MeshRows::latest`].
-const MESH_COMPONENTS: [&str; 5] = [
+const MESH_COMPONENTS: [&str; 6] = [
     "vertex_positions",
     "vertex_normals",
     "triangle_indices",
     LEVEL_COMPONENT,
     DUPLICATE_COMPONENT,
+    "class_ids",
 ];
 
 /// What one pass over a recording's `cloth/mesh` rows finds for one frame.
 #[derive(Default)]
 struct MeshRows {
     /// Per entry of [`MESH_COMPONENTS`]: its latest value at or before the frame.
-    latest: [Latest; 5],
+    latest: [Latest; 6],
     /// First frame with a `cloth/mesh` row.
     first: Option<i64>,
     /// Last frame with a `cloth/mesh` row.
@@ -133,7 +138,7 @@ impl MeshRows {
         if !self.at_frame {
             return Err(no_frame());
         }
-        let [positions, normals, indices, levels, copies] = &self.latest;
+        let [positions, normals, indices, levels, copies, class_ids] = &self.latest;
         let (Some((_, positions)), Some((topology_frame, indices))) = (positions, indices) else {
             return Err(no_frame());
         };
@@ -163,12 +168,27 @@ impl MeshRows {
         if levels.len() != triangles.len() {
             return Err(bad("not one level per triangle"));
         }
+        let vertex_classes = class_ids
+            .as_ref()
+            .and_then(|(_, c)| c.as_primitive_opt::<UInt16Type>())
+            .map(|c| c.values().to_vec())
+            .unwrap_or_default();
+        let classes = if vertex_classes.is_empty() {
+            Vec::new()
+        } else {
+            indices
+                .iter()
+                .map(|t| vertex_classes.get(t[0] as usize).copied())
+                .collect::<Option<Vec<u16>>>()
+                .ok_or_else(|| bad("fewer class ids than vertices"))?
+        };
         Ok(ClothFrame {
             frame,
             positions: positions[..vertices].to_vec(),
             normals: normals.into_iter().take(vertices).collect(),
             triangles,
             levels,
+            classes,
             recorded_vertices,
             topology_frame: *topology_frame,
         })

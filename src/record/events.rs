@@ -1,5 +1,5 @@
-//! Remeshing events as rerun data: labelled points at `events/points`, one text line per event
-//! at `events/log`.
+//! Remeshing events and seam welds as rerun data: labelled points at `events/points`, one text
+//! line per event at `events/log`.
 
 use super::{EventMark, convert};
 
@@ -13,8 +13,10 @@ use super::{EventMark, convert};
 /// | `merge`, `collapse` | blue `#42A5F5` |
 /// | `flip` | grey `#BDBDBD` |
 /// | `rollback` | red `#E53935` |
+/// | `weld` | green `#00C853` (the welded seams' colour) |
 pub fn event_rgb(kind: &str) -> [u8; 3] {
     match kind {
+        "weld" => super::garment::SEAM_WELDED_RGB,
         "split" => [0xFF, 0x8F, 0x00],
         "closure_split" => [0xFF, 0xD5, 0x4F],
         "bounce" => [0xAB, 0x47, 0xBC],
@@ -57,7 +59,7 @@ pub(super) fn event_points(events: &[EventMark], base_edge: Option<f32>) -> reru
             let [r, g, b] = event_rgb(e.kind);
             rerun::Rgba32::from_rgb(r, g, b)
         }))
-        .with_labels(events.iter().map(|e| e.kind));
+        .with_labels(events.iter().map(point_label));
     match base_edge {
         Some(h) => points.with_radii(events.iter().map(|e| {
             let edge = h * 0.5f32.powf(f32::from(e.level) / 2.0);
@@ -67,17 +69,31 @@ pub(super) fn event_points(events: &[EventMark], base_edge: Option<f32>) -> reru
     }
 }
 
-/// One event's log line: `KIND after step S: level L[, angle A deg], at (x, y, z) m`, at level
-/// `WARN` for rollbacks and `INFO` otherwise. `drape inspect` reads the kind back from the
-/// first word.
+/// An event point's label: the kind, and for a weld the seam (`weld left`).
+fn point_label(e: &EventMark) -> String {
+    match &e.weld {
+        Some(w) => format!("{} {}", e.kind, w.seam),
+        None => e.kind.to_owned(),
+    }
+}
+
+/// One event's log line: `KIND after step S: level L[, angle A deg], at (x, y, z) m`, or for a
+/// weld `weld after step S: seam NAME, gap G mm, at (x, y, z) m`, at level `WARN` for
+/// rollbacks and `INFO` otherwise. `drape inspect` reads the kind back from the first word.
 pub(super) fn event_line(e: &EventMark) -> rerun::TextLog {
-    let angle = e
-        .angle
-        .map(|a| format!(", angle {a:.2} deg"))
-        .unwrap_or_default();
+    let what = match &e.weld {
+        Some(w) => format!("seam {}, gap {:.2} mm", w.seam, 1e3 * w.gap),
+        None => {
+            let angle = e
+                .angle
+                .map(|a| format!(", angle {a:.2} deg"))
+                .unwrap_or_default();
+            format!("level {}{angle}", e.level)
+        }
+    };
     let line = format!(
-        "{} after step {}: level {}{angle}, at ({:.3}, {:.3}, {:.3}) m",
-        e.kind, e.step, e.level, e.position.x, e.position.y, e.position.z
+        "{} after step {}: {what}, at ({:.3}, {:.3}, {:.3}) m",
+        e.kind, e.step, e.position.x, e.position.y, e.position.z
     );
     let level = if e.kind == "rollback" { "WARN" } else { "INFO" };
     rerun::TextLog::new(line).with_level(level)

@@ -26,15 +26,52 @@ pub struct FrameView<'a> {
     pub pinned: &'a [u32],
     /// Plot path -> value, e.g. `("energy/kinetic", 0.1)`, logged at `plots/<path>`.
     pub scalars: &'a [(&'a str, f64)],
-    /// Remeshing events since the previous frame, shown at `events/points` and
-    /// written one line each to `events/log`.
+    /// Remeshing events and seam welds since the previous frame, shown at
+    /// `events/points` and written one line each to `events/log`.
     pub events: &'a [EventMark],
+    /// The garment's panels and seams (`None`: a cloth without panels, which has
+    /// no `cloth/seams` and colours as one panel named `cloth`).
+    pub garment: Option<GarmentView<'a>>,
 }
 
-/// One remeshing event, as plain data for the recording.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// A garment's panels and seams at one frame, as plain data for the recording.
+#[derive(Debug, Clone, Copy)]
+pub struct GarmentView<'a> {
+    /// Panel names, in panel index order (the legend of `--colour-by panel`).
+    pub panel_names: &'a [String],
+    /// The panel index of each triangle (same length as [`FrameView::triangles`]).
+    pub triangle_panels: &'a [u16],
+    /// The seams as line segments at `cloth/seams`.
+    pub seams: &'a [SeamSegment<'a>],
+}
+
+/// One segment of a seam: the two vertices of an open seam's pair, or an edge along a
+/// welded seam.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SeamSegment<'a> {
+    /// The seam's name.
+    pub seam: &'a str,
+    /// The segment's two vertices.
+    pub vertices: [u32; 2],
+    /// Whether the seam is welded (an edge of the welded surface) or open (a pair being
+    /// sewn).
+    pub welded: bool,
+}
+
+/// What a `weld` event adds to its mark.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WeldMark {
+    /// The welded seam's name.
+    pub seam: String,
+    /// The largest distance between a pair just before the weld, m.
+    pub gap: f64,
+}
+
+/// One remeshing event or seam weld, as plain data for the recording.
+#[derive(Debug, Clone, PartialEq)]
 pub struct EventMark {
-    /// What happened: `split`, `closure_split`, `bounce`, `merge`, `flip`, `collapse` or `rollback`.
+    /// What happened: `split`, `closure_split`, `bounce`, `merge`, `flip`, `collapse`,
+    /// `rollback` or `weld`.
     pub kind: &'static str,
     /// Where, in world coordinates (m).
     pub position: Vector,
@@ -44,6 +81,8 @@ pub struct EventMark {
     pub angle: Option<f64>,
     /// The step after which it happened.
     pub step: u64,
+    /// For a `weld`: the seam and its gap (`None` for remeshing events).
+    pub weld: Option<WeldMark>,
 }
 
 /// Checks the frame's slices against each other; returns the frame index for the timeline.
@@ -102,5 +141,34 @@ pub(super) fn validate(frame: &FrameView) -> Result<i64, RecordError> {
             "pinned vertex {i} is past the {n} vertices"
         )));
     }
+    if let Some(g) = &frame.garment {
+        validate_garment(g, n, frame.triangles.len()).map_err(invalid)?;
+    }
     Ok(index)
+}
+
+/// Checks a garment's panels and seams against the frame's `n` vertices and
+/// `triangles`; the reason when they do not fit.
+fn validate_garment(g: &GarmentView, n: usize, triangles: usize) -> Result<(), String> {
+    if g.triangle_panels.len() != triangles {
+        return Err(format!(
+            "{} triangle panels for {triangles} triangles",
+            g.triangle_panels.len()
+        ));
+    }
+    let panels = g.panel_names.len();
+    if let Some(p) = g.triangle_panels.iter().find(|&&p| p as usize >= panels) {
+        return Err(format!("panel {p} is past the {panels} panel names"));
+    }
+    if let Some(s) = g
+        .seams
+        .iter()
+        .find(|s| s.vertices.iter().any(|&i| i as usize >= n))
+    {
+        return Err(format!(
+            "seam {} segment {:?} refers to a vertex past the {n} vertices",
+            s.seam, s.vertices
+        ));
+    }
+    Ok(())
 }

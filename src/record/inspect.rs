@@ -11,12 +11,15 @@ use std::path::{Path, PathBuf};
 
 use rerun::external::arrow::array::{
     Array, ArrayRef, AsArray, ListArray, StringArray,
-    types::{Float32Type, Float64Type, UInt8Type},
+    types::{Float32Type, Float64Type, UInt8Type, UInt16Type},
 };
 use rerun::external::re_log_encoding::DecoderApp;
 use rerun::log::{Chunk, LogMsg};
 
-use super::{ENTITY_EDGES, ENTITY_EVENT_LOG, ENTITY_MESH, ENTITY_PLOTS, LEVEL_COMPONENT};
+use super::garment::{SEAM_CLASS_OPEN, SEAM_CLASS_WELDED, SEAM_COMPONENT};
+use super::{
+    ENTITY_EDGES, ENTITY_EVENT_LOG, ENTITY_MESH, ENTITY_PLOTS, ENTITY_SEAMS, LEVEL_COMPONENT,
+};
 use super::{TIMELINE_FRAME, TIMELINE_SIM_TIME, edges::ANGLE_COMPONENT};
 
 /// Why a file could not be inspected.
@@ -70,6 +73,19 @@ pub struct EntityRows {
     pub static_rows: usize,
 }
 
+/// One frame's row of `cloth/seams`.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct SeamRow {
+    /// Segments of open seams (one per pair being sewn).
+    pub open: usize,
+    /// Edges of welded seams.
+    pub welded: usize,
+    /// The seam name of each segment, in logging order.
+    pub names: Vec<String>,
+    /// The class id of each segment (0 open, 1 welded), in logging order.
+    pub classes: Vec<u16>,
+}
+
 /// What the recording holds at one value of the `frame` timeline.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct FrameInfo {
@@ -90,6 +106,8 @@ pub struct FrameInfo {
     pub max_edge_angle: Option<f64>,
     /// Smallest `dihedral_angle_deg` at `cloth/edges`, degrees.
     pub min_edge_angle: Option<f64>,
+    /// The segments of `cloth/seams` (a garment's frames only).
+    pub seams: Option<SeamRow>,
     /// `plots/<name>` values (name without the `plots/` prefix).
     pub scalars: BTreeMap<String, f64>,
     /// The lines of `events/log`, in logging order.
@@ -334,6 +352,8 @@ fn gather_row(info: &mut FrameInfo, entity: &str, cell: impl Fn(&str) -> Option<
             info.max_edge_angle = a.iter().copied().reduce(f64::max);
             info.min_edge_angle = a.iter().copied().reduce(f64::min);
         }
+    } else if entity == ENTITY_SEAMS {
+        info.seams = Some(seam_row(&cell));
     } else if entity == ENTITY_EVENT_LOG {
         if let Some(t) = cell("text")
             && let Some(t) = t.as_any().downcast_ref::<StringArray>()
@@ -348,6 +368,29 @@ fn gather_row(info: &mut FrameInfo, entity: &str, cell: impl Fn(&str) -> Option<
         && let Some(&v) = v.values().first()
     {
         info.scalars.insert(name.to_owned(), v);
+    }
+}
+
+/// One `cloth/seams` row: the segments' classes and seam names, counted by state.
+fn seam_row(cell: &impl Fn(&str) -> Option<ArrayRef>) -> SeamRow {
+    let classes: Vec<u16> = cell("class_ids")
+        .and_then(|c| {
+            c.as_primitive_opt::<UInt16Type>()
+                .map(|c| c.values().to_vec())
+        })
+        .unwrap_or_default();
+    let names: Vec<String> = cell(SEAM_COMPONENT)
+        .and_then(|n| {
+            n.as_any()
+                .downcast_ref::<StringArray>()
+                .map(|n| n.iter().flatten().map(str::to_owned).collect())
+        })
+        .unwrap_or_default();
+    SeamRow {
+        open: classes.iter().filter(|&&c| c == SEAM_CLASS_OPEN).count(),
+        welded: classes.iter().filter(|&&c| c == SEAM_CLASS_WELDED).count(),
+        names,
+        classes,
     }
 }
 

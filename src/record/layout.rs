@@ -1,5 +1,5 @@
-//! The default blueprint sent with every recording: two 3D views (refinement levels, dihedral
-//! angles) above the event log, beside a column of plots.
+//! The default blueprint sent with every recording: two 3D views (refinement levels or
+//! panels, dihedral angles) above the event log, beside a column of plots; and the legend.
 
 use std::fmt::Write as _;
 
@@ -7,8 +7,10 @@ use rerun::{RecordingStream, RecordingStreamError};
 
 use super::blueprint::{self, Node, ViewSpec};
 use super::edges::ANGLE_STOPS;
+use super::garment::{PANEL_COLOUR_NAMES, PANEL_PALETTE, SEAM_OPEN_RGB, SEAM_WELDED_RGB};
 use super::{
-    ENTITY_EDGES, ENTITY_EVENT_LOG, ENTITY_LEGEND, ENTITY_MESH, ENTITY_PLOTS, LEVEL_PALETTE,
+    ENTITY_EDGES, ENTITY_EVENT_LOG, ENTITY_LEGEND, ENTITY_MESH, ENTITY_PLOTS, ENTITY_SEAMS,
+    LEVEL_PALETTE,
 };
 
 /// Names of the palette colours, in [`LEVEL_PALETTE`] order.
@@ -25,23 +27,54 @@ const LEVEL_NAMES: [&str; 8] = [
 /// Names of the angle scale's colours, in [`ANGLE_STOPS`] order.
 const ANGLE_NAMES: [&str; 4] = ["dark slate", "violet", "orange", "yellow"];
 
-/// The legend shown beside the event log (markdown): level colours, the angle scale, and the
-/// event point colours.
-pub(super) fn legend_markdown() -> String {
-    let hex = |[r, g, b]: [u8; 3]| format!("#{r:02X}{g:02X}{b:02X}");
-    let mut s = String::from("**cloth: refinement level**\n\n");
-    let last = LEVEL_PALETTE.len() - 1;
-    for (l, (c, name)) in LEVEL_PALETTE.iter().zip(LEVEL_NAMES).enumerate() {
-        let more = if l == last { " and deeper" } else { "" };
-        let _ = writeln!(s, "- level {l}{more}: {name} `{}`", hex(*c));
+/// `#RRGGBB`.
+fn hex([r, g, b]: [u8; 3]) -> String {
+    format!("#{r:02X}{g:02X}{b:02X}")
+}
+
+/// The legend shown beside the event log (markdown): the cloth's colours (refinement levels,
+/// or with `panels` each panel's name and colour), the angle scale, the seam colours (when
+/// `seams`: a garment) and the event point colours.
+pub(super) fn legend_markdown(panels: Option<&[String]>, seams: bool) -> String {
+    let mut s = String::new();
+    match panels {
+        Some(names) => {
+            s.push_str("**cloth: panel**\n\n");
+            for (p, name) in names.iter().enumerate() {
+                let k = p % PANEL_PALETTE.len();
+                let _ = writeln!(
+                    s,
+                    "- {name}: {} `{}`",
+                    PANEL_COLOUR_NAMES[k],
+                    hex(PANEL_PALETTE[k])
+                );
+            }
+        }
+        None => {
+            s.push_str("**cloth: refinement level**\n\n");
+            let last = LEVEL_PALETTE.len() - 1;
+            for (l, (c, name)) in LEVEL_PALETTE.iter().zip(LEVEL_NAMES).enumerate() {
+                let more = if l == last { " and deeper" } else { "" };
+                let _ = writeln!(s, "- level {l}{more}: {name} `{}`", hex(*c));
+            }
+        }
     }
     s.push_str("\n**angles: dihedral angle per edge** (linear between stops)\n\n");
     for ((a, c), name) in ANGLE_STOPS.iter().zip(ANGLE_NAMES) {
         let _ = writeln!(s, "- {a} deg: {name} `{}`", hex(*c));
     }
+    if seams {
+        let _ = writeln!(
+            s,
+            "\n**seams**: open orange `{}` (each pair being sewn), welded green `{}` (the \
+             seam's edges)",
+            hex(SEAM_OPEN_RGB),
+            hex(SEAM_WELDED_RGB)
+        );
+    }
     s.push_str(
-        "\n**events**: split orange, closure split yellow, merge or collapse blue, \
-         flip grey, rollback red\n",
+        "\n**events**: split orange, closure split yellow, bounce purple, merge or collapse \
+         blue, flip grey, rollback red, weld green\n",
     );
     s
 }
@@ -49,8 +82,9 @@ pub(super) fn legend_markdown() -> String {
 /// Sends the default blueprint:
 ///
 /// - left (two thirds of the width): the 3D view `cloth` (everything but `cloth/edges`: the
-///   mesh coloured by level, pins, events, obstacles) beside the 3D view `angles` (the
-///   edges coloured by dihedral angle, with the event points and obstacles), and below them
+///   mesh coloured by level or panel, seams, pins, events, obstacles) beside the 3D view
+///   `angles` (the edges coloured by dihedral angle, with the seams, the event points and
+///   obstacles), and below them
 ///   the text log view `events` and the text document view `legend`;
 /// - right: one time-series view per top-level plot group (the first segment of the scalar
 ///   names, alphabetically).
@@ -96,6 +130,7 @@ pub(super) fn send_blueprint(
         "/",
         vec![
             format!("+ /{ENTITY_EDGES}"),
+            format!("+ /{ENTITY_SEAMS}"),
             "+ /events/points".to_owned(),
             "+ /obstacles/**".to_owned(),
         ],

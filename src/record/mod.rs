@@ -9,22 +9,29 @@
 //! What a recording holds:
 //! - timelines `frame` (sequence) and `sim_time` (duration, seconds), set before each frame
 //!   (rerun's wall-clock `log_time` timeline is turned off);
-//! - static data: view coordinates at `/` (right-handed, z up) and an annotation context at
-//!   `cloth` that names and colours the refinement levels (`level 0`, `level 1`, ...);
+//! - static data: view coordinates at `/` (right-handed, z up) and, with the first frame, an
+//!   annotation context at `cloth` that names and colours the triangles' classes: the
+//!   refinement levels (`level 0`, `level 1`, ...), or with [`ColourBy::Panel`] the garment's
+//!   panels (class id = panel index, label = panel name; `cloth` for a cloth without panels);
 //! - `cloth/mesh`: a `Mesh3D` with shared vertices, copied only where triangles of different
-//!   levels meet so that each triangle shows its level's colour from [`LEVEL_PALETTE`]; the
-//!   positions and normals every frame, the triangle indices, vertex colours, class ids
-//!   (legend) and the data `triangle_level` (`u8` per triangle) and `duplicate_of` only on
-//!   frames where the topology changed (`mesh.rs`; [`decode::cloth_mesh_at`] reads a frame
-//!   back);
+//!   classes meet so that each triangle shows its class's colour ([`LEVEL_PALETTE`] or
+//!   [`garment::PANEL_PALETTE`]); the positions and normals every frame, the triangle
+//!   indices, vertex colours, class ids (legend) and the data `triangle_level` (`u8` per
+//!   triangle) and `duplicate_of` only on frames where the topology changed (`mesh.rs`;
+//!   [`decode::cloth_mesh_at`] reads a frame back);
+//! - `cloth/seams` every frame of a garment (`garment.rs`): each open seam's pairs as segments
+//!   (class `open seam`, orange) and each welded seam's edges (class `welded seam`, green),
+//!   with the seam name and vertex pair of each segment as data; its annotation context and
+//!   line width are static;
 //! - `cloth/edges` every frame unless turned off: the edges as line segments coloured by their
 //!   dihedral angle (a class id per whole degree, [`edges::angle_class`], coloured and named by
 //!   a static annotation context at `cloth/edges`), with the angle (`dihedral_angle_deg`, `f32`)
 //!   and the vertex pair (`edge_vertices`) of each segment as data; by default the edges near
 //!   the scene's refine threshold, or all, or those above a given angle ([`EdgeDisplay`]);
 //! - `cloth/pins` every frame: the pinned vertices as points;
-//! - `events/points` and `events/log`: the remeshing events since the previous recorded frame;
-//! - `legend` (static): a markdown text document naming the colours;
+//! - `events/points` and `events/log`: the remeshing events and seam welds since the previous
+//!   recorded frame;
+//! - `legend` (static, with the first frame): a markdown text document naming the colours;
 //! - `plots/<name>` every frame for each scalar of [`FrameView::scalars`];
 //! - `obstacles/<name>`: obstacle meshes, static or per frame;
 //! - a default blueprint, sent with the first frame once the plot names are known (`layout.rs`).
@@ -42,17 +49,20 @@ pub mod edges;
 mod error;
 mod events;
 mod frame;
+pub mod garment;
 pub mod inspect;
 mod layout;
 pub mod mesh;
 pub mod obj;
+mod obstacles;
 mod recorder;
 mod report;
 mod sink;
 
 pub use edges::EdgeDisplay;
 pub use error::{BoxError, RecordError};
-pub use frame::{EventMark, FrameView};
+pub use frame::{EventMark, FrameView, GarmentView, SeamSegment, WeldMark};
+pub use garment::ColourBy;
 pub use mesh::{DUPLICATE_COMPONENT, LEVEL_COMPONENT};
 pub use recorder::Recorder;
 pub use sink::{LiveViewer, RecordTarget};
@@ -95,9 +105,11 @@ pub const TIMELINE_SIM_TIME: &str = "sim_time";
 pub const ENTITY_MESH: &str = "cloth/mesh";
 /// Entity of the edges coloured by dihedral angle.
 pub const ENTITY_EDGES: &str = "cloth/edges";
-/// Entity of the static legend (a markdown text document: level colours, angle scale, event
-/// colours).
+/// Entity of the static legend (a markdown text document: level or panel colours, angle scale,
+/// seam colours, event colours).
 pub const ENTITY_LEGEND: &str = "legend";
+/// Entity of the seams of a garment (open pairs and welded edges, coloured by state).
+pub const ENTITY_SEAMS: &str = "cloth/seams";
 /// Entity of the pinned vertices.
 pub const ENTITY_PINS: &str = "cloth/pins";
 /// Parent entity of the scalar plots: scalar `name` is logged at `plots/<name>`.

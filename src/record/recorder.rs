@@ -6,16 +6,13 @@ use std::path::Path;
 
 use rerun::{AsComponents, EntityPath, RecordingStream, RecordingStreamBuilder};
 
+use super::garment::{self, ColourBy, SINGLE_PANEL_NAME};
 use super::{
     APPLICATION_ID, BoxError, ENTITY_EDGES, ENTITY_EVENT_LOG, ENTITY_EVENT_POINTS, ENTITY_LEGEND,
-    ENTITY_MESH, ENTITY_OBSTACLES, ENTITY_PINS, ENTITY_PLOTS, EdgeDisplay, FrameView, RecordError,
+    ENTITY_MESH, ENTITY_PINS, ENTITY_PLOTS, ENTITY_SEAMS, EdgeDisplay, FrameView, RecordError,
     RecordTarget, TIMELINE_FRAME, TIMELINE_SIM_TIME, convert, edges, events, frame, layout, mesh,
     recording_id, sink,
 };
-use crate::math::Vector;
-
-/// Colour of the obstacles (light grey).
-const OBSTACLE_COLOR: [u8; 3] = [0xB0, 0xB0, 0xB0];
 
 /// Colour of the pin markers (white, visible on every level colour).
 const PIN_COLOR: [u8; 3] = [0xFF, 0xFF, 0xFF];
@@ -33,6 +30,12 @@ pub struct Recorder {
     /// `target.describe()`, for error messages.
     described: String,
     edges: EdgeDisplay,
+    /// What the mesh's triangles are coloured by.
+    colour_by: ColourBy,
+    /// The class of each triangle of the frame being logged (scratch).
+    classes: Vec<u16>,
+    /// Whether the static data of `cloth/seams` has been logged.
+    seams_static_sent: bool,
     mesh_path: EntityPath,
     edges_path: EntityPath,
     pins_path: EntityPath,
@@ -51,6 +54,7 @@ impl std::fmt::Debug for Recorder {
         f.debug_struct("Recorder")
             .field("target", &self.target)
             .field("edges", &self.edges)
+            .field("colour_by", &self.colour_by)
             .finish_non_exhaustive()
     }
 }
@@ -59,6 +63,16 @@ impl Recorder {
     /// Opens `path` for writing, with every edge drawn; see [`Recorder::open`].
     pub fn create(path: &Path, scene_name: &str) -> Result<Recorder, RecordError> {
         Recorder::open(&RecordTarget::file(path), scene_name, EdgeDisplay::All)
+    }
+
+    /// Opens the recording's destinations with the triangles coloured by refinement level;
+    /// see [`Recorder::open_coloured`].
+    pub fn open(
+        target: &RecordTarget,
+        scene_name: &str,
+        edges: EdgeDisplay,
+    ) -> Result<Recorder, RecordError> {
+        Recorder::open_coloured(target, scene_name, edges, ColourBy::Level)
     }
 
     /// Opens the recording's destinations and logs the static data.
@@ -71,17 +85,21 @@ impl Recorder {
     ///
     /// The recording id derives from `scene_name` ([`recording_id`]), which is also the
     /// recording's name. Logs once: view coordinates (right-handed, z up) and the annotation
-    /// context of the level colours (and one of the angle classes at `cloth/edges` unless
-    /// edges are off). The default blueprint follows with the first frame.
+    /// context of the angle classes at `cloth/edges` (unless edges are off). The annotation
+    /// context of the triangles' classes (levels, or panels with [`ColourBy::Panel`]), the
+    /// legend, the static parts of `cloth/seams` (garments only) and the default blueprint
+    /// follow with the first frame, which names the panels and tells whether the cloth is a
+    /// garment.
     ///
     /// Without a live viewer the rows of an entity are batched into chunks of up to 2 MiB
     /// whatever the time between frames ([`sink::file_only_batching`]): a slow run otherwise
     /// gets one chunk, with its own schema, per entity and frame. With a viewer rerun's
     /// default (a chunk at least every 200 ms) keeps the viewer up to date.
-    pub fn open(
+    pub fn open_coloured(
         target: &RecordTarget,
         scene_name: &str,
         edges: EdgeDisplay,
+        colour_by: ColourBy,
     ) -> Result<Recorder, RecordError> {
         let described = target.describe();
         let create_err = |source: BoxError| RecordError::Create {
@@ -113,6 +131,9 @@ impl Recorder {
             target: target.clone(),
             described,
             edges,
+            colour_by,
+            classes: Vec::new(),
+            seams_static_sent: false,
             mesh_path: EntityPath::from(ENTITY_MESH),
             edges_path: EntityPath::from(ENTITY_EDGES),
             pins_path: EntityPath::from(ENTITY_PINS),
@@ -125,26 +146,42 @@ impl Recorder {
         Ok(recorder)
     }
 
-    /// Logs what every frame shares, once: view coordinates, the level annotations, the
-    /// angle annotations (unless edges are off) and the legend.
+    /// Logs what every frame shares, once: view coordinates and the angle annotations
+    /// (unless edges are off).
     fn log_static_data(&self) -> Result<(), RecordError> {
         self.stream
             .log_static("/", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP())
             .map_err(|e| self.log_err("/", e))?;
-        self.stream
-            .log_static("cloth", &convert::level_annotations())
-            .map_err(|e| self.log_err("cloth", e))?;
         if self.edges != EdgeDisplay::Off {
             self.stream
                 .log_static(ENTITY_EDGES, &edges::angle_annotations())
                 .map_err(|e| self.log_err(ENTITY_EDGES, e))?;
         }
+        Ok(())
+    }
+
+    /// Logs, with the first frame, the static data that depends on the cloth: the annotation
+    /// context at `cloth` (levels, or the panels' names), the legend, and the blueprint.
+    fn log_first_frame_data(&self, frame: &FrameView) -> Result<(), RecordError> {
+        let single = [SINGLE_PANEL_NAME.to_owned()];
+        let panels = frame
+            .garment
+            .as_ref()
+            .map_or(&single[..], |g| g.panel_names);
+        let context = match self.colour_by {
+            ColourBy::Level => convert::level_annotations(),
+            ColourBy::Panel => garment::panel_annotations(panels),
+        };
         self.stream
-            .log_static(
-                ENTITY_LEGEND,
-                &rerun::TextDocument::from_markdown(layout::legend_markdown()),
-            )
-            .map_err(|e| self.log_err(ENTITY_LEGEND, e))
+            .log_static("cloth", &context)
+            .map_err(|e| self.log_err("cloth", e))?;
+        let legend_panels = (self.colour_by == ColourBy::Panel).then_some(panels);
+        let legend = layout::legend_markdown(legend_panels, frame.garment.is_some());
+        self.stream
+            .log_static(ENTITY_LEGEND, &rerun::TextDocument::from_markdown(legend))
+            .map_err(|e| self.log_err(ENTITY_LEGEND, e))?;
+        let names: Vec<&str> = frame.scalars.iter().map(|(n, _)| *n).collect();
+        layout::send_blueprint(&self.stream, &names).map_err(|e| self.log_err("blueprint", e))
     }
 
     /// Where the recording goes.
@@ -154,9 +191,10 @@ impl Recorder {
 
     /// Logs one frame: sets the `frame` and `sim_time` timelines, then logs the mesh at
     /// `cloth/mesh` (positions and normals; the topology, colours, class ids and
-    /// `triangle_level` data too when the triangles or levels changed), the edges at
-    /// `cloth/edges` (unless [`EdgeDisplay::Off`]), the pinned vertices at `cloth/pins`, the
-    /// events at `events/points` and `events/log`, and each scalar at `plots/<name>`.
+    /// `triangle_level` data too when the triangles, levels or classes changed), the edges at
+    /// `cloth/edges` (unless [`EdgeDisplay::Off`]), a garment's seams at `cloth/seams`, the
+    /// pinned vertices at `cloth/pins`, the events at `events/points` and `events/log`, and
+    /// each scalar at `plots/<name>`.
     ///
     /// The data is validated first ([`RecordError::InvalidFrame`] on a length mismatch, an
     /// index out of range or a non-finite `sim_time`); nothing is logged for an invalid frame
@@ -166,9 +204,7 @@ impl Recorder {
     pub fn record_frame(&mut self, frame: &FrameView) -> Result<(), RecordError> {
         let frame_index = frame::validate(frame)?;
         if !self.blueprint_sent {
-            let names: Vec<&str> = frame.scalars.iter().map(|(n, _)| *n).collect();
-            layout::send_blueprint(&self.stream, &names)
-                .map_err(|e| self.log_err("blueprint", e))?;
+            self.log_first_frame_data(frame)?;
             self.blueprint_sent = true;
             self.base_edge = events::mean_edge_length(frame.positions, frame.triangles);
         }
@@ -179,6 +215,7 @@ impl Recorder {
 
         self.log_mesh(frame)?;
         self.log_edges(frame)?;
+        self.log_seams(frame)?;
         self.log_pins(frame)?;
         self.log_events(frame)?;
         self.log_scalars(frame)
@@ -187,12 +224,28 @@ impl Recorder {
     /// `cloth/mesh`: positions and normals, with the topology when it changed.
     fn log_mesh(&mut self, frame: &FrameView) -> Result<(), RecordError> {
         let (positions, normals) = (frame.positions, frame.vertex_normals);
-        let changed =
-            self.cloth_mesh
-                .update(positions.len(), frame.triangles, frame.triangle_levels);
+        self.classes.clear();
+        match (self.colour_by, &frame.garment) {
+            (ColourBy::Level, _) => self
+                .classes
+                .extend(frame.triangle_levels.iter().map(|&l| u16::from(l))),
+            (ColourBy::Panel, Some(g)) => self.classes.extend_from_slice(g.triangle_panels),
+            (ColourBy::Panel, None) => self.classes.resize(frame.triangles.len(), 0),
+        }
+        let changed = self.cloth_mesh.update(
+            positions.len(),
+            frame.triangles,
+            frame.triangle_levels,
+            &self.classes,
+        );
         let geometry = self.cloth_mesh.geometry(positions, normals);
         let logged = if changed {
-            let (topology, data) = self.cloth_mesh.topology();
+            let (topology, data) = match self.colour_by {
+                ColourBy::Level => self
+                    .cloth_mesh
+                    .topology(|c| convert::level_rgb(u8::try_from(c).unwrap_or(u8::MAX))),
+                ColourBy::Panel => self.cloth_mesh.topology(garment::panel_rgb),
+            };
             self.stream.log(
                 self.mesh_path.clone(),
                 &[&geometry as &dyn AsComponents, &topology, &data],
@@ -216,6 +269,25 @@ impl Recorder {
                 .map_err(|e| self.log_err(ENTITY_EDGES, e))?;
         }
         Ok(())
+    }
+
+    /// `cloth/seams` for a garment: every seam's segments, this frame's positions; with the
+    /// first garment frame its static annotation context and line width.
+    fn log_seams(&mut self, frame: &FrameView) -> Result<(), RecordError> {
+        let Some(g) = &frame.garment else {
+            return Ok(());
+        };
+        if !self.seams_static_sent {
+            let (context, width) = garment::seam_static();
+            self.stream
+                .log_static(ENTITY_SEAMS, &[&context as &dyn AsComponents, &width])
+                .map_err(|e| self.log_err(ENTITY_SEAMS, e))?;
+            self.seams_static_sent = true;
+        }
+        let (strips, data) = garment::seam_row(frame.positions, g.seams);
+        self.stream
+            .log(ENTITY_SEAMS, &[&strips as &dyn AsComponents, &data])
+            .map_err(|e| self.log_err(ENTITY_SEAMS, e))
     }
 
     /// `cloth/pins`: the pinned vertices as white points.
@@ -268,98 +340,6 @@ impl Recorder {
         Ok(())
     }
 
-    /// Logs an obstacle's triangulation at `obstacles/<name>` (non-alphanumeric characters of
-    /// `name` become `_`) in a neutral grey: as static data when `fixed` (log it once), else
-    /// at the current frame (call it after [`Recorder::record_frame`] every frame).
-    pub fn record_obstacle(
-        &mut self,
-        name: &str,
-        positions: &[Vector],
-        triangles: &[[u32; 3]],
-        fixed: bool,
-    ) -> Result<(), RecordError> {
-        let n = positions.len();
-        if let Some(t) = triangles
-            .iter()
-            .find(|t| t.iter().any(|&i| i as usize >= n))
-        {
-            return Err(RecordError::InvalidFrame {
-                frame: 0,
-                reason: format!("obstacle {name}: triangle {t:?} indexes past {n} vertices"),
-            });
-        }
-        let entity = obstacle_entity(name);
-        let [r, g, b] = OBSTACLE_COLOR;
-        let mesh = rerun::Mesh3D::new(positions.iter().map(|&p| convert::position(p)))
-            .with_triangle_indices(triangles.iter().copied())
-            .with_albedo_factor(rerun::Rgba32::from_rgb(r, g, b));
-        let logged = if fixed {
-            self.stream.log_static(entity.as_str(), &mesh)
-        } else {
-            self.stream.log(entity.as_str(), &mesh)
-        };
-        logged.map_err(|e| self.log_err(&entity, e))
-    }
-
-    /// Logs a deforming obstacle mesh at `obstacles/<name>`: its vertex
-    /// positions at the current frame and, when `triangles` is not empty (the
-    /// first frame), its triangles and colour as static data, which every
-    /// frame's positions share (call it after [`Recorder::record_frame`]
-    /// every frame).
-    pub fn record_deforming_obstacle(
-        &mut self,
-        name: &str,
-        positions: &[Vector],
-        triangles: &[[u32; 3]],
-    ) -> Result<(), RecordError> {
-        let n = positions.len();
-        if let Some(t) = triangles
-            .iter()
-            .find(|t| t.iter().any(|&i| i as usize >= n))
-        {
-            return Err(RecordError::InvalidFrame {
-                frame: 0,
-                reason: format!("obstacle {name}: triangle {t:?} indexes past {n} vertices"),
-            });
-        }
-        let entity = obstacle_entity(name);
-        if !triangles.is_empty() {
-            let [r, g, b] = OBSTACLE_COLOR;
-            let topology = rerun::Mesh3D::update_fields()
-                .with_triangle_indices(triangles.iter().copied())
-                .with_albedo_factor(rerun::Rgba32::from_rgb(r, g, b));
-            self.stream
-                .log_static(entity.as_str(), &topology)
-                .map_err(|e| self.log_err(&entity, e))?;
-        }
-        let moved = rerun::Mesh3D::update_fields()
-            .with_vertex_positions(positions.iter().map(|&p| convert::position(p)));
-        self.stream
-            .log(entity.as_str(), &moved)
-            .map_err(|e| self.log_err(&entity, e))
-    }
-
-    /// Logs a moving rigid obstacle's pose at the current frame as the
-    /// `Transform3D` of `obstacles/<name>`, which places the mesh that
-    /// [`Recorder::record_obstacle`] logged once in the obstacle's local frame
-    /// (call it after [`Recorder::record_frame`] every frame).
-    pub fn record_obstacle_pose(
-        &mut self,
-        name: &str,
-        translation: Vector,
-        rotation: glam::DQuat,
-    ) -> Result<(), RecordError> {
-        let entity = obstacle_entity(name);
-        let q = rotation.normalize().to_array().map(|c| c as f32);
-        let transform = rerun::Transform3D::from_translation_rotation(
-            convert::f32x3(translation),
-            rerun::Quaternion::from_xyzw(q),
-        );
-        self.stream
-            .log(entity.as_str(), &transform)
-            .map_err(|e| self.log_err(&entity, e))
-    }
-
     /// Flushes and closes the stream (the file's footer included) and returns the size of the
     /// `.rrd` file in bytes (0 when only streaming to a viewer).
     ///
@@ -383,7 +363,13 @@ impl Recorder {
         }
     }
 
-    fn log_err(
+    /// The recording stream (for the obstacle logging in `obstacles.rs`).
+    pub(super) fn stream(&self) -> &RecordingStream {
+        &self.stream
+    }
+
+    /// A [`RecordError::Log`] for `entity`.
+    pub(super) fn log_err(
         &self,
         entity: &str,
         source: impl std::error::Error + Send + Sync + 'static,
@@ -412,14 +398,4 @@ impl Drop for Recorder {
         }
         drop(stream);
     }
-}
-
-/// `obstacles/<name>`, the characters of `name` other than ASCII letters and
-/// digits replaced by `_`.
-fn obstacle_entity(name: &str) -> String {
-    let clean: String = name
-        .chars()
-        .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
-        .collect();
-    format!("{ENTITY_OBSTACLES}/{clean}")
 }

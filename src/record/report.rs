@@ -36,12 +36,14 @@ fn counts_line(counts: &BTreeMap<String, usize>) -> String {
 }
 
 impl Inspection {
-    /// The overview: file, ids, frames and time span, mesh size range, event counts by kind,
-    /// the frames with the most events, and every entity path with its row counts.
+    /// The overview: file, ids, frames and time span, mesh size range, a garment's seam
+    /// segments, event counts by kind, the frames with the most events, and every entity path
+    /// with its row counts.
     pub fn report(&self) -> String {
         let mut s = String::new();
         self.write_file_lines(&mut s);
         self.write_frame_lines(&mut s);
+        self.write_seam_line(&mut s);
         self.write_event_lines(&mut s);
         let _ = writeln!(s, "entities (rows on the timelines, static rows):");
         let width = self.entities.keys().map(String::len).max().unwrap_or(0);
@@ -130,6 +132,24 @@ impl Inspection {
         }
     }
 
+    /// The overview's seam line (garments only): open segments and welded edges per frame.
+    fn write_seam_line(&self, s: &mut String) {
+        let rows: Vec<_> = self
+            .frames
+            .values()
+            .filter_map(|f| f.seams.as_ref())
+            .collect();
+        if rows.is_empty() {
+            return;
+        }
+        let _ = writeln!(
+            s,
+            "seams per frame: open segments {}; welded edges {}",
+            range(rows.iter().map(|r| r.open)),
+            range(rows.iter().map(|r| r.welded)),
+        );
+    }
+
     /// The overview's event counts by kind and the busiest frames.
     fn write_event_lines(&self, s: &mut String) {
         let counts = self.event_counts();
@@ -210,7 +230,7 @@ impl Inspection {
     }
 
     /// One frame in detail: its time, mesh statistics (triangles, vertices, triangles per
-    /// level), edges, every plot value, and its events.
+    /// level), edges, a garment's seams, every plot value, and its events.
     pub fn frame_report(&self, n: i64) -> Result<String, InspectError> {
         let f = self.frame(n)?;
         let mut s = String::new();
@@ -251,6 +271,13 @@ impl Inspection {
                 "edges: {e} recorded, largest angle {}",
                 f.max_edge_angle
                     .map_or("-".to_owned(), |a| format!("{a:.2} deg"))
+            );
+        }
+        if let Some(r) = &f.seams {
+            let _ = writeln!(
+                s,
+                "seams: {} open segments, {} welded edges",
+                r.open, r.welded
             );
         }
         let _ = writeln!(s, "plots:");

@@ -69,10 +69,11 @@ impl<'a> FrameLoop<'a> {
                     live: live.clone(),
                 };
                 let refine = scene.adapt.as_ref().map(|a| a.refine_angle);
-                Some(Recorder::open(
+                Some(Recorder::open_coloured(
                     &target,
                     &scene.name,
                     opts.edges.resolve(refine),
+                    opts.colour_by,
                 )?)
             }
         };
@@ -181,6 +182,7 @@ impl<'a> FrameLoop<'a> {
         if self.recorder.is_none() {
             // Nobody takes the events: drop them rather than let them pile up.
             self.state.adapter.as_mut().map(Adapter::take_events);
+            self.state.welds.clear();
         }
         Ok(())
     }

@@ -1,12 +1,16 @@
 //! The per-frame recording block of a run: gathers the world's state, the pending remeshing
-//! events and the plots into a [`FrameView`] for the recorder.
+//! events and seam welds, a garment's panels and seams, and the plots into a [`FrameView`]
+//! for the recorder.
+
+use std::collections::HashSet;
 
 use crate::adapt::{AdaptEvent, Adapter, EventKind, edge_angles};
 use crate::collide::Drawn;
 use crate::math::{Scalar, Vector};
+use crate::mesh::Mesh;
 use crate::physics::Energy;
-use crate::record::{EventMark, FrameView, Recorder};
-use crate::sim::{Pipeline, Setup, SimState};
+use crate::record::{EventMark, FrameView, GarmentView, Recorder, SeamSegment, WeldMark};
+use crate::sim::{Pipeline, Setup, SimState, WeldEvent};
 use crate::world::World;
 
 use super::RunError;
@@ -34,9 +38,9 @@ pub(super) struct Snapshot {
     pub frame_interval: Scalar,
 }
 
-/// Records the world's current state as frame `snap.frame`, with the events since the previous
-/// recorded frame, the plots, and the obstacles (their meshes with frame 0, the poses of
-/// moving ones, or the mesh of a moving plane, every recorded frame).
+/// Records the world's current state as frame `snap.frame`, with the events and welds since
+/// the previous recorded frame (taken from the state), a garment's seams, the plots, and the
+/// obstacles ([`record_obstacles`]).
 pub(super) fn record_state(
     rec: &mut Recorder,
     setup: &Setup,
@@ -50,8 +54,16 @@ pub(super) fn record_state(
         .as_mut()
         .map(Adapter::take_events)
         .unwrap_or_default();
+    let welds = std::mem::take(&mut state.welds);
     let world = &state.world;
-    let marks: Vec<EventMark> = events.iter().map(event_mark).collect();
+    let mut marks: Vec<EventMark> = events.iter().map(event_mark).collect();
+    marks.extend(welds.iter().map(weld_mark));
+    let seams = seam_segments(&world.mesh);
+    let garment = world.mesh.panels().map(|p| GarmentView {
+        panel_names: &p.names,
+        triangle_panels: &p.of_triangle,
+        seams: &seams,
+    });
     let angles = edge_angles(world);
     let edges: Vec<[u32; 2]> = world.mesh.edges.iter().map(|e| e.vertices).collect();
     world.vertex_normals(normals);
@@ -103,14 +115,26 @@ pub(super) fn record_state(
         pinned: &pinned,
         scalars: &scalars,
         events: &marks,
+        garment,
     })?;
+    record_obstacles(rec, setup, world, snap.frame)
+}
+
+/// Records the obstacles at `frame`: their meshes with frame 0, and every recorded frame the
+/// poses of moving ones and the mesh of a moving plane or the vertices of a deforming mesh.
+fn record_obstacles(
+    rec: &mut Recorder,
+    setup: &Setup,
+    world: &World,
+    frame: u64,
+) -> Result<(), RunError> {
     if setup.obstacles.is_empty() {
         return Ok(());
     }
     // Every mesh but a moving plane's is logged once, at the first frame;
     // moving rigid shapes are placed by a transform every frame, deforming
     // meshes get their vertex positions every frame.
-    let first = snap.frame == 0;
+    let first = frame == 0;
     for m in setup
         .obstacles
         .meshes(world.time, plane_display(world), first)
@@ -155,5 +179,60 @@ fn event_mark(e: &AdaptEvent) -> EventMark {
         level: e.level,
         angle: e.angle,
         step: e.step,
+        weld: None,
     }
+}
+
+/// The recording's plain view of a seam weld: kind `weld`, with the seam and its gap.
+fn weld_mark(w: &WeldEvent) -> EventMark {
+    EventMark {
+        kind: "weld",
+        position: w.position,
+        level: 0,
+        angle: None,
+        step: w.step,
+        weld: Some(WeldMark {
+            seam: w.seam.clone(),
+            gap: w.gap,
+        }),
+    }
+}
+
+/// A garment's seams as segments for `cloth/seams` (none for a cloth without panels): each
+/// open seam's pairs, and each welded seam's edges, the interior edges between two of its
+/// vertices whose two triangles lie in different panels or meet there with different
+/// pattern coordinates (the edges the weld joined; a chord inside one panel between two
+/// seam vertices is left out).
+fn seam_segments(mesh: &Mesh) -> Vec<SeamSegment<'_>> {
+    let Some(panels) = mesh.panels() else {
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    for seam in &panels.seams {
+        let segment = |vertices: [u32; 2], welded: bool| SeamSegment {
+            seam: &seam.name,
+            vertices,
+            welded,
+        };
+        if seam.is_open() {
+            out.extend(seam.pairs.iter().map(|&p| segment(p, false)));
+            continue;
+        }
+        let on_seam: HashSet<u32> = seam.pairs.iter().flatten().copied().collect();
+        for e in mesh.edges.iter().filter(|e| e.is_interior()) {
+            let [a, b] = e.vertices;
+            if !(on_seam.contains(&a) && on_seam.contains(&b)) {
+                continue;
+            }
+            let [t0, t1] = e.triangles.map(|t| t as usize);
+            let across = mesh.panel_of(t0) != mesh.panel_of(t1)
+                || [a, b]
+                    .iter()
+                    .any(|&v| mesh.corner_at(t0, v) != mesh.corner_at(t1, v));
+            if across {
+                out.push(segment(e.vertices, true));
+            }
+        }
+    }
+    out
 }

@@ -32,6 +32,7 @@ fn mark(kind: &'static str, level: u8, step: u64) -> EventMark {
         level,
         angle: Some(20.0),
         step,
+        weld: None,
     }
 }
 
@@ -68,6 +69,7 @@ fn known_recording(path: &Path) {
             pinned: &[3],
             scalars: &vertices,
             events: ev,
+            garment: None,
         })
         .expect("frame");
     }
@@ -165,6 +167,7 @@ fn inspect_frames_prints_a_line_per_frame_and_the_stepping_total() {
             pinned: &[],
             scalars: &scalars,
             events: &[],
+            garment: None,
         })
         .expect("frame");
     }

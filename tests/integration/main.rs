@@ -22,6 +22,7 @@ mod elements;
 mod energy;
 mod fast_contact;
 mod fuzz;
+mod garment_recording;
 mod garments;
 mod gradient;
 mod inspect_cli;

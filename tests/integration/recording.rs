@@ -78,6 +78,7 @@ fn record_mesh(
             pinned: &mesh.pinned,
             scalars: &scalars,
             events: &[],
+            garment: None,
         })?;
         spent += start.elapsed();
         std::thread::sleep(pause);
@@ -306,6 +307,7 @@ fn dropped_recorder_leaves_valid_file() {
             pinned: &sq.pinned,
             scalars: &[],
             events: &[],
+            garment: None,
         })?;
         // A later frame is invalid: `?` returns early and drops the recorder.
         rec.record_frame(&FrameView {
@@ -320,6 +322,7 @@ fn dropped_recorder_leaves_valid_file() {
             pinned: &[],
             scalars: &[],
             events: &[],
+            garment: None,
         })?;
         Ok(())
     })();
@@ -419,6 +422,7 @@ fn decoded_frame_rebuilds_the_triangle_list_with_levels() {
                 pinned: &m.pinned,
                 scalars: &[],
                 events: &[],
+                garment: None,
             })
             .expect("frame");
             recorded.push(positions);
