@@ -7,7 +7,7 @@
 use std::path::Path;
 
 use crate::math::{Scalar, Vector, rotation_from_euler_deg};
-use crate::mesh::{self, Mesh, MeshError, ObjError};
+use crate::mesh::{self, Mesh, MeshError, ObjError, Sewing};
 use crate::pins::{PinError, Pins};
 use crate::spec::{ClothMesh, ClothSpec, Obstacle, Pin};
 
@@ -85,7 +85,11 @@ impl World {
                 (m, local)
             }
             ClothMesh::Obj { path, uv_scale } => {
-                let obj = mesh::load_obj(Path::new(path), *uv_scale)?;
+                let sewing = Sewing {
+                    stiffness: mesh::DEFAULT_SEWING_STIFFNESS,
+                    weld_gap: mesh::DEFAULT_WELD_GAP,
+                };
+                let obj = mesh::load_obj(Path::new(path), *uv_scale, sewing)?;
                 (obj.mesh, obj.positions)
             }
         };

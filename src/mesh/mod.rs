@@ -16,7 +16,9 @@ pub use generate::{
 };
 pub use obj::{ObjCloth, ObjError, load_obj};
 pub use pairmap::{PairHasher, PairMap, PairSet};
-pub use panels::{Panels, Pattern, Seam, SeamState, Sewing, Weld};
+pub use panels::{
+    DEFAULT_SEWING_STIFFNESS, DEFAULT_WELD_GAP, Panels, Pattern, Seam, SeamState, Sewing, Weld,
+};
 pub use topology::{Edge, NO_TRIANGLE};
 
 use crate::math::{Scalar, Vector2};

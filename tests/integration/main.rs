@@ -31,6 +31,8 @@ mod membrane_runs;
 mod mesh;
 mod meshbody;
 mod metric;
+mod obj_garment_export;
+mod obj_garments;
 mod physics;
 mod pins;
 mod pins_attached;
