@@ -90,9 +90,9 @@ impl World {
             ClothMesh::Obj {
                 path,
                 uv_scale,
-                sewing: _,
+                sewing,
             } => {
-                let obj = mesh::load_obj(Path::new(path), *uv_scale)?;
+                let obj = mesh::load_obj(Path::new(path), *uv_scale, *sewing)?;
                 (obj.mesh, obj.positions)
             }
             ClothMesh::Panels(garment) => {

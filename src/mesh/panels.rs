@@ -18,6 +18,14 @@
 use super::{Mesh, MeshError, topology};
 use crate::math::{Scalar, Vector, Vector2};
 
+/// The sewing stiffness a seam gets unless told otherwise, N/m per m of seam:
+/// a 1 m seam's springs together pull with 50 N per metre of gap.
+pub const DEFAULT_SEWING_STIFFNESS: Scalar = 50.0;
+
+/// The weld gap a seam gets unless told otherwise, m: it is welded once every
+/// pair is closer than 5 mm.
+pub const DEFAULT_WELD_GAP: Scalar = 0.005;
+
 /// Where each triangle's corners lie in material space.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub enum Pattern {
@@ -58,13 +66,6 @@ pub struct Seam {
     /// How the seam is sewn and when it is welded.
     pub sewing: Sewing,
 }
-
-/// The default sewing stiffness per metre of seam, N/m per m: a 2 cm gap
-/// pulls with 1 N per metre of seam.
-pub const DEFAULT_SEWING_STIFFNESS: Scalar = 50.0;
-
-/// The default weld gap, m: a seam whose pairs are all within 5 mm is welded.
-pub const DEFAULT_WELD_GAP: Scalar = 0.005;
 
 /// How a seam is sewn: the pull of its springs and the gap at which it is welded.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -384,6 +385,21 @@ fn check_panel_lengths(
                 vertex: v as u32,
                 value,
             });
+        }
+    }
+    // As in `Mesh::new`: areas must stay in double precision's normal range.
+    let finite: Vec<Vector2> = panels
+        .corners
+        .iter()
+        .flatten()
+        .copied()
+        .filter(|p| p.is_finite())
+        .collect();
+    if !finite.is_empty() {
+        let (lo, hi) = super::bounds(&finite);
+        let size = (hi.x - lo.x).hypot(hi.y - lo.y);
+        if size > 0.0 && !(size * size).is_normal() {
+            return Err(MeshError::OutOfScale { size });
         }
     }
     Ok(())

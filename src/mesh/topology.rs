@@ -111,30 +111,35 @@ fn shares_edge_at(a: &[u32; 3], b: &[u32; 3], v: u32) -> bool {
     a.iter().any(|&w| w != v && b.contains(&w))
 }
 
-struct UnionFind {
+/// Disjoint sets over `0..n` (the smaller root wins a union; path halving).
+pub(super) struct UnionFind {
     parent: Vec<usize>,
 }
 
 impl UnionFind {
-    fn new(n: usize) -> Self {
+    /// `n` singletons.
+    pub(super) fn new(n: usize) -> Self {
         UnionFind {
             parent: (0..n).collect(),
         }
     }
-    fn find(&mut self, mut x: usize) -> usize {
+    /// The representative of `x`'s set: its smallest member.
+    pub(super) fn find(&mut self, mut x: usize) -> usize {
         while self.parent[x] != x {
             self.parent[x] = self.parent[self.parent[x]];
             x = self.parent[x];
         }
         x
     }
-    fn union(&mut self, a: usize, b: usize) {
+    /// Joins the sets of `a` and `b`.
+    pub(super) fn union(&mut self, a: usize, b: usize) {
         let (ra, rb) = (self.find(a), self.find(b));
         if ra != rb {
             self.parent[ra.max(rb)] = ra.min(rb);
         }
     }
-    fn count(&mut self) -> usize {
+    /// The number of sets.
+    pub(super) fn count(&mut self) -> usize {
         (0..self.parent.len())
             .filter(|&i| self.find(i) == i)
             .count()

@@ -1,10 +1,19 @@
 //! Wavefront OBJ export of single frames, for tools that do not read `.rrd`.
+//!
+//! A plain cloth is written with one texture coordinate per vertex
+//! ([`write_frame_obj`]); a garment with one per distinct corner coordinate,
+//! its panels as groups and its open seams as `l` elements
+//! ([`write_mesh_obj`]), so that drape reads the file back as the same panels
+//! and seams.
 
+use std::collections::HashMap;
+use std::collections::hash_map::Entry;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use super::RecordError;
 use crate::math::{Vector, Vector2};
+use crate::mesh::{Mesh, Panels};
 
 /// Writes `DIR/frame_NNNNN.obj` (frame number zero-padded to 5 digits) for one frame.
 ///
@@ -66,4 +75,105 @@ pub fn write_frame_obj(
     };
     write(&mut out).map_err(io_err)?;
     Ok(path)
+}
+
+/// Writes `DIR/frame_NNNNN.obj` for one frame of `mesh` at `positions`: as
+/// [`write_frame_obj`] for a plain cloth; for a garment, one `v` line per vertex,
+/// one `vt` line per distinct (vertex, corner coordinate) (a vertex on a welded
+/// seam has one per panel), a `g NAME` line wherever the panel changes, one
+/// `f a/ta b/tb c/tc` line per triangle and one `l a b` line per pair of each
+/// open seam (first side first).
+///
+/// [`crate::mesh::load_obj`] reads such a file back as the same panels (names,
+/// triangles' panels, corner coordinates), home coordinates and open seams (their
+/// pairs; their names follow the new file's lines), as long as no two vertices
+/// share a position (equal positions are read as one vertex) and the vertices are
+/// numbered in the order the triangles first use them (otherwise they come back
+/// renumbered in that order). A welded seam comes back as its shared vertices.
+///
+/// Fails as [`write_frame_obj`] does, and with [`RecordError::InvalidFrame`] if
+/// `positions` does not have one entry per vertex of `mesh`.
+pub fn write_mesh_obj(
+    dir: &Path,
+    frame: u64,
+    positions: &[Vector],
+    mesh: &Mesh,
+) -> Result<PathBuf, RecordError> {
+    let Some(panels) = mesh.panels() else {
+        return write_frame_obj(dir, frame, positions, &mesh.material, &mesh.triangles);
+    };
+    if positions.len() != mesh.vertex_count() {
+        return Err(RecordError::InvalidFrame {
+            frame,
+            reason: format!(
+                "{} positions for {} vertices",
+                positions.len(),
+                mesh.vertex_count()
+            ),
+        });
+    }
+    let path = dir.join(format!("frame_{frame:05}.obj"));
+    let io_err = |source| RecordError::Obj {
+        path: path.clone(),
+        source,
+    };
+    let file = std::fs::File::create(&path).map_err(io_err)?;
+    let mut out = std::io::BufWriter::new(file);
+    write_garment(&mut out, frame, positions, mesh, panels).map_err(io_err)?;
+    Ok(path)
+}
+
+/// The garment's OBJ text (see [`write_mesh_obj`]).
+fn write_garment(
+    out: &mut impl std::io::Write,
+    frame: u64,
+    positions: &[Vector],
+    mesh: &Mesh,
+    panels: &Panels,
+) -> std::io::Result<()> {
+    writeln!(out, "# drape frame {frame}: {} panels", panels.names.len())?;
+    for p in positions {
+        writeln!(out, "v {} {} {}", p.x, p.y, p.z)?;
+    }
+    // One texture coordinate per distinct (vertex, corner), in first-use order.
+    let mut index: HashMap<(u32, [u64; 2]), u64> = HashMap::new();
+    let mut corner_vt = Vec::with_capacity(mesh.triangles.len());
+    for (tri, corners) in mesh.triangles.iter().zip(&panels.corners) {
+        let mut vt = [0u64; 3];
+        for k in 0..3 {
+            let c: Vector2 = corners[k];
+            let key = (tri[k], [c.x.to_bits(), c.y.to_bits()]);
+            let next = index.len() as u64 + 1;
+            vt[k] = match index.entry(key) {
+                Entry::Occupied(e) => *e.get(),
+                Entry::Vacant(e) => {
+                    writeln!(out, "vt {} {}", c.x, c.y)?;
+                    *e.insert(next)
+                }
+            };
+        }
+        corner_vt.push(vt);
+    }
+    let mut panel = None;
+    for ((tri, vt), &p) in mesh
+        .triangles
+        .iter()
+        .zip(&corner_vt)
+        .zip(&panels.of_triangle)
+    {
+        if panel != Some(p) {
+            writeln!(out, "g {}", panels.names[p as usize])?;
+            panel = Some(p);
+        }
+        let [a, b, c] = tri.map(|i| u64::from(i) + 1);
+        let [ta, tb, tc] = *vt;
+        writeln!(out, "f {a}/{ta} {b}/{tb} {c}/{tc}")?;
+    }
+    for seam in panels.seams.iter().filter(|s| s.is_open()) {
+        writeln!(out, "# seam {}", seam.name)?;
+        for &[a, b] in &seam.pairs {
+            writeln!(out, "l {} {}", u64::from(a) + 1, u64::from(b) + 1)?;
+        }
+    }
+    out.flush()
 }

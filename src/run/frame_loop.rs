@@ -10,7 +10,7 @@ use super::{FrameState, Progress, RunError, RunOptions};
 use crate::adapt::Adapter;
 use crate::math::{Scalar, Vector};
 use crate::physics::Energy;
-use crate::record::{RecordError, RecordTarget, Recorder, obj::write_frame_obj};
+use crate::record::{RecordError, RecordTarget, Recorder, obj::write_mesh_obj};
 use crate::scene::Scene;
 use crate::sim::{
     FrameFailed, FrameFailure, MAX_STEP_HALVINGS, Pipeline, Setup, SimParts, SimState, StepFailure,
@@ -210,7 +210,7 @@ impl<'a> FrameLoop<'a> {
         self.log_frame()?;
         if let Some(dir) = &self.obj_dir {
             let w = &self.state.world;
-            write_frame_obj(dir, self.frame, &w.x, &w.mesh.material, &w.mesh.triangles)?;
+            write_mesh_obj(dir, self.frame, &w.x, &w.mesh)?;
         }
         self.timing.record_s = t1.elapsed().as_secs_f64();
         self.record_seconds += self.timing.record_s;

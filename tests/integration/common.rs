@@ -2,6 +2,7 @@
 
 use drape::adapt::AdaptConfig;
 use drape::math::{Scalar, Vector};
+use drape::mesh::{DEFAULT_SEWING_STIFFNESS, DEFAULT_WELD_GAP, Sewing};
 use drape::physics::{Energy, Model, SolveFailure, Stepper};
 use drape::scene::{AdaptCriterion, AdaptMethod, Pin, PinMotion};
 use drape::world::World;
@@ -18,6 +19,12 @@ pub const BOUNCING_SHEET: [&str; 6] = [
     "adapt.refine_strain=0.02",
     "adapt.rollback=false",
 ];
+
+/// The default sewing, for OBJ files loaded in tests.
+pub const SEWING: Sewing = Sewing {
+    stiffness: DEFAULT_SEWING_STIFFNESS,
+    weld_gap: DEFAULT_WELD_GAP,
+};
 
 /// A fixed pin on `region` with every other key at its default.
 pub fn pin(region: &str) -> Pin {

@@ -11,6 +11,8 @@ use drape::scene::{Scene, load_scene_str};
 use drape::world::World;
 use proptest::prelude::*;
 
+use crate::common::SEWING;
+
 /// Cases per fuzz test: 2000 (about a second each in release), or `PROPTEST_CASES`.
 fn cases() -> u32 {
     std::env::var("PROPTEST_CASES")
@@ -261,7 +263,8 @@ const NUMBERS: [&str; 16] = [
 ];
 
 /// One random OBJ line: vertices, texture coordinates, faces of any arity with
-/// any index forms (`v`, `v/vt`, `v//vn`, negative, 0, out of range), and noise.
+/// any index forms (`v`, `v/vt`, `v//vn`, negative, 0, out of range), `l`
+/// elements (sewing edges) of 0 to 3 vertices, and noise.
 fn obj_line() -> impl Strategy<Value = String> {
     let num = prop::sample::select(&NUMBERS[..]);
     let index = prop_oneof![(-4i32..12).prop_map(|i| i.to_string()), Just(String::new())];
@@ -273,7 +276,8 @@ fn obj_line() -> impl Strategy<Value = String> {
     prop_oneof![
         4 => prop::collection::vec(num.clone(), 0..5).prop_map(|c| format!("v {}", c.join(" "))),
         2 => prop::collection::vec(num, 0..4).prop_map(|c| format!("vt {}", c.join(" "))),
-        4 => prop::collection::vec(corner, 0..6).prop_map(|c| format!("f {}", c.join(" "))),
+        4 => prop::collection::vec(corner.clone(), 0..6).prop_map(|c| format!("f {}", c.join(" "))),
+        2 => prop::collection::vec(corner, 0..4).prop_map(|c| format!("l {}", c.join(" "))),
         1 => "[a-z#/ 0-9.\\-]{0,20}",
         1 => Just("o second".to_owned()),
     ]
@@ -298,7 +302,7 @@ fn obj_samples() -> Vec<String> {
 fn load_bytes(bytes: &[u8], uv_scale: f64, name: &str) -> Result<(), TestCaseError> {
     let path = std::env::temp_dir().join(format!("drape-fuzz-{}-{name}.obj", std::process::id()));
     std::fs::write(&path, bytes).expect("write temp OBJ");
-    let loaded = load_obj(&path, uv_scale);
+    let loaded = load_obj(&path, uv_scale, SEWING);
     // The same file as an obstacle mesh (a different loader, in `collide`).
     let sets = [
         "obstacle.0.shape=mesh".to_owned(),

@@ -33,6 +33,8 @@ mod membrane_runs;
 mod mesh;
 mod meshbody;
 mod metric;
+mod obj_garment_export;
+mod obj_garments;
 mod outline;
 mod physics;
 mod pins;

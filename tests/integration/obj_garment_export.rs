@@ -1,0 +1,151 @@
+//! The per-frame OBJ export of a garment (`write_mesh_obj`) reads back with
+//! `load_obj` as the same panels, corners and open seams, before and after a
+//! seam is welded.
+
+use std::collections::HashMap;
+
+use drape::math::Vector;
+use drape::mesh::{self, ObjCloth};
+use drape::record::obj::write_mesh_obj;
+
+use crate::common::SEWING;
+use crate::obj_garments::{line_of, load, panels, temp_dir};
+
+/// Front and back panels sewn by `l` on one side and welded on the other (the
+/// back's right edge shares its positions with a third panel, `side`, with
+/// other `vt`), one face wound clockwise.
+const SEWN_AND_WELDED: &str = "\
+o front
+v 0 0 0
+v 1 0 0
+v 0 0 0.5
+v 1 0 0.5
+v 0 0 1
+v 1 0 1
+vt 0 0
+vt 1 0
+vt 0 0.5
+vt 1 0.5
+vt 0 1
+vt 1 1
+f 1/1 2/2 4/4
+f 1/1 4/4 3/3
+f 3/3 4/4 6/6
+f 3/3 6/6 5/5
+o back
+v 1.1 0 0
+v 2.1 0 0
+v 1.1 0 0.5
+v 2.1 0 0.5
+v 1.1 0 1
+v 2.1 0 1
+f 7/1 8/2 10/4
+f 7/1 10/4 9/3
+f 9/3 10/4 12/6
+f 9/3 12/6 11/5
+o side
+v 2.1 1 0
+v 2.1 1 0.5
+v 2.1 1 1
+f 8/1 13/2 14/4
+f 8/1 14/4 10/3
+f 10/3 12/5 14/4
+f 12/5 15/6 14/4
+l 2 7
+l 4 9
+l 6 11
+";
+
+/// Vertex `v` of `a` as a vertex of `b`, found by position (`b`'s are distinct).
+fn vertex_map(a: &[Vector], b: &[Vector]) -> Vec<u32> {
+    let key = |p: &Vector| p.to_array().map(f64::to_bits);
+    let index: HashMap<[u64; 3], u32> = b
+        .iter()
+        .enumerate()
+        .map(|(i, p)| (key(p), i as u32))
+        .collect();
+    assert_eq!(index.len(), b.len(), "distinct positions");
+    a.iter().map(|p| index[&key(p)]).collect()
+}
+
+/// Checks that `b` is garment `a` (positions `xa`), its vertices perhaps renumbered.
+fn assert_same_garment(a: &mesh::Mesh, xa: &[Vector], b: &ObjCloth) {
+    assert_eq!(b.positions.len(), xa.len());
+    let map = vertex_map(xa, &b.positions);
+    let (pa, pb) = (a.panels().expect("garment"), panels(b));
+    assert_eq!(pa.names, pb.names);
+    assert_eq!(pa.of_triangle, pb.of_triangle);
+    assert_eq!(a.triangles.len(), b.mesh.triangles.len());
+    let mut worst: f64 = 0.0;
+    for (t, tri) in a.triangles.iter().enumerate() {
+        assert_eq!(
+            b.mesh.triangles[t],
+            tri.map(|v| map[v as usize]),
+            "triangle {t}"
+        );
+        for k in 0..3 {
+            worst = worst.max((pa.corners[t][k] - pb.corners[t][k]).length());
+        }
+    }
+    assert!(worst <= 1e-12, "corners differ by {worst:e} m");
+    for (v, &w) in map.iter().enumerate() {
+        let w = w as usize;
+        assert_eq!(pa.of_vertex[v], pb.of_vertex[w], "home panel of {v}");
+        assert!((a.material[v] - b.mesh.material[w]).length() <= 1e-12);
+    }
+    let open: Vec<_> = pa.seams.iter().filter(|s| s.is_open()).collect();
+    assert_eq!(open.len(), pb.seams.len());
+    for (sa, sb) in open.iter().zip(&pb.seams) {
+        let mapped: Vec<[u32; 2]> = sa
+            .pairs
+            .iter()
+            .map(|p| p.map(|v| map[v as usize]))
+            .collect();
+        assert_eq!(mapped, sb.pairs, "{}", sa.name);
+        assert_eq!((sa.state, sa.sewing), (sb.state, sb.sewing));
+    }
+}
+
+#[test]
+fn exported_garment_frame_reads_back_as_the_same_panels_corners_and_seams() {
+    let cloth = load("sewn_welded", SEWN_AND_WELDED, SEWING).expect("the garment loads");
+    let p = panels(&cloth);
+    assert_eq!(p.names, ["front", "back", "side"]);
+    assert_eq!(p.seams.len(), 1);
+    assert_eq!(
+        cloth.positions.len(),
+        15,
+        "the back and side share three vertices"
+    );
+    // A later frame: the cloth has moved (positions stay distinct).
+    let x: Vec<Vector> = cloth
+        .positions
+        .iter()
+        .enumerate()
+        .map(|(i, p)| *p + Vector::new(0.01, -0.02, 0.003 * i as f64))
+        .collect();
+    let dir = temp_dir("export");
+    let path = write_mesh_obj(&dir, 4, &x, &cloth.mesh).expect("export");
+    let text = std::fs::read_to_string(&path).expect("read export");
+    let back = mesh::load_obj(&path, 1.0, SEWING).expect("the export loads");
+    assert_same_garment(&cloth.mesh, &x, &back);
+    assert_eq!(text.lines().filter(|l| l.starts_with("l ")).count(), 3);
+    assert_eq!(
+        back.mesh.panels().expect("garment").seams[0].name,
+        format!("l{}", line_of(&text, "l "))
+    );
+
+    // Welded: the seam's pairs merge; the export reads back as the three panels,
+    // welded there too, with no open seam.
+    let weld = cloth.mesh.weld(0, 0.5).expect("weld");
+    let mut xw = vec![Vector::ZERO; weld.mesh.vertex_count()];
+    for (v, &w) in weld.new_index.iter().enumerate() {
+        xw[w as usize] = x[v];
+    }
+    let path = write_mesh_obj(&dir, 5, &xw, &weld.mesh).expect("export welded");
+    let back = mesh::load_obj(&path, 1.0, SEWING).expect("the welded export loads");
+    assert_same_garment(&weld.mesh, &xw, &back);
+    assert_eq!(back.positions.len(), 12);
+    assert!(panels(&back).seams.is_empty());
+    std::fs::remove_dir_all(&dir).ok();
+}
