@@ -10,6 +10,7 @@ mod obj;
 mod outline;
 mod pairmap;
 mod panels;
+mod rest_space;
 mod topology;
 
 pub use generate::{
