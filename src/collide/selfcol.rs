@@ -51,6 +51,8 @@ pub struct SelfCollider {
     built_for: Vec<[u32; 3]>,
     patches: Patches,
     area: Vec<Scalar>,
+    /// Every vertex's rest point (`Mesh::rest_points`).
+    rest: Vec<Vector>,
     /// False after the patches were rebuilt: the next step builds the patch trees.
     trees_built: bool,
     scratch: Scratch,
@@ -80,8 +82,6 @@ struct Scratch {
     dx: Vec<Vector>,
     dv: Vec<Vector>,
     count: Vec<u32>,
-    /// Every vertex's rest point (`Mesh::rest_points`).
-    rest: Vec<Vector>,
 }
 
 impl SelfCollider {
@@ -93,6 +93,7 @@ impl SelfCollider {
             culling: s.culling,
             patch_size: s.patch_size,
             built_for: Vec::new(),
+            rest: Vec::new(),
             patches: Patches::default(),
             area: Vec::new(),
             trees_built: false,
@@ -112,6 +113,7 @@ impl SelfCollider {
                 self.area[v as usize] += a;
             }
         }
+        mesh.rest_points(&mut self.rest);
         self.built_for = mesh.triangles.clone();
         self.trees_built = false;
     }
@@ -204,8 +206,7 @@ impl SelfCollider {
         s.prims.par_sort_unstable();
         s.prims.dedup();
         // Parts that are close in the rest state cannot be held a thickness apart.
-        mesh.rest_points(&mut s.rest);
-        let rest_points = &s.rest;
+        let rest_points = &self.rest;
         let rest = |i: u32| rest_points[i as usize];
         s.prims.retain(|p| {
             let (ids, w) = weights(p, tris, &rest);

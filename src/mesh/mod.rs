@@ -166,32 +166,9 @@ impl Mesh {
     /// material space; the mesh must be a connected manifold without degenerate
     /// triangles or unused vertices.
     pub fn new(material: Vec<Vector2>, mut triangles: Vec<[u32; 3]>) -> Result<Mesh, MeshError> {
-        if triangles.is_empty() {
-            return Err(MeshError::Empty);
-        }
-        if let Some((vertex, value)) = material.iter().enumerate().find_map(|(v, p)| {
-            [p.x, p.y]
-                .into_iter()
-                .find(|c| !c.is_finite())
-                .map(|c| (v as u32, c))
-        }) {
-            return Err(MeshError::NonFinite { vertex, value });
-        }
+        check_input(&material, &triangles)?;
+        check_scale(&material)?;
         let n = material.len();
-        for (t, tri) in triangles.iter().enumerate() {
-            if let Some(&v) = tri.iter().find(|&&v| v as usize >= n) {
-                return Err(MeshError::BadIndex {
-                    triangle: t,
-                    vertex: v,
-                    count: n,
-                });
-            }
-        }
-        let (lo, hi) = bounds(&material);
-        let size = (hi.x - lo.x).hypot(hi.y - lo.y);
-        if size > 0.0 && !(size * size).is_normal() {
-            return Err(MeshError::OutOfScale { size });
-        }
         // Degeneracy is relative to the mesh's scale: a triangle whose area is a
         // vanishing fraction of its longest edge squared is refused. Each triangle
         // is then wound counter-clockwise on its own (OBJ winding is unreliable).
@@ -293,6 +270,47 @@ fn bounds(points: &[Vector2]) -> (Vector2, Vector2) {
 pub fn signed_area(material: &[Vector2], tri: &[u32; 3]) -> Scalar {
     let [a, b, c] = tri.map(|v| material[v as usize]);
     0.5 * (b - a).perp_dot(c - a)
+}
+
+/// The checks every mesh's input gets: some triangles, finite material
+/// coordinates, and triangles that index existing vertices.
+fn check_input(material: &[Vector2], triangles: &[[u32; 3]]) -> Result<(), MeshError> {
+    if triangles.is_empty() {
+        return Err(MeshError::Empty);
+    }
+    if let Some((vertex, value)) = material.iter().enumerate().find_map(|(v, p)| {
+        [p.x, p.y]
+            .into_iter()
+            .find(|c| !c.is_finite())
+            .map(|c| (v as u32, c))
+    }) {
+        return Err(MeshError::NonFinite { vertex, value });
+    }
+    let n = material.len();
+    for (t, tri) in triangles.iter().enumerate() {
+        if let Some(&v) = tri.iter().find(|&&v| v as usize >= n) {
+            return Err(MeshError::BadIndex {
+                triangle: t,
+                vertex: v,
+                count: n,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Areas of points spanning this much must stay in double precision's normal
+/// range (no points: nothing to check).
+fn check_scale(points: &[Vector2]) -> Result<(), MeshError> {
+    if points.is_empty() {
+        return Ok(());
+    }
+    let (lo, hi) = bounds(points);
+    let size = (hi.x - lo.x).hypot(hi.y - lo.y);
+    if size > 0.0 && !(size * size).is_normal() {
+        return Err(MeshError::OutOfScale { size });
+    }
+    Ok(())
 }
 
 /// Unfolded neighbours run their shared edge in opposite directions; if both run

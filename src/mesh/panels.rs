@@ -193,14 +193,16 @@ impl Mesh {
         }
     }
 
-    /// The material coordinate of vertex `v` as a corner of triangle `t` (its
-    /// home coordinate when `v` is not a corner of `t`).
+    /// The material coordinate of vertex `v` as a corner of triangle `t`.
+    ///
+    /// # Panics
+    /// When `v` is not a corner of `t`.
     pub fn corner_at(&self, t: usize, v: u32) -> Vector2 {
-        let tri = self.triangles[t];
-        match tri.iter().position(|&w| w == v) {
-            Some(k) => self.corners(t)[k],
-            None => self.material[v as usize],
-        }
+        let k = self.triangles[t]
+            .iter()
+            .position(|&w| w == v)
+            .unwrap_or_else(|| panic!("vertex {v} is not a corner of triangle {t}"));
+        self.corners(t)[k]
     }
 
     /// The panel of triangle `t` (0 for a cloth without panels).
@@ -281,19 +283,8 @@ fn check_panel_lengths(
     triangles: &[[u32; 3]],
     panels: &Panels,
 ) -> Result<(), MeshError> {
-    if triangles.is_empty() {
-        return Err(MeshError::Empty);
-    }
+    super::check_input(material, triangles)?;
     let n = material.len();
-    for (t, tri) in triangles.iter().enumerate() {
-        if let Some(&v) = tri.iter().find(|&&v| v as usize >= n) {
-            return Err(MeshError::BadIndex {
-                triangle: t,
-                vertex: v,
-                count: n,
-            });
-        }
-    }
     let counts = [
         panels.of_triangle.len(),
         panels.corners.len(),
@@ -306,15 +297,8 @@ fn check_panel_lengths(
     if panels.of_triangle.iter().any(bad_panel) || panels.of_vertex.iter().any(bad_panel) {
         return Err(MeshError::PanelTables);
     }
-    for (v, p) in material.iter().enumerate() {
-        if let Some(value) = [p.x, p.y].into_iter().find(|c| !c.is_finite()) {
-            return Err(MeshError::NonFinite {
-                vertex: v as u32,
-                value,
-            });
-        }
-    }
-    // As in `Mesh::new`: areas must stay in double precision's normal range.
+    // Corners that are not finite are refused, naming their triangle, by
+    // `orient_corners`.
     let finite: Vec<Vector2> = panels
         .corners
         .iter()
@@ -322,14 +306,7 @@ fn check_panel_lengths(
         .copied()
         .filter(|p| p.is_finite())
         .collect();
-    if !finite.is_empty() {
-        let (lo, hi) = super::bounds(&finite);
-        let size = (hi.x - lo.x).hypot(hi.y - lo.y);
-        if size > 0.0 && !(size * size).is_normal() {
-            return Err(MeshError::OutOfScale { size });
-        }
-    }
-    Ok(())
+    super::check_scale(&finite)
 }
 
 /// Refuses a degenerate triangle and winds it counter-clockwise in its corners.

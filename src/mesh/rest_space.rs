@@ -4,7 +4,7 @@
 //! both are made panel by panel.
 
 use super::Mesh;
-use crate::math::{Scalar, Vector};
+use crate::math::{Scalar, Vector, Vector2};
 
 impl Mesh {
     /// A point per vertex in rest space, for telling apart parts that are close in
@@ -38,30 +38,35 @@ impl Mesh {
     /// about the shared edge. A garment has no one flat rest shape (a skirt
     /// closes into a tube), but every stencil has.
     pub fn lay_flat(&self, ids: &[u32], flat: &mut [Vector]) {
-        let Some(base) = self.triangle_with(ids[0], ids[1], ids[2]) else {
-            return;
-        };
+        let base = self
+            .triangle_with(ids[0], ids[1], ids[2])
+            .expect("a stencil starts with a triangle of the mesh");
         let tri = self.triangles[base];
         for &v in &ids[..3] {
             flat[v as usize] = self.corner_at(base, v).extend(0.0);
         }
         for &tip in &ids[3..] {
-            for k in 0..3 {
-                let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                let Some(other) = self.triangle_with(a, b, tip) else {
-                    continue;
-                };
-                let frame = |t: usize| {
-                    let (pa, pb) = (self.corner_at(t, a), self.corner_at(t, b));
-                    (pa, (pb - pa).normalize())
-                };
-                let ((a0, u0), (a1, u1)) = (frame(base), frame(other));
-                let d = self.corner_at(other, tip) - a1;
-                let p = a0 + u0 * d.dot(u1) + u0.perp() * u1.perp_dot(d);
-                flat[tip as usize] = p.extend(0.0);
-                break;
-            }
+            let (other, a, b) = (0..3)
+                .map(|k| (tri[k], tri[(k + 1) % 3]))
+                .find_map(|(a, b)| self.triangle_with(a, b, tip).map(|t| (t, a, b)))
+                .expect("a stencil's tip lies across one of its triangle's edges");
+            flat[tip as usize] = self.unfold(base, other, [a, b], tip).extend(0.0);
         }
+    }
+
+    /// Vertex `tip` of triangle `other`, unfolded into triangle `base`'s pattern
+    /// about their shared edge `edge`: the same distances from the edge's ends,
+    /// on the other side of it. Both wind counter-clockwise in their own
+    /// patterns, so a rotation does it.
+    pub fn unfold(&self, base: usize, other: usize, edge: [u32; 2], tip: u32) -> Vector2 {
+        let [a, b] = edge;
+        let frame = |t: usize| {
+            let (pa, pb) = (self.corner_at(t, a), self.corner_at(t, b));
+            (pa, (pb - pa).normalize())
+        };
+        let ((a0, u0), (a1, u1)) = (frame(base), frame(other));
+        let d = self.corner_at(other, tip) - a1;
+        a0 + u0 * d.dot(u1) + u0.perp() * u1.perp_dot(d)
     }
 
     /// The triangle with corners `a`, `b` and `c`, if any.

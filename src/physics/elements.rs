@@ -488,8 +488,7 @@ fn material_distance(material: &[Vector2], p: u32, q: u32) -> Scalar {
 
 /// The rest distance between the wing tips of interior edge `e`. On a garment the
 /// second wing may lie in another panel's pattern: it is unfolded into the first
-/// wing's pattern about their shared edge (both wind counter-clockwise, so a
-/// rotation does it).
+/// wing's pattern about their shared edge ([`Mesh::unfold`]).
 fn tip_distance(mesh: &Mesh, e: usize) -> Scalar {
     let edge = &mesh.edges[e];
     let [t0, t1] = edge.triangles;
@@ -500,15 +499,7 @@ fn tip_distance(mesh: &Mesh, e: usize) -> Scalar {
     if mesh.panels().is_none() {
         return material_distance(&mesh.material, p, q);
     }
-    let [a, b] = edge.vertices;
     let (t0, t1) = (t0 as usize, t1 as usize);
-    let frame = |t: usize| {
-        let (pa, pb) = (mesh.corner_at(t, a), mesh.corner_at(t, b));
-        (pa, (pb - pa).normalize())
-    };
-    let ((a0, u0), (a1, u1)) = (frame(t0), frame(t1));
-    let d = mesh.corner_at(t1, q) - a1;
-    let (along, across) = (d.dot(u1), u1.perp_dot(d));
-    let unfolded = a0 + u0 * along + u0.perp() * across;
+    let unfolded = mesh.unfold(t0, t1, edge.vertices, q);
     mesh.corner_at(t0, p).distance(unfolded)
 }

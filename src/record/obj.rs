@@ -52,14 +52,7 @@ pub fn write_frame_obj(
         )));
     }
 
-    let path = dir.join(format!("frame_{frame:05}.obj"));
-    let io_err = |source| RecordError::Obj {
-        path: path.clone(),
-        source,
-    };
-    let file = std::fs::File::create(&path).map_err(io_err)?;
-    let mut out = std::io::BufWriter::new(file);
-    let write = |out: &mut std::io::BufWriter<std::fs::File>| -> std::io::Result<()> {
+    write_file(dir, frame, |out| {
         writeln!(out, "# drape frame {frame}")?;
         for p in positions {
             writeln!(out, "v {} {} {}", p.x, p.y, p.z)?;
@@ -71,9 +64,25 @@ pub fn write_frame_obj(
             let [a, b, c] = tri.map(|i| u64::from(i) + 1);
             writeln!(out, "f {a}/{a} {b}/{b} {c}/{c}")?;
         }
-        out.flush()
+        Ok(())
+    })
+}
+
+/// Creates `DIR/frame_NNNNN.obj`, fills it with `write` and flushes it;
+/// returns its path.
+fn write_file(
+    dir: &Path,
+    frame: u64,
+    write: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> std::io::Result<()>,
+) -> Result<PathBuf, RecordError> {
+    let path = dir.join(format!("frame_{frame:05}.obj"));
+    let io_err = |source| RecordError::Obj {
+        path: path.clone(),
+        source,
     };
-    write(&mut out).map_err(io_err)?;
+    let file = std::fs::File::create(&path).map_err(io_err)?;
+    let mut out = std::io::BufWriter::new(file);
+    write(&mut out).and_then(|()| out.flush()).map_err(io_err)?;
     Ok(path)
 }
 
@@ -112,15 +121,9 @@ pub fn write_mesh_obj(
             ),
         });
     }
-    let path = dir.join(format!("frame_{frame:05}.obj"));
-    let io_err = |source| RecordError::Obj {
-        path: path.clone(),
-        source,
-    };
-    let file = std::fs::File::create(&path).map_err(io_err)?;
-    let mut out = std::io::BufWriter::new(file);
-    write_garment(&mut out, frame, positions, mesh, panels).map_err(io_err)?;
-    Ok(path)
+    write_file(dir, frame, |out| {
+        write_garment(out, frame, positions, mesh, panels)
+    })
 }
 
 /// The garment's OBJ text (see [`write_mesh_obj`]).
@@ -175,5 +178,5 @@ fn write_garment(
             writeln!(out, "l {} {}", u64::from(a) + 1, u64::from(b) + 1)?;
         }
     }
-    out.flush()
+    Ok(())
 }

@@ -18,16 +18,7 @@ impl Recorder {
         triangles: &[[u32; 3]],
         fixed: bool,
     ) -> Result<(), RecordError> {
-        let n = positions.len();
-        if let Some(t) = triangles
-            .iter()
-            .find(|t| t.iter().any(|&i| i as usize >= n))
-        {
-            return Err(RecordError::InvalidFrame {
-                frame: 0,
-                reason: format!("obstacle {name}: triangle {t:?} indexes past {n} vertices"),
-            });
-        }
+        check_indices(name, positions, triangles)?;
         let entity = obstacle_entity(name);
         let [r, g, b] = OBSTACLE_COLOR;
         let mesh = rerun::Mesh3D::new(positions.iter().map(|&p| convert::position(p)))
@@ -52,16 +43,7 @@ impl Recorder {
         positions: &[Vector],
         triangles: &[[u32; 3]],
     ) -> Result<(), RecordError> {
-        let n = positions.len();
-        if let Some(t) = triangles
-            .iter()
-            .find(|t| t.iter().any(|&i| i as usize >= n))
-        {
-            return Err(RecordError::InvalidFrame {
-                frame: 0,
-                reason: format!("obstacle {name}: triangle {t:?} indexes past {n} vertices"),
-            });
-        }
+        check_indices(name, positions, triangles)?;
         let entity = obstacle_entity(name);
         if !triangles.is_empty() {
             let [r, g, b] = OBSTACLE_COLOR;
@@ -109,4 +91,23 @@ fn obstacle_entity(name: &str) -> String {
         .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
         .collect();
     format!("{ENTITY_OBSTACLES}/{clean}")
+}
+
+/// Refuses an obstacle mesh whose triangles index past its vertices.
+fn check_indices(
+    name: &str,
+    positions: &[Vector],
+    triangles: &[[u32; 3]],
+) -> Result<(), RecordError> {
+    let n = positions.len();
+    match triangles
+        .iter()
+        .find(|t| t.iter().any(|&i| i as usize >= n))
+    {
+        Some(t) => Err(RecordError::InvalidFrame {
+            frame: 0,
+            reason: format!("obstacle {name}: triangle {t:?} indexes past {n} vertices"),
+        }),
+        None => Ok(()),
+    }
 }

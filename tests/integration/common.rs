@@ -4,7 +4,9 @@ use drape::adapt::AdaptConfig;
 use drape::math::{Scalar, Vector};
 use drape::mesh::{DEFAULT_SEWING_STIFFNESS, DEFAULT_WELD_GAP, Sewing};
 use drape::physics::{Energy, Model, SolveFailure, Stepper};
+use drape::scene::Scene;
 use drape::scene::{AdaptCriterion, AdaptMethod, Pin, PinMotion};
+use drape::sim::{Pipeline, Setup, SimParts, SimState, build};
 use drape::world::World;
 
 /// Overrides of `scenes/hanging_sheet_rest.toml` that made the sizing
@@ -156,5 +158,34 @@ impl std::ops::Deref for BareStepper {
 impl std::ops::DerefMut for BareStepper {
     fn deref_mut(&mut self) -> &mut Stepper {
         &mut self.stepper
+    }
+}
+
+/// A scene's simulation, stepped by the run's own pipeline.
+pub struct Sim {
+    /// What the run holds fixed.
+    pub setup: Setup,
+    /// The state.
+    pub state: SimState,
+    /// The pipeline that steps it.
+    pub pipe: Pipeline,
+}
+
+impl Sim {
+    /// Builds `scene`'s simulation (panics on a scene that does not build).
+    pub fn new(scene: &Scene) -> Sim {
+        let SimParts {
+            setup,
+            state,
+            pipeline: pipe,
+        } = build(&scene.resolve().expect("resolve")).expect("simulation");
+        Sim { setup, state, pipe }
+    }
+
+    /// One step of `h` seconds (panics when it is rejected).
+    pub fn step(&mut self, h: Scalar) {
+        if let Err(e) = self.pipe.step(&self.setup, &mut self.state, h) {
+            panic!("step rejected: {e}");
+        }
     }
 }

@@ -12,9 +12,11 @@ use drape::mesh::{DEFAULT_SEWING_STIFFNESS, DEFAULT_WELD_GAP, SeamState, Sewing}
 use drape::physics::forces::energy;
 use drape::physics::{Elements, ExternalForces, MaterialParams, Membrane};
 use drape::scene::{BendingModel, StiffnessRule, load_scene_str};
-use drape::sim::{Pipeline, Setup, SimParts, SimState, build};
+use drape::sim::build;
 use drape::spec::{Garment, PanelSpec, Placement, SeamSide, SeamSpec};
 use drape::world::World;
+
+use crate::common::Sim;
 
 fn sewing() -> Sewing {
     Sewing {
@@ -75,50 +77,32 @@ a = { panel = "left", side = 2 }
 b = { panel = "right", side = 4 }
 "#;
 
-struct Sim {
-    setup: Setup,
-    state: SimState,
-    pipe: Pipeline,
+/// The simulation of a garment scene given as text, with `--set` overrides.
+fn garment_sim(text: &str, sets: &[&str]) -> Sim {
+    let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+    Sim::new(&load_scene_str(text, "garment.toml", &sets).expect("scene"))
 }
 
-impl Sim {
-    fn new(text: &str, sets: &[&str]) -> Sim {
-        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
-        let scene = load_scene_str(text, "garment.toml", &sets).expect("scene");
-        let SimParts {
-            setup,
-            state,
-            pipeline: pipe,
-        } = build(&scene.resolve().expect("resolve")).expect("simulation");
-        Sim { setup, state, pipe }
-    }
-
-    fn step(&mut self, h: Scalar) {
-        if let Err(e) = self.pipe.step(&self.setup, &mut self.state, h) {
-            panic!("step rejected: {e}");
-        }
-    }
-
-    fn seam_state(&self, s: usize) -> SeamState {
-        self.state.world.mesh.panels().expect("panels").seams[s].state
-    }
+/// The state of seam `s`.
+fn seam_state(sim: &Sim, s: usize) -> SeamState {
+    sim.state.world.mesh.panels().expect("panels").seams[s].state
 }
 
 #[test]
 fn sewing_closes_a_two_panel_seam_and_welds_it_within_a_bounded_time() {
     for gap in ["0.02", "0.05"] {
         let set = format!("panel.1.position=[{gap}, 0.0, 0.0]");
-        let mut sim = Sim::new(TWO_SQUARES, &[&set]);
+        let mut sim = garment_sim(TWO_SQUARES, &[&set]);
         let before = sim.state.world.mesh.vertex_count();
         let pairs = sim.state.world.mesh.panels().expect("panels").seams[0]
             .pairs
             .len();
         let mut steps = 0;
-        while sim.seam_state(0) == SeamState::Open && steps < 200 {
+        while seam_state(&sim, 0) == SeamState::Open && steps < 200 {
             sim.step(0.005);
             steps += 1;
         }
-        let SeamState::Welded { time } = sim.seam_state(0) else {
+        let SeamState::Welded { time } = seam_state(&sim, 0) else {
             panic!("a {gap} m seam still open after 1 s");
         };
         let mesh = &sim.state.world.mesh;
@@ -141,7 +125,7 @@ fn sewing_closes_a_two_panel_seam_and_welds_it_within_a_bounded_time() {
 
 #[test]
 fn welding_conserves_mass_and_momentum() {
-    let mut sim = Sim::new(TWO_SQUARES, &[]);
+    let mut sim = garment_sim(TWO_SQUARES, &[]);
     let mat = sim.setup.model.material;
     let w = &mut sim.state.world;
     // Each panel moves differently, so merging pairs must average momenta.
@@ -261,9 +245,9 @@ fn a_welded_seam_bends_like_the_panel_interior() {
 }
 
 #[test]
-fn an_unwelded_cut_carries_no_bending_across_it() {
-    // The same tube with its seams left open: the cuts are free edges, so the
-    // energy differs from the welded tube's; welding is what joins the panels.
+fn open_seams_leave_the_panels_unjoined() {
+    // The same tube with its seams left open: no edge joins the two panels
+    // until the seams are welded.
     let r = 0.1;
     let welded = cylinder_bending_energy(2, r, 0.03);
     let BuiltGarment { mesh, .. } = garment::build(&Garment {
@@ -420,12 +404,12 @@ fn the_skirt_sews_and_welds_on_the_mannequin_identically_at_any_thread_count() {
             .build()
             .expect("pool");
         pool.install(|| {
-            let mut sim = Sim::new(&text, &[]);
+            let mut sim = garment_sim(&text, &[]);
             let vertices = sim.state.world.mesh.vertex_count();
             for _ in 0..30 {
                 sim.step(1.0 / 210.0);
             }
-            let welded: Vec<SeamState> = (0..2).map(|s| sim.seam_state(s)).collect();
+            let welded: Vec<SeamState> = (0..2).map(|s| seam_state(&sim, s)).collect();
             (vertices, sim.state.world.x.clone(), welded)
         })
     };

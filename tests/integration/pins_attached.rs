@@ -7,7 +7,8 @@ use drape::collide::obstacle::Body;
 use drape::math::{Scalar, Vector};
 use drape::physics::pins::Pins;
 use drape::scene::{Scene, load_scene_str};
-use drape::sim::{Pipeline, Setup, SimParts, SimState, build};
+
+use crate::common::Sim;
 
 /// A sheet whose top edge is attached to the lower link of a two-link arm:
 /// the root (turned 90 deg about z) slides 0.5 m along y and turns back from
@@ -68,30 +69,6 @@ position = [3.0, 0.0, 0.0]
 fn arm(sets: &[&str]) -> Scene {
     let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
     load_scene_str(ARM, "arm.toml", &sets).expect("scene")
-}
-
-/// The scene's simulation, stepped by the run's own pipeline.
-struct Sim {
-    setup: Setup,
-    state: SimState,
-    pipe: Pipeline,
-}
-
-impl Sim {
-    fn new(scene: &Scene) -> Sim {
-        let SimParts {
-            setup,
-            state,
-            pipeline: pipe,
-        } = build(&scene.resolve().expect("resolve")).expect("simulation");
-        Sim { setup, state, pipe }
-    }
-
-    fn step(&mut self, h: Scalar) {
-        if let Err(e) = self.pipe.step(&self.setup, &mut self.state, h) {
-            panic!("step rejected: {e}");
-        }
-    }
 }
 
 /// Runs `scene` for `steps` steps of `h` and compares every held vertex after
