@@ -1,9 +1,9 @@
 //! Consistency checks after remeshing: manifold, conforming, positive rest
 //! areas, exact mass.
 
-use crate::adapt::transfer::lumped_masses;
+use crate::adapt::transfer::mesh_lumped_masses;
 use crate::math::Scalar;
-use crate::mesh::{Mesh, MeshError, signed_area};
+use crate::mesh::{Mesh, MeshError};
 use crate::world::World;
 
 /// A broken invariant of the adapted mesh.
@@ -61,11 +61,9 @@ pub enum ConsistencyError {
 
 /// Material-space boundary length of a mesh, m.
 pub fn boundary_length(mesh: &Mesh) -> Scalar {
-    let (edges, m) = (&mesh.edges, &mesh.material);
-    edges
-        .iter()
-        .filter(|e| !e.is_interior())
-        .map(|e| m[e.vertices[0] as usize].distance(m[e.vertices[1] as usize]))
+    (0..mesh.edges.len())
+        .filter(|&e| !mesh.edges[e].is_interior())
+        .map(|e| mesh.rest_length(e))
         .sum()
 }
 
@@ -83,8 +81,8 @@ pub fn check_consistency(
             vertices: mesh.vertex_count(),
         });
     }
-    for (t, tri) in mesh.triangles.iter().enumerate() {
-        let a = signed_area(&mesh.material, tri);
+    for t in 0..mesh.triangles.len() {
+        let a = mesh.rest_area(t);
         if a.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
             return Err(ConsistencyError::Area {
                 triangle: t,
@@ -92,7 +90,10 @@ pub fn check_consistency(
             });
         }
     }
-    Mesh::new(mesh.material.clone(), mesh.triangles.clone())?;
+    match mesh.panels() {
+        None => Mesh::new(mesh.material.clone(), mesh.triangles.clone())?,
+        Some(p) => Mesh::from_panels(mesh.material.clone(), mesh.triangles.clone(), p.clone())?,
+    };
     let got = mesh.total_rest_area();
     if (got - area).abs() > 1e-12 * area {
         return Err(ConsistencyError::TotalArea { got, want: area });
@@ -104,9 +105,7 @@ pub fn check_consistency(
             want: boundary,
         });
     }
-    let mass: Scalar = lumped_masses(&mesh.material, &mesh.triangles, density)
-        .iter()
-        .sum();
+    let mass: Scalar = mesh_lumped_masses(mesh, density).iter().sum();
     if (mass - density * area).abs() > 1e-12 * density * area {
         return Err(ConsistencyError::Mass {
             got: mass,

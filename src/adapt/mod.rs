@@ -18,6 +18,7 @@ pub mod soup;
 pub mod tensor;
 mod tensor_pass;
 pub mod transfer;
+mod transfer_panels;
 mod tri_list;
 
 pub use check::{ConsistencyError, boundary_length, check_consistency};
@@ -219,6 +220,10 @@ enum MethodState {
     Edge(edge::Limits),
     /// The rectangle's grid lines.
     Tensor(tensor::TensorGrid),
+    /// A garment whose seams are still being sewn: remeshing starts, on the
+    /// welded mesh as its level 0, once every seam is welded (a split of an
+    /// open seam's side would leave a vertex without a partner).
+    AwaitingWelds,
 }
 
 /// What the caller has measured on the world already, for
@@ -241,13 +246,12 @@ pub enum AdaptSetupError {
     /// The tensor method needs a generated rectangle's grid.
     #[error("{0}")]
     NotAGrid(#[from] tensor::NotAGrid),
-    /// The cloth is a garment: a remesh would have to split and merge across
-    /// seams, which neither method does yet.
+    /// The cloth is a garment and the method cannot remesh one.
     #[error(
-        "adaptive remeshing does not work on garments (a cloth with panels or seams) yet; \
-         run it without [adapt]"
+        "the {0} method cannot remesh a garment (a cloth with panels or seams): \
+         use method = \"red_green\""
     )]
-    Garment,
+    Garment(&'static str),
 }
 
 impl Adapter {
@@ -262,8 +266,23 @@ impl Adapter {
         density: Scalar,
     ) -> Result<Adapter, AdaptSetupError> {
         let m = &world.mesh;
-        if m.panels().is_some() {
-            return Err(AdaptSetupError::Garment);
+        if let Some(panels) = m.panels() {
+            match config.method {
+                AdaptMethod::Edge => return Err(AdaptSetupError::Garment("edge")),
+                AdaptMethod::Tensor => return Err(AdaptSetupError::Garment("tensor")),
+                AdaptMethod::RedGreen | AdaptMethod::None => {}
+            }
+            if panels.seams.iter().any(|s| s.is_open()) {
+                return Ok(Adapter {
+                    stats: AdaptStats::default(),
+                    events: Vec::new(),
+                    method: MethodState::AwaitingWelds,
+                    density,
+                    area: m.total_rest_area(),
+                    boundary: boundary_length(m),
+                    last_origins: Vec::new(),
+                });
+            }
         }
         let method = match config.method {
             AdaptMethod::Edge => MethodState::Edge(edge::Limits::for_mesh(
@@ -288,6 +307,28 @@ impl Adapter {
         })
     }
 
+    /// True while the adapter waits for a garment's seams to be welded.
+    pub fn awaiting_welds(&self) -> bool {
+        matches!(self.method, MethodState::AwaitingWelds)
+    }
+
+    /// Starts red-green remeshing of a garment whose seams are now all welded
+    /// (only red-green waits for welds): its current triangles become level 0,
+    /// and its area and boundary the ones the checks hold it to. False while a
+    /// seam is still open.
+    fn start_after_welds(&mut self, world: &World) -> bool {
+        let m = &world.mesh;
+        if m.panels()
+            .is_some_and(|p| p.seams.iter().any(|s| s.is_open()))
+        {
+            return false;
+        }
+        self.method = MethodState::RedGreen(Box::new(RedGreenState::new(world)));
+        self.area = m.total_rest_area();
+        self.boundary = boundary_length(m);
+        true
+    }
+
     /// Where each vertex of the world's mesh came from in the latest remesh
     /// that changed it (for state kept outside the world, such as the resting
     /// contacts: [`transfer::carry_contacts`]); empty before the first.
@@ -301,11 +342,17 @@ impl Adapter {
     /// the red-green tables against a rebuild. Runs after
     /// every remesh in debug builds; tests call it in release builds too.
     pub fn check(&self, world: &World) -> Result<(), ConsistencyError> {
+        if self.awaiting_welds() {
+            // Nothing remeshed yet, and each weld shortens the boundary: the
+            // mesh is checked against itself.
+            let m = &world.mesh;
+            return check_consistency(world, self.density, m.total_rest_area(), boundary_length(m));
+        }
         check_consistency(world, self.density, self.area, self.boundary)?;
         match &self.method {
             MethodState::Tensor(grid) => grid.check(&world.mesh),
             MethodState::RedGreen(rg) => rg.hierarchy.check_tables(),
-            MethodState::Edge(_) => Ok(()),
+            MethodState::Edge(_) | MethodState::AwaitingWelds => Ok(()),
         }
         .map_err(ConsistencyError::Tables)
     }
@@ -354,7 +401,11 @@ impl Adapter {
         step: u64,
         known: Measured,
     ) -> Result<bool, MeshError> {
+        if self.awaiting_welds() && !self.start_after_welds(world) {
+            return Ok(false);
+        }
         match &self.method {
+            MethodState::AwaitingWelds => Ok(false),
             MethodState::Tensor(_) => self.tensor_pass(config, world, step),
             MethodState::Edge(limits) => {
                 let limits = *limits;

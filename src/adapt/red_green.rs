@@ -24,6 +24,8 @@ mod merge;
 mod mesh;
 mod undo;
 
+pub use mesh::Built;
+
 use crate::math::Vector2;
 use crate::mesh::PairMap;
 
@@ -35,6 +37,12 @@ const NONE: u32 = u32::MAX;
 struct Node {
     /// Vertices, counter-clockwise in material space.
     v: [u32; 3],
+    /// The material coordinates of the corners, in the node's panel's pattern
+    /// (a vertex on a welded seam has one coordinate per panel).
+    uv: [Vector2; 3],
+    /// The garment panel of the root this node descends from (0 for a cloth
+    /// without panels).
+    panel: u16,
     /// Paper A level (even: 0, 2, 4, ...).
     level: u8,
     /// Parent node, or [`NONE`].
@@ -118,6 +126,25 @@ fn edges_of(v: [u32; 3]) -> [(u32, u32); 3] {
 impl RedGreen {
     /// A forest whose roots are the triangles of the input mesh (all level 0).
     pub fn new(triangles: &[[u32; 3]], material: &[Vector2]) -> RedGreen {
+        let corners: Vec<[Vector2; 3]> = triangles
+            .iter()
+            .map(|t| t.map(|v| material[v as usize]))
+            .collect();
+        let panels = vec![0; triangles.len()];
+        RedGreen::with_corners(triangles, material, &corners, &panels)
+    }
+
+    /// A forest over a garment's triangles: each root carries its corners'
+    /// pattern coordinates and its panel (`corners` and `panels`, one per
+    /// triangle), and every node made from it takes its corners from its
+    /// parent's, so a split across a welded seam gives each side the midpoint
+    /// in its own pattern. `material` is each vertex's home coordinate.
+    pub fn with_corners(
+        triangles: &[[u32; 3]],
+        material: &[Vector2],
+        corners: &[[Vector2; 3]],
+        panels: &[u16],
+    ) -> RedGreen {
         let mut rg = RedGreen {
             nodes: Vec::with_capacity(triangles.len()),
             roots: Vec::with_capacity(triangles.len()),
@@ -129,9 +156,11 @@ impl RedGreen {
             created: Vec::new(),
             first_new: material.len() as u32,
         };
-        for &v in triangles {
+        for ((&v, &uv), &panel) in triangles.iter().zip(corners).zip(panels) {
             let id = rg.alloc(Node {
                 v,
+                uv,
+                panel,
                 level: 0,
                 parent: NONE,
                 children: None,
@@ -193,6 +222,16 @@ impl RedGreen {
         self.nodes[n as usize].v
     }
 
+    /// Material coordinates of node `n`'s corners, in its panel's pattern.
+    pub fn corners(&self, n: u32) -> [Vector2; 3] {
+        self.nodes[n as usize].uv
+    }
+
+    /// The garment panel of node `n` (0 for a cloth without panels).
+    pub fn panel(&self, n: u32) -> u16 {
+        self.nodes[n as usize].panel
+    }
+
     /// Material coordinates of all vertices (old and made in this pass).
     pub fn material(&self) -> &[Vector2] {
         &self.material
@@ -205,9 +244,9 @@ impl RedGreen {
 
     /// Shortest material edge of node `n`, m.
     pub fn shortest_edge(&self, n: u32) -> f64 {
-        edges_of(self.vertices(n))
-            .iter()
-            .map(|&(a, b)| self.material[a as usize].distance(self.material[b as usize]))
+        let p = self.corners(n);
+        (0..3)
+            .map(|k| p[k].distance(p[(k + 1) % 3]))
             .fold(f64::INFINITY, f64::min)
     }
 
@@ -260,17 +299,27 @@ impl RedGreen {
             })
             .collect();
         let level = self.level(t) + 2;
+        let panel = self.panel(t);
+        let [ua, ub, uc] = self.corners(t);
+        let (uab, ubc, uca) = ((ua + ub) * 0.5, (ub + uc) * 0.5, (uc + ua) * 0.5);
         self.remove_leaf_edges(t);
-        let corners = [[a, mab, mca], [mab, b, mbc], [mca, mbc, c], [mab, mbc, mca]];
+        let corners = [
+            ([a, mab, mca], [ua, uab, uca]),
+            ([mab, b, mbc], [uab, ub, ubc]),
+            ([mca, mbc, c], [uca, ubc, uc]),
+            ([mab, mbc, mca], [uab, ubc, uca]),
+        ];
         let mut ids = [0u32; 4];
         let nodes_before = self.nodes.len() as u32;
         let mut reused = Vec::new();
-        for (k, v) in corners.into_iter().enumerate() {
+        for (k, (v, uv)) in corners.into_iter().enumerate() {
             if let Some(&slot) = self.free.last() {
                 reused.push(self.nodes[slot as usize].clone());
             }
             ids[k] = self.alloc(Node {
                 v,
+                uv,
+                panel,
                 level,
                 parent: t,
                 children: None,

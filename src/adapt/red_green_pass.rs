@@ -5,7 +5,7 @@
 use std::collections::HashMap;
 
 use super::red_green::{Applied, RedGreen, RedGreenOp};
-use super::transfer::{Origin, VertexOrder, compact, transfer};
+use super::transfer::{Origin, PanelCorners, VertexOrder, compact, transfer};
 use super::{AdaptConfig, AdaptEvent, Adapter, EventKind, Measured, MethodState, edge_angles};
 use crate::math::{Scalar, Vector};
 use crate::mesh::MeshError;
@@ -35,8 +35,15 @@ pub(super) struct RedGreenState {
 impl RedGreenState {
     /// The hierarchy of `world`'s mesh, its triangles at level 0.
     pub(super) fn new(world: &World) -> RedGreenState {
+        let m = &world.mesh;
+        let hierarchy = match m.panels() {
+            None => RedGreen::new(&m.triangles, &m.material),
+            Some(p) => {
+                RedGreen::with_corners(&m.triangles, &m.material, &p.corners, &p.of_triangle)
+            }
+        };
         RedGreenState {
-            hierarchy: RedGreen::new(&world.mesh.triangles, &world.mesh.material),
+            hierarchy,
             owner: (0..world.mesh.triangles.len() as u32).collect(),
             merged_last_pass: Vec::new(),
             pass_merges: Vec::new(),
@@ -74,19 +81,25 @@ impl RedGreenState {
         density: Scalar,
         alternate_diagonals: bool,
     ) -> Result<Vec<Origin>, MeshError> {
-        let (tris, levels, owner) = self.hierarchy.build(alternate_diagonals);
+        let built = self.hierarchy.build_with_corners(alternate_diagonals);
         let (first_new, created) = self.hierarchy.created();
-        let (map, remeshed) = compact(
+        let (map, mut remeshed) = compact(
             self.hierarchy.material(),
             (first_new, created),
-            &tris,
-            levels,
+            &built.triangles,
+            built.levels,
             VertexOrder::FirstUse,
         );
-        let material = remeshed.material.clone();
+        if world.mesh.panels().is_some() {
+            remeshed.corners = Some(PanelCorners {
+                corners: built.corners,
+                of_triangle: built.panels,
+            });
+        }
         let origins = transfer(world, density, remeshed)?;
-        self.hierarchy.remap(&map, &material);
-        self.owner = owner;
+        // A garment's home coordinates are chosen by the transfer.
+        self.hierarchy.remap(&map, &world.mesh.material);
+        self.owner = built.owner;
         Ok(origins)
     }
 

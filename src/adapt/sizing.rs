@@ -139,7 +139,7 @@ use super::AdaptConfig;
 use super::proximity::{ObstaclePlane, edge_obstacle_lean};
 use super::red_green_pass::RedGreenState;
 use crate::math::{Scalar, Vector2};
-use crate::mesh::{Edge, NO_TRIANGLE};
+use crate::mesh::{Edge, Mesh, NO_TRIANGLE};
 use crate::world::World;
 
 /// How many bounces (module docs) double a parent's hysteresis at most: 2^30
@@ -180,16 +180,24 @@ pub fn edge_curvature(world: &World, e: &Edge, deg: Scalar) -> Scalar {
     if !e.is_interior() || deg <= 0.0 {
         return 0.0;
     }
-    let m = &world.mesh;
-    let centroid = |t: u32| {
-        m.triangles[t as usize]
-            .iter()
-            .map(|&v| m.material[v as usize])
-            .sum::<Vector2>()
-            / 3.0
-    };
-    let d = centroid(e.triangles[0]).distance(centroid(e.triangles[1]));
+    let d = centroid_distance(&world.mesh, e);
     if d > 0.0 { deg.to_radians() / d } else { 0.0 }
+}
+
+/// The distance between the material centroids of the two triangles at interior
+/// edge `e`, m. Across a garment's welded seam the second triangle is unfolded
+/// into the first's pattern about the edge (`Mesh::unfold`).
+fn centroid_distance(m: &Mesh, e: &Edge) -> Scalar {
+    let [t0, t1] = e.triangles.map(|t| t as usize);
+    let centroid = |p: [Vector2; 3]| p.into_iter().sum::<Vector2>() / 3.0;
+    if m.panels().is_none() {
+        return centroid(m.corners(t0)).distance(centroid(m.corners(t1)));
+    }
+    let edge = e.vertices;
+    let tip = m.opposite_vertex(t1 as u32, e);
+    let [a, b] = edge.map(|v| m.corner_at(t0, v));
+    let other = [a, b, m.unfold(t0, t1, edge, tip)];
+    centroid(m.corners(t0)).distance(centroid(other))
 }
 
 /// The membrane (Green) strain of world triangle `t` in material axes,
@@ -197,7 +205,7 @@ pub fn edge_curvature(world: &World, e: &Edge, deg: Scalar) -> Scalar {
 /// [m1 - m0, m2 - m0]^-1`: `E = (F^T F - I) / 2`.
 pub fn triangle_strain(world: &World, t: u32) -> [Scalar; 3] {
     let tri = world.mesh.triangles[t as usize];
-    let [m0, m1, m2] = tri.map(|v| world.mesh.material[v as usize]);
+    let [m0, m1, m2] = world.mesh.corners(t as usize);
     let [x0, x1, x2] = tri.map(|v| world.x[v as usize]);
     let (d1, d2, e1, e2) = (m1 - m0, m2 - m0, x1 - x0, x2 - x0);
     let det = d1.perp_dot(d2);
@@ -303,8 +311,7 @@ impl RedGreenState {
 
     /// Centroid spacing of hierarchy node `n`, m.
     fn node_spacing(&self, n: u32) -> Scalar {
-        let mat = self.hierarchy.material();
-        spacing(self.hierarchy.vertices(n).map(|v| mat[v as usize]))
+        spacing(self.hierarchy.corners(n))
     }
 
     /// Leaves coarser than their target (`kappa * D > refine_angle`, or a strain

@@ -368,6 +368,7 @@ impl TensorGrid {
             levels,
             origin,
             parents_first,
+            corners: None,
         }
     }
 }

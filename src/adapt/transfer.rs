@@ -37,6 +37,7 @@
 //! velocities and pins are transferred in [`Remeshed::parents_first`] order
 //! (ascending old ids), where every midpoint follows both ends of its edge.
 
+use super::transfer_panels::panels_after_remesh;
 use crate::math::{Scalar, Vector, Vector2};
 use crate::mesh::{Mesh, MeshError, signed_area};
 use crate::physics::Contact;
@@ -66,13 +67,63 @@ pub struct Remeshed {
     pub origin: Vec<Origin>,
     /// The new vertices in an order where a midpoint comes after its parents.
     pub parents_first: Vec<u32>,
+    /// A garment's corners and panels, one per triangle (`None` for a cloth
+    /// without panels, whose corners are its vertices' material coordinates).
+    pub corners: Option<PanelCorners>,
+}
+
+/// A remeshed garment's triangles in its panels' patterns.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PanelCorners {
+    /// Each triangle's corners in its panel's pattern, m.
+    pub corners: Vec<[Vector2; 3]>,
+    /// Each triangle's panel.
+    pub of_triangle: Vec<u16>,
+}
+
+impl Remeshed {
+    /// Rest area of triangle `t`, m^2 (from its corners for a garment).
+    fn rest_area(&self, t: usize) -> Scalar {
+        match &self.corners {
+            None => signed_area(&self.material, &self.triangles[t]),
+            Some(p) => {
+                let [a, b, c] = p.corners[t];
+                0.5 * (b - a).perp_dot(c - a)
+            }
+        }
+    }
+
+    /// Lumped vertex masses `density * sum(A_t) / 3` of the new mesh.
+    fn lumped_masses(&self, density: Scalar) -> Vec<Scalar> {
+        let areas = (0..self.triangles.len()).map(|t| self.rest_area(t));
+        lump(self.material.len(), &self.triangles, areas, density)
+    }
 }
 
 /// Lumped vertex masses `density * sum(A_t) / 3`.
 pub fn lumped_masses(material: &[Vector2], triangles: &[[u32; 3]], density: Scalar) -> Vec<Scalar> {
-    let mut m = vec![0.0; material.len()];
-    for t in triangles {
-        let share = density * signed_area(material, t) / 3.0;
+    let areas = triangles.iter().map(|t| signed_area(material, t));
+    lump(material.len(), triangles, areas, density)
+}
+
+/// Lumped vertex masses of `mesh` from its triangles' rest areas (a garment's
+/// from their corners in their panels' patterns).
+pub fn mesh_lumped_masses(mesh: &Mesh, density: Scalar) -> Vec<Scalar> {
+    let areas = (0..mesh.triangles.len()).map(|t| mesh.rest_area(t));
+    lump(mesh.vertex_count(), &mesh.triangles, areas, density)
+}
+
+/// A third of each triangle's mass (`density` times its area, from `areas`) at
+/// each of its corners.
+fn lump(
+    vertices: usize,
+    triangles: &[[u32; 3]],
+    areas: impl Iterator<Item = Scalar>,
+    density: Scalar,
+) -> Vec<Scalar> {
+    let mut m = vec![0.0; vertices];
+    for (t, area) in triangles.iter().zip(areas) {
+        let share = density * area / 3.0;
         for &v in t {
             m[v as usize] += share;
         }
@@ -117,8 +168,8 @@ pub fn transfer(
     density: Scalar,
     new: Remeshed,
 ) -> Result<Vec<Origin>, MeshError> {
-    let old_mass = lumped_masses(&world.mesh.material, &world.mesh.triangles, density);
-    let new_mass = lumped_masses(&new.material, &new.triangles, density);
+    let old_mass = mesh_lumped_masses(&world.mesh, density);
+    let new_mass = new.lumped_masses(density);
     let n = new.origin.len();
     let mut x = vec![Vector::ZERO; n];
     let mut v = vec![Vector::ZERO; n];
@@ -151,7 +202,19 @@ pub fn transfer(
     let anchor_of = carry_pins(world, &old_index, &new);
     // The only fallible step comes before the world changes, so a refused
     // mesh leaves the world as it was.
-    let mesh = Mesh::from_parts(new.material, new.triangles, new.levels)?;
+    let mesh = match new.corners {
+        None => Mesh::from_parts(new.material, new.triangles, new.levels)?,
+        Some(corners) => {
+            let (pattern, home) = panels_after_remesh(
+                &world.mesh,
+                &old_index,
+                &new.origin,
+                &new.triangles,
+                corners,
+            )?;
+            Mesh::from_parts_with_pattern(home, new.triangles, new.levels, pattern)?
+        }
+    };
     world.pins.anchors = anchor_of.into_iter().flatten().collect();
     world.mesh = mesh;
     world.x = x;
@@ -292,6 +355,7 @@ pub(super) fn compact(
         levels,
         origin,
         parents_first,
+        corners: None,
     };
     (map, remeshed)
 }

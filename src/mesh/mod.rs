@@ -213,6 +213,26 @@ impl Mesh {
         })
     }
 
+    /// [`Mesh::from_parts`] with the triangles' corners in `pattern` (a remeshed
+    /// garment); checks that the panel tables match the mesh.
+    pub fn from_parts_with_pattern(
+        material: Vec<Vector2>,
+        triangles: Vec<[u32; 3]>,
+        levels: Vec<u8>,
+        pattern: Pattern,
+    ) -> Result<Mesh, MeshError> {
+        if let Pattern::Panels(p) = &pattern
+            && (p.corners.len() != triangles.len()
+                || p.of_triangle.len() != triangles.len()
+                || p.of_vertex.len() != material.len())
+        {
+            return Err(MeshError::PanelTables);
+        }
+        let mut mesh = Mesh::from_parts(material, triangles, levels)?;
+        mesh.pattern = pattern;
+        Ok(mesh)
+    }
+
     /// Number of vertices.
     pub fn vertex_count(&self) -> usize {
         self.material.len()

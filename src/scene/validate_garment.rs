@@ -8,6 +8,7 @@ use super::model::{PanelTable, SeamTable};
 use super::validate::{all_finite, positive};
 use super::{ClothShape, Scene};
 use crate::garment::SEAM_LENGTH_TOLERANCE;
+use crate::spec::AdaptMethod;
 
 fn at(table: &str, i: usize, key: &str) -> KeyPath {
     vec![Seg::Key(table.into()), Seg::Index(i), Seg::Key(key.into())]
@@ -37,18 +38,16 @@ pub(super) fn garment(scene: &Scene) -> Result<(), Issue> {
         )
         .because(keys(&["cloth", "shape"])));
     }
-    if scene
-        .adapt
-        .as_ref()
-        .is_some_and(|a| a.method != crate::spec::AdaptMethod::None)
+    if let Some(method) = scene.adapt.as_ref().map(|a| a.method)
+        && matches!(method, AdaptMethod::Edge | AdaptMethod::Tensor)
     {
         return Err(Issue::new(
             keys(&["adapt", "method"]),
             Kind::Unsupported,
-            "adaptive remeshing does not work on garments (shape = \"panels\") yet: \
-             a remesh would have to split and merge across seams",
+            "a garment (shape = \"panels\") is remeshed by red-green refinement only: \
+             the edge and tensor methods do not split and merge across seams",
         )
-        .allowed("method = \"none\", or no [adapt] table")
+        .allowed("method = \"red_green\" or \"none\"")
         .because(keys(&["cloth", "shape"])));
     }
     for (i, p) in scene.panel.iter().enumerate() {

@@ -23,6 +23,7 @@ mod energy;
 mod fast_contact;
 mod fuzz;
 mod garment_recording;
+mod garment_remesh;
 mod garments;
 mod gradient;
 mod inspect_cli;

@@ -61,40 +61,63 @@ impl RedGreen {
     /// of the flipped pair is owned by the corner child, the second by the
     /// middle child.
     pub fn build(&self, alternate: bool) -> (Vec<[u32; 3]>, Vec<u8>, Vec<u32>) {
+        let b = self.build_with_corners(alternate);
+        (b.triangles, b.levels, b.owner)
+    }
+
+    /// [`RedGreen::build`] with each emitted triangle's corners in its panel's
+    /// pattern and its panel (what a garment's mesh needs).
+    pub fn build_with_corners(&self, alternate: bool) -> Built {
         let leaves = self.leaves();
-        let mut tris = Vec::with_capacity(leaves.len() + leaves.len() / 4);
-        let mut levels = Vec::with_capacity(tris.capacity());
-        let mut owner = Vec::with_capacity(tris.capacity());
+        let capacity = leaves.len() + leaves.len() / 4;
+        let mut out = Built {
+            triangles: Vec::with_capacity(capacity),
+            levels: Vec::with_capacity(capacity),
+            owner: Vec::with_capacity(capacity),
+            corners: Vec::with_capacity(capacity),
+            panels: Vec::with_capacity(capacity),
+        };
         for t in leaves {
             let v = self.vertices(t);
             let level = self.level(t);
+            let panel = self.panel(t);
             if alternate {
                 match self.flipped_pair(t) {
                     Some(Flip::Middle) => continue, // emitted with its corner child
                     Some(Flip::Corner { pair, middle }) => {
-                        tris.extend(pair);
-                        levels.extend([level, level]);
-                        owner.extend([t, middle]);
+                        for (tri, owner) in pair.into_iter().zip([t, middle]) {
+                            let uv = tri.map(|w| self.corner_in(&[t, middle], w));
+                            out.push(tri, level, owner, uv, panel);
+                        }
                         continue;
                     }
                     None => {}
                 }
             }
             match self.hanging_node(t) {
-                None => {
-                    tris.push(v);
-                    levels.push(level);
-                    owner.push(t);
-                }
+                None => out.push(v, level, t, self.corners(t), panel),
                 Some((k, m)) => {
                     let (p, q, o) = (v[k], v[(k + 1) % 3], v[(k + 2) % 3]);
-                    tris.extend([[p, m, o], [m, q, o]]);
-                    levels.extend([level + 1, level + 1]);
-                    owner.extend([t, t]);
+                    let u = self.corners(t);
+                    let (up, uq, uo) = (u[k], u[(k + 1) % 3], u[(k + 2) % 3]);
+                    let um = (up + uq) * 0.5;
+                    out.push([p, m, o], level + 1, t, [up, um, uo], panel);
+                    out.push([m, q, o], level + 1, t, [um, uq, uo], panel);
                 }
             }
         }
-        (tris, levels, owner)
+        out
+    }
+
+    /// The corner coordinate of vertex `v` in the first of `nodes` that has it.
+    fn corner_in(&self, nodes: &[u32], v: u32) -> Vector2 {
+        nodes
+            .iter()
+            .find_map(|&n| {
+                let k = self.vertices(n).iter().position(|&w| w == v)?;
+                Some(self.corners(n)[k])
+            })
+            .expect("a flipped pair's vertices are corners of its two children")
     }
 
     /// The first edge of leaf `t` (from corner k to k + 1) that carries a
@@ -111,7 +134,7 @@ impl RedGreen {
     /// relative 1e-9, so that a grid's right angles count despite rounding),
     /// if any.
     fn square_corner(&self, n: u32) -> Option<usize> {
-        let v = self.vertices(n).map(|i| self.material[i as usize]);
+        let v = self.corners(n);
         (0..3).find(|&k| {
             let (a, b) = (v[(k + 2) % 3] - v[k], v[(k + 1) % 3] - v[k]);
             a.dot(b) <= 1e-9 * a.length() * b.length()
@@ -251,6 +274,32 @@ fn rekey<V: Copy>(
         stays
     });
     table.extend(moved);
+}
+
+/// The conforming mesh [`RedGreen::build_with_corners`] emits, one entry per
+/// triangle in each list.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Built {
+    /// Triangles over the forest's vertices, counter-clockwise in their pattern.
+    pub triangles: Vec<[u32; 3]>,
+    /// Paper A level of each triangle.
+    pub levels: Vec<u8>,
+    /// The leaf of the forest that owns each triangle.
+    pub owner: Vec<u32>,
+    /// Each triangle's corners in its panel's pattern, m.
+    pub corners: Vec<[Vector2; 3]>,
+    /// Each triangle's garment panel (0 for a cloth without panels).
+    pub panels: Vec<u16>,
+}
+
+impl Built {
+    fn push(&mut self, tri: [u32; 3], level: u8, owner: u32, uv: [Vector2; 3], panel: u16) {
+        self.triangles.push(tri);
+        self.levels.push(level);
+        self.owner.push(owner);
+        self.corners.push(uv);
+        self.panels.push(panel);
+    }
 }
 
 /// A leaf's part in a flipped pair.
