@@ -125,6 +125,8 @@ pub struct FrameState<'a> {
     pub material: &'a [crate::math::Vector2],
     /// Triangles (vertex indices).
     pub triangles: &'a [[u32; 3]],
+    /// Where the triangles' corners lie in material space (a garment's panels).
+    pub pattern: &'a crate::mesh::Pattern,
 }
 
 impl From<BuildError> for RunError {

@@ -21,30 +21,75 @@ pub struct Located {
 /// Sample points on a regular `n` x `n` grid over the mesh's material bounds,
 /// kept where they fall inside the cloth (for a disk or an OBJ outline).
 pub fn grid_samples(mesh: &Mesh, n: usize) -> Vec<Vector2> {
-    let (lo, hi) = mesh.material_bounds();
+    panel_grid_samples(mesh, n)
+        .into_iter()
+        .map(|(p, _)| p)
+        .collect()
+}
+
+/// Sample points with their panel: for a garment, a regular `n` x `n` grid over
+/// each panel's pattern bounds, kept where it falls inside that panel; for one
+/// piece, [`grid_samples`]' points, all in panel 0.
+pub fn panel_grid_samples(mesh: &Mesh, n: usize) -> Vec<(Vector2, u16)> {
+    let panels = mesh.panels().map_or(1, |p| p.names.len()) as u16;
     let n = n.max(1);
-    let mut out = Vec::with_capacity(n * n);
-    for j in 0..n {
-        for i in 0..n {
-            // Cell centres: never exactly on the boundary.
-            let t = Vector2::new(
-                (i as Scalar + 0.5) / n as Scalar,
-                (j as Scalar + 0.5) / n as Scalar,
-            );
-            out.push(lo + (hi - lo) * t);
+    let mut out = Vec::new();
+    for panel in 0..panels {
+        let (lo, hi) = panel_bounds(mesh, panel);
+        let mut grid = Vec::with_capacity(n * n);
+        for j in 0..n {
+            for i in 0..n {
+                // Cell centres: never exactly on the boundary.
+                let t = Vector2::new(
+                    (i as Scalar + 0.5) / n as Scalar,
+                    (j as Scalar + 0.5) / n as Scalar,
+                );
+                grid.push(lo + (hi - lo) * t);
+            }
+        }
+        let in_panel = vec![panel; grid.len()];
+        let located = locate_in_panels(mesh, &grid, &in_panel);
+        out.extend(
+            grid.into_iter()
+                .zip(located)
+                .filter_map(|(p, l)| l.map(|_| (p, panel))),
+        );
+    }
+    out
+}
+
+/// The bounds of panel `panel`'s corners in its pattern (the whole mesh's
+/// material bounds for one piece).
+fn panel_bounds(mesh: &Mesh, panel: u16) -> (Vector2, Vector2) {
+    let mut lo = Vector2::splat(Scalar::INFINITY);
+    let mut hi = Vector2::splat(Scalar::NEG_INFINITY);
+    for t in (0..mesh.triangles.len()).filter(|&t| mesh.panel_of(t) == panel) {
+        for c in mesh.corners(t) {
+            lo = lo.min(c);
+            hi = hi.max(c);
         }
     }
-    let located = locate(mesh, &out);
-    out.into_iter()
-        .zip(located)
-        .filter_map(|(p, l)| l.map(|_| p))
-        .collect()
+    (lo, hi)
 }
 
 /// Finds each point's triangle, or `None` outside the cloth. Uses a uniform
 /// bucket grid over the triangles' material bounding boxes.
 pub fn locate(mesh: &Mesh, points: &[Vector2]) -> Vec<Option<Located>> {
-    let (lo, hi) = mesh.material_bounds();
+    locate_in_panels(mesh, points, &vec![0; points.len()])
+}
+
+/// [`locate`] for points that each name their panel (`panels`, one per point;
+/// all 0 for one piece): a point is found only among its panel's triangles, by
+/// their corners in that panel's pattern.
+pub fn locate_in_panels(mesh: &Mesh, points: &[Vector2], panels: &[u16]) -> Vec<Option<Located>> {
+    let mut lo = Vector2::splat(Scalar::INFINITY);
+    let mut hi = Vector2::splat(Scalar::NEG_INFINITY);
+    for t in 0..mesh.triangles.len() {
+        for c in mesh.corners(t) {
+            lo = lo.min(c);
+            hi = hi.max(c);
+        }
+    }
     let cells = ((mesh.triangles.len() as Scalar).sqrt().ceil() as usize).max(1);
     let size = (hi - lo).max(Vector2::splat(Scalar::MIN_POSITIVE)) / cells as Scalar;
     let cell_of = |p: Vector2| {
@@ -55,8 +100,8 @@ pub fn locate(mesh: &Mesh, points: &[Vector2]) -> Vec<Option<Located>> {
         )
     };
     let mut buckets: Vec<Vec<u32>> = vec![Vec::new(); cells * cells];
-    for (t, tri) in mesh.triangles.iter().enumerate() {
-        let corners = tri.map(|v| mesh.material[v as usize]);
+    for t in 0..mesh.triangles.len() {
+        let corners = mesh.corners(t);
         let (a, b) = (
             corners[0].min(corners[1]).min(corners[2]),
             corners[0].max(corners[1]).max(corners[2]),
@@ -70,15 +115,19 @@ pub fn locate(mesh: &Mesh, points: &[Vector2]) -> Vec<Option<Located>> {
     }
     points
         .iter()
-        .map(|&p| {
+        .zip(panels)
+        .map(|(&p, &panel)| {
             let (x, y) = cell_of(p);
-            buckets[y * cells + x].iter().find_map(|&t| {
-                let w = barycentric(mesh, t, p)?;
-                Some(Located {
-                    triangle: t,
-                    weights: w,
+            buckets[y * cells + x]
+                .iter()
+                .filter(|&&t| mesh.panel_of(t as usize) == panel)
+                .find_map(|&t| {
+                    let w = barycentric(mesh, t, p)?;
+                    Some(Located {
+                        triangle: t,
+                        weights: w,
+                    })
                 })
-            })
         })
         .collect()
 }
@@ -86,7 +135,7 @@ pub fn locate(mesh: &Mesh, points: &[Vector2]) -> Vec<Option<Located>> {
 /// Barycentric weights of `p` in triangle `t`, if it lies inside (with a small
 /// tolerance so that points on shared edges are found).
 fn barycentric(mesh: &Mesh, t: u32, p: Vector2) -> Option<[Scalar; 3]> {
-    let [a, b, c] = mesh.triangles[t as usize].map(|v| mesh.material[v as usize]);
+    let [a, b, c] = mesh.corners(t as usize);
     let area = (b - a).perp_dot(c - a);
     if area == 0.0 {
         return None;

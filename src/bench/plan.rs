@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use super::ladder::{self, Compare, Ladder, StepPolicy};
-use super::metric::{diagonal, grid_samples};
+use super::metric::{diagonal, panel_grid_samples};
 use super::sampling::{SamplePoints, read_json, write_json};
 use super::{BenchError, BenchOptions};
 use crate::math::{Scalar, Vector};
@@ -228,7 +228,13 @@ fn resolve_ladder(opts: &BenchOptions, base_set: &[String]) -> Result<Ladder, Be
     } else {
         match &opts.ladder {
             Some(l) => l.clone(),
-            None => ladder::default_ladder(&load(&opts.scene, base_set, "scene")?),
+            None => {
+                let scene = load(&opts.scene, base_set, "scene")?;
+                match is_garment(&scene) {
+                    true => ladder::default_garment_ladder(&scene),
+                    false => ladder::default_ladder(&scene),
+                }
+            }
         }
     };
     if !opts.rungs.is_empty() {
@@ -268,15 +274,10 @@ pub fn make_plan(opts: &BenchOptions) -> Result<(Plan, SamplePoints), BenchError
         base_set.push(format!("simulation.duration={d:e}"));
     }
     let base = load(&opts.scene, &base_set, "scene")?;
-    if base.cloth.shape == crate::scene::ClothShape::Panels {
-        return Err(BenchError::Plan(
-            "drape bench compares runs point by point in material coordinates, and a garment's \
-             panels share their pattern coordinates; garments (shape = \"panels\") cannot be \
-             benched yet"
-                .into(),
-        ));
-    }
     let ladder = resolve_ladder(opts, &base_set)?;
+    if is_garment(&base) {
+        check_garment_ladder(opts, &ladder)?;
+    }
     let step = match opts.time_ladder {
         true => StepPolicy::Own,
         false => opts.step.or(ladder.step).unwrap_or(StepPolicy::Common),
@@ -311,11 +312,13 @@ pub fn make_plan(opts: &BenchOptions) -> Result<(Plan, SamplePoints), BenchError
         runs.push(lift_floor(&opts.scene, &ref_set, &ref_scene)?);
     }
     let world = World::from_scene(&ref_scene).map_err(RunError::from)?;
+    let samples = panel_grid_samples(&world.mesh, opts.grid);
     let points = SamplePoints {
-        points: grid_samples(&world.mesh, opts.grid)
-            .iter()
-            .map(|p| p.to_array())
-            .collect(),
+        points: samples.iter().map(|(p, _)| p.to_array()).collect(),
+        panels: match world.mesh.panels() {
+            Some(_) => samples.iter().map(|&(_, panel)| panel).collect(),
+            None => Vec::new(),
+        },
         diagonal: diagonal(&world.mesh),
     };
     let plan = Plan {
@@ -341,14 +344,50 @@ pub fn make_plan(opts: &BenchOptions) -> Result<(Plan, SamplePoints), BenchError
     Ok((plan, points))
 }
 
+/// True for a garment (`shape = "panels"`).
+fn is_garment(scene: &Scene) -> bool {
+    scene.cloth.shape == crate::scene::ClothShape::Panels
+}
+
+/// A garment's runs are set by `cloth.max_edge`, not a resolution: its ladder
+/// must name its reference (the default garment ladder does), and
+/// `--reference-resolution` does not apply.
+fn check_garment_ladder(opts: &BenchOptions, ladder: &Ladder) -> Result<(), BenchError> {
+    if opts.reference_resolution.is_some() {
+        return Err(BenchError::Plan(
+            "--reference-resolution: a garment's meshes are set by `cloth.max_edge`; \
+             name the reference in the ladder file (reference = [\"cloth.max_edge=...\"])"
+                .into(),
+        ));
+    }
+    if ladder.reference.is_none() && !opts.time_ladder {
+        return Err(BenchError::Plan(
+            "a garment's ladder must name its reference, a uniform run finer than every rung \
+             (reference = [\"adapt.method=none\", \"cloth.max_edge=...\"]): its meshes are \
+             set by `cloth.max_edge`, which the bench cannot refine on its own"
+                .into(),
+        ));
+    }
+    Ok(())
+}
+
 /// The lift floor: the reference with the cloth started [`FLOOR_LIFT`] higher
-/// (against gravity), moved back down before comparing.
+/// (against gravity), moved back down before comparing. A garment's panels are
+/// each lifted.
 fn lift_floor(path: &Path, ref_set: &[String], ref_scene: &Scene) -> Result<RunPlan, BenchError> {
     let g = Vector::from(ref_scene.simulation.gravity);
     let lift = (-g).try_normalize().unwrap_or(Vector::Z) * FLOOR_LIFT;
-    let p = Vector::from(ref_scene.cloth.position) + lift;
-    let moved = format!("cloth.position=[{:e}, {:e}, {:e}]", p.x, p.y, p.z);
-    let set = chain(ref_set, &[moved]);
+    let at = |p: [f64; 3]| {
+        let p = Vector::from(p) + lift;
+        format!("[{:e}, {:e}, {:e}]", p.x, p.y, p.z)
+    };
+    let moved: Vec<String> = match is_garment(ref_scene) {
+        false => vec![format!("cloth.position={}", at(ref_scene.cloth.position))],
+        true => (ref_scene.panel.iter().enumerate())
+            .map(|(k, p)| format!("panel.{k}.position={}", at(p.position)))
+            .collect(),
+    };
+    let set = chain(ref_set, &moved);
     let scene = load(path, &set, LIFT_LABEL)?;
     Ok(RunPlan {
         floor: true,

@@ -10,7 +10,7 @@ use std::time::{Instant, SystemTime, UNIX_EPOCH};
 use serde::{Deserialize, Serialize};
 
 use super::BenchError;
-use super::metric::{locate, relative_rms, sample_positions};
+use super::metric::{locate_in_panels, relative_rms, sample_positions};
 use crate::math::{Scalar, Vector, Vector2};
 use crate::mesh::Mesh;
 use crate::run::{FrameState, RunError, RunOptions, run_observed};
@@ -23,8 +23,12 @@ pub const SAMPLES_FORMAT: &str = "drape-samples-1";
 /// The material points a job samples (`points.json` of a plan).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SamplePoints {
-    /// Material coordinates of each point, m.
+    /// Material coordinates of each point, m (in its panel's pattern).
     pub points: Vec<[Scalar; 2]>,
+    /// The garment panel of each point (empty for a cloth in one piece: every
+    /// point in panel 0).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub panels: Vec<u16>,
     /// The cloth's diagonal in material space, m (the error's scale).
     pub diagonal: Scalar,
 }
@@ -41,6 +45,14 @@ impl SamplePoints {
             .iter()
             .map(|p| Vector2::from_array(*p))
             .collect()
+    }
+
+    /// The panel of each point (all 0 for a cloth in one piece).
+    pub fn point_panels(&self) -> Vec<u16> {
+        match self.panels.is_empty() {
+            true => vec![0; self.points.len()],
+            false => self.panels.clone(),
+        }
     }
 }
 
@@ -117,6 +129,7 @@ impl Samples {
 pub struct Sampler<'a> {
     points: &'a SamplePoints,
     at: Vec<Vector2>,
+    panels: Vec<u16>,
     frames: Vec<FrameSamples>,
     sampling_s: Scalar,
     started: Scalar,
@@ -128,6 +141,7 @@ impl<'a> Sampler<'a> {
         Sampler {
             points,
             at: points.vectors(),
+            panels: points.point_panels(),
             frames: Vec::new(),
             sampling_s: 0.0,
             started: unix_now(),
@@ -137,7 +151,7 @@ impl<'a> Sampler<'a> {
     /// Samples one recorded frame (its time is taken out of the run's).
     pub fn observe(&mut self, f: &FrameState) {
         let t0 = Instant::now();
-        self.frames.push(sample_frame(f, &self.at));
+        self.frames.push(sample_frame(f, &self.at, &self.panels));
         self.sampling_s += t0.elapsed().as_secs_f64();
     }
 
@@ -212,17 +226,17 @@ fn unix_now() -> Scalar {
         .map_or(0.0, |d| d.as_secs_f64())
 }
 
-/// Samples one frame: locates the points in the frame's mesh by material
-/// coordinates and interpolates the world positions.
-pub fn sample_frame(f: &FrameState, points: &[Vector2]) -> FrameSamples {
+/// Samples one frame: locates the points (each in its panel, `panels`) in the
+/// frame's mesh by material coordinates and interpolates the world positions.
+pub fn sample_frame(f: &FrameState, points: &[Vector2], panels: &[u16]) -> FrameSamples {
     let mesh = Mesh {
         material: f.material.to_vec(),
         triangles: f.triangles.to_vec(),
         levels: Vec::new(),
         edges: Vec::new(),
-        pattern: crate::mesh::Pattern::PerVertex,
+        pattern: f.pattern.clone(),
     };
-    let positions = locate(&mesh, points)
+    let positions = locate_in_panels(&mesh, points, panels)
         .iter()
         .map(|l| l.map(|l| sample_positions(&mesh, f.positions, &[l])[0].to_array()))
         .collect();

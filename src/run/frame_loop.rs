@@ -175,6 +175,7 @@ impl<'a> FrameLoop<'a> {
             positions: &world.x,
             material: &world.mesh.material,
             triangles: &world.mesh.triangles,
+            pattern: &world.mesh.pattern,
         });
         if self.frame.is_multiple_of(self.record_every) || self.frame == self.frames {
             self.record_now()?;

@@ -336,9 +336,9 @@ fn garment_mistakes_name_file_line_and_key() {
         (
             edit(
                 "max_edge = 0.025",
-                "max_edge = 0.025\n[adapt]\nmethod = \"red_green\"",
+                "max_edge = 0.025\n[adapt]\nmethod = \"edge\"",
             ),
-            "key `adapt.method`: adaptive remeshing does not work on garments",
+            "key `adapt.method`: a garment (shape = \"panels\") is remeshed by red-green refinement only",
         ),
         (
             edit("max_edge = 0.025\n", ""),
@@ -431,23 +431,5 @@ fn the_skirt_sews_and_welds_on_the_mannequin_identically_at_any_thread_count() {
         a.1.iter()
             .zip(&b.1)
             .all(|(p, q)| p.to_array() == q.to_array())
-    );
-}
-
-#[test]
-fn bench_refuses_a_garment_with_the_reason() {
-    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/skirt.toml");
-    let dir = std::env::temp_dir().join(format!("drape-bench-garment-{}", std::process::id()));
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_drape"))
-        .args(["bench", scene, "--out"])
-        .arg(&dir)
-        .output()
-        .expect("drape");
-    let err = String::from_utf8_lossy(&out.stderr);
-    println!("{err}");
-    assert_eq!(out.status.code(), Some(1));
-    assert!(
-        err.contains("garments (shape = \"panels\") cannot be benched yet"),
-        "{err}"
     );
 }

@@ -22,6 +22,7 @@ mod elements;
 mod energy;
 mod fast_contact;
 mod fuzz;
+mod garment_bench;
 mod garment_recording;
 mod garment_remesh;
 mod garments;
