@@ -24,8 +24,9 @@
 //! (`transfer.rs`).
 
 use crate::math::{Scalar, Vector2};
+use crate::mesh::Mesh;
 
-pub use super::soup::{Soup, SoupOp, VertexChange};
+pub use super::soup::{Soup, SoupOp, SoupTri, VertexChange};
 
 /// One operation of the edge method, for events.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -38,20 +39,17 @@ pub enum EdgeOp {
     Collapse(u32, u32),
 }
 
-/// A triangle to be halved by a split: slot `t` with corners `tri`, the split
-/// edge running p -> q, `o` the opposite corner.
+/// A triangle to be halved by a split: `old` as it is, the split edge running
+/// p -> q, `o` the opposite corner, and their pattern coordinates with the
+/// midpoint's (`um`, in this triangle's panel).
 struct Halved {
-    t: u32,
-    tri: [u32; 3],
+    old: SoupTri,
     p: u32,
     q: u32,
     o: u32,
-    level: u8,
+    uv: [Vector2; 3],
+    um: Vector2,
 }
-
-/// A triangle that a collapse moves: its slot, its corners and its corners after
-/// the collapse.
-type Moved = (u32, [u32; 3], [u32; 3]);
 
 fn sorted(a: u32, b: u32) -> (u32, u32) {
     (a.min(b), a.max(b))
@@ -110,26 +108,28 @@ impl Soup {
         if around.is_empty() {
             return false;
         }
-        let m_pos = (self.material[a as usize] + self.material[b as usize]) * 0.5;
         if self.len2(a, b).sqrt() * 0.5 < limits.min_edge {
             return false;
         }
         let mut plan = Vec::new();
         for t in around.iter() {
-            let Some(tri) = self.tris[t as usize] else {
+            let Some(old) = self.soup_tri(t) else {
                 continue;
             };
-            let Some(half) = self.halve(t, tri, a, b, m_pos, limits) else {
+            let Some(half) = self.halve(old, a, b, limits) else {
                 return false;
             };
             plan.push(half);
         }
+        let Some(first) = plan.first() else {
+            return false;
+        };
         let m = self.material.len() as u32;
         let base = self.tris.len() as u32;
         let mut op = SoupOp {
             vertex: Some(VertexChange::Append {
                 id: m,
-                material: m_pos,
+                material: first.um,
                 parent: (a, b),
             }),
             slots: (base, base + 2 * plan.len() as u32),
@@ -138,9 +138,23 @@ impl Soup {
         let mut touched = Vec::new();
         for (k, h) in plan.iter().enumerate() {
             let slot = base + 2 * k as u32;
-            op.removed.push((h.t, h.tri, h.level));
-            op.added.push((slot, [h.p, m, h.o], h.level + 1));
-            op.added.push((slot + 1, [m, h.q, h.o], h.level + 1));
+            let [up, uq, uo] = h.uv;
+            let (level, panel) = (h.old.level + 1, h.old.panel);
+            op.removed.push(h.old);
+            op.added.push(SoupTri {
+                slot,
+                tri: [h.p, m, h.o],
+                level,
+                uv: [up, h.um, uo],
+                panel,
+            });
+            op.added.push(SoupTri {
+                slot: slot + 1,
+                tri: [m, h.q, h.o],
+                level,
+                uv: [h.um, uq, uo],
+                panel,
+            });
             touched.extend([h.p, h.q, h.o]);
         }
         // The new vertex is not in the soup yet: its flag starts false.
@@ -185,40 +199,32 @@ impl Soup {
         }
     }
 
-    /// Triangle `t` (corners `tri`) halved across its edge (a, b) at the material
-    /// point `m_pos`; `None` when a half would go past `max_level` or below
-    /// `min_angle`.
-    fn halve(
-        &self,
-        t: u32,
-        tri: [u32; 3],
-        a: u32,
-        b: u32,
-        m_pos: Vector2,
-        limits: &Limits,
-    ) -> Option<Halved> {
+    /// Triangle `old` halved across its edge (a, b) at its midpoint in the
+    /// triangle's pattern; `None` when a half would go past `max_level` or
+    /// below `min_angle`.
+    fn halve(&self, old: SoupTri, a: u32, b: u32, limits: &Limits) -> Option<Halved> {
+        let tri = old.tri;
         let k = (0..3)
             .find(|&k| sorted(tri[k], tri[(k + 1) % 3]) == sorted(a, b))
             .unwrap_or(0);
         let (p, q, o) = (tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]);
-        let level = self.levels[t as usize];
-        if level as u32 + 1 > limits.max_level as u32 {
+        if old.level as u32 + 1 > limits.max_level as u32 {
             return None;
         }
-        let mp = self.material[p as usize];
-        let (mq, mo) = (self.material[q as usize], self.material[o as usize]);
-        if min_angle_deg([mp, m_pos, mo]) < limits.min_angle
-            || min_angle_deg([m_pos, mq, mo]) < limits.min_angle
+        let (mp, mq, mo) = (old.uv[k], old.uv[(k + 1) % 3], old.uv[(k + 2) % 3]);
+        let um = (mp + mq) * 0.5;
+        if min_angle_deg([mp, um, mo]) < limits.min_angle
+            || min_angle_deg([um, mq, mo]) < limits.min_angle
         {
             return None;
         }
         Some(Halved {
-            t,
-            tri,
+            old,
             p,
             q,
             o,
-            level,
+            uv: [mp, mq, mo],
+            um,
         })
     }
 
@@ -245,10 +251,10 @@ impl Soup {
                 Some(pair) => pair,
                 None => continue,
             };
-            let (Some(t0), Some(t1)) = (self.tris[ts[0] as usize], self.tris[ts[1] as usize])
-            else {
+            let (Some(s0), Some(s1)) = (self.soup_tri(ts[0]), self.soup_tri(ts[1])) else {
                 continue;
             };
+            let (t0, t1) = (s0.tri, s1.tri);
             let opp = |t: [u32; 3]| t.into_iter().find(|&v| v != a && v != b).unwrap_or(a);
             let (c, d) = (opp(t0), opp(t1));
             if self.has_edge(c, d) {
@@ -257,12 +263,13 @@ impl Soup {
             // Orient: t0 runs a -> b, so the flipped pair is (c, a, d), (d, b, c).
             let runs_ab = (0..3).any(|k| t0[k] == a && t0[(k + 1) % 3] == b);
             let (a, b) = if runs_ab { (a, b) } else { (b, a) };
-            let (pa, pb, pc, pd) = (
-                self.material[a as usize],
-                self.material[b as usize],
-                self.material[c as usize],
-                self.material[d as usize],
-            );
+            let at = |t: u32, v: u32| self.corner_at(t, v).unwrap_or(Vector2::ZERO);
+            let (pa, pb, pc, pd) = (at(ts[0], a), at(ts[0], b), at(ts[0], c), at(ts[1], d));
+            // A garment's welded seam is not flipped: its two triangles lie in
+            // different patterns.
+            if s0.panel != s1.panel || at(ts[1], a) != pa || at(ts[1], b) != pb {
+                continue;
+            }
             let new0 = [pc, pa, pd];
             let new1 = [pd, pb, pc];
             let area = |p: [Vector2; 3]| (p[1] - p[0]).perp_dot(p[2] - p[0]);
@@ -280,14 +287,21 @@ impl Soup {
             if after < limits.min_angle || after <= before {
                 continue;
             }
-            let (l0, l1) = (self.levels[ts[0] as usize], self.levels[ts[1] as usize]);
+            let level = s0.level.max(s1.level);
             let base = self.tris.len() as u32;
+            let added = |slot: u32, tri: [u32; 3], uv: [Vector2; 3]| SoupTri {
+                slot,
+                tri,
+                level,
+                uv,
+                panel: s0.panel,
+            };
             let op = SoupOp {
                 vertex: None,
-                removed: vec![(ts[0], t0, l0), (ts[1], t1, l1)],
+                removed: vec![s0, s1],
                 added: vec![
-                    (base, [c, a, d], l0.max(l1)),
-                    (base + 1, [d, b, c], l0.max(l1)),
+                    added(base, [c, a, d], new0),
+                    added(base + 1, [d, b, c], new1),
                 ],
                 slots: (base, base + 2),
                 touched: self.touching(&[a, b, c, d]),
@@ -345,10 +359,18 @@ impl Soup {
         if common != shared.len() {
             return false;
         }
-        if self.on_boundary(v) && !self.straight_boundary(v, u, &nv, shared.len()) {
+        // A vertex on a garment's welded seam has a coordinate in each panel:
+        // it stays (a collapse moves triangles in one pattern only).
+        if !self.in_one_pattern(v) {
             return false;
         }
-        let Some(replaced) = self.moved_triangles(v, u, limits) else {
+        let Some(pu) = shared.iter().find_map(|t| self.corner_at(t, u)) else {
+            return false;
+        };
+        if self.on_boundary(v) && !self.straight_boundary(v, u, pu, &nv, shared.len()) {
+            return false;
+        }
+        let Some(replaced) = self.moved_triangles(v, u, pu, limits) else {
             return false;
         };
         let base = self.tris.len() as u32;
@@ -357,15 +379,14 @@ impl Soup {
             slots: (base, base + replaced.len() as u32),
             ..SoupOp::default()
         };
-        for t in shared.iter() {
-            if let Some(tri) = self.tris[t as usize] {
-                op.removed.push((t, tri, self.levels[t as usize]));
-            }
-        }
-        for (k, &(t, old, new)) in replaced.iter().enumerate() {
-            let level = self.levels[t as usize];
-            op.removed.push((t, old, level));
-            op.added.push((base + k as u32, new, level));
+        op.removed
+            .extend(shared.iter().filter_map(|t| self.soup_tri(t)));
+        for (k, (old, new)) in replaced.into_iter().enumerate() {
+            op.removed.push(old);
+            op.added.push(SoupTri {
+                slot: base + k as u32,
+                ..new
+            });
         }
         let mut touched = nv;
         touched.push(v);
@@ -375,10 +396,11 @@ impl Soup {
         true
     }
 
-    /// A boundary vertex `v` (neighbours `nv`) collapses into `u` only along a
-    /// straight boundary: (u, v) is a boundary edge (one shared triangle) and v's
-    /// other boundary neighbour continues the line from u through v.
-    fn straight_boundary(&self, v: u32, u: u32, nv: &[u32], shared: usize) -> bool {
+    /// A boundary vertex `v` (neighbours `nv`) collapses into `u` (at `pu` in
+    /// v's pattern) only along a straight boundary: (u, v) is a boundary edge
+    /// (one shared triangle) and v's other boundary neighbour continues the
+    /// line from u through v.
+    fn straight_boundary(&self, v: u32, u: u32, pu: Vector2, nv: &[u32], shared: usize) -> bool {
         if shared != 1 {
             return false;
         }
@@ -388,34 +410,49 @@ impl Soup {
             .filter(|&w| w != u && self.tris_at(v, w).len() == 1)
             .collect();
         let [w] = others[..] else { return false };
-        let (pu, pv, pw) = (
-            self.material[u as usize],
-            self.material[v as usize],
-            self.material[w as usize],
-        );
+        let Some((pv, pw)) = self
+            .tris_at(v, w)
+            .iter()
+            .find_map(|t| Some((self.corner_at(t, v)?, self.corner_at(t, w)?)))
+        else {
+            return false;
+        };
         if (pv - pu).perp_dot(pw - pv).abs() > 1e-12 * (pv - pu).length_squared().max(1e-300) {
             return false;
         }
         true
     }
 
-    /// The triangles at `v` but not at `u`, each with its corners after `v`
-    /// moves onto `u`; `None` when one would invert or fall below `min_angle`.
-    fn moved_triangles(&self, v: u32, u: u32, limits: &Limits) -> Option<Vec<Moved>> {
+    /// The triangles at `v` but not at `u`, each as it is and as it is after
+    /// `v` moves onto `u` (at `pu` in their pattern); `None` when one would
+    /// invert or fall below `min_angle`.
+    fn moved_triangles(
+        &self,
+        v: u32,
+        u: u32,
+        pu: Vector2,
+        limits: &Limits,
+    ) -> Option<Vec<(SoupTri, SoupTri)>> {
         let mut replaced = Vec::new();
         for &t in &self.vert_tris[v as usize] {
-            let Some(tri) = self.tris[t as usize] else {
+            let Some(old) = self.soup_tri(t) else {
                 continue;
             };
-            if tri.contains(&u) {
+            if old.tri.contains(&u) {
                 continue;
             }
-            let new = tri.map(|w| if w == v { u } else { w });
-            let p = self.corners(new);
+            let mut new = old;
+            for k in 0..3 {
+                if old.tri[k] == v {
+                    new.tri[k] = u;
+                    new.uv[k] = pu;
+                }
+            }
+            let p = new.uv;
             if (p[1] - p[0]).perp_dot(p[2] - p[0]) <= 0.0 || min_angle_deg(p) < limits.min_angle {
                 return None;
             }
-            replaced.push((t, tri, new));
+            replaced.push((old, new));
         }
         Some(replaced)
     }
@@ -436,21 +473,12 @@ pub struct Limits {
 
 impl Limits {
     /// Limits for an input mesh: half its smallest angle, and collapses below
-    /// 0.75 of its shortest edge.
-    pub fn for_mesh(
-        material: &[Vector2],
-        tris: &[[u32; 3]],
-        max_level: u8,
-        min_edge: Scalar,
-    ) -> Limits {
-        let min_angle = tris
-            .iter()
-            .map(|t| min_angle_deg(t.map(|v| material[v as usize])))
-            .fold(180.0, Scalar::min);
-        let shortest = tris
-            .iter()
-            .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
-            .map(|(a, b)| material[a as usize].distance(material[b as usize]))
+    /// 0.75 of its shortest edge (in its triangles' patterns).
+    pub fn for_mesh(mesh: &Mesh, max_level: u8, min_edge: Scalar) -> Limits {
+        let corners = (0..mesh.triangles.len()).map(|t| mesh.corners(t));
+        let min_angle = corners.clone().map(min_angle_deg).fold(180.0, Scalar::min);
+        let shortest = corners
+            .flat_map(|p| (0..3).map(move |k| p[k].distance(p[(k + 1) % 3])))
             .fold(Scalar::INFINITY, Scalar::min);
         Limits {
             min_angle: 0.5 * min_angle,

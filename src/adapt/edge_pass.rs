@@ -3,7 +3,7 @@
 
 use std::collections::HashMap;
 
-use super::transfer::{VertexOrder, compact, transfer};
+use super::transfer::{PanelCorners, VertexOrder, compact, transfer};
 use super::{AdaptConfig, AdaptEvent, Adapter, EventKind, MethodState, edge, edge_angles};
 use crate::math::{Scalar, Vector};
 use crate::mesh::MeshError;
@@ -32,7 +32,7 @@ impl Adapter {
         let angles = edge_angles(world);
         self.stats.passes += 1;
         let m = &world.mesh;
-        let mut soup = edge::Soup::new(&m.material, &m.triangles, &m.levels);
+        let mut soup = edge::Soup::of_mesh(m);
         let mut ops = Vec::new();
         let mut marks: Vec<(usize, Scalar)> = angles
             .iter()
@@ -135,13 +135,20 @@ impl Adapter {
         soup: &edge::Soup,
     ) -> Result<Vec<u32>, MeshError> {
         let (tris, levels) = soup.live();
-        let (map, remeshed) = compact(
+        let (map, mut remeshed) = compact(
             &soup.material,
             (soup.first_new, &soup.created),
             &tris,
             levels,
             VertexOrder::Kept,
         );
+        if world.mesh.panels().is_some() {
+            let (corners, of_triangle) = soup.live_corners();
+            remeshed.corners = Some(PanelCorners {
+                corners,
+                of_triangle,
+            });
+        }
         self.last_origins = transfer(world, self.density, remeshed)?;
         Ok(map)
     }
@@ -168,21 +175,16 @@ fn collapse_candidates(
             vertex_max[v as usize] = vertex_max[v as usize].max(angles[e]);
         }
     }
-    let mut by_length: Vec<(Scalar, u32, u32)> = m
-        .edges
-        .iter()
-        .filter(|e| {
-            e.vertices
+    let mut by_length: Vec<(Scalar, u32, u32)> = (0..m.edges.len())
+        .filter(|&e| {
+            m.edges[e]
+                .vertices
                 .iter()
                 .all(|&v| vertex_max[v as usize] < flat_limit)
         })
         .map(|e| {
-            let [a, b] = e.vertices;
-            (
-                m.material[a as usize].distance(m.material[b as usize]),
-                a,
-                b,
-            )
+            let [a, b] = m.edges[e].vertices;
+            (m.rest_length(e), a, b)
         })
         .filter(|&(len, _, _)| len < limits.collapse_below)
         .collect();

@@ -249,7 +249,7 @@ pub enum AdaptSetupError {
     /// The cloth is a garment and the method cannot remesh one.
     #[error(
         "the {0} method cannot remesh a garment (a cloth with panels or seams): \
-         use method = \"red_green\""
+         use method = \"red_green\" or \"edge\""
     )]
     Garment(&'static str),
 }
@@ -266,35 +266,13 @@ impl Adapter {
         density: Scalar,
     ) -> Result<Adapter, AdaptSetupError> {
         let m = &world.mesh;
-        if let Some(panels) = m.panels() {
-            match config.method {
-                AdaptMethod::Edge => return Err(AdaptSetupError::Garment("edge")),
-                AdaptMethod::Tensor => return Err(AdaptSetupError::Garment("tensor")),
-                AdaptMethod::RedGreen | AdaptMethod::None => {}
-            }
-            if panels.seams.iter().any(|s| s.is_open()) {
-                return Ok(Adapter {
-                    stats: AdaptStats::default(),
-                    events: Vec::new(),
-                    method: MethodState::AwaitingWelds,
-                    density,
-                    area: m.total_rest_area(),
-                    boundary: boundary_length(m),
-                    last_origins: Vec::new(),
-                });
-            }
-        }
-        let method = match config.method {
-            AdaptMethod::Edge => MethodState::Edge(edge::Limits::for_mesh(
-                &m.material,
-                &m.triangles,
-                config.max_level,
-                config.min_edge_length,
-            )),
-            AdaptMethod::Tensor => MethodState::Tensor(tensor::TensorGrid::from_mesh(m)?),
-            AdaptMethod::RedGreen | AdaptMethod::None => {
-                MethodState::RedGreen(Box::new(RedGreenState::new(world)))
-            }
+        let awaiting = m
+            .panels()
+            .is_some_and(|p| p.seams.iter().any(|s| s.is_open()));
+        let method = match awaiting {
+            // Checked now, so that a refusal comes before the run.
+            true => Adapter::method_state(config, world).map(|_| MethodState::AwaitingWelds)?,
+            false => Adapter::method_state(config, world)?,
         };
         Ok(Adapter {
             stats: AdaptStats::default(),
@@ -307,26 +285,49 @@ impl Adapter {
         })
     }
 
+    /// The state of `config`'s method on `world`'s mesh as level 0.
+    fn method_state(config: &AdaptConfig, world: &World) -> Result<MethodState, AdaptSetupError> {
+        let m = &world.mesh;
+        Ok(match config.method {
+            AdaptMethod::Tensor if m.panels().is_some() => {
+                return Err(AdaptSetupError::Garment("tensor"));
+            }
+            AdaptMethod::Edge => MethodState::Edge(edge::Limits::for_mesh(
+                m,
+                config.max_level,
+                config.min_edge_length,
+            )),
+            AdaptMethod::Tensor => MethodState::Tensor(tensor::TensorGrid::from_mesh(m)?),
+            AdaptMethod::RedGreen | AdaptMethod::None => {
+                MethodState::RedGreen(Box::new(RedGreenState::new(world)))
+            }
+        })
+    }
+
     /// True while the adapter waits for a garment's seams to be welded.
     pub fn awaiting_welds(&self) -> bool {
         matches!(self.method, MethodState::AwaitingWelds)
     }
 
-    /// Starts red-green remeshing of a garment whose seams are now all welded
-    /// (only red-green waits for welds): its current triangles become level 0,
-    /// and its area and boundary the ones the checks hold it to. False while a
-    /// seam is still open.
-    fn start_after_welds(&mut self, world: &World) -> bool {
+    /// Starts remeshing a garment whose seams are now all welded: its current
+    /// triangles become level 0, and its area and boundary the ones the checks
+    /// hold it to. False while a seam is still open.
+    fn start_after_welds(
+        &mut self,
+        config: &AdaptConfig,
+        world: &World,
+    ) -> Result<bool, MeshError> {
         let m = &world.mesh;
         if m.panels()
             .is_some_and(|p| p.seams.iter().any(|s| s.is_open()))
         {
-            return false;
+            return Ok(false);
         }
-        self.method = MethodState::RedGreen(Box::new(RedGreenState::new(world)));
+        // `Adapter::new` built this method's state once already.
+        self.method = Adapter::method_state(config, world).map_err(|_| MeshError::PanelTables)?;
         self.area = m.total_rest_area();
         self.boundary = boundary_length(m);
-        true
+        Ok(true)
     }
 
     /// Where each vertex of the world's mesh came from in the latest remesh
@@ -401,7 +402,7 @@ impl Adapter {
         step: u64,
         known: Measured,
     ) -> Result<bool, MeshError> {
-        if self.awaiting_welds() && !self.start_after_welds(world) {
+        if self.awaiting_welds() && !self.start_after_welds(config, world)? {
             return Ok(false);
         }
         match &self.method {

@@ -15,7 +15,7 @@
 //! compaction, would change with each refused split.
 
 use crate::math::Vector2;
-use crate::mesh::PairMap;
+use crate::mesh::{Mesh, PairMap};
 
 use super::tri_list::TriList;
 
@@ -80,16 +80,32 @@ impl VertexChange {
     }
 }
 
+/// A triangle of the soup as an operation adds or removes it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SoupTri {
+    /// Its slot.
+    pub slot: u32,
+    /// Its vertices, counter-clockwise in its pattern.
+    pub tri: [u32; 3],
+    /// Its level (split depth).
+    pub level: u8,
+    /// Its corners' material coordinates, in its panel's pattern (a vertex on
+    /// a garment's welded seam has one coordinate per panel).
+    pub uv: [Vector2; 3],
+    /// Its garment panel (0 for a cloth without panels).
+    pub panel: u16,
+}
+
 /// One remeshing operation as a value: apply it with [`Soup::commit`], undo it
 /// by applying [`SoupOp::inverse`].
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct SoupOp {
     /// The vertex added or removed, if any.
     pub vertex: Option<VertexChange>,
-    /// Triangles removed: slot, corners, level.
-    pub removed: Vec<(u32, [u32; 3], u8)>,
-    /// Triangles added: slot, corners, level (new slots in increasing order).
-    pub added: Vec<(u32, [u32; 3], u8)>,
+    /// Triangles removed.
+    pub removed: Vec<SoupTri>,
+    /// Triangles added (new slots in increasing order).
+    pub added: Vec<SoupTri>,
     /// Number of triangle slots before and after.
     pub slots: (u32, u32),
     /// Vertices whose `touched` flag changes: vertex, before, after.
@@ -123,6 +139,11 @@ pub struct Soup {
     pub tris: Vec<Option<[u32; 3]>>,
     /// Level (split depth) of each triangle.
     pub levels: Vec<u8>,
+    /// Each triangle's corners in its panel's pattern (the vertices' material
+    /// coordinates for a cloth without panels).
+    pub uv: Vec<[Vector2; 3]>,
+    /// Each triangle's garment panel (0 for a cloth without panels).
+    pub panels: Vec<u16>,
     /// Parent edge of each vertex created in this pass (id `first_new + k`).
     pub created: Vec<(u32, u32)>,
     /// Id of the first vertex created in this pass.
@@ -137,14 +158,40 @@ pub struct Soup {
 }
 
 impl Soup {
-    /// A soup of the given mesh.
+    /// A soup of the given mesh (in one piece: every corner at its vertex's
+    /// material coordinate).
     pub fn new(material: &[Vector2], tris: &[[u32; 3]], levels: &[u8]) -> Soup {
+        let uv: Vec<[Vector2; 3]> = tris
+            .iter()
+            .map(|t| t.map(|v| material[v as usize]))
+            .collect();
+        Soup::with_corners(material, tris, levels, &uv, &vec![0; tris.len()])
+    }
+
+    /// A soup of `mesh`, a garment's triangles with their panels' corners.
+    pub fn of_mesh(mesh: &Mesh) -> Soup {
+        let n = mesh.triangles.len();
+        let uv: Vec<[Vector2; 3]> = (0..n).map(|t| mesh.corners(t)).collect();
+        let panels: Vec<u16> = (0..n).map(|t| mesh.panel_of(t)).collect();
+        Soup::with_corners(&mesh.material, &mesh.triangles, &mesh.levels, &uv, &panels)
+    }
+
+    /// A soup whose triangles carry their corners `uv` and `panels`.
+    pub fn with_corners(
+        material: &[Vector2],
+        tris: &[[u32; 3]],
+        levels: &[u8],
+        uv: &[[Vector2; 3]],
+        panels: &[u16],
+    ) -> Soup {
         let mut edge_tris = PairMap::default();
         edge_tris.reserve(tris.len() * 3 / 2 + 16);
         let mut s = Soup {
             material: material.to_vec(),
             tris: Vec::with_capacity(tris.len() * 2),
             levels: Vec::with_capacity(tris.len() * 2),
+            uv: Vec::with_capacity(tris.len() * 2),
+            panels: Vec::with_capacity(tris.len() * 2),
             created: Vec::new(),
             first_new: material.len() as u32,
             removed: vec![false; material.len()],
@@ -156,6 +203,8 @@ impl Soup {
         for (t, &tri) in tris.iter().enumerate() {
             s.tris.push(Some(tri));
             s.levels.push(levels[t]);
+            s.uv.push(uv[t]);
+            s.panels.push(panels[t]);
             s.link(t as u32, tri);
         }
         s
@@ -223,25 +272,33 @@ impl Soup {
             self.vert_tris.push(Vec::new());
             self.touched.push(false);
         }
-        for &(slot, tri, _) in &op.removed {
-            debug_assert_eq!(self.tris[slot as usize], Some(tri), "removed triangle");
-            self.tris[slot as usize] = None;
-            self.unlink(slot, tri);
+        for r in &op.removed {
+            debug_assert_eq!(self.tris[r.slot as usize], Some(r.tri), "removed triangle");
+            self.tris[r.slot as usize] = None;
+            self.unlink(r.slot, r.tri);
         }
-        for &(slot, tri, level) in &op.added {
-            if slot as usize == self.tris.len() {
-                self.tris.push(Some(tri));
-                self.levels.push(level);
+        for a in &op.added {
+            let slot = a.slot as usize;
+            if slot == self.tris.len() {
+                self.tris.push(Some(a.tri));
+                self.levels.push(a.level);
+                self.uv.push(a.uv);
+                self.panels.push(a.panel);
             } else {
-                debug_assert_eq!(self.tris[slot as usize], None, "added slot is free");
-                self.tris[slot as usize] = Some(tri);
-                self.levels[slot as usize] = level;
+                debug_assert_eq!(self.tris[slot], None, "added slot is free");
+                self.tris[slot] = Some(a.tri);
+                self.levels[slot] = a.level;
+                self.uv[slot] = a.uv;
+                self.panels[slot] = a.panel;
             }
-            self.link(slot, tri);
+            self.link(a.slot, a.tri);
         }
         debug_assert!(self.tris[op.slots.1 as usize..].iter().all(Option::is_none));
-        self.tris.truncate(op.slots.1 as usize);
-        self.levels.truncate(op.slots.1 as usize);
+        let slots = op.slots.1 as usize;
+        self.tris.truncate(slots);
+        self.levels.truncate(slots);
+        self.uv.truncate(slots);
+        self.panels.truncate(slots);
         for &(v, _, after) in &op.touched {
             self.touched[v as usize] = after;
         }
@@ -269,14 +326,55 @@ impl Soup {
             .unwrap_or_default()
     }
 
-    /// Material coordinates of a triangle's corners.
-    pub(super) fn corners(&self, tri: [u32; 3]) -> [Vector2; 3] {
-        tri.map(|v| self.material[v as usize])
+    /// The triangle of slot `t` as an operation removes it.
+    pub(super) fn soup_tri(&self, t: u32) -> Option<SoupTri> {
+        let tri = self.tris[t as usize]?;
+        Some(SoupTri {
+            slot: t,
+            tri,
+            level: self.levels[t as usize],
+            uv: self.uv[t as usize],
+            panel: self.panels[t as usize],
+        })
     }
 
-    /// Squared material length of (a, b).
+    /// The material coordinate of vertex `v` as a corner of slot `t` (in its
+    /// panel's pattern), if it is one.
+    pub(super) fn corner_at(&self, t: u32, v: u32) -> Option<Vector2> {
+        let tri = self.tris[t as usize]?;
+        let k = tri.iter().position(|&w| w == v)?;
+        Some(self.uv[t as usize][k])
+    }
+
+    /// Squared material length of (a, b), in the first triangle at it (the
+    /// vertices' distance when none is).
     pub(super) fn len2(&self, a: u32, b: u32) -> crate::math::Scalar {
-        self.material[a as usize].distance_squared(self.material[b as usize])
+        let in_triangle = self.tris_at(a, b).iter().find_map(|t| {
+            let (pa, pb) = (self.corner_at(t, a)?, self.corner_at(t, b)?);
+            Some(pa.distance_squared(pb))
+        });
+        in_triangle.unwrap_or_else(|| {
+            self.material[a as usize].distance_squared(self.material[b as usize])
+        })
+    }
+
+    /// True when every triangle at `v` is in one panel and gives `v` one
+    /// coordinate (always, for a cloth without panels): `v` is not on a welded
+    /// seam, and so may move onto a neighbour in that panel's pattern.
+    pub(super) fn in_one_pattern(&self, v: u32) -> bool {
+        let mut seen: Option<(u16, Vector2)> = None;
+        for &t in &self.vert_tris[v as usize] {
+            let Some(at) = self.corner_at(t, v) else {
+                continue;
+            };
+            let here = (self.panels[t as usize], at);
+            match seen {
+                None => seen = Some(here),
+                Some(s) if s != here => return false,
+                Some(_) => {}
+            }
+        }
+        true
     }
 
     /// True when some triangle has the edge (a, b).
@@ -306,6 +404,12 @@ impl Soup {
             }
         }
         (tris, levels)
+    }
+
+    /// The live triangles' corners and panels, in [`Soup::live`]'s order.
+    pub fn live_corners(&self) -> (Vec<[Vector2; 3]>, Vec<u16>) {
+        let live = (0..self.tris.len()).filter(|&t| self.tris[t].is_some());
+        live.map(|t| (self.uv[t], self.panels[t])).unzip()
     }
 
     /// Checks the incrementally kept incidence tables against tables built from

@@ -38,16 +38,14 @@ pub(super) fn garment(scene: &Scene) -> Result<(), Issue> {
         )
         .because(keys(&["cloth", "shape"])));
     }
-    if let Some(method) = scene.adapt.as_ref().map(|a| a.method)
-        && matches!(method, AdaptMethod::Edge | AdaptMethod::Tensor)
-    {
+    if scene.adapt.as_ref().map(|a| a.method) == Some(AdaptMethod::Tensor) {
         return Err(Issue::new(
             keys(&["adapt", "method"]),
             Kind::Unsupported,
-            "a garment (shape = \"panels\") is remeshed by red-green refinement only: \
-             the edge and tensor methods do not split and merge across seams",
+            "a garment (shape = \"panels\") has no grid lines for the tensor method to \
+             insert or remove",
         )
-        .allowed("method = \"red_green\" or \"none\"")
+        .allowed("method = \"red_green\", \"edge\" or \"none\"")
         .because(keys(&["cloth", "shape"])));
     }
     for (i, p) in scene.panel.iter().enumerate() {

@@ -1,9 +1,10 @@
-//! Red-green remeshing of garments: splits and merges across a welded seam
-//! keep both panels' pattern coordinates (each vertex on the seam has one
-//! coordinate per panel, at the same height on both sides), the panels' areas,
-//! the mass and the momentum; merging everything back gives the welded mesh's
-//! corners exactly; and a garment scene with `[adapt]` remeshes once its seams
-//! are welded, consistent after every step.
+//! Remeshing garments: red-green splits and merges and the edge method's
+//! splits, flips and collapses across a welded seam keep both panels' pattern
+//! coordinates (each vertex on the seam has one coordinate per panel, at the
+//! same height on both sides), the panels' areas, the mass and the momentum;
+//! red-green merged everything back gives the welded mesh's corners exactly;
+//! and a garment scene with `[adapt]` remeshes once its seams are welded,
+//! consistent after every step.
 
 use std::collections::HashMap;
 use std::f64::consts::PI;
@@ -31,14 +32,23 @@ const HEIGHT: Scalar = 0.3;
 fn welded_tube() -> (World, Scalar) {
     let r = 0.1;
     let width = PI * r;
-    let half = |name: &str, angle: Scalar| PanelSpec {
+    let wrap = |angle: Scalar| Placement::Cylinder {
+        radius: r,
+        angle,
+        position: [0.0; 3],
+    };
+    welded_halves(width, [wrap(0.0), wrap(180.0)])
+}
+
+/// Two `width` x 0.3 m panels ("front" and "back") placed as given, the
+/// front's side 2 sewn to the back's side 4 and the back's side 2 to the
+/// front's side 4, both seams welded; velocities set to an uneven field.
+fn welded_halves(width: Scalar, placements: [Placement; 2]) -> (World, Scalar) {
+    let [pf, pb] = placements;
+    let half = |name: &str, placement: Placement| PanelSpec {
         name: name.into(),
         outline: vec![[0.0, 0.0], [width, 0.0], [width, HEIGHT], [0.0, HEIGHT]],
-        placement: Placement::Cylinder {
-            radius: r,
-            angle,
-            position: [0.0; 3],
-        },
+        placement,
     };
     let side = |panel: &str, side: usize| SeamSide {
         panel: panel.into(),
@@ -57,7 +67,7 @@ fn welded_tube() -> (World, Scalar) {
         },
     ];
     let BuiltGarment { mesh, positions } = garment::build(&Garment {
-        panels: vec![half("front", 0.0), half("back", 180.0)],
+        panels: vec![half("front", pf), half("back", pb)],
         seams,
         max_edge: 0.06,
         sewing: Sewing {
@@ -213,6 +223,111 @@ proptest! {
         prop_assert_eq!(world.mesh.triangles.len(), base.len());
         prop_assert!(corner_sets(&world.mesh) == base, "merged back, the corners differ");
     }
+}
+
+/// The tube's positions unrolled into the plane y = 0 (x = arc length from
+/// the +x axis, the seam at the back opened up), or rolled back.
+fn reshape(x: &mut [Vector], unroll: bool) {
+    let r = 0.1;
+    for p in x.iter_mut() {
+        *p = match unroll {
+            true => Vector::new(r * p.y.atan2(p.x), 0.0, p.z),
+            false => Vector::new(r * (p.x / r).cos(), r * (p.x / r).sin(), p.z),
+        };
+    }
+}
+
+fn edge_config(refine_angle: Scalar, coarsen_angle: Scalar) -> AdaptConfig {
+    AdaptConfig {
+        refine_angle,
+        coarsen_angle,
+        max_level: 4,
+        ..angle_config(AdaptMethod::Edge)
+    }
+}
+
+/// One edge pass on `world` at thresholds (`refine`, `coarsen`) degrees, then
+/// the checks of the red-green test.
+fn edge_pass_and_check(
+    ad: &mut Adapter,
+    world: &mut World,
+    (refine, coarsen): (Scalar, Scalar),
+    before: (&[Scalar], Scalar, Vector),
+    width: Scalar,
+) -> Result<bool, TestCaseError> {
+    let changed = ad
+        .remesh(&edge_config(refine, coarsen), world, 0)
+        .map_err(|e| TestCaseError::fail(e.to_string()))?;
+    ad.check(world)
+        .map_err(|e| TestCaseError::fail(e.to_string()))?;
+    check_seam_coordinates(&world.mesh, width).map_err(TestCaseError::fail)?;
+    for (a, a0) in panel_areas(&world.mesh).iter().zip(before.0) {
+        prop_assert!((a - a0).abs() <= 1e-14, "panel area {a} != {a0}");
+    }
+    let (m, p) = mass_and_momentum(world);
+    prop_assert!((m - before.1).abs() <= 1e-15, "mass {m} != {}", before.1);
+    prop_assert!(
+        (p - before.2).length() <= 1e-14,
+        "momentum {p:?} != {:?}",
+        before.2
+    );
+    Ok(changed)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 16, ..ProptestConfig::default() })]
+
+    /// The edge method on a tube welded from two panels, rolled and unrolled
+    /// at random between passes at random thresholds (splits where it is
+    /// rolled, collapses and flips where it is flat): after every pass the
+    /// checks of the red-green test hold.
+    #[test]
+    fn edge_method_across_a_welded_seam_keeps_both_panels_pattern_coordinates(
+        rounds in prop::collection::vec((10.0f64..60.0, 0.5f64..5.0, any::<bool>()), 1..6),
+    ) {
+        let (mut world, width) = welded_tube();
+        let mut ad = Adapter::new(&edge_config(15.0, 1.5), &world, DENSITY)
+            .expect("edge method on a welded garment");
+        let areas = panel_areas(&world.mesh);
+        let (m0, p0) = mass_and_momentum(&world);
+        let mut unrolled = false;
+        for &(refine, coarsen, unroll) in &rounds {
+            if unroll != unrolled {
+                reshape(&mut world.x, unroll);
+                unrolled = unroll;
+            }
+            let thresholds = (refine, coarsen.min(0.5 * refine));
+            edge_pass_and_check(&mut ad, &mut world, thresholds, (&areas, m0, p0), width)?;
+        }
+    }
+}
+
+/// The edge method splits the welded seam's edges where the tube is rolled
+/// (the new vertices join the seam, one coordinate per panel), and where it
+/// is unrolled flat it collapses interior vertices but never a seam vertex.
+#[test]
+fn edge_splits_a_welded_seam_and_never_collapses_it() {
+    let (mut world, width) = welded_tube();
+    let mut ad = Adapter::new(&edge_config(15.0, 1.5), &world, DENSITY).expect("adapter");
+    let before = (panel_areas(&world.mesh), mass_and_momentum(&world));
+    let seam0 = check_seam_coordinates(&world.mesh, width).expect("seam");
+    let at = (&before.0[..], before.1.0, before.1.1);
+    edge_pass_and_check(&mut ad, &mut world, (10.0, 1.0), at, width).expect("split pass");
+    let split = check_seam_coordinates(&world.mesh, width).expect("seam");
+    let n_split = world.mesh.vertex_count();
+    reshape(&mut world.x, true);
+    for _ in 0..3 {
+        edge_pass_and_check(&mut ad, &mut world, (60.0, 5.0), at, width).expect("flat pass");
+    }
+    let after = check_seam_coordinates(&world.mesh, width).expect("seam");
+    println!(
+        "seam vertices {seam0} -> {split} after the split pass ({n_split} vertices) -> {after} after three flat passes ({} vertices; stats {:?})",
+        world.mesh.vertex_count(),
+        ad.stats
+    );
+    assert!(split > seam0, "no seam edge split");
+    assert!(world.mesh.vertex_count() < n_split, "nothing collapsed");
+    assert!(after >= split, "a seam vertex collapsed");
 }
 
 /// Splitting every triangle along the seam puts the new midpoints on the seam:

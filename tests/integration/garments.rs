@@ -336,9 +336,9 @@ fn garment_mistakes_name_file_line_and_key() {
         (
             edit(
                 "max_edge = 0.025",
-                "max_edge = 0.025\n[adapt]\nmethod = \"edge\"",
+                "max_edge = 0.025\n[adapt]\nmethod = \"tensor\"",
             ),
-            "key `adapt.method`: a garment (shape = \"panels\") is remeshed by red-green refinement only",
+            "key `adapt.method`: a garment (shape = \"panels\") has no grid lines for the tensor method",
         ),
         (
             edit("max_edge = 0.025\n", ""),

@@ -192,7 +192,7 @@ proptest! {
         max_level in 1u8..5,
     ) {
         let m = mesh::rectangle(1.0, 1.0, 5, DiagonalPattern::Alternating).unwrap();
-        let limits = Limits { max_level, ..Limits::for_mesh(&m.material, &m.triangles, max_level, 0.0) };
+        let limits = Limits { max_level, ..Limits::for_mesh(&m, max_level, 0.0) };
         let mut soup = Soup::new(&m.material, &m.triangles, &m.levels);
         let mut states = vec![(0, soup.clone())];
         let mut ops = Vec::new();
