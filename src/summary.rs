@@ -245,9 +245,24 @@ impl Summary {
             self.energy_retries,
             self.solver.describe(),
             match &self.adapt {
+                Some(a) if a.awaiting_welds => {
+                    " Adaptive: not started, as remeshing waits until every seam is welded.".into()
+                }
                 Some(a) => format!(
-                    " Adaptive: {} splits ({} forced), {} merges ({} bounced), {} rollbacks, max level {}.",
-                    a.splits, a.closure_splits, a.merges, a.bounces, a.rollbacks, self.max_level
+                    " Adaptive: {} splits ({} forced), {} merges ({} bounced), {} rollbacks, max level {}{}.",
+                    a.splits,
+                    a.closure_splits,
+                    a.merges,
+                    a.bounces,
+                    a.rollbacks,
+                    self.max_level,
+                    match a.started_at > 0.0 {
+                        true => format!(
+                            "; remeshing from t = {:.3} s, once every seam was welded",
+                            a.started_at
+                        ),
+                        false => String::new(),
+                    }
                 ),
                 None => String::new(),
             },

@@ -108,6 +108,12 @@ pub struct AdaptStats {
     pub top_level_area_fraction_mean: Scalar,
     /// That share after the last pass.
     pub top_level_area_fraction_final: Scalar,
+    /// True while a garment's remeshing waits for every seam to be welded
+    /// (at the end of a run: it never started).
+    pub awaiting_welds: bool,
+    /// Simulated time at which remeshing started, s: 0, or when a garment's
+    /// last seam was welded.
+    pub started_at: Scalar,
 }
 
 impl AdaptStats {
@@ -275,7 +281,10 @@ impl Adapter {
             false => Adapter::method_state(config, world)?,
         };
         Ok(Adapter {
-            stats: AdaptStats::default(),
+            stats: AdaptStats {
+                awaiting_welds: awaiting,
+                ..AdaptStats::default()
+            },
             events: Vec::new(),
             method,
             density,
@@ -327,6 +336,8 @@ impl Adapter {
         self.method = Adapter::method_state(config, world).map_err(|_| MeshError::PanelTables)?;
         self.area = m.total_rest_area();
         self.boundary = boundary_length(m);
+        self.stats.awaiting_welds = false;
+        self.stats.started_at = world.time;
         Ok(true)
     }
 

@@ -14,7 +14,7 @@ use drape::adapt::transfer::mesh_lumped_masses;
 use drape::adapt::{AdaptConfig, Adapter};
 use drape::garment::{self, BuiltGarment};
 use drape::math::{Scalar, Vector, Vector2};
-use drape::mesh::{DEFAULT_SEWING_STIFFNESS, DEFAULT_WELD_GAP, Mesh, Sewing};
+use drape::mesh::{DEFAULT_SEWING_STIFFNESS, DEFAULT_WELD_GAP, Mesh, SeamState, Sewing};
 use drape::physics::{Elements, MaterialParams, Membrane};
 use drape::scene::{AdaptMethod, BendingModel, StiffnessRule, load_scene_str};
 use drape::spec::{Garment, PanelSpec, Placement, SeamSide, SeamSpec};
@@ -399,6 +399,26 @@ fn a_garment_scene_remeshes_once_its_seams_are_welded() {
             first_remesh = Some(step);
         }
     }
+    let stats = sim.state.adapter.as_ref().expect("adapter").stats;
+    assert!(!stats.awaiting_welds);
+    let welded_at = sim
+        .state
+        .world
+        .mesh
+        .panels()
+        .expect("panels")
+        .seams
+        .iter()
+        .map(|s| match s.state {
+            SeamState::Welded { time } => time,
+            SeamState::Open => Scalar::INFINITY,
+        });
+    let last_weld = welded_at.fold(0.0, Scalar::max);
+    println!(
+        "last weld at {last_weld:.3} s, remeshing from {:.3} s",
+        stats.started_at
+    );
+    assert!(stats.started_at >= last_weld && stats.started_at < last_weld + 0.03);
     let w = &sim.state.world;
     let (m1, _) = mass_and_momentum(w);
     let refined = w.mesh.levels.iter().filter(|&&l| l > 0).count();
