@@ -8,6 +8,7 @@
 
 mod check;
 pub mod edge;
+mod edge_collapse;
 mod edge_pass;
 mod marks;
 pub mod proximity;

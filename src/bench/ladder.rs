@@ -254,45 +254,6 @@ pub fn default_ladder(scene: &Scene) -> Ladder {
     }
 }
 
-/// The default ladder for a garment (`shape = "panels"`), whose meshes are set
-/// by `cloth.max_edge` (`e`, the scene's): uniform meshes at `2e`, `1.5e` and
-/// `e`, red-green runs whose finest edges are `e` (base `2e` up to level 2,
-/// base `4e` up to level 4), and a uniform reference at `e / 1.5`.
-pub fn default_garment_ladder(scene: &Scene) -> Ladder {
-    let e = scene.cloth.max_edge.unwrap_or(0.03);
-    let edge = |x: Scalar| format!("cloth.max_edge={}", metres(x));
-    let mut rung: Vec<Rung> = [2.0, 1.5, 1.0]
-        .iter()
-        .map(|&f| {
-            let set = vec!["adapt.method=none".into(), edge(f * e)];
-            Rung::new(format!("uniform {} m", metres(f * e)), set)
-        })
-        .collect();
-    for (base, level) in [(2.0, 2), (4.0, 4)] {
-        let set = vec![
-            "adapt.method=red_green".into(),
-            edge(base * e),
-            format!("adapt.max_level={level}"),
-        ];
-        let label = format!("red_green {} m L{level}", metres(base * e));
-        rung.push(Rung::new(label, set));
-    }
-    Ladder {
-        reference: Some(vec!["adapt.method=none".into(), edge(e / 1.5)]),
-        compare: None,
-        step: None,
-        rung,
-    }
-}
-
-/// A length in metres with at most four decimals, trailing zeros dropped
-/// (0.02 for 0.019999999999999997).
-fn metres(x: Scalar) -> String {
-    let s = format!("{x:.4}");
-    let s = s.trim_end_matches('0');
-    s.strip_suffix('.').unwrap_or(s).to_owned()
-}
-
 /// Segments along the cloth's longer side of the uniform mesh whose edges are
 /// as short as the finest edges `scene` can reach: the resolution, doubled
 /// for every two levels (a red 1-4 split adds two levels and halves the

@@ -27,6 +27,7 @@
 
 pub mod chart;
 pub mod collect;
+mod garment;
 pub mod ladder;
 pub mod metric;
 pub mod plan;

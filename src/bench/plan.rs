@@ -15,6 +15,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+use super::garment::{check_garment_ladder, default_garment_ladder, is_garment};
 use super::ladder::{self, Compare, Ladder, StepPolicy};
 use super::metric::{diagonal, panel_grid_samples};
 use super::sampling::{SamplePoints, read_json, write_json};
@@ -231,7 +232,7 @@ fn resolve_ladder(opts: &BenchOptions, base_set: &[String]) -> Result<Ladder, Be
             None => {
                 let scene = load(&opts.scene, base_set, "scene")?;
                 match is_garment(&scene) {
-                    true => ladder::default_garment_ladder(&scene),
+                    true => default_garment_ladder(&scene),
                     false => ladder::default_ladder(&scene),
                 }
             }
@@ -342,33 +343,6 @@ pub fn make_plan(opts: &BenchOptions) -> Result<(Plan, SamplePoints), BenchError
         jobs: Vec::new(),
     };
     Ok((plan, points))
-}
-
-/// True for a garment (`shape = "panels"`).
-fn is_garment(scene: &Scene) -> bool {
-    scene.cloth.shape == crate::scene::ClothShape::Panels
-}
-
-/// A garment's runs are set by `cloth.max_edge`, not a resolution: its ladder
-/// must name its reference (the default garment ladder does), and
-/// `--reference-resolution` does not apply.
-fn check_garment_ladder(opts: &BenchOptions, ladder: &Ladder) -> Result<(), BenchError> {
-    if opts.reference_resolution.is_some() {
-        return Err(BenchError::Plan(
-            "--reference-resolution: a garment's meshes are set by `cloth.max_edge`; \
-             name the reference in the ladder file (reference = [\"cloth.max_edge=...\"])"
-                .into(),
-        ));
-    }
-    if ladder.reference.is_none() && !opts.time_ladder {
-        return Err(BenchError::Plan(
-            "a garment's ladder must name its reference, a uniform run finer than every rung \
-             (reference = [\"adapt.method=none\", \"cloth.max_edge=...\"]): its meshes are \
-             set by `cloth.max_edge`, which the bench cannot refine on its own"
-                .into(),
-        ));
-    }
-    Ok(())
 }
 
 /// The lift floor: the reference with the cloth started [`FLOOR_LIFT`] higher
