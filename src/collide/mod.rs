@@ -39,6 +39,7 @@ pub mod geometry;
 pub mod motion;
 pub mod obstacle;
 mod response;
+mod self_prims;
 pub mod selfcol;
 pub mod sequence;
 mod shapes;

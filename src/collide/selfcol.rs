@@ -16,15 +16,11 @@ use parry3d_f64::bounding_volume::{Aabb, BoundingVolume};
 use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
 use rayon::prelude::*;
 
-use super::geometry::{closest_on_segments, closest_on_triangle};
+use super::self_prims::{Prim, RestBounds, edge};
 use super::volino::{Patches, ProjectedEdge};
 use crate::math::{Scalar, Vector};
 use crate::mesh::Mesh;
 use crate::spec::SelfCollision;
-
-/// Primitive pair: `(kind, a, b, c, d)`; kind 0: vertex `a` against triangle `b`;
-/// kind 1: edge `(a, b)` against edge `(c, d)`.
-type Prim = (u8, u32, u32, u32, u32);
 
 /// What one self-collision pass did.
 #[derive(Debug, Clone, Copy, Default)]
@@ -53,6 +49,8 @@ pub struct SelfCollider {
     area: Vec<Scalar>,
     /// Every vertex's rest point (`Mesh::rest_points`).
     rest: Vec<Vector>,
+    /// Every triangle's extent in rest space, for telling far triangle pairs.
+    rest_bounds: RestBounds,
     /// False after the patches were rebuilt: the next step builds the patch trees.
     trees_built: bool,
     scratch: Scratch,
@@ -78,7 +76,9 @@ struct Scratch {
     /// Per patch: its box-overlapping triangle pairs and the pairs culling skipped.
     pairs: Vec<(Vec<(u32, u32)>, u64)>,
     prims: Vec<Prim>,
-    fixes: Vec<Option<Fix>>,
+    fixes: Vec<Fix>,
+    /// Per vertex: corrected by the latest repulsion pass.
+    moved: Vec<bool>,
     dx: Vec<Vector>,
     dv: Vec<Vector>,
     count: Vec<u32>,
@@ -94,6 +94,7 @@ impl SelfCollider {
             patch_size: s.patch_size,
             built_for: Vec::new(),
             rest: Vec::new(),
+            rest_bounds: RestBounds::default(),
             patches: Patches::default(),
             area: Vec::new(),
             trees_built: false,
@@ -114,6 +115,7 @@ impl SelfCollider {
             }
         }
         mesh.rest_points(&mut self.rest);
+        self.rest_bounds = RestBounds::new(&mesh.triangles, &self.rest);
         self.built_for = mesh.triangles.clone();
         self.trees_built = false;
     }
@@ -141,11 +143,20 @@ impl SelfCollider {
             }
         }));
         let mut stats = self.candidates(mesh, x0, x, &mut s);
+        s.moved.clear();
+        s.moved.resize(x.len(), true);
         for _ in 0..self.iterations {
-            s.prims
-                .par_iter()
-                .map(|p| self.fix(mesh, p, x0, x, v, &s.inv_mass))
-                .collect_into_vec(&mut s.fixes);
+            // A pair none of whose vertices the last pass moved gives what it
+            // gave then: nothing (a pair that acted moved its vertices).
+            let tris = &mesh.triangles;
+            let moved = &s.moved;
+            // Only the pairs that act are kept, in pair order (few of them: a
+            // list of every pair's outcome would be most of the step's traffic).
+            s.fixes.clear();
+            s.fixes.par_extend(s.prims.par_iter().filter_map(|p| {
+                let touched = p.vertices(tris).iter().any(|&i| moved[i as usize]);
+                touched.then(|| self.fix(mesh, *p, x0, x, v, &s.inv_mass))?
+            }));
             for buf in [&mut s.dx, &mut s.dv] {
                 buf.clear();
                 buf.resize(x.len(), Vector::ZERO);
@@ -153,7 +164,7 @@ impl SelfCollider {
             s.count.clear();
             s.count.resize(x.len(), 0);
             let mut acted = 0u64;
-            for f in s.fixes.iter().flatten() {
+            for f in &s.fixes {
                 acted += 1;
                 for k in 0..4 {
                     let i = f.vertex[k] as usize;
@@ -169,6 +180,7 @@ impl SelfCollider {
                 break;
             }
             for i in 0..x.len() {
+                s.moved[i] = s.count[i] > 0;
                 if s.count[i] > 0 {
                     let c = s.count[i] as Scalar;
                     x[i] += s.dx[i] / c;
@@ -200,18 +212,24 @@ impl SelfCollider {
             .collect_into_vec(&mut s.culled);
         self.fit_trees(s);
         self.collect_pairs(tris, s);
-        let stats = primitive_pairs(tris, s);
+        let limit = 1.5 * self.thickness;
+        let stats = primitive_pairs(tris, s, &self.rest_bounds, limit);
         // Sorted and deduplicated, the list does not depend on the order the trees
-        // report their pairs in (so neither on the trees' shapes).
+        // report their pairs in (so neither on the trees' shapes). Of a pair's
+        // copies the first is kept: one from a triangle pair far apart in rest
+        // space, if any (`self_prims.rs`).
         s.prims.par_sort_unstable();
-        s.prims.dedup();
+        s.prims.dedup_by(|later, kept| later.same_pair(*kept));
         // Parts that are close in the rest state cannot be held a thickness apart.
         let rest_points = &self.rest;
         let rest = |i: u32| rest_points[i as usize];
         s.prims.retain(|p| {
-            let (ids, w) = weights(p, tris, &rest);
+            if !p.near() {
+                return true;
+            }
+            let (ids, w) = p.weights(tris, &rest);
             let r: Vector = (0..4).map(|k| rest(ids[k]) * w[k]).sum();
-            r.length() >= 1.5 * self.thickness
+            r.length() >= limit
         });
         stats
     }
@@ -330,7 +348,7 @@ impl SelfCollider {
     fn fix(
         &self,
         mesh: &Mesh,
-        p: &Prim,
+        p: Prim,
         x0: &[Vector],
         x: &[Vector],
         v: &[Vector],
@@ -339,10 +357,10 @@ impl SelfCollider {
         let tris = &mesh.triangles;
         let at0 = |i: u32| x0[i as usize];
         let at1 = |i: u32| x[i as usize];
-        let (ids0, w0) = weights(p, tris, &at0);
+        let (ids0, w0) = p.weights(tris, &at0);
         let r0: Vector = (0..4).map(|k| at0(ids0[k]) * w0[k]).sum();
         let n0 = r0.try_normalize()?;
-        let (ids1, w1) = weights(p, tris, &at1);
+        let (ids1, w1) = p.weights(tris, &at1);
         let r1: Vector = (0..4).map(|k| at1(ids1[k]) * w1[k]).sum();
         let (ids, w, n, gap) = if r1.dot(n0) <= 0.0 {
             // Crossed during the step: push back to the start side along the start normal.
@@ -391,48 +409,33 @@ struct Fix {
 }
 
 /// Every triangle pair of `s.pairs` as its 6 vertex-triangle and 9 edge-edge primitive
-/// pairs, into `s.prims` (unsorted, with repeats); counts the pairs tested and culled.
-fn primitive_pairs(tris: &[[u32; 3]], s: &mut Scratch) -> SelfStats {
+/// pairs, into `s.prims` (unsorted, with repeats), each marked near unless its
+/// triangles are farther than `limit` apart in rest space; counts the pairs
+/// tested and culled.
+fn primitive_pairs(
+    tris: &[[u32; 3]],
+    s: &mut Scratch,
+    rest: &RestBounds,
+    limit: Scalar,
+) -> SelfStats {
     let mut stats = SelfStats::default();
     s.prims.clear();
     for (pairs, skipped) in &s.pairs {
         stats.pairs_culled += skipped;
         stats.pairs_tested += pairs.len() as u64;
         for &(t, u) in pairs {
+            let near = !rest.far(t, u, limit);
             let (a, b) = (tris[t as usize], tris[u as usize]);
             for k in 0..3 {
-                s.prims.push((0, a[k], u, 0, 0));
-                s.prims.push((0, b[k], t, 0, 0));
+                s.prims.push(Prim::vertex_triangle(a[k], u, near));
+                s.prims.push(Prim::vertex_triangle(b[k], t, near));
                 let e = edge(a[k], a[(k + 1) % 3]);
                 for j in 0..3 {
                     let f = edge(b[j], b[(j + 1) % 3]);
-                    let (lo, hi) = if e <= f { (e, f) } else { (f, e) };
-                    s.prims.push((1, lo[0], lo[1], hi[0], hi[1]));
+                    s.prims.push(Prim::edge_edge(e, f, near));
                 }
             }
         }
     }
     stats
-}
-
-/// The edge `(a, b)` with its smaller vertex first.
-fn edge(a: u32, b: u32) -> [u32; 2] {
-    [a.min(b), a.max(b)]
-}
-
-/// The four vertices of a primitive pair and their weights: the relative position of the
-/// two closest points is `sum w_k x_k` (positive side first), at the positions `at`.
-fn weights(p: &Prim, tris: &[[u32; 3]], at: &impl Fn(u32) -> Vector) -> ([u32; 4], [Scalar; 4]) {
-    match p.0 {
-        0 => {
-            let t = tris[p.2 as usize];
-            let [a, b, c] = t.map(at);
-            let bary = closest_on_triangle(at(p.1), a, b, c);
-            ([p.1, t[0], t[1], t[2]], [1.0, -bary[0], -bary[1], -bary[2]])
-        }
-        _ => {
-            let (s, t) = closest_on_segments(at(p.1), at(p.2), at(p.3), at(p.4));
-            ([p.1, p.2, p.3, p.4], [1.0 - s, s, -(1.0 - t), -t])
-        }
-    }
 }
