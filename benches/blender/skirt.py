@@ -173,8 +173,8 @@ def main():
 
     # Rest shape: the flat pattern (drape's material space): every rest length
     # and rest bending angle then comes from it, as in drape. Both panels' patterns
-    # overlap in (u, v); the back is put 1 m away, which only the (zero-length)
-    # sewing springs see.
+    # overlap in (u, v), so each panel's lies in its own plane, 1 m apart, which only
+    # the (zero-length) sewing springs see.
     cloth.shape_key_add(name="Basis", from_mix=False)
     flat = cloth.shape_key_add(name="pattern", from_mix=False)
     panels = sorted({p for p in panel if p is not None})
