@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The skirt against Blender 3.4, side by side in one sitting: writes the shared
+# The skirt against Blender 3.4, side by side, one after the other: writes the shared
 # inputs (the unsewn skirt OBJ and the mannequin at rest as an OBJ), runs drape
 # on skirt_rest.toml and Blender on skirt.py N times each (no `nice`: this is
 # the measurement), measures seams and penetration of both the same way
