@@ -93,7 +93,7 @@ pub(super) fn panel_annotations(names: &[String]) -> rerun::AnnotationContext {
 }
 
 /// The static parts of `cloth/seams`: its annotation context (`open seam` orange, `welded
-/// seam` green) and the line width shared by every frame's segments.
+/// seam` green) and the line width shared by every frame's segments, labels hidden.
 pub(super) fn seam_static() -> (rerun::AnnotationContext, rerun::LineStrips3D) {
     let [r0, g0, b0] = SEAM_OPEN_RGB;
     let [r1, g1, b1] = SEAM_WELDED_RGB;
@@ -109,8 +109,11 @@ pub(super) fn seam_static() -> (rerun::AnnotationContext, rerun::LineStrips3D) {
             rerun::Rgba32::from_rgb(r1, g1, b1),
         ),
     ]);
+    // The class labels would be drawn at every segment, dozens per seam on a
+    // refined garment: the colours say open or welded, the legend says which.
     let width = rerun::LineStrips3D::update_fields()
-        .with_radii([rerun::Radius::new_ui_points(SEAM_RADIUS_UI)]);
+        .with_radii([rerun::Radius::new_ui_points(SEAM_RADIUS_UI)])
+        .with_show_labels(false);
     (context, width)
 }
 
