@@ -22,6 +22,7 @@ fn sewing() -> Sewing {
     Sewing {
         stiffness: DEFAULT_SEWING_STIFFNESS,
         weld_gap: DEFAULT_WELD_GAP,
+        max_force: None,
     }
 }
 

@@ -124,6 +124,7 @@ fn two_panels_with_l_sewing_edges_read_as_two_panels_and_one_seam() {
     let sewing = Sewing {
         stiffness: 80.0,
         weld_gap: 0.002,
+        max_force: Some(30.0),
     };
     let cloth = load("two_panels", TWO_PANELS, sewing).expect("a two-panel garment loads");
     check_two_panels(&cloth, line_of(TWO_PANELS, "l "), sewing);
