@@ -16,14 +16,15 @@
 //! and never stiffer than `k`, so the implicit step's matrix stays positive
 //! definite and the explicit step bound of a spring of stiffness `k`
 //! (`timestep.rs`) still holds. Because the capped force is conservative, the
-//! energy the implicit integrator checks is the energy the forces do work
-//! against.
+//! energy the run checks each frame (`sim::pipeline`) is the energy the forces
+//! do work against.
 //!
 //! The capped springs stay in [`Elements::springs`], so every per-vertex list,
 //! the block pattern and the solvers treat them as springs; [`Elements::sewing_caps`]
 //! lists them with their caps. Each place that evaluates springs computes every
 //! spring as usual and then overwrites the few capped ones (forces, energy,
-//! the implicit blocks), so the loops over the ordinary springs are unchanged.
+//! the implicit blocks, the multirate kicks), so the loops over the ordinary
+//! springs are unchanged.
 //! Within `d0` a capped spring's force, energy and blocks are the uncapped
 //! spring's to the last bit, so a cap that is never reached changes nothing.
 
