@@ -67,7 +67,8 @@ pub struct Seam {
     pub sewing: Sewing,
 }
 
-/// How a seam is sewn: the pull of its springs and the gap at which it is welded.
+/// How a seam is sewn: the pull of its springs, its cap, and the gap at which
+/// it is welded.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Sewing {
     /// Sewing stiffness per metre of seam, N/m per m: each pair's zero-length
@@ -75,6 +76,11 @@ pub struct Sewing {
     pub stiffness: Scalar,
     /// The seam is welded once every pair is closer than this, m.
     pub weld_gap: Scalar,
+    /// The largest pull per metre of seam, N/m (`None`: no cap): each pair's
+    /// spring pulls with at most this times its share of the seam's length,
+    /// and beyond the gap where it reaches that force its energy grows
+    /// linearly (`physics::sewing`).
+    pub max_force: Option<Scalar>,
 }
 
 /// Whether a seam is open (sewing springs pull it) or welded into one surface.

@@ -33,6 +33,9 @@
 //!   all get the same constant, which in 2D is itself resolution independent; the
 //!   inconsistency shows when refinement raises the level.
 //! * Damping (paper B, eq. 2) is stiffness proportional: `c_e = damping * k_e`.
+//! * Sewing ([`super::sewing`]): a zero-length spring per pair of an open seam,
+//!   `k = stiffness * s` with `s` the pair's share of the seam's length, and
+//!   with `max_force` a cap `max_force * s` on its force (a Huber energy).
 //! * Dihedral bending: hinge energy `E_e = (B/2) * theta^2 * L_e^2 / (A1 + A2)`,
 //!   i.e. curvature `theta / h_e` with `h_e = (A1 + A2) / L_e` (the mean height of
 //!   the two wings over the edge) integrated over the hinge's area `A1 + A2`
@@ -56,6 +59,7 @@ mod reuse;
 pub use reuse::RebuildCounts;
 
 use super::membrane::{MEMBRANE_SLOTS, Membrane, MembraneTriangle};
+use super::sewing::{SpringCap, sewing_springs};
 use super::shape::{
     FoldSplits, SHAPE_SLOTS, ShapeScratch, ShapeTriangle, build_shape_triangles_into,
 };
@@ -156,9 +160,13 @@ pub struct Elements {
     pub mass: Vec<Scalar>,
     /// Rest area attributed to each vertex (a third of each adjacent triangle), m^2.
     pub vertex_area: Vec<Scalar>,
-    /// Stretch springs (one per edge, with [`Membrane::Springs`]) followed by hinge
-    /// springs when that bending model is on.
+    /// Stretch springs (one per edge, with [`Membrane::Springs`]), then hinge
+    /// springs when that bending model is on, then the sewing springs of a
+    /// garment's open seams.
     pub springs: Vec<Spring>,
+    /// The sewing springs with a maximum force, in spring order (empty unless a
+    /// seam has `max_force`; `super::sewing`).
+    pub sewing_caps: Vec<SpringCap>,
     /// Continuum membrane triangles, one per triangle (with [`Membrane::Triangles`]).
     pub membrane_triangles: Vec<MembraneTriangle>,
     /// Dihedral hinges (only with the dihedral model and non-zero rigidity).
@@ -278,7 +286,7 @@ impl Elements {
         self.fold_splits = FoldSplits::new(&self.shape_triangles, splits)
             .expect("the plate matrices of a valid mesh are positive definite");
         edge_bending(mesh, mat, area, &mut self.springs, &mut self.hinges);
-        sewing_springs(mesh, mat, &mut self.springs);
+        sewing_springs(mesh, mat, &mut self.springs, &mut self.sewing_caps);
         self.fill_tables(n, mesh);
         self.previous
             .record(mesh, mat, clamped, &self.shape_triangles);
@@ -375,27 +383,6 @@ fn stretch_springs(mesh: &Mesh, mat: &MaterialParams, area: &[Scalar], springs: 
             k,
             c: mat.damping * k,
         });
-    }
-}
-
-/// A zero-length spring between the two vertices of each pair of every open seam,
-/// appended to `springs`: stiffness the seam's (per metre) times the pair's share
-/// of the seam's length, so the pull per metre of seam does not depend on how
-/// finely it is sampled; damped like the stretch springs.
-fn sewing_springs(mesh: &Mesh, mat: &MaterialParams, springs: &mut Vec<Spring>) {
-    let Some(panels) = mesh.panels() else {
-        return;
-    };
-    for seam in panels.seams.iter().filter(|s| s.is_open()) {
-        for (pair, share) in seam.pairs.iter().zip(seam.pair_lengths(mesh)) {
-            let k = seam.sewing.stiffness * share;
-            springs.push(Spring {
-                v: *pair,
-                rest: 0.0,
-                k,
-                c: mat.damping * k,
-            });
-        }
     }
 }
 

@@ -1,6 +1,7 @@
 //! Force evaluation in two parallel phases without atomics:
 //! 1. **element pass**: each spring, membrane triangle, hinge and (wind) triangle computes its forces
-//!    into its own slots of scratch arrays;
+//!    into its own slots of scratch arrays (the capped sewing springs, `sewing.rs`, are
+//!    computed as plain springs and then overwritten);
 //! 2. **gather**: each vertex sums its slots in a fixed order (CSR lists), adds its
 //!    own forces (gravity, drag), and the integrator uses the sum at once.
 //!
@@ -13,6 +14,7 @@ use rayon::prelude::*;
 use super::bending::dihedral_angle_and_gradient;
 use super::elements::Elements;
 use super::membrane::MEMBRANE_SLOTS;
+use super::sewing::{cap_energy_change, cap_forces};
 use super::shape::{SHAPE_SLOTS, ShapeJacobian, spread};
 use crate::math::{Scalar, Vector, deterministic_sum};
 
@@ -180,6 +182,7 @@ pub fn element_pass(
             let [a, b] = [s.v[0] as usize, s.v[1] as usize];
             *f = spring_force(x[a], x[b], v[a], v[b], s.rest, s.k, s.c);
         });
+    cap_forces(el, x, v, &mut scratch.spring);
     scratch.hinge.resize(4 * el.hinges.len(), Vector::ZERO);
     scratch
         .hinge
@@ -304,6 +307,12 @@ pub fn energy(el: &Elements, ext: &ExternalForces, x: &[Vector], v: &[Vector]) -
         let stretch = x[sp.v[1] as usize].distance(x[sp.v[0] as usize]) - sp.rest;
         0.5 * sp.k * stretch * stretch
     });
+    // The capped sewing springs' energy is Huber, not quadratic (`sewing.rs`).
+    let stretch = if el.sewing_caps.is_empty() {
+        stretch
+    } else {
+        stretch + cap_energy_change(el, x)
+    };
     let bend = deterministic_sum(el.hinges.len(), |h| {
         let hg = &el.hinges[h];
         let (theta, _) = dihedral_angle_and_gradient(hg.v.map(|i| x[i as usize]));

@@ -18,6 +18,7 @@ pub mod multirate;
 /// Pinned vertices (a top-level module, [`crate::pins`], so that `world` needs nothing
 /// from `physics`); kept reachable here.
 pub use crate::pins;
+pub mod sewing;
 pub mod shape;
 pub mod timestep;
 pub mod work;
@@ -27,6 +28,7 @@ pub use elements::{Elements, Hinge, MaterialParams, Spring};
 pub use forces::{Energy, ExternalForces, WindForce};
 pub use implicit::SolveFailure;
 pub use membrane::{Membrane, MembraneTriangle, Orthotropic};
+pub use sewing::SpringCap;
 pub use shape::{SHAPE_SLOTS, ShapeTriangle};
 
 use crate::math::{Scalar, Vector};

@@ -20,7 +20,8 @@
 //! symplectic Euler exactly. (Holding the other levels still instead was tried
 //! first and is unstable at the level interfaces.)
 //!
-//! A kick computes only the springs, hinges, shape triangles, membrane and wind triangles that touch the
+//! A kick computes only the springs (the capped sewing springs with their cap),
+//! hinges, shape triangles, membrane and wind triangles that touch the
 //! level's vertices. Element forces are computed in parallel and written back
 //! in a fixed order, so results do not depend on the thread count.
 
@@ -33,6 +34,7 @@ use super::bending::dihedral_angle_and_gradient;
 use super::elements::Elements;
 use super::forces::{ForceScratch, gather, solve_splits, spring_force, wind_share};
 use super::membrane::MEMBRANE_SLOTS;
+use super::sewing::cap_force;
 use super::shape::SHAPE_SLOTS;
 use super::timestep::{SAFETY, vertex_limits};
 use super::{Model, Stepper};
@@ -47,6 +49,9 @@ struct Group {
     substeps: u32,
     vertices: Vec<u32>,
     springs: Vec<u32>,
+    /// The capped sewing springs among `springs`, as indices of
+    /// [`Elements::sewing_caps`].
+    caps: Vec<u32>,
     hinges: Vec<u32>,
     shape: Vec<u32>,
     triangles: Vec<u32>,
@@ -126,6 +131,15 @@ fn assign_elements(groups: &mut [Group], mesh: &Mesh, el: &Elements) -> Vec<usiz
             sp.v.iter().map(|&v| mark[v as usize]),
             s as u32,
             |g| &mut g.springs,
+        );
+    }
+    for (c, cap) in el.sewing_caps.iter().enumerate() {
+        let sp = &el.springs[cap.spring as usize];
+        touch(
+            groups,
+            sp.v.iter().map(|&v| mark[v as usize]),
+            c as u32,
+            |g| &mut g.caps,
         );
     }
     for (h, hg) in el.hinges.iter().enumerate() {
@@ -308,6 +322,10 @@ fn level_forces(
         .collect_into_vec(&mut level.springs);
     for (&s, &f) in g.springs.iter().zip(&level.springs) {
         scratch.spring[s as usize] = f;
+    }
+    for &c in &g.caps {
+        let cap = &el.sewing_caps[c as usize];
+        scratch.spring[cap.spring as usize] = cap_force(el, cap, x, v);
     }
     g.hinges
         .par_iter()

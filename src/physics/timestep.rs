@@ -2,7 +2,9 @@
 //! accuracy cap for the implicit one.
 //!
 //! The largest eigenvalue of `M^-1 K` is bounded by Gershgorin's theorem: a
-//! spring adds at most `2 k` to each end's row, a dihedral hinge
+//! spring adds at most `2 k` to each end's row (a capped sewing spring too:
+//! beyond its cap its stiffness `(F / d) (I - n n^T)` is below `k`,
+//! `sewing.rs`), a dihedral hinge
 //! `k |g_i| sum_j |g_j|` (its Gauss-Newton stiffness `k g g^T`, evaluated on the
 //! flat rest shape), a membrane triangle the absolute row sums of its rest
 //! stiffness. With `omega^2` that bound and `zeta = max_i sum 2 c / m_i`

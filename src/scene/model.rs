@@ -104,6 +104,10 @@ pub struct SewingTable {
     /// A seam is welded once every sewn pair is closer than this, m (> 0).
     #[serde(default = "default_weld_gap")]
     pub weld_gap: f64,
+    /// The largest pull of the sewing springs per metre of seam, N/m (> 0);
+    /// absent: no cap.
+    #[serde(default)]
+    pub max_force: Option<f64>,
 }
 
 impl Default for SewingTable {
@@ -111,6 +115,7 @@ impl Default for SewingTable {
         SewingTable {
             stiffness: default_sewing_stiffness(),
             weld_gap: default_weld_gap(),
+            max_force: None,
         }
     }
 }

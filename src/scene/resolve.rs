@@ -95,6 +95,7 @@ fn sewing(c: &Cloth) -> Sewing {
     Sewing {
         stiffness: c.sewing.stiffness,
         weld_gap: c.sewing.weld_gap,
+        max_force: c.sewing.max_force,
     }
 }
 

@@ -315,8 +315,7 @@ fn cloth(c: &Cloth, written: Option<&Table>) -> Result<(), Issue> {
     if let Some(e) = c.max_edge {
         positive(at("max_edge"), e)?;
     }
-    positive(keys(&["cloth", "sewing", "stiffness"]), c.sewing.stiffness)?;
-    positive(keys(&["cloth", "sewing", "weld_gap"]), c.sewing.weld_gap)?;
+    super::validate_garment::sewing(&c.sewing)?;
     all_finite(at("position"), &c.position)?;
     all_finite(at("rotation"), &c.rotation)
 }

@@ -1,10 +1,11 @@
 //! Checks of a garment's `[[panel]]` and `[[seam]]` tables: names, outlines,
-//! placements, and seams that name existing panel sides of matching length.
+//! placements, and seams that name existing panel sides of matching length;
+//! and of `[cloth.sewing]`, which sews both these seams and an OBJ's.
 //! Each check names the key path, which `parse.rs` turns into a line of the
 //! file or a `--set`.
 
 use super::error::{Issue, KeyPath, SceneErrorKind as Kind, Seg, keys};
-use super::model::{PanelTable, SeamTable};
+use super::model::{PanelTable, SeamTable, SewingTable};
 use super::validate::{all_finite, positive};
 use super::{ClothShape, Scene};
 use crate::garment::SEAM_LENGTH_TOLERANCE;
@@ -55,6 +56,18 @@ pub(super) fn garment(scene: &Scene) -> Result<(), Issue> {
         seam(i, s, &scene.seam[..i], &scene.panel)?;
     }
     Ok(())
+}
+
+/// `[cloth.sewing]`: a positive, finite stiffness, weld gap and (when given)
+/// maximum force.
+pub(super) fn sewing(s: &SewingTable) -> Result<(), Issue> {
+    let at = |key: &str| keys(&["cloth", "sewing", key]);
+    positive(at("stiffness"), s.stiffness)?;
+    positive(at("weld_gap"), s.weld_gap)?;
+    match s.max_force {
+        Some(f) => positive(at("max_force"), f),
+        None => Ok(()),
+    }
 }
 
 fn unique_name(

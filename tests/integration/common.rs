@@ -26,6 +26,7 @@ pub const BOUNCING_SHEET: [&str; 6] = [
 pub const SEWING: Sewing = Sewing {
     stiffness: DEFAULT_SEWING_STIFFNESS,
     weld_gap: DEFAULT_WELD_GAP,
+    max_force: None,
 };
 
 /// A fixed pin on `region` with every other key at its default.

@@ -73,6 +73,7 @@ fn welded_halves(width: Scalar, placements: [Placement; 2]) -> (World, Scalar) {
         sewing: Sewing {
             stiffness: DEFAULT_SEWING_STIFFNESS,
             weld_gap: DEFAULT_WELD_GAP,
+            max_force: None,
         },
     })
     .expect("garment");

@@ -22,6 +22,7 @@ fn sewing() -> Sewing {
     Sewing {
         stiffness: DEFAULT_SEWING_STIFFNESS,
         weld_gap: DEFAULT_WELD_GAP,
+        max_force: None,
     }
 }
 
@@ -49,7 +50,7 @@ fn rectangle(name: &str, w: Scalar, h: Scalar, placement: Placement) -> PanelSpe
 
 /// Two 0.2 m squares side by side in the xy plane, `gap` apart, the left
 /// one's right side sewn to the right one's left side.
-const TWO_SQUARES: &str = r#"
+pub(crate) const TWO_SQUARES: &str = r#"
 name = "two_squares"
 [simulation]
 duration = 1.0
@@ -78,13 +79,13 @@ b = { panel = "right", side = 4 }
 "#;
 
 /// The simulation of a garment scene given as text, with `--set` overrides.
-fn garment_sim(text: &str, sets: &[&str]) -> Sim {
+pub(crate) fn garment_sim(text: &str, sets: &[&str]) -> Sim {
     let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
     Sim::new(&load_scene_str(text, "garment.toml", &sets).expect("scene"))
 }
 
 /// The state of seam `s`.
-fn seam_state(sim: &Sim, s: usize) -> SeamState {
+pub(crate) fn seam_state(sim: &Sim, s: usize) -> SeamState {
     sim.state.world.mesh.panels().expect("panels").seams[s].state
 }
 

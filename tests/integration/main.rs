@@ -46,6 +46,8 @@ mod recording;
 mod recording_run;
 mod remesh_ops;
 mod scene_errors;
+mod sewing_cap;
+mod sewing_cap_runs;
 mod sim;
 mod solver;
 mod stability;

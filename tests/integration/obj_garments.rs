@@ -54,7 +54,7 @@ pub(crate) fn line_of(text: &str, prefix: &str) -> usize {
 /// Two panels 0.1 m apart, each 1 m square in two rows of two triangles, in
 /// the plane y = 0; `l` elements sew the front's right edge (x = 1) to the
 /// back's left edge (x = 1.1), the middle one written back side first.
-const TWO_PANELS: &str = "\
+pub(crate) const TWO_PANELS: &str = "\
 # Two panels with sewing edges between them.
 o front
 v 0 0 0
@@ -124,6 +124,7 @@ fn two_panels_with_l_sewing_edges_read_as_two_panels_and_one_seam() {
     let sewing = Sewing {
         stiffness: 80.0,
         weld_gap: 0.002,
+        max_force: Some(30.0),
     };
     let cloth = load("two_panels", TWO_PANELS, sewing).expect("a two-panel garment loads");
     check_two_panels(&cloth, line_of(TWO_PANELS, "l "), sewing);

@@ -9,6 +9,7 @@ use super::super::bending::dihedral_angle_and_gradient;
 use super::super::elements::Elements;
 use super::super::forces::{PAR_MIN, fold_angles_and_splits, spring_force, wind_share};
 use super::super::membrane::{ColumnBlocks, MEMBRANE_SLOTS};
+use super::super::sewing::{capped_spring_force, capped_spring_stiffness};
 use super::super::shape::{SHAPE_SLOTS, rates, spread};
 use super::super::{ExternalForces, Model, Stepper};
 use super::ImplicitScratch;
@@ -78,9 +79,51 @@ fn springs(
                 0.0
             };
             let stiff = (nn + (Matrix3::IDENTITY - nn) * transverse) * sp.k;
-            *block = stiff * (h * h) + nn * (h * sp.c);
-            *slot = f * h - stiff * (v[a] - v[b]) * (h * h * k_term);
+            (*block, *slot) = spring_terms(f, stiff, nn, sp.c, v[a] - v[b], h, k_term);
         });
+    capped_springs(s, el, x, v, h, k_term);
+}
+
+/// The block `h^2 K + h c n n^T` and the slot `h f - h^2 K (v_a - v_b)` of a
+/// spring with force `f` on its first end, stiffness `K`, axis projector
+/// `nn = n n^T`, damping coefficient `c` and relative velocity `dv = v_a - v_b`.
+#[inline(always)]
+fn spring_terms(
+    f: Vector,
+    stiff: Matrix3,
+    nn: Matrix3,
+    c: Scalar,
+    dv: Vector,
+    h: Scalar,
+    k_term: Scalar,
+) -> (Matrix3, Vector) {
+    let block = stiff * (h * h) + nn * (h * c);
+    (block, f * h - stiff * dv * (h * h * k_term))
+}
+
+/// The capped sewing springs' blocks and slots over the plain ones the pass
+/// above wrote (their force and stiffness of the Huber energy, `sewing.rs`).
+fn capped_springs(
+    s: &mut ImplicitScratch,
+    el: &Elements,
+    x: &[Vector],
+    v: &[Vector],
+    h: Scalar,
+    k_term: Scalar,
+) {
+    for cap in &el.sewing_caps {
+        let e = cap.spring as usize;
+        let sp = &el.springs[e];
+        let [a, b] = [sp.v[0] as usize, sp.v[1] as usize];
+        let d = x[b] - x[a];
+        let len = d.length();
+        let dir = if len > 0.0 { d / len } else { Vector::ZERO };
+        let f = capped_spring_force(x[a], x[b], v[a], v[b], sp.k, sp.c, cap.max_force);
+        let stiff = capped_spring_stiffness(d, sp.k, cap.max_force);
+        let nn = outer(dir, dir);
+        (s.spring_block[e], s.spring_slot[e]) =
+            spring_terms(f, stiff, nn, sp.c, v[a] - v[b], h, k_term);
+    }
 }
 
 /// Per hinge: the angle's gradient, `h^2 k` and the four slots.
