@@ -263,7 +263,10 @@ impl Soup {
             // Orient: t0 runs a -> b, so the flipped pair is (c, a, d), (d, b, c).
             let runs_ab = (0..3).any(|k| t0[k] == a && t0[(k + 1) % 3] == b);
             let (a, b) = if runs_ab { (a, b) } else { (b, a) };
-            let at = |t: u32, v: u32| self.corner_at(t, v).unwrap_or(Vector2::ZERO);
+            let at = |t: u32, v: u32| {
+                self.corner_at(t, v)
+                    .expect("a flip's four vertices are corners of its two triangles")
+            };
             let (pa, pb, pc, pd) = (at(ts[0], a), at(ts[0], b), at(ts[0], c), at(ts[1], d));
             // A garment's welded seam is not flipped: its two triangles lie in
             // different patterns.

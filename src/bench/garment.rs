@@ -11,9 +11,12 @@ use crate::scene::Scene;
 /// The default ladder for a garment (`shape = "panels"`), whose meshes are set
 /// by `cloth.max_edge` (`e`, the scene's): uniform meshes at `2e`, `1.5e` and
 /// `e`, red-green runs whose finest edges are `e` (base `2e` up to level 2,
-/// base `4e` up to level 4), and a uniform reference at `e / 1.5`.
-pub fn default_garment_ladder(scene: &Scene) -> Ladder {
-    let e = scene.cloth.max_edge.unwrap_or(0.03);
+/// base `4e` up to level 4), and a uniform reference at `e / 1.5`. Fails on a
+/// scene without `max_edge` (which scene validation refuses for a garment).
+pub fn default_garment_ladder(scene: &Scene) -> Result<Ladder, BenchError> {
+    let e = scene.cloth.max_edge.ok_or_else(|| {
+        BenchError::Plan("a garment's default ladder needs the scene's `cloth.max_edge`".into())
+    })?;
     let edge = |x: Scalar| format!("cloth.max_edge={}", metres(x));
     let mut rung: Vec<Rung> = [2.0, 1.5, 1.0]
         .iter()
@@ -31,12 +34,12 @@ pub fn default_garment_ladder(scene: &Scene) -> Ladder {
         let label = format!("red_green {} m L{level}", metres(base * e));
         rung.push(Rung::new(label, set));
     }
-    Ladder {
+    Ok(Ladder {
         reference: Some(vec!["adapt.method=none".into(), edge(e / 1.5)]),
         compare: None,
         step: None,
         rung,
-    }
+    })
 }
 
 /// A length in metres with at most four decimals, trailing zeros dropped

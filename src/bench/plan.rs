@@ -232,7 +232,7 @@ fn resolve_ladder(opts: &BenchOptions, base_set: &[String]) -> Result<Ladder, Be
             None => {
                 let scene = load(&opts.scene, base_set, "scene")?;
                 match is_garment(&scene) {
-                    true => default_garment_ladder(&scene),
+                    true => default_garment_ladder(&scene)?,
                     false => ladder::default_ladder(&scene),
                 }
             }

@@ -70,9 +70,7 @@ fn springs(
             let [a, b] = [sp.v[0] as usize, sp.v[1] as usize];
             let f = spring_force(x[a], x[b], v[a], v[b], sp.rest, sp.k, sp.c);
             let d = x[b] - x[a];
-            let len = d.length();
-            let dir = if len > 0.0 { d / len } else { Vector::ZERO };
-            let nn = outer(dir, dir);
+            let (len, nn) = axis(d);
             let transverse = if len > 0.0 {
                 (1.0 - sp.rest / len).max(0.0)
             } else {
@@ -82,6 +80,15 @@ fn springs(
             (*block, *slot) = spring_terms(f, stiff, nn, sp.c, v[a] - v[b], h, k_term);
         });
     capped_springs(s, el, x, v, h, k_term);
+}
+
+/// The length of a spring's separation `d` and the projector `n n^T` on its
+/// axis (zero for coincident ends).
+#[inline(always)]
+fn axis(d: Vector) -> (Scalar, Matrix3) {
+    let len = d.length();
+    let dir = if len > 0.0 { d / len } else { Vector::ZERO };
+    (len, outer(dir, dir))
 }
 
 /// The block `h^2 K + h c n n^T` and the slot `h f - h^2 K (v_a - v_b)` of a
@@ -116,11 +123,9 @@ fn capped_springs(
         let sp = &el.springs[e];
         let [a, b] = [sp.v[0] as usize, sp.v[1] as usize];
         let d = x[b] - x[a];
-        let len = d.length();
-        let dir = if len > 0.0 { d / len } else { Vector::ZERO };
+        let (_, nn) = axis(d);
         let f = capped_spring_force(x[a], x[b], v[a], v[b], sp.k, sp.c, cap.max_force);
         let stiff = capped_spring_stiffness(d, sp.k, cap.max_force);
-        let nn = outer(dir, dir);
         (s.spring_block[e], s.spring_slot[e]) =
             spring_terms(f, stiff, nn, sp.c, v[a] - v[b], h, k_term);
     }
