@@ -339,7 +339,14 @@ fn describe_time_step(
     adaptive: bool,
 ) {
     let interval = sim.frame_interval();
+    if sim.dt == TimeStep::Adaptive {
+        let _ = writeln!(s, "integrator: {:?}", sim.integrator);
+        describe_implicit_solver(s, sim);
+        describe_adaptive_step(s, sim);
+        return;
+    }
     let (target, how) = match sim.dt {
+        TimeStep::Adaptive => unreachable!("described above"),
         TimeStep::Fixed(dt) => (dt, "fixed".to_string()),
         TimeStep::Auto => {
             let how = match sim.integrator {
@@ -370,6 +377,28 @@ fn describe_time_step(
         sim.frame_rate,
         frames,
         frames * steps
+    );
+}
+
+/// `dt = "adaptive"`: the tolerances and the step's bounds.
+fn describe_adaptive_step(s: &mut String, sim: &Simulation) {
+    let a = sim.adaptive_dt.unwrap_or_default();
+    let interval = sim.frame_interval();
+    let largest = a.max.map_or(interval, |m| m.min(interval));
+    let _ = writeln!(
+        s,
+        "time step: adaptive, from {:.3e} s to {largest:.4e} s (first {:.3e} s); a step is refused above an error estimate of {:e} m or a penetration of {:e} m",
+        a.min,
+        crate::sim::step_control::FIRST_STEP.min(largest),
+        a.tolerance,
+        a.penetration
+    );
+    let _ = writeln!(
+        s,
+        "run: {} s, {} fps: {} frames after the initial one",
+        sim.duration,
+        sim.frame_rate,
+        sim.frame_count()
     );
 }
 

@@ -89,7 +89,7 @@ pub enum RunError {
     },
     /// The state became non-finite even with the smallest step tried.
     #[error(
-        "numerical failure at step {step} in frame {frame} (t = {time:.4} s): {failure} even with the step halved {halvings} times to {dt:.3e} s; the run stopped and the recording holds every frame up to the last good one. Likely cause: the time step is too large for the stiffness ({cause})"
+        "numerical failure at step {step} in frame {frame} (t = {time:.4} s): {failure}{tried}; the run stopped and the recording holds every frame up to the last good one. Likely cause: {cause}"
     )]
     Numerical {
         /// The step (counted from the start of the run) that failed.
@@ -104,6 +104,9 @@ pub enum RunError {
         halvings: u32,
         /// The last step size tried.
         dt: Scalar,
+        /// What was tried, in words (empty, or " even with the step halved N
+        /// times to DT s").
+        tried: String,
         /// A hint naming the likely cause.
         cause: String,
         /// What the run produced up to the failure.

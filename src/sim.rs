@@ -32,6 +32,7 @@ mod bound;
 mod pipeline;
 mod setup;
 mod state;
+pub mod step_control;
 
 pub use bound::{EXPLOSION_FACTOR, EnergyBound, StepFailure};
 pub use pipeline::{
@@ -39,7 +40,10 @@ pub use pipeline::{
     Pipeline, StepError, StepOutcome, WeldEvent,
 };
 pub use setup::{Settings, Setup, StepSize};
-pub use state::{Effort, Ledger, SimState};
+pub use state::{Effort, Ledger, RefusedSteps, SimState};
+pub use step_control::{
+    AdaptiveStep, DEFAULT_MIN_STEP, DEFAULT_STEP_PENETRATION, DEFAULT_STEP_TOLERANCE, StepControl,
+};
 
 use crate::adapt::Adapter;
 use crate::collide::{CollideError, Obstacles};

@@ -60,6 +60,17 @@ pub struct EnergySummary {
     pub excess_max: Scalar,
 }
 
+/// What the adaptive step did (`dt = "adaptive"`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct AdaptiveDtSummary {
+    /// The largest step taken, s (the smallest is [`Summary::dt`]).
+    pub max_dt: Scalar,
+    /// Steps refused, by reason.
+    pub refused: crate::sim::RefusedSteps,
+    /// The largest error estimate of an accepted step, m.
+    pub largest_error: Scalar,
+}
+
 /// Where the recording went.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct RecordingSummary {
@@ -91,6 +102,8 @@ pub struct Summary {
     /// The smallest time step taken, s (with `dt = "auto"` and adaptivity the
     /// step follows the finest triangles).
     pub dt: Scalar,
+    /// The adaptive step's figures, with `dt = "adaptive"`.
+    pub adaptive_dt: Option<AdaptiveDtSummary>,
     /// Steps times mean vertices per second of stepping wall time.
     pub vertex_steps_per_s: Scalar,
     /// Vertex counts over the recorded frames.
@@ -203,6 +216,24 @@ impl SeamSummary {
 }
 
 impl Summary {
+    /// The steps taken, in words: the fixed or smallest step, or the adaptive
+    /// step's range and refusals.
+    fn step_sizes(&self) -> String {
+        match &self.adaptive_dt {
+            None => format!("{:.3e} s", self.dt),
+            Some(a) => format!(
+                "{:.3e} to {:.3e} s (adaptive: {} refused, {} for the error, {} for penetration, {} failed; largest accepted error estimate {:.3e} m)",
+                self.dt,
+                a.max_dt,
+                a.refused.total(),
+                a.refused.error,
+                a.refused.penetration,
+                a.refused.failed,
+                a.largest_error
+            ),
+        }
+    }
+
     /// The one-paragraph summary printed at the end of a run.
     pub fn paragraph(&self) -> String {
         let rec = match &self.recording {
@@ -219,14 +250,14 @@ impl Summary {
             ""
         };
         format!(
-            "{}: {} frames, {} steps of {:.3e} s to t = {:.3} s in {:.2} s wall ({:.2} s stepping, {:.2} s recording); \
+            "{}: {} frames, {} steps of {} to t = {:.3} s in {:.2} s wall ({:.2} s stepping, {:.2} s recording); \
              {:.0} vertices, {:.0} triangles; {:.3e} vertex-steps/s. Mass {:.6} -> {:.6} kg; \
              energy {:.4e} -> {:.4e} J (max {:.4e}; external work {:.3e} J; largest excess over initial + work {:.3e} J); \
              {} recoveries (frame attempts retried with halved steps, {} for energy gain); {}.{}{}{}{} {}",
             self.scene,
             self.frames,
             self.steps,
-            self.dt,
+            self.step_sizes(),
             self.sim_time,
             self.wall_time_s,
             self.simulation_wall_s,

@@ -315,10 +315,12 @@ pub fn time_ladder(dt: Scalar) -> Ladder {
 
 /// The step `scene` takes, fitted to fill its frames exactly: its fixed step,
 /// or its automatic one on its initial mesh (the implicit integrator's cap, or
-/// the explicit integrators' stability estimate; without multirate).
+/// the explicit integrators' stability estimate; without multirate); for an
+/// adaptive step, its first proposal (the implicit integrator's cap).
 pub fn scene_step(scene: &Scene) -> Result<Scalar, BenchError> {
     let target = match scene.simulation.dt {
         TimeStep::Fixed(dt) => dt,
+        TimeStep::Adaptive => crate::sim::step_control::FIRST_STEP,
         TimeStep::Auto => {
             let world = World::from_scene(scene).map_err(RunError::from)?;
             let model = Model::from_scene(scene);
@@ -334,6 +336,7 @@ pub fn scene_step(scene: &Scene) -> Result<Scalar, BenchError> {
 pub fn step_origin(scene: &Scene) -> &'static str {
     match (scene.simulation.dt, scene.simulation.integrator) {
         (TimeStep::Fixed(_), _) => "the scene's fixed step",
+        (TimeStep::Adaptive, _) => "the adaptive step's first proposal (the implicit cap)",
         (TimeStep::Auto, Integrator::Implicit) => "the implicit integrator's automatic step",
         (TimeStep::Auto, _) => "the explicit stability estimate on the reference's mesh",
     }

@@ -196,6 +196,7 @@ fn run_plan(label: &str, set: Vec<String>, scene: &Scene) -> RunPlan {
         integrator: integrator_name(scene.simulation.integrator).to_owned(),
         dt: match scene.simulation.dt {
             TimeStep::Auto => "auto".into(),
+            TimeStep::Adaptive => "adaptive".into(),
             TimeStep::Fixed(dt) => format!("{dt}"),
         },
     }

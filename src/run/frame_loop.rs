@@ -14,6 +14,7 @@ use crate::record::{RecordError, RecordTarget, Recorder, obj::write_mesh_obj};
 use crate::scene::Scene;
 use crate::sim::{
     FrameFailed, FrameFailure, MAX_STEP_HALVINGS, Pipeline, Setup, SimParts, SimState, StepFailure,
+    StepSize,
 };
 use crate::summary::Summary;
 
@@ -266,12 +267,26 @@ impl<'a> FrameLoop<'a> {
                 time: self.state.world.time,
                 halvings: MAX_STEP_HALVINGS,
                 dt: f.last_dt,
-                cause: format!(
-                    "step {:.3e} s with the {:?} integrator; try a smaller `simulation.dt`, `dt = \"auto\"`, or `integrator = \"implicit\"`{}",
-                    self.pipeline.step_size(&self.setup, &self.state.world),
-                    self.setup.model.integrator,
-                    solver_hint(&f.failure)
-                ),
+                tried: match self.setup.settings.step {
+                    StepSize::Adaptive(_) => String::new(),
+                    _ => format!(
+                        " even with the step halved {MAX_STEP_HALVINGS} times to {:.3e} s",
+                        f.last_dt
+                    ),
+                },
+                cause: match self.setup.settings.step {
+                    StepSize::Adaptive(_) => format!(
+                        "the tolerances are tighter than any step down to `simulation.adaptive_dt.min` = {:.3e} s meets (try a smaller `min`, or a larger `simulation.adaptive_dt.tolerance` or `penetration`{})",
+                        f.last_dt,
+                        solver_hint(&f.failure)
+                    ),
+                    _ => format!(
+                        "the time step is too large for the stiffness (step {:.3e} s with the {:?} integrator; try a smaller `simulation.dt`, `dt = \"auto\"`, or `integrator = \"implicit\"`{})",
+                        self.pipeline.step_size(&self.setup, &self.state.world),
+                        self.setup.model.integrator,
+                        solver_hint(&f.failure)
+                    ),
+                },
                 summary: Box::new(summary),
             }),
         }
@@ -294,6 +309,7 @@ impl<'a> FrameLoop<'a> {
             sim_wall_s: self.sim_seconds,
             record_wall_s: self.record_seconds,
             dt,
+            adaptive_dt: matches!(self.setup.settings.step, StepSize::Adaptive(_)),
             interrupted: self.interrupted,
             recording,
             state,

@@ -6,7 +6,7 @@ use crate::math::Scalar;
 use crate::physics::{Energy, Model, Stepper};
 use crate::scene::Pin;
 use crate::sim::SimState;
-use crate::summary::{EnergySummary, Range, RecordingSummary, Summary};
+use crate::summary::{AdaptiveDtSummary, EnergySummary, Range, RecordingSummary, Summary};
 use crate::world::World;
 
 /// Running statistics for the summary.
@@ -30,6 +30,8 @@ pub(super) struct TallyEnd<'a> {
     pub(super) sim_wall_s: Scalar,
     pub(super) record_wall_s: Scalar,
     pub(super) dt: Scalar,
+    /// True with `dt = "adaptive"`.
+    pub(super) adaptive_dt: bool,
     pub(super) interrupted: bool,
     pub(super) recording: Option<(PathBuf, u64, u64)>,
     /// The state at the end: its ledger, effort and adaptive counters.
@@ -80,6 +82,11 @@ impl Tally {
             simulation_wall_s: end.sim_wall_s,
             recording_wall_s: end.record_wall_s,
             dt: end.dt,
+            adaptive_dt: end.adaptive_dt.then(|| AdaptiveDtSummary {
+                max_dt: effort.max_dt,
+                refused: effort.refused,
+                largest_error: effort.largest_step_error,
+            }),
             vertex_steps_per_s: if end.sim_wall_s > 0.0 {
                 vertex_steps / end.sim_wall_s
             } else {

@@ -140,9 +140,12 @@ pub struct Simulation {
     /// Time integrator.
     #[serde(default)]
     pub integrator: Integrator,
-    /// Time step: `"auto"` or a step in seconds (> 0).
+    /// Time step: `"auto"`, `"adaptive"` or a step in seconds (> 0).
     #[serde(default)]
     pub dt: TimeStep,
+    /// The error control of `dt = "adaptive"` (defaults when absent).
+    #[serde(default)]
+    pub adaptive_dt: Option<AdaptiveDt>,
     /// Gravity in m/s^2; z is up. `[0, 0, 0]` turns gravity off.
     #[serde(default = "default_gravity")]
     pub gravity: [f64; 3],
@@ -183,7 +186,8 @@ impl Simulation {
     }
 }
 
-/// A fixed step in seconds, or `"auto"` (a stability estimate).
+/// A fixed step in seconds, `"auto"` (a stability estimate) or `"adaptive"`
+/// (error control, implicit integrator only).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub enum TimeStep {
     /// Chosen from the stiffest spring and the lightest mass (see `physics::timestep`).
@@ -191,6 +195,52 @@ pub enum TimeStep {
     Auto,
     /// This step in seconds (rounded down so that a whole number of steps fills a frame).
     Fixed(f64),
+    /// Chosen step by step by error control (`[simulation.adaptive_dt]`,
+    /// `sim::step_control`).
+    Adaptive,
+}
+
+/// `[simulation.adaptive_dt]`: the tolerances of `dt = "adaptive"`, in
+/// physical units.
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct AdaptiveDt {
+    /// Largest estimated local position error of a step, m: half the distance
+    /// between the step's free vertices and where their start velocity alone
+    /// would have carried them (backward Euler's local error estimate).
+    #[serde(default = "default_adaptive_tolerance")]
+    pub tolerance: f64,
+    /// Largest depth below an obstacle surface a step may end with, m.
+    #[serde(default = "default_adaptive_penetration")]
+    pub penetration: f64,
+    /// Smallest step, s: a step that still fails its tolerances at this size
+    /// fails the frame (retried, then the run stops with the reason).
+    #[serde(default = "default_adaptive_min")]
+    pub min: f64,
+    /// Largest step, s (absent: one frame, 1 / frame_rate).
+    #[serde(default)]
+    pub max: Option<f64>,
+}
+
+impl Default for AdaptiveDt {
+    fn default() -> AdaptiveDt {
+        AdaptiveDt {
+            tolerance: default_adaptive_tolerance(),
+            penetration: default_adaptive_penetration(),
+            min: default_adaptive_min(),
+            max: None,
+        }
+    }
+}
+
+fn default_adaptive_tolerance() -> f64 {
+    crate::sim::DEFAULT_STEP_TOLERANCE
+}
+fn default_adaptive_penetration() -> f64 {
+    crate::sim::DEFAULT_STEP_PENETRATION
+}
+fn default_adaptive_min() -> f64 {
+    crate::sim::DEFAULT_MIN_STEP
 }
 
 /// `[cloth]`: the rest shape (material space) and the initial placement in the world.
@@ -361,11 +411,13 @@ impl<'de> Deserialize<'de> for TimeStep {
         impl serde::de::Visitor<'_> for V {
             type Value = TimeStep;
             fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-                f.write_str("\"auto\" or a time step in seconds")
+                f.write_str("\"auto\", \"adaptive\" or a time step in seconds")
             }
             fn visit_str<E: serde::de::Error>(self, s: &str) -> Result<TimeStep, E> {
                 if s == "auto" {
                     Ok(TimeStep::Auto)
+                } else if s == "adaptive" {
+                    Ok(TimeStep::Adaptive)
                 } else {
                     Err(E::invalid_value(serde::de::Unexpected::Str(s), &self))
                 }

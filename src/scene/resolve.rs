@@ -13,7 +13,7 @@ use crate::world::{BuildError, World};
 
 use super::model::{PanelTable, SeamTable};
 use super::{Cloth, ClothShape, DEFAULT_AIR_DENSITY, Scene, TimeStep};
-use crate::sim::{Settings, SimSpec, StepSize};
+use crate::sim::{AdaptiveStep, Settings, SimSpec, StepSize};
 
 impl Scene {
     /// The engine's specification of this (validated) scene: the one input of
@@ -28,6 +28,15 @@ impl Scene {
                 step: match self.simulation.dt {
                     TimeStep::Fixed(dt) => StepSize::Fixed(dt),
                     TimeStep::Auto => StepSize::Auto,
+                    TimeStep::Adaptive => {
+                        let a = self.simulation.adaptive_dt.unwrap_or_default();
+                        StepSize::Adaptive(AdaptiveStep {
+                            tolerance: a.tolerance,
+                            penetration: a.penetration,
+                            min: a.min,
+                            max: a.max,
+                        })
+                    }
                 },
                 multirate: self.adapt.as_ref().is_some_and(|a| a.multirate),
                 self_collision: self.self_collision.clone(),

@@ -15,7 +15,14 @@ pub(crate) fn allowed(path: &str) -> Option<&'static str> {
         "simulation.duration" => "a finite number > 0 (s)",
         "simulation.frame_rate" => "a finite number > 0 (frames per second)",
         "simulation.integrator" => "\"symplectic_euler\", \"rk4\" or \"implicit\"",
-        "simulation.dt" => "\"auto\" or a finite number of seconds > 0 and <= 1/frame_rate",
+        "simulation.dt" => {
+            "\"auto\", \"adaptive\" (implicit integrator) or a finite number of seconds > 0 and <= 1/frame_rate"
+        }
+        "simulation.adaptive_dt" => "a table [simulation.adaptive_dt] (with dt = \"adaptive\")",
+        "simulation.adaptive_dt.tolerance" => "a finite number > 0 (m)",
+        "simulation.adaptive_dt.penetration" => "a finite number > 0 (m)",
+        "simulation.adaptive_dt.min" => "a finite number of seconds > 0 and <= 1/frame_rate",
+        "simulation.adaptive_dt.max" => "a finite number of seconds >= min",
         "simulation.gravity" => "an array of 3 finite numbers (m/s^2)",
         "simulation.cg_tolerance" => "a number in the open interval (0, 1)",
         "simulation.cg_max_iterations" => "an integer >= 1",

@@ -166,6 +166,7 @@ fn simulation(s: &Simulation) -> Result<(), Issue> {
             .because(at("frame_rate")));
         }
     }
+    super::validate_step::adaptive_dt(s)?;
     super::limits::counts(s)?;
     all_finite(at("gravity"), &s.gravity)?;
     finite(&at("cg_tolerance"), s.cg_tolerance)?;

@@ -1,5 +1,6 @@
 //! The energy bound a step is held to, and why a step is rejected.
 
+use super::step_control::Refusal;
 use crate::math::{Scalar, Vector, deterministic_sum};
 use crate::physics::{Model, SolveFailure, Stepper};
 use crate::world::World;
@@ -24,6 +25,14 @@ pub enum StepFailure {
         /// The bound it exceeded, J.
         bound: Scalar,
     },
+    /// An adaptive step (`dt = "adaptive"`) at its smallest size still exceeded
+    /// a tolerance.
+    AboveTolerance {
+        /// The step, s.
+        dt: Scalar,
+        /// Which tolerance, and the measured value.
+        reason: Refusal,
+    },
 }
 
 impl std::fmt::Display for StepFailure {
@@ -35,6 +44,20 @@ impl std::fmt::Display for StepFailure {
                 f,
                 "the energy exploded (kinetic + gravitational {energy:.4e} J, above the explosion limit {bound:.4e} J)"
             ),
+            StepFailure::AboveTolerance { dt, reason } => match reason {
+                Refusal::Error(e) => write!(
+                    f,
+                    "at the smallest adaptive step ({dt:.3e} s, simulation.adaptive_dt.min) the error estimate {e:.3e} m exceeds simulation.adaptive_dt.tolerance"
+                ),
+                Refusal::Penetration(p) => write!(
+                    f,
+                    "at the smallest adaptive step ({dt:.3e} s, simulation.adaptive_dt.min) the cloth ends {p:.3e} m below an obstacle surface, deeper than simulation.adaptive_dt.penetration"
+                ),
+                Refusal::Failed => write!(
+                    f,
+                    "at the smallest adaptive step ({dt:.3e} s, simulation.adaptive_dt.min) the step failed"
+                ),
+            },
         }
     }
 }

@@ -1,6 +1,7 @@
 //! [`Pipeline`]: advances a [`SimState`] by a step or a frame; holds only scratch.
 
 use super::bound::is_finite;
+use super::step_control::{self, AdaptiveStep, Refusal};
 use super::{Setup, SimState, StepFailure, StepSize};
 use crate::collide::{Collider, StepCloth};
 use crate::math::Scalar;
@@ -8,6 +9,7 @@ use crate::mesh::MeshError;
 use crate::physics::{Energy, Model, StepStats, Stepper};
 use crate::world::World;
 
+mod adaptive;
 mod remesh;
 mod sew;
 
@@ -44,6 +46,15 @@ pub enum StepError {
     /// state is left as the failed attempt made it.
     #[error("{0}")]
     Rejected(StepFailure),
+    /// The adaptive step's controller refused the step (`dt = "adaptive"`);
+    /// the state is back at the step's start.
+    #[error("the step was refused: {reason:?}; retry with {retry:.3e} s")]
+    Refused {
+        /// Why.
+        reason: Refusal,
+        /// The step to try instead, s.
+        retry: Scalar,
+    },
     /// Remeshing produced an invalid mesh (a bug: please report it).
     #[error("adaptive remeshing: {0}")]
     Remesh(#[from] MeshError),
@@ -111,6 +122,9 @@ pub struct Pipeline {
     /// frame measured it (its energy check, the adaptation after it having left
     /// the mesh as it was); taken by [`Pipeline::take_frame_end_energy`].
     frame_end_energy: Option<Energy>,
+    /// Per vertex, held by a pin at the step's start (buffer for the error
+    /// estimate).
+    held: Vec<bool>,
 }
 
 impl Pipeline {
@@ -132,6 +146,7 @@ impl Pipeline {
             angles_fresh: false,
             obstacle_planes: Vec::new(),
             frame_end_energy: None,
+            held: Vec::new(),
         }
     }
 
@@ -220,11 +235,28 @@ impl Pipeline {
         // Set by every rejected attempt: the last halving always ends in one.
         let mut failure = StepFailure::NonFinite;
         for halving in 0..=MAX_STEP_HALVINGS {
-            let healthy = match self.steps_through(setup, state, frame_interval, halving) {
+            let stepped = match setup.settings.step {
+                StepSize::Adaptive(control) => {
+                    self.adaptive_steps_through(setup, state, frame_interval, halving, &control)
+                }
+                _ => self.steps_through(setup, state, frame_interval, halving),
+            };
+            let healthy = match stepped {
                 Ok(()) => true,
+                // Halving the largest adaptive step cannot help a step that
+                // fails its tolerances at the smallest.
+                Err(StepError::Rejected(why @ StepFailure::AboveTolerance { .. })) => {
+                    failure = why;
+                    state.restore(start);
+                    self.mesh_changed(setup, state);
+                    break;
+                }
                 Err(StepError::Rejected(why)) => {
                     failure = why;
                     false
+                }
+                Err(StepError::Refused { .. }) => {
+                    unreachable!("the adaptive frame loop retries refused steps itself")
                 }
                 Err(StepError::Remesh(e)) => return Err(FrameFailed::Remesh(e)),
             };
@@ -251,7 +283,10 @@ impl Pipeline {
             state.restore(start);
             self.mesh_changed(setup, state);
         }
-        let last_dt = self.step_size(setup, &state.world) / (1u64 << MAX_STEP_HALVINGS) as Scalar;
+        let last_dt = match setup.settings.step {
+            StepSize::Adaptive(control) => control.min,
+            _ => self.step_size(setup, &state.world) / (1u64 << MAX_STEP_HALVINGS) as Scalar,
+        };
         Err(FrameFailed::Steps(FrameFailure {
             last_dt,
             failure,
@@ -276,6 +311,7 @@ impl Pipeline {
             let h = evened_step(remaining, self.step_size(setup, &state.world) / shrink);
             self.step(setup, state, h)?;
             state.effort.min_dt = state.effort.min_dt.min(h);
+            state.effort.max_dt = state.effort.max_dt.max(h);
             self.last_step = Some(h);
             done += h;
         }
@@ -296,12 +332,13 @@ impl Pipeline {
     /// The step for the current mesh: the fixed one, or the stepper's automatic
     /// estimate for `setup`'s model.
     pub fn step_size(&mut self, setup: &Setup, world: &World) -> Scalar {
-        if let StepSize::Fixed(dt) = setup.settings.step {
-            return dt;
+        match setup.settings.step {
+            StepSize::Fixed(dt) => dt,
+            StepSize::Adaptive(_) => step_control::FIRST_STEP,
+            StepSize::Auto => *self
+                .auto_dt
+                .get_or_insert_with(|| self.stepper.auto_dt(&setup.model, world)),
         }
-        *self
-            .auto_dt
-            .get_or_insert_with(|| self.stepper.auto_dt(&setup.model, world))
     }
 
     /// One step of `h` seconds, in phases: forces + integrate, collide, account,
@@ -317,6 +354,20 @@ impl Pipeline {
         state: &mut SimState,
         h: Scalar,
     ) -> Result<StepOutcome, StepError> {
+        self.judged_step(setup, state, h, None)
+    }
+
+    /// [`Pipeline::step`], judged by the adaptive step's controller when
+    /// `control` is given (`(settings, proposed step, largest step)`): a step it
+    /// refuses returns [`StepError::Refused`] with the state back at the step's
+    /// start; an accepted one sets the state's next proposal.
+    fn judged_step(
+        &mut self,
+        setup: &Setup,
+        state: &mut SimState,
+        h: Scalar,
+        control: Option<(&AdaptiveStep, Scalar, Scalar)>,
+    ) -> Result<StepOutcome, StepError> {
         debug_assert_eq!(
             self.stepper.elements.mass.len(),
             state.world.x.len(),
@@ -324,16 +375,25 @@ impl Pipeline {
         );
         let rollback = setup.settings.adapt.as_ref().is_some_and(|a| a.rollback);
         let mut rollbacks = 0;
+        let mut next = None;
         loop {
             self.angles_fresh = false;
-            if rollback {
+            if rollback || control.is_some() {
                 self.remember_step_start(state);
             }
-            self.attempt(setup, state, h)?;
+            let attempted = self.attempt(setup, state, h);
+            if let Some((settings, proposed, largest)) = control {
+                next = Some(self.judge(settings, state, h, proposed, largest, attempted)?);
+            } else {
+                attempted?;
+            }
             if rollback && self.rollback(setup, state, &mut rollbacks)? {
                 continue;
             }
             break;
+        }
+        if let Some(next) = next {
+            state.step_control.next = next;
         }
         state.ledger.steps_done += 1;
         let remeshed = self.adapt(setup, state)?;

@@ -7,6 +7,8 @@ use crate::math::Scalar;
 use crate::physics::Model;
 use crate::spec::SelfCollision;
 
+use super::step_control::AdaptiveStep;
+
 /// Everything a run holds fixed (SPEC section 2's model): given to every call
 /// that advances a state, next to the state (`pipeline.step(&setup, &mut
 /// state, h)`), so that the state holds only what changes and the pipeline
@@ -43,4 +45,6 @@ pub enum StepSize {
     Auto,
     /// This many seconds.
     Fixed(Scalar),
+    /// Error control (`dt = "adaptive"`, [`super::step_control`]).
+    Adaptive(AdaptiveStep),
 }

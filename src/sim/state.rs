@@ -6,7 +6,7 @@ use crate::math::{Scalar, Vector};
 use crate::physics::{Contact, StepStats};
 use crate::world::World;
 
-use super::{EnergyBound, Pipeline, Setup, WeldEvent};
+use super::{EnergyBound, Pipeline, Setup, StepControl, WeldEvent};
 
 /// The simulation state: one cloneable value (see the [module docs](super)).
 ///
@@ -36,6 +36,9 @@ pub struct SimState {
     pub effort: Effort,
     /// Seams welded since the recording last took them.
     pub welds: Vec<WeldEvent>,
+    /// The adaptive step's proposal for the next step (read with
+    /// `dt = "adaptive"` only).
+    pub step_control: StepControl,
 }
 
 /// The energy accounting of a run: the work done on the cloth from outside, the
@@ -74,6 +77,30 @@ pub struct Effort {
     pub energy_retries: u64,
     /// Halvings spent on frames that failed or gained energy.
     pub step_halvings: u64,
+    /// Largest step taken so far, s (zero before the first).
+    pub max_dt: Scalar,
+    /// Adaptive steps refused, by reason (`dt = "adaptive"`).
+    pub refused: RefusedSteps,
+    /// Largest error estimate of an accepted adaptive step, m.
+    pub largest_step_error: Scalar,
+}
+
+/// Adaptive steps refused by the controller ([`super::step_control`]), by reason.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
+pub struct RefusedSteps {
+    /// The error estimate exceeded its tolerance.
+    pub error: u64,
+    /// The cloth ended deeper below an obstacle surface than its tolerance.
+    pub penetration: u64,
+    /// The step failed (solve, finiteness, energy) and was retried smaller.
+    pub failed: u64,
+}
+
+impl RefusedSteps {
+    /// All refusals.
+    pub fn total(&self) -> u64 {
+        self.error + self.penetration + self.failed
+    }
 }
 
 impl Default for Effort {
@@ -83,6 +110,9 @@ impl Default for Effort {
             min_dt: Scalar::INFINITY,
             energy_retries: 0,
             step_halvings: 0,
+            max_dt: 0.0,
+            refused: RefusedSteps::default(),
+            largest_step_error: 0.0,
         }
     }
 }
@@ -110,6 +140,7 @@ impl SimState {
             },
             effort: Effort::default(),
             welds: Vec::new(),
+            step_control: StepControl::default(),
         }
     }
 
@@ -132,6 +163,7 @@ impl Clone for SimState {
             ledger: self.ledger,
             effort: self.effort,
             welds: self.welds.clone(),
+            step_control: self.step_control,
         }
     }
 
@@ -147,6 +179,7 @@ impl Clone for SimState {
             ledger,
             effort,
             welds,
+            step_control,
         } = source;
         let World {
             mesh,
@@ -166,5 +199,6 @@ impl Clone for SimState {
         self.ledger = *ledger;
         self.effort = *effort;
         self.welds.clone_from(welds);
+        self.step_control = *step_control;
     }
 }

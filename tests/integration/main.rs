@@ -5,6 +5,7 @@ mod adapt;
 mod adapt_cost;
 mod adapt_sizing;
 mod adapt_tensor;
+mod adaptive_dt;
 mod articulated;
 mod bad_cli;
 mod bad_input;

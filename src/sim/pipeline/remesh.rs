@@ -10,24 +10,56 @@ use crate::mesh::MeshError;
 use crate::sim::{Ledger, Setup, SimState};
 use crate::spec::AdaptEvery;
 
-/// What a rollback restores: the step's start positions, velocities, time and
-/// ledger (so the rejected attempt's work and collision counts leave no trace).
+/// What a rollback or a refused adaptive step restores: the step's start
+/// positions, velocities, time and ledger (so the rejected attempt's work and
+/// collision counts leave no trace), and for a refused step the resting
+/// contacts and the warm start it began with.
 #[derive(Default)]
 pub(super) struct StepStart {
     x: Vec<Vector>,
     v: Vec<Vector>,
     time: Scalar,
     ledger: Option<Ledger>,
+    contacts: Vec<crate::physics::Contact>,
+    warm_start: Vec<Vector>,
 }
 
 impl Pipeline {
-    /// Saves what a rollback restores.
+    /// Saves what a rollback or a refused step restores.
     pub(super) fn remember_step_start(&mut self, state: &SimState) {
         let s = &mut self.step_start;
         s.x.clone_from(&state.world.x);
         s.v.clone_from(&state.world.v);
         s.time = state.world.time;
         s.ledger = Some(state.ledger);
+        s.contacts.clone_from(&state.contacts);
+        s.warm_start.clone_from(&state.warm_start);
+    }
+
+    /// The positions, velocities and time the step started from (saved by
+    /// [`Pipeline::remember_step_start`]).
+    pub(super) fn step_start_motion(&self) -> (&[Vector], &[Vector], Scalar) {
+        let s = &self.step_start;
+        (&s.x, &s.v, s.time)
+    }
+
+    /// Puts the state back at the step's start, mesh unchanged (a refused
+    /// adaptive step): positions, velocities, time, ledger, resting contacts
+    /// and warm start. The air power cache is forgotten (it is recomputed from
+    /// the restored state, to the same value).
+    pub(super) fn restore_step_start(&mut self, state: &mut SimState) {
+        let s = &mut self.step_start;
+        debug_assert_eq!(s.x.len(), state.world.x.len(), "restoring another mesh");
+        state.world.x.clone_from(&s.x);
+        state.world.v.clone_from(&s.v);
+        state.world.time = s.time;
+        if let Some(ledger) = s.ledger {
+            state.ledger = ledger;
+        }
+        state.contacts.clone_from(&s.contacts);
+        state.warm_start.clone_from(&s.warm_start);
+        self.air_power = None;
+        self.angles_fresh = false;
     }
 
     /// Rollback (paper A): when the step bent an edge past the upper threshold and
