@@ -284,13 +284,19 @@ pub const TIME_LADDER_DIVISORS: [u32; 3] = [1, 2, 4];
 /// reference's own error is about 1/8 of that rung's.
 pub const TIME_REFERENCE_DIVISOR: u32 = 32;
 
+/// The tolerances of the time-step ladder's adaptive rungs (`dt = "adaptive"`,
+/// implicit scenes), m: around the default, each a quarter of the last, so
+/// that the step halves from one to the next.
+pub const TIME_LADDER_TOLERANCES: [Scalar; 3] = [2e-3, 5e-4, 1.25e-4];
+
 /// The time-step ladder on one uniform mesh (the scene's resolution): rungs at
-/// `dt / k` for `k` in [`TIME_LADDER_DIVISORS`], the reference at
+/// `dt / k` for `k` in [`TIME_LADDER_DIVISORS`], with `implicit` the adaptive
+/// step at each of [`TIME_LADDER_TOLERANCES`], and the reference at
 /// `dt / TIME_REFERENCE_DIVISOR` on the same mesh. `dt` is the scene's step
 /// ([`scene_step`] of the uniform scene).
-pub fn time_ladder(dt: Scalar) -> Ladder {
+pub fn time_ladder(dt: Scalar, implicit: bool) -> Ladder {
     let uniform = ["adapt.method=none", "adapt.multirate=false"].map(String::from);
-    let rung = TIME_LADDER_DIVISORS
+    let mut rung = TIME_LADDER_DIVISORS
         .iter()
         .map(|&k| {
             let h = dt / Scalar::from(k);
@@ -302,7 +308,15 @@ pub fn time_ladder(dt: Scalar) -> Ladder {
             };
             Rung::new(label, set)
         })
-        .collect();
+        .collect::<Vec<_>>();
+    if implicit {
+        rung.extend(TIME_LADDER_TOLERANCES.iter().map(|&tolerance| {
+            let mut set = uniform.to_vec();
+            set.push("simulation.dt=\"adaptive\"".to_owned());
+            set.push(format!("simulation.adaptive_dt.tolerance={tolerance:e}"));
+            Rung::new(format!("adaptive {tolerance:e} m"), set)
+        }));
+    }
     let mut reference = uniform.to_vec();
     reference.push(dt_override(dt / Scalar::from(TIME_REFERENCE_DIVISOR)));
     Ladder {

@@ -226,7 +226,8 @@ fn resolve_ladder(opts: &BenchOptions, base_set: &[String]) -> Result<Ladder, Be
     let mut ladder = if opts.time_ladder {
         let uniform = ["adapt.method=none", "adapt.multirate=false"].map(String::from);
         let scene = load(&opts.scene, &chain(base_set, &uniform), "scene")?;
-        ladder::time_ladder(ladder::scene_step(&scene)?)
+        let implicit = scene.simulation.integrator == Integrator::Implicit;
+        ladder::time_ladder(ladder::scene_step(&scene)?, implicit)
     } else {
         match &opts.ladder {
             Some(l) => l.clone(),

@@ -58,7 +58,7 @@ struct LadderArgs {
     /// ladder built from the scene: uniform 16 to 64 and adaptive runs, see docs/bench.md).
     #[arg(long, value_name = "FILE.toml")]
     ladder: Option<PathBuf>,
-    /// Run the time-step ladder instead: one uniform mesh at the scene's step, 1/2 and 1/4 of it, against 1/32 of it (files SCENE-time.*).
+    /// Run the time-step ladder instead: one uniform mesh at the scene's step, 1/2 and 1/4 of it, and for an implicit scene `dt = "adaptive"` at tolerances 2e-3, 5e-4 and 1.25e-4 m, against 1/32 of the step (files SCENE-time.*).
     #[arg(long, conflicts_with_all = ["ladder", "reference_resolution", "step"])]
     time_ladder: bool,
     /// What the error compares: `frames` (every recorded frame, mean; dynamic scenes) or `rest` (the last frame; quasi-static scenes). Default: the ladder's `compare`, else `frames`.

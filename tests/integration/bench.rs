@@ -6,7 +6,9 @@ use std::process::Command;
 use std::sync::atomic::AtomicBool;
 
 use drape::bench::collect::pareto_front;
-use drape::bench::ladder::{TIME_LADDER_DIVISORS, TIME_REFERENCE_DIVISOR, time_ladder};
+use drape::bench::ladder::{
+    TIME_LADDER_DIVISORS, TIME_LADDER_TOLERANCES, TIME_REFERENCE_DIVISOR, time_ladder,
+};
 use drape::bench::plan::JOBS_FILE;
 use drape::bench::report::CSV_HEADER;
 use drape::bench::sampling::{FrameSamples, frame_error};
@@ -185,8 +187,26 @@ floor = true
 
 #[test]
 fn time_ladder_halves_the_step_against_a_much_smaller_one() {
-    let l = time_ladder(0.01);
-    assert_eq!(l.rung.len(), TIME_LADDER_DIVISORS.len());
+    assert_eq!(
+        time_ladder(0.01, false).rung.len(),
+        TIME_LADDER_DIVISORS.len()
+    );
+    let l = time_ladder(0.01, true);
+    assert_eq!(
+        l.rung.len(),
+        TIME_LADDER_DIVISORS.len() + TIME_LADDER_TOLERANCES.len()
+    );
+    for (r, tolerance) in l.rung[TIME_LADDER_DIVISORS.len()..]
+        .iter()
+        .zip(TIME_LADDER_TOLERANCES)
+    {
+        assert!(
+            r.set.contains(&"simulation.dt=\"adaptive\"".to_owned()),
+            "{r:?}"
+        );
+        let set = format!("simulation.adaptive_dt.tolerance={tolerance:e}");
+        assert!(r.set.contains(&set), "{r:?}");
+    }
     for (r, k) in l.rung.iter().zip(TIME_LADDER_DIVISORS) {
         let dt: f64 = r
             .set
@@ -467,11 +487,17 @@ fn time_ladder_end_to_end_error_falls_with_the_step() {
     let res = bench_out(&opts, &dir);
     assert_eq!(res.plan.stem, "tiny-time");
     assert!(res.plan.common_dt.is_none());
-    let e: Vec<f64> = res.rows.iter().map(|r| r.error).collect();
+    let all: Vec<f64> = res.rows.iter().map(|r| r.error).collect();
+    println!("errors: fixed steps, then adaptive at 2e-3, 5e-4, 1.25e-4 m: {all:?}");
+    assert_eq!(all.len(), 6, "{all:?}");
+    let (e, adaptive) = all.split_at(3);
+    assert!(e[0] > e[1] && e[1] > e[2] && e[2] > 0.0, "{e:?}");
+    // The implicit scene's adaptive rungs: a tighter tolerance, a smaller error.
     assert!(
-        e.len() == 3 && e[0] > e[1] && e[1] > e[2] && e[2] > 0.0,
-        "{e:?}"
+        adaptive[0] > adaptive[2] && adaptive[2] > 0.0,
+        "adaptive {adaptive:?}"
     );
+    assert!(res.rows[3..].iter().all(|r| r.status == "ok"));
     // Backward Euler is first order; the reference's own error (1/8 of the
     // smallest rung's) raises the observed order a little above 1.
     let order = (e[0] / e[2]).log2() / 2.0;
