@@ -2,9 +2,10 @@
 //! edge), packed into one sortable integer each, and the rest-space test that
 //! tells which triangle pairs may hold parts that are close in the rest state.
 //!
-//! A triangle pair whose two triangles overlap in their swept boxes yields 6
-//! vertex-triangle and 9 edge-edge pairs; neighbouring triangle pairs yield
-//! many of the same ones, so the list is sorted and deduplicated every step.
+//! A triangle pair whose two triangles overlap in their swept boxes yields up
+//! to 6 vertex-triangle and 9 edge-edge pairs (those whose own swept boxes
+//! overlap too, `selfcol.rs`); neighbouring triangle pairs yield many of the
+//! same ones, so the list is sorted and deduplicated every step.
 //! Packed into a `u128` in the order of its fields, a pair sorts by one
 //! integer comparison, in the same order as its fields would.
 //!

@@ -65,6 +65,8 @@ struct Scratch {
     inv_mass: Vec<Scalar>,
     /// Swept box of every triangle.
     boxes: Vec<Aabb>,
+    /// Swept box of every vertex, inflated by the thickness.
+    vertex_boxes: Vec<Aabb>,
     /// Per patch: Volino's test passed.
     culled: Vec<bool>,
     /// Per patch: its projected boundary (Volino's test).
@@ -235,9 +237,15 @@ impl SelfCollider {
     }
 
     /// The swept box of every triangle, into `s.boxes`: its corners at the start and at
-    /// the end of the step, inflated by the thickness.
+    /// the end of the step, inflated by the thickness; and of every vertex, into
+    /// `s.vertex_boxes`.
     fn swept_boxes(&self, tris: &[[u32; 3]], x0: &[Vector], x: &[Vector], s: &mut Scratch) {
         let pad = Vector::splat(self.thickness);
+        x0.par_iter()
+            .zip(x.par_iter())
+            .with_min_len(1024)
+            .map(|(a, b)| Aabb::new(a.min(*b) - pad, a.max(*b) + pad))
+            .collect_into_vec(&mut s.vertex_boxes);
         tris.par_iter()
             .map(|t| {
                 let mut lo = Vector::splat(Scalar::INFINITY);
@@ -412,6 +420,13 @@ struct Fix {
 /// pairs, into `s.prims` (unsorted, with repeats), each marked near unless its
 /// triangles are farther than `limit` apart in rest space; counts the pairs
 /// tested and culled.
+///
+/// A primitive pair whose swept boxes, each inflated by the thickness, do not
+/// overlap is left out: its parts stay more than two thicknesses apart along
+/// an axis at the start and at the end of the step, the margin the triangle
+/// pairs were found with. Of the primitive pairs of box-overlapping triangle
+/// pairs, most are such (two triangles side by side overlap in their boxes;
+/// a vertex of one and the far edge of the other do not).
 fn primitive_pairs(
     tris: &[[u32; 3]],
     s: &mut Scratch,
@@ -419,23 +434,61 @@ fn primitive_pairs(
     limit: Scalar,
 ) -> SelfStats {
     let mut stats = SelfStats::default();
-    s.prims.clear();
     for (pairs, skipped) in &s.pairs {
         stats.pairs_culled += skipped;
         stats.pairs_tested += pairs.len() as u64;
-        for &(t, u) in pairs {
-            let near = !rest.far(t, u, limit);
-            let (a, b) = (tris[t as usize], tris[u as usize]);
-            for k in 0..3 {
-                s.prims.push(Prim::vertex_triangle(a[k], u, near));
-                s.prims.push(Prim::vertex_triangle(b[k], t, near));
-                let e = edge(a[k], a[(k + 1) % 3]);
-                for j in 0..3 {
-                    let f = edge(b[j], b[(j + 1) % 3]);
-                    s.prims.push(Prim::edge_edge(e, f, near));
-                }
+    }
+    let vb = &s.vertex_boxes;
+    s.prims.clear();
+    // In patch order per patch, in any order across them: the list is sorted next.
+    s.prims
+        .par_extend(s.pairs.par_iter().flat_map_iter(|(pairs, _)| {
+            let mut out = Vec::with_capacity(8 * pairs.len());
+            for &(t, u) in pairs {
+                let near = !rest.far(t, u, limit);
+                pair_prims(tris, vb, t, u, near, &mut out);
+            }
+            out
+        }));
+    stats
+}
+
+/// The primitive pairs of triangles `t` and `u` whose inflated swept boxes
+/// overlap, into `out` ([`primitive_pairs`]).
+fn pair_prims(tris: &[[u32; 3]], vb: &[Aabb], t: u32, u: u32, near: bool, out: &mut Vec<Prim>) {
+    let edge_box = |e: [u32; 2]| vb[e[0] as usize].merged(&vb[e[1] as usize]);
+    let (a, b) = (tris[t as usize], tris[u as usize]);
+    let (box_a, box_b) = (
+        vb[a[0] as usize]
+            .merged(&vb[a[1] as usize])
+            .merged(&vb[a[2] as usize]),
+        vb[b[0] as usize]
+            .merged(&vb[b[1] as usize])
+            .merged(&vb[b[2] as usize]),
+    );
+    let edges_b = [0, 1, 2].map(|j| {
+        let f = edge(b[j], b[(j + 1) % 3]);
+        (f, edge_box(f))
+    });
+    for k in 0..3 {
+        if vb[a[k] as usize].intersects(&box_b) {
+            out.push(Prim::vertex_triangle(a[k], u, near));
+        }
+        if vb[b[k] as usize].intersects(&box_a) {
+            out.push(Prim::vertex_triangle(b[k], t, near));
+        }
+        let e = edge(a[k], a[(k + 1) % 3]);
+        let eb = edge_box(e);
+        if !eb.intersects(&box_b) {
+            continue;
+        }
+        for (f, fb) in &edges_b {
+            if eb.intersects(fb) {
+                out.push(Prim::edge_edge(e, *f, near));
             }
         }
     }
-    stats
 }
+
+#[cfg(test)]
+mod tests;
