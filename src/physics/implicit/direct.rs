@@ -128,6 +128,25 @@ pub(super) fn solve(
     reference: Scalar,
     contact_push: bool,
 ) -> Result<(), SolveFailure> {
+    let pattern = assemble(st, held);
+    let outcome = iterate(st, model, &pattern, reference);
+    let s = &mut st.implicit;
+    let a = &mut s.direct;
+    // dv = dv_c + y.
+    s.dv.par_iter_mut()
+        .zip(a.prescribed.par_iter().zip(a.y.par_iter()))
+        .with_min_len(PAR_MIN)
+        .for_each(|(d, (c, y))| *d = *c + *y);
+    if outcome.is_ok() && contact_push {
+        contact_pressure(st, &pattern);
+    }
+    outcome
+}
+
+/// Assembles `A` from the linearised step's element terms into the block pattern
+/// (built first for a new mesh), and `A_s` and `b_s` (module docs) from the first
+/// guess `dv` and `held`; timed as assembly. Returns the pattern.
+pub(super) fn assemble(st: &mut Stepper, held: &[bool]) -> Arc<BlockPattern> {
     let started = Instant::now();
     let n = st.implicit.dv.len();
     let s = &mut st.implicit;
@@ -168,18 +187,7 @@ pub(super) fn solve(
         .for_each(|((r, (b, ap)), proj)| *r = project(*proj, *b - *ap));
     pattern.project(&a.raw, &a.projection, &st.elements.mass, &mut a.system);
     st.stats.assembly_s += started.elapsed().as_secs_f64();
-    let outcome = iterate(st, model, &pattern, reference);
-    let s = &mut st.implicit;
-    let a = &mut s.direct;
-    // dv = dv_c + y.
-    s.dv.par_iter_mut()
-        .zip(a.prescribed.par_iter().zip(a.y.par_iter()))
-        .with_min_len(PAR_MIN)
-        .for_each(|(d, (c, y))| *d = *c + *y);
-    if outcome.is_ok() && contact_push {
-        contact_pressure(st, &pattern);
-    }
-    outcome
+    pattern
 }
 
 /// Splits the first guess `dv` into its prescribed part and the free first guess
