@@ -31,8 +31,7 @@ const RESOLUTIONS: [u32; 2] = [63, 127];
 /// The elements the assembly visits (module docs).
 fn elements(sheet: &Sheet) -> u64 {
     let e = &sheet.stepper.elements;
-    (e.springs.len() + e.hinges.len() + e.shape_triangles.len() + e.membrane_triangles.len())
-        as u64
+    (e.springs.len() + e.hinges.len() + e.shape_triangles.len() + e.membrane_triangles.len()) as u64
 }
 
 /// The sheet with the shape operator and the default direct solver.

@@ -72,10 +72,14 @@ fn implicit_step(c: &mut Criterion) {
 fn time_split() {
     println!("time split per step over 60 steps (after 30 warm-up steps), dt = 1/120 s:");
     for resolution in [63u32, 127] {
-        let dihedral = CASES.map(|(label, solver, refactor)| {
-            (label, BendingModel::Dihedral, solver, refactor)
-        });
-        let shape = ("direct shape_op", BendingModel::ShapeOperator, Solver::Direct, 7);
+        let dihedral = CASES
+            .map(|(label, solver, refactor)| (label, BendingModel::Dihedral, solver, refactor));
+        let shape = (
+            "direct shape_op",
+            BendingModel::ShapeOperator,
+            Solver::Direct,
+            7,
+        );
         for (label, bending, solver, refactor) in dihedral.into_iter().chain([shape]) {
             let mut sheet = setup(resolution, bending, solver, refactor);
             let before = sheet.stepper.stats;
