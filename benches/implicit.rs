@@ -12,7 +12,10 @@
 //! every step factors) and `cg` (matrix-free Jacobi CG).
 //!
 //! After the Criterion groups, the time split per step (assembly, factorization,
-//! solve, the rest) of 60 further steps is printed for each case.
+//! solve, the rest) of 60 further steps is printed for each case, and for the
+//! `direct` case with the shape-operator bending (`direct shape_op`), the
+//! scenes' default; the timed steps use dihedral bending. The assembly alone is
+//! timed by the `assembly` bench.
 //!
 //! A second group, `remesh_tables`, times what a remesh rebuilds before the
 //! symbolic factorization: the element tables and the block pattern, and the
@@ -23,21 +26,19 @@
 //! Run with `cargo bench --bench implicit`; the figures at commit 03aac28 are in that
 //! commit's `docs/performance.md`.
 
+mod sheet;
+
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group};
-use drape::math::{Scalar, Vector};
 use drape::physics::block::BlockPattern;
 use drape::physics::cholesky::{Factorization, Ordering};
 use drape::physics::elements::Elements;
-use drape::physics::{
-    ExternalForces, MaterialParams, Model, Solver, SolverSettings, StepStats, Stepper,
-};
-use drape::scene::{BendingModel, DiagonalPattern, Integrator, Pin, PinMotion, StiffnessRule};
+use drape::physics::{MaterialParams, Solver, StepStats};
+use drape::scene::{BendingModel, DiagonalPattern, StiffnessRule};
 use drape::world::World;
-
-const DT: Scalar = 1.0 / 120.0;
+use sheet::setup;
 
 /// The solver cases: label, solver, refactor_iterations.
 const CASES: [(&str, Solver, u32); 3] = [
@@ -45,93 +46,6 @@ const CASES: [(&str, Solver, u32); 3] = [
     ("direct_every_step", Solver::Direct, 1),
     ("cg", Solver::Cg, 4),
 ];
-
-fn corner(region: &str) -> Pin {
-    Pin {
-        region: region.into(),
-        box_min: None,
-        box_max: None,
-        motion: PinMotion::Fixed,
-        velocity: [0.0; 3],
-        acceleration: [0.0; 3],
-        center: [0.0; 3],
-        axis: [0.0, 0.0, 1.0],
-        angular_velocity: 0.0,
-        release_time: None,
-        keyframes: Vec::new(),
-        easing: Default::default(),
-        after_last: Default::default(),
-        attach: None,
-    }
-}
-
-/// The swinging sheet at `resolution` after 30 steps, with its stepper.
-fn setup(resolution: u32, solver: Solver, refactor_iterations: u32) -> Sheet {
-    let mesh = drape::mesh::rectangle(1.0, 1.0, resolution, DiagonalPattern::Alternating)
-        .expect("valid rectangle");
-    let x = mesh.material.iter().map(|p| p.extend(1.0)).collect();
-    let mut world = World::new(mesh, x);
-    let pins = [corner("corner:top_left"), corner("corner:top_right")];
-    world.pins = drape::physics::pins::Pins::select(&pins, &world.mesh, &world.x).expect("pins");
-    let model = Model {
-        material: MaterialParams {
-            density: 0.15,
-            stretch: 200.0,
-            membrane: drape::physics::Membrane::Springs,
-            bending: 1e-5,
-            damping: 0.001,
-            bending_model: BendingModel::Dihedral,
-            stiffness_rule: StiffnessRule::Consistent,
-        },
-        external: ExternalForces {
-            gravity: Some(Vector::new(0.0, 0.0, -9.81)),
-            drag: Some(0.02),
-            ..Default::default()
-        },
-        integrator: Integrator::Implicit,
-        cg_tolerance: 1e-6,
-        cg_max_iterations: 5000,
-        solver: SolverSettings {
-            solver,
-            refactor_iterations,
-            ..SolverSettings::default()
-        },
-    };
-    let stepper = Stepper::new(&model, &world);
-    let mut sheet = Sheet {
-        world,
-        model,
-        stepper,
-        warm_start: Vec::new(),
-    };
-    for _ in 0..30 {
-        sheet.step();
-    }
-    sheet
-}
-
-/// A bench sheet: the world, its model, its stepper and the implicit warm start
-/// (the simulation state's, in a run).
-struct Sheet {
-    world: World,
-    model: Model,
-    stepper: Stepper,
-    warm_start: Vec<Vector>,
-}
-
-impl Sheet {
-    /// One implicit step of `DT`.
-    fn step(&mut self) {
-        self.stepper
-            .step(
-                &self.model,
-                black_box(&mut self.world),
-                &mut self.warm_start,
-                DT,
-            )
-            .expect("solved");
-    }
-}
 
 fn implicit_step(c: &mut Criterion) {
     let mut group = c.benchmark_group("implicit_step");
@@ -141,7 +55,7 @@ fn implicit_step(c: &mut Criterion) {
         .sample_size(10);
     for resolution in [63u32, 127] {
         for (label, solver, refactor) in CASES {
-            let mut sheet = setup(resolution, solver, refactor);
+            let mut sheet = setup(resolution, BendingModel::Dihedral, solver, refactor);
             let vertices = sheet.world.mesh.vertex_count() as u64;
             group.throughput(Throughput::Elements(vertices));
             group.bench_function(BenchmarkId::new(label, vertices), |b| {
@@ -152,12 +66,22 @@ fn implicit_step(c: &mut Criterion) {
     group.finish();
 }
 
-/// Per-step time split over 60 steps after the warm-up, for each case.
+/// Per-step time split over 60 steps after the warm-up, for each case with
+/// dihedral bending, and for the default direct solver with the shape operator
+/// (the scenes' default bending).
 fn time_split() {
     println!("time split per step over 60 steps (after 30 warm-up steps), dt = 1/120 s:");
     for resolution in [63u32, 127] {
-        for (label, solver, refactor) in CASES {
-            let mut sheet = setup(resolution, solver, refactor);
+        let dihedral = CASES
+            .map(|(label, solver, refactor)| (label, BendingModel::Dihedral, solver, refactor));
+        let shape = (
+            "direct shape_op",
+            BendingModel::ShapeOperator,
+            Solver::Direct,
+            7,
+        );
+        for (label, bending, solver, refactor) in dihedral.into_iter().chain([shape]) {
+            let mut sheet = setup(resolution, bending, solver, refactor);
             let before = sheet.stepper.stats;
             let started = Instant::now();
             for _ in 0..60 {

@@ -1,12 +1,42 @@
 //! The implicit system matrix assembled into a fixed 3x3-block sparsity pattern.
 //!
 //! [`BlockPattern`] is built once per mesh topology: one block per vertex pair
-//! coupled by a spring, a membrane triangle, a hinge or a shape triangle (both triangles stored, columns sorted per row),
-//! and for every block of the lower triangle the list of element terms that sum
-//! into it, in element order. Assembly ([`BlockPattern::gather`]) then needs no
-//! triplets, no sorting and no atomics: each lower block sums its own sources in a
-//! fixed order (parallel over rows), and each upper block copies the transpose of its
-//! mirror, so the values are identical at any thread count.
+//! coupled by a spring, a membrane triangle, a hinge or a shape triangle (both
+//! triangles stored, columns sorted per row), and for every block of the lower
+//! triangle the list of element terms that sum into it, in element order.
+//!
+//! # Assembly
+//! Each step assembles the lower blocks of `A` ([`BlockPattern::gather`]) with
+//! no atomics, locks or allocation once the scratch has grown to the mesh:
+//! 1. Parallel over elements, every hinge and membrane triangle writes the
+//!    blocks it adds to the lower triangle (pairs of its vertices `(i, j)` with
+//!    `j <= i`) into its own fixed-size stretch of a flat array
+//!    ([`ElementTerms`]), hinges first, each kind in element order.
+//! 2. Parallel over bands of [`BAND_ROWS`] rows, each band owning its rows'
+//!    blocks: every lower block sums its springs' blocks (read where the
+//!    linearisation left them: added on the diagonal, subtracted off it) and
+//!    its hinge and membrane terms, by precomputed index lists of plain 3x3
+//!    additions (no dispatch on the element kind); then each shape triangle
+//!    with a slot in the band, in triangle order, forms its products
+//!    `sum_b M_ab J_bl` once and adds its blocks `h^2 sum_a J_ak (M J)_al^T`
+//!    with their row in the band straight into them, by its precomputed slots,
+//!    and the Frobenius norms of its dropped blocks there into the diagonal
+//!    compensation; last the mass on the diagonal.
+//!
+//! The shape triangles are the bulk (21 blocks each, against 3 per spring), and
+//! adding them in place is what makes the pass cheap: summed per block from
+//! the Jacobians, a triangle's products were recomputed for every block it adds
+//! to and again for the compensation (`perf`: two thirds of a shape-operator
+//! sheet's assembly), and written once to a flat array they cost 12 MB of
+//! memory traffic a step at 4,096 vertices, where a band's blocks stay in the
+//! cache. A triangle with slots in two bands forms its products in both.
+//!
+//! Every block sums its terms in one fixed order (springs, hinges, membrane
+//! triangles, shape triangles, each in element order, then the mass), whatever
+//! the thread count; and it is the order and the arithmetic of summing each
+//! block's terms one by one, each computed alone, so the values are those to
+//! the last bit. The upper blocks are not stored: [`BlockPattern::project`]
+//! and [`BlockPattern::multiply_lower`] read one as its mirror's transpose.
 //!
 //! The pattern also carries the scalar compressed-column (CSC) structure of the
 //! lower triangle that the sparse Cholesky factorization reads ([`super::cholesky`]),
@@ -32,36 +62,20 @@
 //! full factor's extra size is worth (the direct solver's module docs, "Which
 //! factor", in the implicit module).
 //!
+mod assemble;
 mod buckets;
 mod csc;
+mod sources;
 mod terms;
 #[cfg(test)]
 mod tests;
 
-pub use terms::ElementBlocks;
-
-use rayon::prelude::*;
+pub use terms::{ElementBlocks, ElementTerms};
 
 use super::elements::Elements;
-use super::forces::{PAR_MIN, PAR_MIN_ROWS};
-use super::shape::SHAPE_SLOTS;
-use crate::math::{Matrix3, Scalar, Vector};
+use crate::math::{Matrix3, Vector};
 use buckets::{group_by_key, sorted_unique_rows};
-
-/// One element term summed into a lower block.
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum Source {
-    /// `+K_e` of spring `e` (a diagonal block of one of its ends).
-    SpringDiagonal(u32),
-    /// `-K_e` of spring `e` (the block coupling its ends).
-    SpringCoupling(u32),
-    /// `c_h g_k g_l^T` of hinge `h`, `k` and `l` its local vertices.
-    Hinge { hinge: u32, k: u8, l: u8 },
-    /// `h^2 sum_ab M_ab J_ak J_bl^T` of shape triangle `tri`, slots `k` and `l`.
-    Shape { tri: u32, k: u8, l: u8 },
-    /// Corner block `(k, l)` of membrane triangle `tri`.
-    Membrane { tri: u32, k: u8, l: u8 },
-}
+use sources::TermLayout;
 
 /// A fixed 3x3-block sparsity pattern for one mesh topology (module docs).
 #[derive(Debug, Clone, Default)]
@@ -83,17 +97,29 @@ pub struct BlockPattern {
     /// dropped tip-tip coupling is compensated on this vertex's diagonal.
     compensation_start: Vec<u32>,
     compensation: Vec<u32>,
-    /// Per vertex, CSC-like: the shape-triangle blocks `(tri, k, l)` of row `i` that
-    /// the factorization drops; each is compensated by its Frobenius norm on the
-    /// diagonal (`[[s I, -B], [-B^T, s I]]` is positive semi-definite for
-    /// `s >= |B|`), so the factored matrix stays positive definite. The tighter
-    /// rank-one compensation `B B^T / |B|` (each such `B = u v^T` involves a
-    /// tip) saves about 1 % of the iterations, not worth its code.
+    /// Per vertex, CSC-like: the shape-triangle blocks of row `i` that the
+    /// factorization drops, as indices of their Frobenius norms in
+    /// [`ElementTerms`]; each is compensated by its norm on the diagonal
+    /// (`[[s I, -B], [-B^T, s I]]` is positive semi-definite for `s >= |B|`), so
+    /// the factored matrix stays positive definite. The tighter rank-one
+    /// compensation `B B^T / |B|` (each such `B = u v^T` involves a tip) saves
+    /// about 1 % of the iterations, not worth its code.
     shape_dropped_start: Vec<u32>,
-    shape_dropped: Vec<(u32, u8, u8)>,
-    /// Per block (lower blocks only; empty range for upper ones): its sources.
-    source_start: Vec<u32>,
-    sources: Vec<Source>,
+    shape_dropped: Vec<u32>,
+    /// Per shape triangle: bit `6 k + l` set when the factorization drops its
+    /// block `(k, l)` (row `v[k]`), whose norm [`ElementTerms`] then holds.
+    shape_dropped_mask: Vec<u64>,
+    /// Per block (lower blocks only; empty range for upper ones): the springs
+    /// whose block it adds (diagonal) or subtracts (coupling), in spring order.
+    spring_start: Vec<u32>,
+    springs: Vec<u32>,
+    /// Per block (lower blocks only): the indices of its other element terms
+    /// in [`ElementTerms`], ascending (hinges, membrane, shape triangles, each in
+    /// element order).
+    term_start: Vec<u32>,
+    terms: Vec<u32>,
+    /// Where each element's terms lie in [`ElementTerms`].
+    layout: TermLayout,
     /// Scalar CSC structure of the lower triangle: column pointers.
     csc_column_start: Vec<u32>,
     /// Scalar CSC row indices.
@@ -212,79 +238,15 @@ impl BlockPattern {
         (s + found.unwrap_or(0)) as u32
     }
 
-    /// The element terms of every lower block, in element order, and the shape
-    /// triangles' blocks that the factorization drops (`shape_dropped`).
-    fn build_sources(&mut self, elements: &Elements) {
-        let mut tagged: Vec<(u32, Source)> = Vec::new();
-        let lower = |s: &Self, i: u32, j: u32| if j <= i { s.slot(i, j) } else { s.slot(j, i) };
-        for (e, sp) in elements.springs.iter().enumerate() {
-            let [a, b] = sp.v;
-            let e = e as u32;
-            tagged.push((self.diagonal[a as usize], Source::SpringDiagonal(e)));
-            tagged.push((self.diagonal[b as usize], Source::SpringDiagonal(e)));
-            tagged.push((lower(self, a, b), Source::SpringCoupling(e)));
+    /// The block of the lower triangle joining `i` and `j` (either order).
+    fn lower_slot(&self, i: u32, j: u32) -> u32 {
+        if i == j {
+            self.diagonal[i as usize]
+        } else if j < i {
+            self.slot(i, j)
+        } else {
+            self.slot(j, i)
         }
-        for (h, hg) in elements.hinges.iter().enumerate() {
-            for k in 0..4u8 {
-                for l in 0..4u8 {
-                    let (i, j) = (hg.v[k as usize], hg.v[l as usize]);
-                    if j <= i {
-                        let hinge = h as u32;
-                        tagged.push((self.slot(i, j), Source::Hinge { hinge, k, l }));
-                    }
-                }
-            }
-        }
-        for (ti, t) in elements.membrane_triangles.iter().enumerate() {
-            for k in 0..3u8 {
-                for l in 0..3u8 {
-                    let (i, j) = (t.v[k as usize], t.v[l as usize]);
-                    if j <= i {
-                        let tri = ti as u32;
-                        tagged.push((self.slot(i, j), Source::Membrane { tri, k, l }));
-                    }
-                }
-            }
-        }
-        // The shape triangles' sources, and the blocks the factorization drops
-        // (compensated on the diagonal: `shape_dropped`), from one lookup per
-        // pair of slots: `factored` is symmetric, so the lower block tells.
-        let mut dropped: Vec<(u32, (u32, u8, u8))> = Vec::new();
-        for (ti, t) in elements.shape_triangles.iter().enumerate() {
-            let mut active = [(0usize, 0u32); SHAPE_SLOTS];
-            let mut count = 0;
-            for (k, i) in t.slots() {
-                active[count] = (k, i);
-                count += 1;
-            }
-            let active = &active[..count];
-            let mut lower_slot = [[0u32; SHAPE_SLOTS]; SHAPE_SLOTS];
-            for (x, &(_, i)) in active.iter().enumerate() {
-                for (y, &(_, j)) in active.iter().enumerate().take(x + 1) {
-                    let b = if i == j {
-                        self.diagonal[i as usize]
-                    } else {
-                        lower(self, i, j)
-                    };
-                    (lower_slot[x][y], lower_slot[y][x]) = (b, b);
-                }
-            }
-            let tri = ti as u32;
-            for (x, &(k, i)) in active.iter().enumerate() {
-                for (y, &(l, j)) in active.iter().enumerate() {
-                    let (b, k, l) = (lower_slot[x][y], k as u8, l as u8);
-                    if i != j && !self.factored[b as usize] {
-                        dropped.push((i, (tri, k, l)));
-                    }
-                    if j <= i {
-                        tagged.push((b, Source::Shape { tri, k, l }));
-                    }
-                }
-            }
-        }
-        (self.shape_dropped_start, self.shape_dropped) = group_by_key(self.vertices(), &dropped);
-        // Grouped stably: the sources of a block stay in element order.
-        (self.source_start, self.sources) = group_by_key(self.blocks(), &tagged);
     }
 
     /// Per block: the block holding its transpose. Row `j` lists its columns in
@@ -304,169 +266,6 @@ impl BlockPattern {
             cursor[j as usize] += 1;
         }
         mirror
-    }
-
-    /// Per vertex: the diagonal compensation of the dropped tip-tip blocks (module
-    /// docs), projected like the system (`S c g g^T S`).
-    pub fn compensation(
-        &self,
-        terms: &ElementBlocks<'_>,
-        projection: &[Option<Vector>],
-        extra: &mut Vec<Matrix3>,
-    ) {
-        extra.resize(self.vertices(), Matrix3::ZERO);
-        extra
-            .par_iter_mut()
-            .enumerate()
-            .with_min_len(PAR_MIN_ROWS)
-            .for_each(|(i, out)| {
-                let range =
-                    self.compensation_start[i] as usize..self.compensation_start[i + 1] as usize;
-                let mut m = Matrix3::ZERO;
-                for &k in &self.compensation[range] {
-                    let g = terms.hinge_gradients[k as usize];
-                    m += outer(g, g) * terms.hinge_coefficients[k as usize / 4];
-                }
-                let range =
-                    self.shape_dropped_start[i] as usize..self.shape_dropped_start[i + 1] as usize;
-                let mut sigma = 0.0;
-                for &(tri, k, l) in &self.shape_dropped[range] {
-                    let b = terms.shape_block(tri as usize, k as usize, l as usize);
-                    sigma += (b.x_axis.length_squared()
-                        + b.y_axis.length_squared()
-                        + b.z_axis.length_squared())
-                    .sqrt();
-                }
-                m += Matrix3::from_diagonal(Vector::splat(sigma));
-                *out = match projection[i] {
-                    None => m,
-                    Some(n) if n == Vector::ZERO => Matrix3::ZERO,
-                    Some(n) => {
-                        let s = Matrix3::IDENTITY - outer(n, n);
-                        s * m * s
-                    }
-                };
-            });
-    }
-
-    /// Sums the element terms into `blocks` (module docs): `M + h D + h^2 K`.
-    /// `lower`: scratch that receives the lower blocks first.
-    pub fn gather(
-        &self,
-        terms: &ElementBlocks<'_>,
-        lower: &mut Vec<Matrix3>,
-        blocks: &mut Vec<Matrix3>,
-    ) {
-        lower.resize(self.blocks(), Matrix3::ZERO);
-        blocks.resize(self.blocks(), Matrix3::ZERO);
-        // Each lower block (and the diagonal) from its own sources, in element order.
-        lower
-            .par_iter_mut()
-            .enumerate()
-            .with_min_len(PAR_MIN)
-            .for_each(|(slot, out)| {
-                let (i, j) = (self.rows[slot] as usize, self.columns[slot] as usize);
-                if j > i {
-                    return;
-                }
-                let mut m = Matrix3::ZERO;
-                let range = self.source_start[slot] as usize..self.source_start[slot + 1] as usize;
-                for src in &self.sources[range] {
-                    m += match *src {
-                        Source::SpringDiagonal(e) => terms.springs[e as usize],
-                        Source::SpringCoupling(e) => -terms.springs[e as usize],
-                        Source::Hinge { hinge, k, l } => {
-                            let g = &terms.hinge_gradients[4 * hinge as usize..];
-                            outer(g[k as usize], g[l as usize])
-                                * terms.hinge_coefficients[hinge as usize]
-                        }
-                        Source::Shape { tri, k, l } => {
-                            terms.shape_block(tri as usize, k as usize, l as usize)
-                        }
-                        Source::Membrane { tri, k, l } => {
-                            let tri = tri as usize;
-                            terms.membrane_triangles[tri].block(
-                                &terms.membrane_blocks[tri],
-                                k as usize,
-                                l as usize,
-                            )
-                        }
-                    };
-                }
-                if j == i {
-                    m += Matrix3::from_diagonal(Vector::splat(terms.diagonal_mass[i]));
-                }
-                *out = m;
-            });
-        // Then every block: a lower one as computed, an upper one as its mirror's
-        // transpose (summed once, not twice).
-        let lower = &*lower;
-        blocks
-            .par_iter_mut()
-            .enumerate()
-            .with_min_len(PAR_MIN)
-            .for_each(|(slot, out)| {
-                *out = if self.columns[slot] <= self.rows[slot] {
-                    lower[slot]
-                } else {
-                    lower[self.mirror[slot] as usize].transpose()
-                };
-            });
-    }
-
-    /// The projected system `S A S + (I - S) m` of the module docs of
-    /// [`super::implicit`]: `filter[i]` is `None` for a free vertex, `Some(0)` for a
-    /// held one (all three directions prescribed) and `Some(n)` for a contact whose
-    /// normal `n` is prescribed. `scale[i]` is the diagonal put back on the
-    /// prescribed directions (the vertex's mass, so the matrix keeps its scale).
-    pub fn project(
-        &self,
-        raw: &[Matrix3],
-        projection: &[Option<Vector>],
-        scale: &[Scalar],
-        out: &mut Vec<Matrix3>,
-    ) {
-        out.resize(raw.len(), Matrix3::ZERO);
-        let s = |i: usize| match projection[i] {
-            None => None,
-            Some(n) if n == Vector::ZERO => Some(Matrix3::ZERO),
-            Some(n) => Some(Matrix3::IDENTITY - outer(n, n)),
-        };
-        out.par_iter_mut()
-            .enumerate()
-            .with_min_len(PAR_MIN)
-            .for_each(|(slot, out)| {
-                let (i, j) = (self.rows[slot] as usize, self.columns[slot] as usize);
-                let si = s(i);
-                let mut m = raw[slot];
-                if let Some(si) = si {
-                    m = si * m;
-                }
-                if let Some(sj) = s(j) {
-                    m *= sj;
-                }
-                if i == j
-                    && let Some(si) = si
-                {
-                    m += (Matrix3::IDENTITY - si) * scale[i];
-                }
-                *out = m;
-            });
-    }
-
-    /// `y = A x` with the blocks `a` of this pattern, by rows (deterministic).
-    pub fn multiply(&self, a: &[Matrix3], x: &[Vector], y: &mut [Vector]) {
-        y.par_iter_mut()
-            .enumerate()
-            .with_min_len(PAR_MIN_ROWS)
-            .for_each(|(i, out)| {
-                let range = self.row_start[i] as usize..self.row_start[i + 1] as usize;
-                let mut acc = Vector::ZERO;
-                for s in range {
-                    acc += a[s] * x[self.columns[s] as usize];
-                }
-                *out = acc;
-            });
     }
 }
 

@@ -237,6 +237,26 @@ pub fn backward_euler(
     Ok(())
 }
 
+/// What a step of `h` counts as assembly, without the solve: the pins held at
+/// the world's time, the linearisation at its state (element terms and `b`) and,
+/// with the direct solver, the block matrix `A` and the projected system (the
+/// pattern built for a new mesh). The first guess is zero; the world is left as
+/// it is. Benchmarks time this through [`Stepper::assemble_implicit`].
+pub(super) fn assemble(st: &mut Stepper, model: &Model, w: &World, h: Scalar) {
+    let n = w.x.len();
+    w.pins.held_at(w.time, &mut st.held);
+    linearise(st, model, w, h, false);
+    let s = &mut st.implicit;
+    s.dv.clear();
+    s.dv.resize(n, Vector::ZERO);
+    contact_filters(s, &st.contacts, &st.held, &w.v);
+    if model.solver.solver == Solver::Direct {
+        let held = std::mem::take(&mut st.held);
+        direct::assemble(st, &held);
+        st.held = held;
+    }
+}
+
 /// The Newton iterations of a step, the first one set up by the caller.
 fn newton(
     st: &mut Stepper,

@@ -253,6 +253,17 @@ impl Stepper {
         Ok(())
     }
 
+    /// Linearises an implicit step of `dt` at the world's current state and
+    /// assembles its linear system without solving it: what a step counts as
+    /// assembly ([`StepStats::assembly_s`], which this adds to). With the direct
+    /// solver that is the element terms, the block matrix and its projection;
+    /// with conjugate gradients the element terms alone. The world is not
+    /// changed. A hook for benchmarks of the assembly alone; a step does the
+    /// same on its own.
+    pub fn assemble_implicit(&mut self, model: &Model, world: &World, dt: Scalar) {
+        implicit::assemble(self, model, world, dt);
+    }
+
     /// Energies of the world's current state under `model`.
     pub fn energy(&self, model: &Model, world: &World) -> Energy {
         forces::energy(&self.elements, &model.external, &world.x, &world.v)

@@ -1,17 +1,25 @@
 //! The per-element matrix terms that [`super::BlockPattern::gather`] sums into
-//! its blocks: what the implicit step computed per element, and the blocks of
-//! the elements that store theirs in a factored form.
+//! its blocks: what the implicit step computed per element ([`ElementBlocks`]),
+//! and the lower blocks that each element adds, written once per step into a
+//! flat array in element order ([`ElementTerms`], the block module docs,
+//! "Assembly").
 
-use super::outer;
+use rayon::prelude::*;
+
+use super::super::forces::PAR_MIN;
+use super::{BlockPattern, outer};
 use crate::math::{Matrix3, Scalar, Vector};
+use crate::physics::elements::Hinge;
 use crate::physics::membrane::{ColumnBlocks, MembraneTriangle};
-use crate::physics::shape::{ShapeJacobian, ShapeTriangle};
+use crate::physics::shape::{SHAPE_SLOTS, ShapeJacobian, ShapeTriangle};
 
 /// The per-element matrix terms of one implicit step, computed by the caller.
 #[derive(Debug, Clone, Copy)]
 pub struct ElementBlocks<'a> {
     /// Per spring: `h^2 K_e + h D_e`, acting on `x_a - x_b`.
     pub springs: &'a [Matrix3],
+    /// The hinges (their vertices).
+    pub hinges: &'a [Hinge],
     /// Per hinge, four gradients of its angle (one per vertex).
     pub hinge_gradients: &'a [Vector],
     /// Per hinge: `h^2 k` (its Gauss-Newton block is `coef g g^T`).
@@ -30,23 +38,205 @@ pub struct ElementBlocks<'a> {
     pub membrane_blocks: &'a [ColumnBlocks],
 }
 
+/// The lower blocks that the hinges, membrane triangles and shape triangles add
+/// to `A` in one step, and the norms of the shape blocks that the factorization
+/// drops, laid out by the pattern (block module docs, "Assembly"): each element
+/// owns a stretch of fixed length (the most that an element of its kind has),
+/// in element order, so that the elements fill it in parallel; entries past an
+/// element's own stay unread. Kept between steps (no allocation once grown).
+#[derive(Debug, Clone, Default)]
+pub struct ElementTerms {
+    /// Per element, its lower blocks in [`lower_pairs`] order.
+    blocks: Vec<Matrix3>,
+    /// Per shape triangle, the Frobenius norms of its dropped blocks, in the
+    /// order of their bits in the pattern's mask.
+    norms: Vec<Scalar>,
+}
+
+impl ElementTerms {
+    /// The element blocks (indexed by the pattern's term lists).
+    pub(super) fn blocks(&self) -> &[Matrix3] {
+        &self.blocks
+    }
+
+    /// The dropped shape blocks' norms (indexed by the pattern's dropped lists).
+    pub(super) fn norms(&self) -> &[Scalar] {
+        &self.norms
+    }
+}
+
+impl BlockPattern {
+    /// Writes every element's lower blocks and the shape triangles' dropped
+    /// norms into `out`, parallel over the elements of each kind (module docs).
+    pub fn element_terms(&self, terms: &ElementBlocks<'_>, out: &mut ElementTerms) {
+        let l = &self.layout;
+        out.blocks.resize(l.len, Matrix3::ZERO);
+        let (hinges, rest) = out.blocks.split_at_mut(l.membrane_start);
+        let (membrane, shape) = rest.split_at_mut(l.shape_start - l.membrane_start);
+        let hinge_count = terms.hinge_coefficients.len();
+        if hinge_count > 0 {
+            hinges
+                .par_chunks_mut(l.hinge)
+                .zip(terms.hinge_gradients.par_chunks_exact(4))
+                .zip(terms.hinge_coefficients.par_iter())
+                .zip(terms.hinges.par_iter())
+                .with_min_len(PAR_MIN / 4)
+                .for_each(|(((out, g), &c), hinge)| {
+                    let mut w = 0;
+                    lower_pairs(&hinge.v, 0b1111, |k, l| {
+                        out[w] = outer(g[k], g[l]) * c;
+                        w += 1;
+                    });
+                });
+        }
+        if !terms.membrane_triangles.is_empty() {
+            membrane
+                .par_chunks_mut(l.membrane)
+                .zip(terms.membrane_triangles.par_iter())
+                .zip(terms.membrane_blocks.par_iter())
+                .with_min_len(PAR_MIN / 4)
+                .for_each(|((out, t), m)| {
+                    let mut w = 0;
+                    lower_pairs(&t.v, 0b111, |k, l| {
+                        out[w] = t.block(m, k, l);
+                        w += 1;
+                    });
+                });
+        }
+        let norms = l.shape_norms.max(1);
+        out.norms.resize(norms * terms.shape_triangles.len(), 0.0);
+        if !terms.shape_triangles.is_empty() {
+            let h2 = terms.h2;
+            shape
+                .par_chunks_mut(l.shape)
+                .zip(out.norms.par_chunks_mut(norms))
+                .zip(terms.shape_triangles.par_iter())
+                .zip(terms.shape_jacobians.par_iter())
+                .zip(self.shape_dropped_mask.par_iter())
+                .with_min_len(PAR_MIN / SHAPE_SLOTS)
+                .for_each(|((((out, norms), t), jac), &mask)| {
+                    shape_terms(t, jac, h2, mask, out, norms);
+                });
+        }
+    }
+}
+
+/// Calls `f(k, l)` for every block that an element with vertices `v` adds to
+/// the lower triangle: local vertices `k` and `l`, both set in `active` (bit
+/// `k`), with `v[l] <= v[k]`; `k` outer and `l` inner, each ascending. The
+/// pattern (where each term goes) and [`BlockPattern::element_terms`] (what
+/// it is) both enumerate through here, so they agree.
+#[inline(always)]
+pub(super) fn lower_pairs(v: &[u32], active: u32, mut f: impl FnMut(usize, usize)) {
+    for k in (0..v.len()).filter(|&k| active >> k & 1 != 0) {
+        for l in (0..v.len()).filter(|&l| active >> l & 1 != 0) {
+            if v[l] <= v[k] {
+                f(k, l);
+            }
+        }
+    }
+}
+
+/// The used slots of a shape triangle as a bit set: its own three vertices and
+/// the tips across its interior edges.
+#[inline(always)]
+pub(super) fn shape_active(t: &ShapeTriangle) -> u32 {
+    (0..3).fold(0b111, |bits, a| bits | u32::from(t.interior[a]) << (3 + a))
+}
+
+/// One shape triangle's lower blocks into `out` (in [`lower_pairs`] order) and
+/// the norms of its blocks whose bit `6 k + l` is set in `dropped` into
+/// `norms`. The products `M J` are formed once for all its blocks.
+#[inline(always)]
+fn shape_terms(
+    t: &ShapeTriangle,
+    jac: &ShapeJacobian,
+    h2: Scalar,
+    dropped: u64,
+    out: &mut [Matrix3],
+    norms: &mut [Scalar],
+) {
+    let mj = times_m(&t.m, jac);
+    let active = shape_active(t);
+    let (mut w, mut n) = (0, 0);
+    for k in (0..SHAPE_SLOTS).filter(|&k| active >> k & 1 != 0) {
+        for l in (0..SHAPE_SLOTS).filter(|&l| active >> l & 1 != 0) {
+            let lower = t.v[l] <= t.v[k];
+            let drop = dropped >> (SHAPE_SLOTS * k + l) & 1 != 0;
+            if !lower && !drop {
+                continue;
+            }
+            let block = shape_block(jac, &mj, h2, k, l);
+            if lower {
+                out[w] = block;
+                w += 1;
+            }
+            if drop {
+                norms[n] = frobenius(&block);
+                n += 1;
+            }
+        }
+    }
+}
+
+/// `(M J)_al = sum_b M_ab J_bl` for every angle `a` and slot `l`. A tip slot
+/// `3 + b` moves angle `b` only (`shape.rs`, `HINGE_SLOTS`), so its column has
+/// one term; skipping the exact zeros leaves every value the same to the last
+/// bit.
+#[inline(always)]
+fn times_m(m: &[[Scalar; 3]; 3], jac: &ShapeJacobian) -> [[Vector; SHAPE_SLOTS]; 3] {
+    let mut mj = [[Vector::ZERO; SHAPE_SLOTS]; 3];
+    for (row, out) in m.iter().zip(&mut mj) {
+        for (l, o) in out.iter_mut().enumerate() {
+            *o = match l {
+                0..3 => jac[0][l] * row[0] + jac[1][l] * row[1] + jac[2][l] * row[2],
+                _ => jac[l - 3][l] * row[l - 3],
+            };
+        }
+    }
+    mj
+}
+
+/// Block `(k, l)` of a shape triangle, `h^2 sum_a J_ak (M J)_al^T`, over the
+/// angles that slot `k` moves (a tip's block sums one outer product instead of
+/// three).
+#[inline(always)]
+fn shape_block(
+    jac: &ShapeJacobian,
+    mj: &[[Vector; SHAPE_SLOTS]; 3],
+    h2: Scalar,
+    k: usize,
+    l: usize,
+) -> Matrix3 {
+    let mut out = Matrix3::ZERO;
+    for a in moved_angles(k) {
+        out += outer(jac[a][k], mj[a][l]);
+    }
+    out * h2
+}
+
+/// The Frobenius norm of `b`.
+#[inline(always)]
+pub(super) fn frobenius(b: &Matrix3) -> Scalar {
+    (b.x_axis.length_squared() + b.y_axis.length_squared() + b.z_axis.length_squared()).sqrt()
+}
+
+/// The angles of a shape triangle that slot `k` moves: all three for one of
+/// its own vertices, angle `a` alone for the tip across edge `a` (slot `3 + a`).
+#[inline(always)]
+fn moved_angles(k: usize) -> std::ops::Range<usize> {
+    if k < 3 { 0..3 } else { k - 3..k - 2 }
+}
+
+#[cfg(test)]
 impl ElementBlocks<'_> {
-    /// Block `(k, l)` of shape triangle `tri`: `h^2 sum_ab M_ab J_ak J_bl^T`.
-    ///
-    /// `M J` is not precomputed per triangle and step: the gather reads blocks
-    /// in pattern order, not triangle order, and a second 432-byte row per
-    /// triangle measured slower than the arithmetic it saves.
-    ///
-    /// A tip slot `3 + a` moves angle `a` only (`shape.rs`, `HINGE_SLOTS`), so
-    /// its gradients by the other two angles are zero and their terms are
-    /// skipped: a block with one tip sums one outer product or one term of
-    /// `M J` instead of three, a tip-tip block one of each. Skipping exact
-    /// zeros leaves every block the same to the last bit.
+    /// Block `(k, l)` of shape triangle `tri` computed alone, from the
+    /// Jacobians: `h^2 sum_ab M_ab J_ak J_bl^T`, summed as the per-triangle pass
+    /// does (the tests' reference).
     pub(super) fn shape_block(&self, tri: usize, k: usize, l: usize) -> Matrix3 {
         let (m, jac) = (&self.shape_triangles[tri].m, &self.shape_jacobians[tri]);
         let mut out = Matrix3::ZERO;
         for a in moved_angles(k) {
-            // sum_b M_ab J_bl
             let row = &m[a];
             let right = match l {
                 0..3 => jac[0][l] * row[0] + jac[1][l] * row[1] + jac[2][l] * row[2],
@@ -56,11 +246,4 @@ impl ElementBlocks<'_> {
         }
         out * self.h2
     }
-}
-
-/// The angles of a shape triangle that slot `k` moves: all three for one of
-/// its own vertices, angle `a` alone for the tip across edge `a` (slot `3 + a`).
-#[inline(always)]
-fn moved_angles(k: usize) -> std::ops::Range<usize> {
-    if k < 3 { 0..3 } else { k - 3..k - 2 }
 }

@@ -1,13 +1,18 @@
-//! The pattern's derived tables against the searches they replaced: mirrors by
-//! per-row cursors, and the shape triangles' dropped blocks from one lookup per
-//! pair of slots.
+//! The pattern's derived tables against the searches they replaced (mirrors by
+//! per-row cursors, the shape triangles' dropped blocks from one lookup per pair
+//! of slots), and the assembly against references: each block summed term by
+//! term in element order (to the last bit), a dense sum of every element's
+//! full formula (to 1e-12), and the same matrix at one and two threads.
 
-use super::BlockPattern;
+use super::{BlockPattern, ElementBlocks, ElementTerms, outer};
 use crate::adapt::{AdaptConfig, Adapter};
-use crate::mesh::Mesh;
-use crate::physics::Model;
+use crate::math::{Matrix3, Scalar, Vector};
+use crate::mesh::{Mesh, rectangle};
 use crate::physics::elements::{Elements, MaterialParams};
-use crate::scene::default_scene;
+use crate::physics::membrane::{ColumnBlocks, Membrane, Orthotropic};
+use crate::physics::shape::{SHAPE_SLOTS, ShapeJacobian};
+use crate::physics::{Model, forces::PAR_MIN};
+use crate::scene::{BendingModel, DiagonalPattern, default_scene};
 use crate::world::World;
 
 /// The default scene's sheet at 12 x 12 and its fabric, and the same grid
@@ -22,12 +27,7 @@ fn meshes() -> (Vec<Mesh>, MaterialParams) {
     ];
     let scene = default_scene(&overrides.map(String::from)).expect("the default scene");
     let grid = World::from_scene(&scene).expect("its sheet").mesh;
-    let bent = grid
-        .material
-        .iter()
-        .map(|p| p.extend((p.x - 0.1).max(0.0)))
-        .collect();
-    let mut world = World::new(grid.clone(), bent);
+    let mut world = World::new(grid.clone(), bent(&grid));
     let config = AdaptConfig::from_scene(scene.adapt.as_ref()).expect("it adapts");
     let mut adapter = Adapter::new(&config, &world, scene.material.density).unwrap();
     adapter
@@ -35,6 +35,139 @@ fn meshes() -> (Vec<Mesh>, MaterialParams) {
         .expect("the crease refines");
     assert!(world.mesh.triangles.len() > grid.triangles.len());
     (vec![grid, world.mesh], Model::from_scene(&scene).material)
+}
+
+/// `mesh` bent 45 degrees along `x = 0.1`, and rippled so that no two folds match.
+fn bent(mesh: &Mesh) -> Vec<Vector> {
+    mesh.material
+        .iter()
+        .map(|p| p.extend((p.x - 0.1).max(0.0) + 0.01 * (9.0 * p.y).sin() * (7.0 * p.x).cos()))
+        .collect()
+}
+
+/// The shape operator with springs (the scenes' default), and dihedral hinges
+/// with the membrane triangles: between them every kind of element.
+fn materials(fabric: MaterialParams) -> [MaterialParams; 2] {
+    [
+        MaterialParams {
+            bending_model: BendingModel::ShapeOperator,
+            membrane: Membrane::Springs,
+            ..fabric
+        },
+        MaterialParams {
+            bending_model: BendingModel::Dihedral,
+            membrane: Membrane::Triangles(Orthotropic::isotropic(200.0)),
+            ..fabric
+        },
+    ]
+}
+
+/// A fixed pseudo-random number in [-1, 1) for `(i, salt)`.
+fn noise(i: usize, salt: u64) -> Scalar {
+    let mut z =
+        (i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ salt.wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z ^= z >> 31;
+    z = z.wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^= z >> 29;
+    (z >> 11) as Scalar / (1u64 << 52) as Scalar - 1.0
+}
+
+fn noise_vector(i: usize, salt: u64) -> Vector {
+    Vector::new(
+        noise(3 * i, salt),
+        noise(3 * i + 1, salt),
+        noise(3 * i + 2, salt),
+    )
+}
+
+/// A pseudo-random symmetric matrix (springs' and membrane blocks are symmetric,
+/// so that an upper block is its mirror's transpose).
+fn noise_symmetric(i: usize, salt: u64) -> Matrix3 {
+    let m = Matrix3::from_cols(
+        noise_vector(3 * i, salt),
+        noise_vector(3 * i + 1, salt),
+        noise_vector(3 * i + 2, salt),
+    );
+    m + m.transpose()
+}
+
+/// Element terms of one step: pseudo-random blocks, gradients and masses, and
+/// the shape triangles' true Jacobians at `x` (their zeros are structural).
+struct Terms {
+    springs: Vec<Matrix3>,
+    hinge_gradients: Vec<Vector>,
+    hinge_coefficients: Vec<Scalar>,
+    diagonal_mass: Vec<Scalar>,
+    shape_jacobians: Vec<ShapeJacobian>,
+    membrane_blocks: Vec<ColumnBlocks>,
+}
+
+impl Terms {
+    fn new(elements: &Elements, x: &[Vector]) -> Terms {
+        Terms {
+            springs: (0..elements.springs.len())
+                .map(|e| noise_symmetric(e, 1))
+                .collect(),
+            hinge_gradients: (0..4 * elements.hinges.len())
+                .map(|k| noise_vector(k, 2))
+                .collect(),
+            hinge_coefficients: (0..elements.hinges.len())
+                .map(|h| 1.5 + noise(h, 3))
+                .collect(),
+            diagonal_mass: (0..x.len()).map(|i| 2.0 + noise(i, 4)).collect(),
+            shape_jacobians: elements
+                .shape_triangles
+                .iter()
+                .map(|t| t.angles(x).1)
+                .collect(),
+            membrane_blocks: (0..elements.membrane_triangles.len())
+                .map(|t| ColumnBlocks {
+                    aa: noise_symmetric(t, 5),
+                    ab: Matrix3::from_cols(
+                        noise_vector(3 * t, 6),
+                        noise_vector(3 * t + 1, 6),
+                        noise_vector(3 * t + 2, 6),
+                    ),
+                    bb: noise_symmetric(t, 9),
+                })
+                .collect(),
+        }
+    }
+
+    fn view<'a>(&'a self, elements: &'a Elements) -> ElementBlocks<'a> {
+        ElementBlocks {
+            springs: &self.springs,
+            hinges: &elements.hinges,
+            hinge_gradients: &self.hinge_gradients,
+            hinge_coefficients: &self.hinge_coefficients,
+            diagonal_mass: &self.diagonal_mass,
+            shape_triangles: &elements.shape_triangles,
+            shape_jacobians: &self.shape_jacobians,
+            h2: 0.7e-4,
+            membrane_triangles: &elements.membrane_triangles,
+            membrane_blocks: &self.membrane_blocks,
+        }
+    }
+}
+
+/// The assembly's outputs: lower blocks, compensation, projected system.
+fn assemble(p: &BlockPattern, terms: &ElementBlocks<'_>) -> [Vec<Matrix3>; 3] {
+    let n = p.vertices();
+    let mut element = ElementTerms::default();
+    let (mut lower, mut extra, mut system) = (Vec::new(), Vec::new(), Vec::new());
+    p.element_terms(terms, &mut element);
+    p.gather(terms, &element, &mut lower);
+    let projection: Vec<Option<Vector>> = (0..n)
+        .map(|i| match i % 7 {
+            0 => Some(Vector::ZERO),
+            3 => Some(noise_vector(i, 10).normalize()),
+            _ => None,
+        })
+        .collect();
+    p.compensation(terms, &element, &projection, &mut extra);
+    let scale: Vec<Scalar> = (0..n).map(|i| 1.0 + noise(i, 11)).collect();
+    p.project(&lower, &projection, &scale, &mut system);
+    [lower, extra, system]
 }
 
 #[test]
@@ -48,24 +181,234 @@ fn mirrors_and_dropped_blocks_match_the_searches() {
             for b in 0..p.blocks() {
                 assert_eq!(p.mirror[b], p.slot(p.columns[b], p.rows[b]), "block {b}");
             }
-            let mut dropped: Vec<(u32, (u32, u8, u8))> = Vec::new();
+            let mut dropped: Vec<(u32, (u32, usize, usize))> = Vec::new();
             for (ti, t) in elements.shape_triangles.iter().enumerate() {
                 for (k, i) in t.slots() {
                     for (l, j) in t.slots() {
                         if i != j && !p.factored[p.slot(i, j) as usize] {
-                            dropped.push((i, (ti as u32, k as u8, l as u8)));
+                            dropped.push((i, (ti as u32, k, l)));
                         }
                     }
                 }
             }
             let (start, items) = super::group_by_key(n, &dropped);
+            // Each norm index names a triangle and the n-th bit of its mask.
+            let stride = p.layout.shape_norms;
+            let decoded: Vec<(u32, usize, usize)> = p
+                .shape_dropped
+                .iter()
+                .map(|&index| {
+                    let (tri, nth) = (index as usize / stride, index as usize % stride);
+                    let mut bits = p.shape_dropped_mask[tri];
+                    (0..nth).for_each(|_| bits &= bits - 1);
+                    let bit = bits.trailing_zeros() as usize;
+                    (tri as u32, bit / SHAPE_SLOTS, bit % SHAPE_SLOTS)
+                })
+                .collect();
             assert_eq!(p.shape_dropped_start, start);
-            assert_eq!(p.shape_dropped, items);
+            assert_eq!(decoded, items);
             assert_eq!(
                 p.shape_dropped.is_empty(),
                 factor_tips,
                 "the reduced pattern drops tip blocks, the full one none"
             );
         }
+    }
+}
+
+/// Each lower block summed term by term, every term computed alone, in element
+/// order (springs, hinges, membrane triangles, shape triangles), then the mass:
+/// what the flat array and its index lists must reproduce to the last bit.
+fn per_term_sum(p: &BlockPattern, el: &Elements, t: &ElementBlocks<'_>) -> Vec<Matrix3> {
+    let mut acc = vec![Matrix3::ZERO; p.blocks()];
+    for (e, sp) in el.springs.iter().enumerate() {
+        let [a, b] = sp.v;
+        acc[p.diagonal[a as usize] as usize] += t.springs[e];
+        acc[p.diagonal[b as usize] as usize] += t.springs[e];
+        acc[p.lower_slot(a, b) as usize] += -t.springs[e];
+    }
+    for (h, hg) in el.hinges.iter().enumerate() {
+        let g = &t.hinge_gradients[4 * h..4 * h + 4];
+        for k in 0..4 {
+            for l in 0..4 {
+                if hg.v[l] <= hg.v[k] {
+                    let slot = p.slot(hg.v[k], hg.v[l]) as usize;
+                    acc[slot] += outer(g[k], g[l]) * t.hinge_coefficients[h];
+                }
+            }
+        }
+    }
+    for (ti, tri) in el.membrane_triangles.iter().enumerate() {
+        for k in 0..3 {
+            for l in 0..3 {
+                if tri.v[l] <= tri.v[k] {
+                    let slot = p.slot(tri.v[k], tri.v[l]) as usize;
+                    acc[slot] += tri.block(&t.membrane_blocks[ti], k, l);
+                }
+            }
+        }
+    }
+    for (ti, tri) in el.shape_triangles.iter().enumerate() {
+        for (k, i) in tri.slots() {
+            for (l, j) in tri.slots() {
+                if j <= i {
+                    acc[p.slot(i, j) as usize] += t.shape_block(ti, k, l);
+                }
+            }
+        }
+    }
+    for i in 0..p.vertices() {
+        acc[p.diagonal[i] as usize] += Matrix3::from_diagonal(Vector::splat(t.diagonal_mass[i]));
+    }
+    acc
+}
+
+/// Every block of `A` (both triangles) from each element's full formula, and
+/// per block the sum of its terms' norms (the scale of its rounding).
+fn dense(p: &BlockPattern, el: &Elements, t: &ElementBlocks<'_>) -> (Vec<Matrix3>, Vec<Scalar>) {
+    let mut a = vec![Matrix3::ZERO; p.blocks()];
+    let mut scale = vec![0.0; p.blocks()];
+    let mut add = |i: u32, j: u32, m: Matrix3| {
+        let s = p.slot(i, j) as usize;
+        a[s] += m;
+        scale[s] += super::terms::frobenius(&m);
+    };
+    for (e, sp) in el.springs.iter().enumerate() {
+        let [x, y] = sp.v;
+        let k = t.springs[e];
+        for (i, j, m) in [(x, x, k), (y, y, k), (x, y, -k), (y, x, -k)] {
+            add(i, j, m);
+        }
+    }
+    for (h, hg) in el.hinges.iter().enumerate() {
+        let g = &t.hinge_gradients[4 * h..4 * h + 4];
+        for k in 0..4 {
+            for l in 0..4 {
+                add(
+                    hg.v[k],
+                    hg.v[l],
+                    outer(g[k], g[l]) * t.hinge_coefficients[h],
+                );
+            }
+        }
+    }
+    for (ti, tri) in el.membrane_triangles.iter().enumerate() {
+        for k in 0..3 {
+            for l in 0..3 {
+                add(tri.v[k], tri.v[l], tri.block(&t.membrane_blocks[ti], k, l));
+            }
+        }
+    }
+    for (ti, tri) in el.shape_triangles.iter().enumerate() {
+        let jac = &t.shape_jacobians[ti];
+        for (k, i) in tri.slots() {
+            for (l, j) in tri.slots() {
+                let mut m = Matrix3::ZERO;
+                for (x, row) in tri.m.iter().enumerate() {
+                    for (y, &mxy) in row.iter().enumerate() {
+                        m += outer(jac[x][k], jac[y][l]) * (t.h2 * mxy);
+                    }
+                }
+                add(i, j, m);
+            }
+        }
+    }
+    for i in 0..p.vertices() as u32 {
+        add(
+            i,
+            i,
+            Matrix3::from_diagonal(Vector::splat(t.diagonal_mass[i as usize])),
+        );
+    }
+    (a, scale)
+}
+
+#[test]
+fn gather_matches_the_per_term_sum_and_a_dense_assembly() {
+    let (meshes, fabric) = meshes();
+    for m in &meshes {
+        let x = bent(m);
+        for material in materials(fabric) {
+            let el = Elements::build(m, &material);
+            let terms = Terms::new(&el, &x);
+            let t = terms.view(&el);
+            let p = BlockPattern::build(m.vertex_count(), &el, false);
+            let [lower, extra, _] = assemble(&p, &t);
+            let reference = per_term_sum(&p, &el, &t);
+            let (a, scale) = dense(&p, &el, &t);
+            for s in 0..p.blocks() {
+                let got = p.full_block(&lower, s);
+                if p.columns[s] <= p.rows[s] {
+                    let bits = |m: Matrix3| m.to_cols_array().map(Scalar::to_bits);
+                    assert_eq!(
+                        bits(got),
+                        bits(reference[s]),
+                        "block {s}: not the per-term sum"
+                    );
+                }
+                let error = super::terms::frobenius(&(got - a[s]));
+                assert!(
+                    error <= 1e-12 * scale[s],
+                    "block {s}: {error:e} of {:e}",
+                    scale[s]
+                );
+            }
+            // The compensation of a free vertex: its dropped hinge tips' c g g^T
+            // and its dropped shape blocks' norms (one vertex in 7 is free of
+            // both projections in `assemble`).
+            let mut sigma = vec![0.0; p.vertices()];
+            for (ti, tri) in el.shape_triangles.iter().enumerate() {
+                for (k, i) in tri.slots() {
+                    for (l, j) in tri.slots() {
+                        if i != j && !p.factored[p.lower_slot(i, j) as usize] {
+                            sigma[i as usize] += super::terms::frobenius(&t.shape_block(ti, k, l));
+                        }
+                    }
+                }
+            }
+            for i in (0..p.vertices()).filter(|i| ![0, 3].contains(&(i % 7))) {
+                let mut expected = Matrix3::from_diagonal(Vector::splat(sigma[i]));
+                for &k in &p.compensation
+                    [p.compensation_start[i] as usize..p.compensation_start[i + 1] as usize]
+                {
+                    let g = t.hinge_gradients[k as usize];
+                    expected += outer(g, g) * t.hinge_coefficients[k as usize / 4];
+                }
+                let error = super::terms::frobenius(&(extra[i] - expected));
+                assert!(
+                    error <= 1e-12 * super::terms::frobenius(&expected),
+                    "vertex {i}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn assembly_is_identical_at_one_and_two_threads() {
+    // 49 x 49 vertices: every pass splits (PAR_MIN blocks, PAR_MIN / 6 triangles).
+    let m = rectangle(1.0, 1.0, 48, DiagonalPattern::Alternating).expect("a grid");
+    let x = bent(&m);
+    let (_, fabric) = meshes();
+    for material in materials(fabric) {
+        let el = Elements::build(&m, &material);
+        let terms = Terms::new(&el, &x);
+        let t = terms.view(&el);
+        let p = BlockPattern::build(m.vertex_count(), &el, false);
+        assert!(p.blocks() > 8 * PAR_MIN && m.triangles.len() > 2 * PAR_MIN);
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .expect("a pool");
+            pool.install(|| assemble(&p, &t))
+        };
+        let bits = |m: &[Vec<Matrix3>; 3]| -> Vec<u64> {
+            m.iter()
+                .flatten()
+                .flat_map(|b| b.to_cols_array().map(Scalar::to_bits))
+                .collect()
+        };
+        assert_eq!(bits(&run(1)), bits(&run(2)));
     }
 }

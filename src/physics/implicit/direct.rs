@@ -59,7 +59,7 @@ use super::cg::dot;
 use super::refactor::RefactorPolicy;
 use super::{ImplicitScratch, SolveFailure};
 use crate::math::{Matrix3, Scalar, Vector};
-use crate::physics::block::{BlockPattern, ElementBlocks};
+use crate::physics::block::{BlockPattern, ElementBlocks, ElementTerms};
 use crate::physics::cholesky::{FactorError, Factorization};
 use crate::physics::elements::Elements;
 use crate::physics::forces::PAR_MIN;
@@ -87,10 +87,10 @@ pub(super) struct DirectScratch {
     /// which the full factor is the cheaper one (module docs, "Which factor");
     /// `None` until a solve has asked.
     tips_break_even: Option<Scalar>,
-    /// `A` as assembled.
-    raw: Vec<Matrix3>,
-    /// The lower blocks of `A` while it is assembled (upper ones are their mirrors).
+    /// The lower blocks of `A` (the upper ones are their mirrors' transposes).
     lower: Vec<Matrix3>,
+    /// Every element's lower blocks, gathered into `lower`.
+    element: ElementTerms,
     /// `A_s`, the projected matrix.
     system: Vec<Matrix3>,
     /// Per vertex: the diagonal compensation added to the factored matrix.
@@ -128,6 +128,25 @@ pub(super) fn solve(
     reference: Scalar,
     contact_push: bool,
 ) -> Result<(), SolveFailure> {
+    let pattern = assemble(st, held);
+    let outcome = iterate(st, model, &pattern, reference);
+    let s = &mut st.implicit;
+    let a = &mut s.direct;
+    // dv = dv_c + y.
+    s.dv.par_iter_mut()
+        .zip(a.prescribed.par_iter().zip(a.y.par_iter()))
+        .with_min_len(PAR_MIN)
+        .for_each(|(d, (c, y))| *d = *c + *y);
+    if outcome.is_ok() && contact_push {
+        contact_pressure(st, &pattern);
+    }
+    outcome
+}
+
+/// Assembles `A` from the linearised step's element terms into the block pattern
+/// (built first for a new mesh), and `A_s` and `b_s` (module docs) from the first
+/// guess `dv` and `held`; timed as assembly. Returns the pattern.
+pub(super) fn assemble(st: &mut Stepper, held: &[bool]) -> Arc<BlockPattern> {
     let started = Instant::now();
     let n = st.implicit.dv.len();
     let s = &mut st.implicit;
@@ -143,6 +162,7 @@ pub(super) fn solve(
     split_prescribed(s, held);
     let terms = ElementBlocks {
         springs: &s.spring_block,
+        hinges: &st.elements.hinges,
         hinge_gradients: &s.hinge_grad,
         hinge_coefficients: &s.hinge_coef,
         diagonal_mass: &s.diag_mass,
@@ -153,12 +173,13 @@ pub(super) fn solve(
         membrane_blocks: &s.membrane_block,
     };
     let a = &mut s.direct;
-    pattern.gather(&terms, &mut a.lower, &mut a.raw);
-    pattern.compensation(&terms, &a.projection, &mut a.compensation);
+    pattern.element_terms(&terms, &mut a.element);
+    pattern.gather(&terms, &a.element, &mut a.lower);
+    pattern.compensation(&terms, &a.element, &a.projection, &mut a.compensation);
     let a = &mut s.direct;
     // b_s = S (b - A dv_c).
     a.ap.resize(n, Vector::ZERO);
-    pattern.multiply(&a.raw, &a.prescribed, &mut a.ap);
+    pattern.multiply_lower(&a.lower, &a.prescribed, &mut a.ap);
     a.rhs.resize(n, Vector::ZERO);
     a.rhs
         .par_iter_mut()
@@ -166,20 +187,9 @@ pub(super) fn solve(
         .zip(a.projection.par_iter())
         .with_min_len(PAR_MIN)
         .for_each(|((r, (b, ap)), proj)| *r = project(*proj, *b - *ap));
-    pattern.project(&a.raw, &a.projection, &st.elements.mass, &mut a.system);
+    pattern.project(&a.lower, &a.projection, &st.elements.mass, &mut a.system);
     st.stats.assembly_s += started.elapsed().as_secs_f64();
-    let outcome = iterate(st, model, &pattern, reference);
-    let s = &mut st.implicit;
-    let a = &mut s.direct;
-    // dv = dv_c + y.
-    s.dv.par_iter_mut()
-        .zip(a.prescribed.par_iter().zip(a.y.par_iter()))
-        .with_min_len(PAR_MIN)
-        .for_each(|(d, (c, y))| *d = *c + *y);
-    if outcome.is_ok() && contact_push {
-        contact_pressure(st, &pattern);
-    }
-    outcome
+    pattern
 }
 
 /// Splits the first guess `dv` into its prescribed part and the free first guess
@@ -457,7 +467,7 @@ fn refactor(
 fn contact_pressure(st: &mut Stepper, pattern: &BlockPattern) {
     let s = &mut st.implicit;
     if s.filter.iter().any(|f| *f != Vector::ZERO) {
-        pattern.multiply(&s.direct.raw, &s.dv, &mut s.direct.ap);
+        pattern.multiply_lower(&s.direct.lower, &s.dv, &mut s.direct.ap);
     }
     super::contact_push_from(
         &s.filter,
