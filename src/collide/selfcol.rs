@@ -438,18 +438,13 @@ fn primitive_pairs(
         stats.pairs_culled += skipped;
         stats.pairs_tested += pairs.len() as u64;
     }
-    let vb = &s.vertex_boxes;
     s.prims.clear();
-    // In patch order per patch, in any order across them: the list is sorted next.
-    s.prims
-        .par_extend(s.pairs.par_iter().flat_map_iter(|(pairs, _)| {
-            let mut out = Vec::with_capacity(8 * pairs.len());
-            for &(t, u) in pairs {
-                let near = !rest.far(t, u, limit);
-                pair_prims(tris, vb, t, u, near, &mut out);
-            }
-            out
-        }));
+    for (pairs, _) in &s.pairs {
+        for &(t, u) in pairs {
+            let near = !rest.far(t, u, limit);
+            pair_prims(tris, &s.vertex_boxes, t, u, near, &mut s.prims);
+        }
+    }
     stats
 }
 
