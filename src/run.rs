@@ -89,7 +89,8 @@ pub enum RunError {
     },
     /// The state became non-finite even with the smallest step tried.
     #[error(
-        "numerical failure at step {step} in frame {frame} (t = {time:.4} s): {failure}{tried}; the run stopped and the recording holds every frame up to the last good one. Likely cause: {cause}"
+        "numerical failure at step {step} in frame {frame} (t = {time:.4} s): {failure}{}; the run stopped and the recording holds every frame up to the last good one. Likely cause: {cause}",
+        tried(*halvings, *dt)
     )]
     Numerical {
         /// The step (counted from the start of the run) that failed.
@@ -100,13 +101,11 @@ pub enum RunError {
         frame: u64,
         /// Simulated time at the start of that frame.
         time: Scalar,
-        /// Halvings tried.
+        /// Halvings tried (0 with `dt = "adaptive"`, whose steps shrink
+        /// by error control instead).
         halvings: u32,
         /// The last step size tried.
         dt: Scalar,
-        /// What was tried, in words (empty, or " even with the step halved N
-        /// times to DT s").
-        tried: String,
         /// A hint naming the likely cause.
         cause: String,
         /// What the run produced up to the failure.
@@ -200,4 +199,14 @@ pub fn run_built(
         }
         frames.finish()
     })
+}
+
+/// What a failed frame tried, in words: " even with the step halved N times
+/// to DT s", or nothing when it was not halved (an adaptive step).
+fn tried(halvings: u32, dt: Scalar) -> String {
+    if halvings == 0 {
+        String::new()
+    } else {
+        format!(" even with the step halved {halvings} times to {dt:.3e} s")
+    }
 }

@@ -265,15 +265,11 @@ impl<'a> FrameLoop<'a> {
                 failure: f.failure,
                 frame,
                 time: self.state.world.time,
-                halvings: MAX_STEP_HALVINGS,
-                dt: f.last_dt,
-                tried: match self.setup.settings.step {
-                    StepSize::Adaptive(_) => String::new(),
-                    _ => format!(
-                        " even with the step halved {MAX_STEP_HALVINGS} times to {:.3e} s",
-                        f.last_dt
-                    ),
+                halvings: match self.setup.settings.step {
+                    StepSize::Adaptive(_) => 0,
+                    _ => MAX_STEP_HALVINGS,
                 },
+                dt: f.last_dt,
                 cause: match self.setup.settings.step {
                     StepSize::Adaptive(_) => format!(
                         "the tolerances are tighter than any step down to `simulation.adaptive_dt.min` = {:.3e} s meets (try a smaller `min`, or a larger `simulation.adaptive_dt.tolerance` or `penetration`{})",

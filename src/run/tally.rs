@@ -82,7 +82,7 @@ impl Tally {
             simulation_wall_s: end.sim_wall_s,
             recording_wall_s: end.record_wall_s,
             dt: end.dt,
-            adaptive_dt: end.adaptive_dt.then(|| AdaptiveDtSummary {
+            adaptive_dt: end.adaptive_dt.then_some(AdaptiveDtSummary {
                 max_dt: effort.max_dt,
                 refused: effort.refused,
                 largest_error: effort.largest_step_error,

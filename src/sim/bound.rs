@@ -27,12 +27,7 @@ pub enum StepFailure {
     },
     /// An adaptive step (`dt = "adaptive"`) at its smallest size still exceeded
     /// a tolerance.
-    AboveTolerance {
-        /// The step, s.
-        dt: Scalar,
-        /// Which tolerance, and the measured value.
-        reason: Refusal,
-    },
+    AboveTolerance(Refusal),
 }
 
 impl std::fmt::Display for StepFailure {
@@ -44,18 +39,18 @@ impl std::fmt::Display for StepFailure {
                 f,
                 "the energy exploded (kinetic + gravitational {energy:.4e} J, above the explosion limit {bound:.4e} J)"
             ),
-            StepFailure::AboveTolerance { dt, reason } => match reason {
+            StepFailure::AboveTolerance(reason) => match reason {
                 Refusal::Error(e) => write!(
                     f,
-                    "at the smallest adaptive step ({dt:.3e} s, simulation.adaptive_dt.min) the error estimate {e:.3e} m exceeds simulation.adaptive_dt.tolerance"
+                    "at the smallest adaptive step (simulation.adaptive_dt.min) the error estimate {e:.3e} m exceeds simulation.adaptive_dt.tolerance"
                 ),
                 Refusal::Penetration(p) => write!(
                     f,
-                    "at the smallest adaptive step ({dt:.3e} s, simulation.adaptive_dt.min) the cloth ends {p:.3e} m below an obstacle surface, deeper than simulation.adaptive_dt.penetration"
+                    "at the smallest adaptive step (simulation.adaptive_dt.min) the cloth ends {p:.3e} m below an obstacle surface, deeper than simulation.adaptive_dt.penetration"
                 ),
                 Refusal::Failed => write!(
                     f,
-                    "at the smallest adaptive step ({dt:.3e} s, simulation.adaptive_dt.min) the step failed"
+                    "at the smallest adaptive step (simulation.adaptive_dt.min) the step failed"
                 ),
             },
         }

@@ -245,7 +245,7 @@ impl Pipeline {
                 Ok(()) => true,
                 // Halving the largest adaptive step cannot help a step that
                 // fails its tolerances at the smallest.
-                Err(StepError::Rejected(why @ StepFailure::AboveTolerance { .. })) => {
+                Err(StepError::Rejected(why @ StepFailure::AboveTolerance(_))) => {
                     failure = why;
                     state.restore(start);
                     self.mesh_changed(setup, state);

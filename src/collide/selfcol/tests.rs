@@ -83,7 +83,7 @@ proptest! {
 fn side_by_side_triangles_keep_only_their_near_primitive_pairs() {
     let mesh = strip();
     let (a, b) = (mesh.triangles[0], mesh.triangles[3]);
-    let mut x = vec![Vector::ZERO; 6];
+    let mut x = [Vector::ZERO; 6];
     let shape = [
         Vector::new(0.0, 0.0, 0.0),
         Vector::new(0.01, 0.0, 0.0),

@@ -101,10 +101,7 @@ impl Pipeline {
                 Ok(next)
             }
             Verdict::Refuse { reason, .. } if step_control::at_minimum(control, h) => {
-                Err(StepError::Rejected(StepFailure::AboveTolerance {
-                    dt: h,
-                    reason,
-                }))
+                Err(StepError::Rejected(StepFailure::AboveTolerance(reason)))
             }
             Verdict::Refuse { reason, retry } => {
                 self.restore_step_start(state);
