@@ -9,7 +9,7 @@ use crate::physics::{Elements, ExternalForces, MaterialParams, Membrane, Model, 
 use crate::pins::PinPath;
 use crate::run::RunError;
 use crate::scene::{
-    AdaptCriterion, AdaptMethod, BendingModel, ClothShape, Integrator, PinMotion, Scene,
+    AdaptCriterion, AdaptMethod, BendingModel, ClothShape, Integrator, PinMotion, Refactor, Scene,
     Simulation, Solver, StiffnessRule, TimeStep,
 };
 use crate::sim::SimBuildError;
@@ -405,10 +405,18 @@ fn describe_adaptive_step(s: &mut String, sim: &Simulation) {
 /// The implicit integrator's linear solver, its tolerances and the Newton iterations.
 fn describe_implicit_solver(s: &mut String, sim: &Simulation) {
     let solver = match sim.solver {
-        Solver::Direct => format!(
-            "direct (sparse Cholesky, reused as the preconditioner of conjugate gradients, refactored when an older factor's iterations outweigh a factorization worth {} of them)",
-            sim.refactor_iterations
-        ),
+        Solver::Direct => match sim.refactor {
+            Refactor::Cost => format!(
+                "direct (sparse Cholesky, reused as the preconditioner of conjugate gradients, refactored when an older factor's iterations outweigh a factorization worth {} of them)",
+                sim.refactor_iterations
+            ),
+            Refactor::EverySolve => {
+                "direct (sparse Cholesky of every solve's matrix, the preconditioner of conjugate gradients)".to_string()
+            }
+            Refactor::PerMesh => {
+                "direct (sparse Cholesky of each mesh's first matrix, kept as the preconditioner of conjugate gradients until the mesh changes or a solve reaches the iteration cap)".to_string()
+            }
+        },
         Solver::Cg => "cg (matrix-free, Jacobi preconditioner)".to_string(),
     };
     let _ = writeln!(s, "  linear solver: {solver}");

@@ -152,6 +152,22 @@ pub enum Solver {
     Cg,
 }
 
+/// When the direct solver factors its matrix anew (`docs/model.md`, "The linear
+/// solver").
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum Refactor {
+    /// Weigh a factorization (worth `refactor_iterations` iterations) against the
+    /// iterations an older factor costs, at the start of a solve and during it.
+    #[default]
+    Cost,
+    /// Factor this solve's matrix at the start of every solve.
+    EverySolve,
+    /// Factor the first matrix of each mesh and keep it as the preconditioner
+    /// until the mesh changes (or a solve with it reaches the iteration cap).
+    PerMesh,
+}
+
 /// The time integrator.
 #[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq, Default)]
 #[serde(rename_all = "snake_case")]

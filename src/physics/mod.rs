@@ -23,7 +23,7 @@ pub mod shape;
 pub mod timestep;
 pub mod work;
 
-pub use crate::spec::Solver;
+pub use crate::spec::{Refactor, Solver};
 pub use elements::{Elements, Hinge, MaterialParams, Spring};
 pub use forces::{Energy, ExternalForces, WindForce};
 pub use implicit::SolveFailure;
@@ -61,6 +61,8 @@ pub struct SolverSettings {
     /// iterations, weighed against the iterations an older factor costs
     /// (`implicit::refactor` module docs).
     pub refactor_iterations: u32,
+    /// Direct solver: when it factors anew.
+    pub refactor: Refactor,
     /// Newton iterations per step (1: Baraff and Witkin's linearised step).
     pub newton_iterations: u32,
     /// Relative residual at which Newton iterations stop.
@@ -74,6 +76,7 @@ impl Default for SolverSettings {
         SolverSettings {
             solver: Solver::Direct,
             refactor_iterations: 7,
+            refactor: Refactor::Cost,
             newton_iterations: 1,
             newton_tolerance: 1e-3,
         }

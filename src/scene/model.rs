@@ -11,8 +11,8 @@ use crate::physics::membrane::{Membrane, Orthotropic};
 pub use crate::spec::{
     Adapt, AdaptCriterion, AdaptEvery, AdaptMethod, BendingModel, BodySurface, ClothShape,
     DEFAULT_THICKNESS, DiagonalPattern, Integrator, Keyframe, KeyframeAfter, KeyframeEasing,
-    Measurement, MembraneModel, Obstacle, ObstacleShape, Part, Pin, PinMotion, SelfCollision,
-    SequenceFiles, Solver, StiffnessRule,
+    Measurement, MembraneModel, Obstacle, ObstacleShape, Part, Pin, PinMotion, Refactor,
+    SelfCollision, SequenceFiles, Solver, StiffnessRule,
 };
 
 /// A whole scene file.
@@ -165,6 +165,9 @@ pub struct Simulation {
     /// (`physics::implicit::refactor`).
     #[serde(default = "default_refactor_iterations")]
     pub refactor_iterations: u32,
+    /// Direct solver: when it factors its matrix anew.
+    #[serde(default)]
+    pub refactor: Refactor,
     /// Newton iterations per implicit step (1: the linearised step of Baraff and Witkin).
     #[serde(default = "default_newton_iterations")]
     pub newton_iterations: u32,

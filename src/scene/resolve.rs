@@ -191,6 +191,7 @@ impl Model {
             solver: SolverSettings {
                 solver: scene.simulation.solver,
                 refactor_iterations: scene.simulation.refactor_iterations,
+                refactor: scene.simulation.refactor,
                 newton_iterations: scene.simulation.newton_iterations,
                 newton_tolerance: scene.simulation.newton_tolerance,
             },

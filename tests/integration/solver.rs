@@ -444,3 +444,46 @@ fn a_fine_fabric_keeps_the_reduced_factor_and_a_stiff_strip_switches() {
         "the strip kept the reduced factor: {strip:?}"
     );
 }
+
+/// The direct solver's `refactor` rules (`docs/model.md`, "When to factor anew")
+/// factor when they say: `every_solve` at every solve, `per_mesh` once on a mesh
+/// that never changes (a sheet at rest, where its factor stays good), and all
+/// three solve to the same tolerance, so the sheets agree to far below a
+/// micrometre after a second at rest.
+#[test]
+fn each_refactor_rule_factors_when_it_says_and_reaches_the_same_state() {
+    let state = |rule: &str| {
+        let overrides = [
+            "adapt.method=none".to_string(),
+            "cloth.resolution=16".to_string(),
+            format!("simulation.refactor=\"{rule}\""),
+        ];
+        let (mut sim, frame) = simulation("scenes/hanging_sheet_rest.toml", &overrides);
+        let stats = run_frames(&mut sim, frame, 30);
+        (stats, sim.state.world.x.clone())
+    };
+    let (cost, x_cost) = state("cost");
+    let (every, x_every) = state("every_solve");
+    let (once, x_once) = state("per_mesh");
+    assert_eq!(
+        every.factorizations, every.newton_iterations,
+        "every_solve: {every:?}"
+    );
+    assert_eq!(once.factorizations, 1, "per_mesh: {once:?}");
+    assert!(
+        cost.factorizations > 1 && cost.factorizations < cost.newton_iterations,
+        "cost: {cost:?}"
+    );
+    for (rule, x) in [("every_solve", &x_every), ("per_mesh", &x_once)] {
+        let largest = x_cost
+            .iter()
+            .zip(x.iter())
+            .map(|(a, b)| (*a - *b).length())
+            .fold(0.0, f64::max);
+        println!("{rule}: largest distance from the cost rule's sheet {largest:.3e} m");
+        assert!(
+            largest < 1e-7,
+            "{rule}: {largest:e} m from the cost rule's sheet"
+        );
+    }
+}

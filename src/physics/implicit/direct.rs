@@ -63,7 +63,7 @@ use crate::physics::block::{BlockPattern, ElementBlocks, ElementTerms};
 use crate::physics::cholesky::{FactorError, Factorization};
 use crate::physics::elements::Elements;
 use crate::physics::forces::PAR_MIN;
-use crate::physics::{Model, StepStats, Stepper};
+use crate::physics::{Model, Refactor, StepStats, Stepper};
 
 /// Iterations with a fresh factor of the reduced matrix (block module docs) at
 /// which the solver first asks whether factoring the tip-tip blocks too would be
@@ -240,8 +240,9 @@ fn iterate(
     let goal = tolerance * reference;
     let factorization_cost = Scalar::from(model.solver.refactor_iterations);
     let cap = model.cg_max_iterations;
+    let rule = model.solver.refactor;
     let a = &mut st.implicit.direct;
-    let mut fresh = !a.factorization.is_valid() || a.policy.renew_at_start(factorization_cost);
+    let mut fresh = !a.factorization.is_valid() || renew_at_start(a, rule, factorization_cost);
     if fresh {
         refactor(a, pattern, &mut st.stats)?;
         a.policy.factored(false);
@@ -258,7 +259,8 @@ fn iterate(
             if norm <= goal {
                 break 'restart Ok(());
             }
-            if since_factor >= cap {
+            // A `per_mesh` factor that reaches the cap is renewed instead (`give_up`).
+            if since_factor >= cap && (fresh || rule != Refactor::PerMesh) {
                 let failure = SolveFailure::not_converged(total, norm, reference, tolerance);
                 break 'restart Err(failure);
             }
@@ -279,8 +281,14 @@ fn iterate(
                 }
             }
             if !fresh
-                && a.policy
-                    .give_up(factorization_cost, since_factor, restart_norm, norm, goal)
+                && give_up(
+                    a,
+                    rule,
+                    factorization_cost,
+                    since_factor,
+                    cap,
+                    (restart_norm, norm, goal),
+                )
             {
                 st.stats.solve_s += started.elapsed().as_secs_f64();
                 refactor(a, pattern, &mut st.stats)?;
@@ -306,6 +314,36 @@ fn iterate(
     }
     st.stats.solve_s += started.elapsed().as_secs_f64();
     outcome
+}
+
+/// Whether to factor anew at the start of a solve with a valid factor, by the
+/// scene's `refactor` rule (module docs).
+fn renew_at_start(a: &mut DirectScratch, rule: Refactor, factorization_cost: Scalar) -> bool {
+    match rule {
+        Refactor::Cost => a.policy.renew_at_start(factorization_cost),
+        Refactor::EverySolve => true,
+        Refactor::PerMesh => false,
+    }
+}
+
+/// Whether a solve with an older factor gives it up after `spent` iterations, by the
+/// scene's `refactor` rule; `residuals`: the norms at the restart, now and the goal.
+/// With `per_mesh` only the iteration cap gives the factor up.
+fn give_up(
+    a: &DirectScratch,
+    rule: Refactor,
+    factorization_cost: Scalar,
+    spent: u32,
+    cap: u32,
+    (first, now, goal): (Scalar, Scalar, Scalar),
+) -> bool {
+    match rule {
+        Refactor::Cost => a
+            .policy
+            .give_up(factorization_cost, spent, first, now, goal),
+        Refactor::EverySolve => false,
+        Refactor::PerMesh => spent >= cap,
+    }
 }
 
 /// Starts (or restarts) the preconditioned iteration from the residual `r`:
