@@ -141,7 +141,7 @@ pub struct Summary {
     pub contacts: Scalar,
     /// Mean number of cloth triangle pairs given to the exact self-collision tests per step.
     pub self_pairs_tested: Scalar,
-    /// Share of the box-overlapping triangle pairs that Volino culling removed (0..1).
+    /// Share of the triangles whose patch Volino culling spared its self-test (0..1).
     pub self_culled_fraction: Scalar,
     /// Wall time in the obstacle collision passes, s (part of `simulation_wall_s`).
     pub collision_wall_s: Scalar,

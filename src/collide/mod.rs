@@ -111,8 +111,11 @@ pub struct CollisionStats {
     pub last_penetration: Scalar,
     /// Triangle pairs given to the exact self-collision tests, summed over the steps.
     pub self_pairs_tested: u64,
-    /// Box-overlapping triangle pairs skipped by Volino culling, summed over the steps.
-    pub self_pairs_culled: u64,
+    /// Triangles whose patch skipped its self-test (Volino culling), summed over
+    /// the steps.
+    pub self_triangles_culled: u64,
+    /// Triangles given to self-collision, summed over the steps.
+    pub self_triangles: u64,
     /// Work the moving obstacles did on the cloth, J (zero with static obstacles).
     pub obstacle_work: Scalar,
     /// Self-collision primitive pairs that acted, summed over steps and iterations.
@@ -134,13 +137,13 @@ impl CollisionStats {
         self.self_pairs_tested as Scalar / self.steps.max(1) as Scalar
     }
 
-    /// Share of box-overlapping pairs that culling removed (0 when none were found).
+    /// Share of the triangles whose patch culling spared its self-test (0 without
+    /// self-collision).
     pub fn self_culled_fraction(&self) -> Scalar {
-        let all = self.self_pairs_tested + self.self_pairs_culled;
-        if all == 0 {
+        if self.self_triangles == 0 {
             0.0
         } else {
-            self.self_pairs_culled as Scalar / all as Scalar
+            self.self_triangles_culled as Scalar / self.self_triangles as Scalar
         }
     }
 }
@@ -346,7 +349,8 @@ impl Collider {
                 &self.held,
             );
             stats.self_pairs_tested += s.pairs_tested;
-            stats.self_pairs_culled += s.pairs_culled;
+            stats.self_triangles_culled += s.triangles_culled;
+            stats.self_triangles += s.triangles;
             stats.self_resolved += s.resolved;
             stats.self_collision_wall_s += started.elapsed().as_secs_f64();
         }

@@ -27,8 +27,10 @@ use crate::spec::SelfCollision;
 pub struct SelfStats {
     /// Triangle pairs given to the exact tests.
     pub pairs_tested: u64,
-    /// Box-overlapping triangle pairs skipped by Volino culling.
-    pub pairs_culled: u64,
+    /// Triangles whose patch skipped its self-test (Volino culling).
+    pub triangles_culled: u64,
+    /// Triangles in all.
+    pub triangles: u64,
     /// Primitive pairs that acted (summed over the iterations).
     pub resolved: u64,
 }
@@ -75,8 +77,8 @@ struct Scratch {
     trees: Vec<Bvh>,
     /// Box of every patch tree.
     patch_box: Vec<Aabb>,
-    /// Per patch: its box-overlapping triangle pairs and the pairs culling skipped.
-    pairs: Vec<(Vec<(u32, u32)>, u64)>,
+    /// Per patch: its box-overlapping triangle pairs.
+    pairs: Vec<Vec<(u32, u32)>>,
     prims: Vec<Prim>,
     fixes: Vec<Fix>,
     /// Per vertex: corrected by the latest repulsion pass.
@@ -215,7 +217,11 @@ impl SelfCollider {
         self.fit_trees(s);
         self.collect_pairs(tris, s);
         let limit = 1.5 * self.thickness;
-        let stats = primitive_pairs(tris, s, &self.rest_bounds, limit);
+        let mut stats = primitive_pairs(tris, s, &self.rest_bounds, limit);
+        stats.triangles_culled = (s.culled.iter().zip(&self.patches.triangles))
+            .filter(|(culled, _)| **culled)
+            .map(|(_, ts)| ts.len() as u64)
+            .sum();
         // Sorted and deduplicated, the list does not depend on the order the trees
         // report their pairs in (so neither on the trees' shapes). Of a pair's
         // copies the first is kept: one from a triangle pair far apart in rest
@@ -298,8 +304,8 @@ impl SelfCollider {
         s.patch_box.extend(s.trees.iter().map(|b| b.root_aabb()));
     }
 
-    /// Per patch, into `s.pairs`: its own box-overlapping pairs (or their count when
-    /// culled) and its pairs with later patches.
+    /// Per patch, into `s.pairs`: its own box-overlapping pairs (none when culled:
+    /// its tree is not even searched) and its pairs with later patches.
     fn collect_pairs(&self, tris: &[[u32; 3]], s: &mut Scratch) {
         let pt = &self.patches;
         let Scratch {
@@ -315,41 +321,36 @@ impl SelfCollider {
             !ta.iter().any(|v| tb.contains(v))
         };
         pairs.resize_with(pt.len(), Default::default);
-        pairs
-            .par_iter_mut()
-            .enumerate()
-            .for_each(|(p, (pairs, skipped))| {
-                pairs.clear();
-                *skipped = 0;
-                for &t in &pt.triangles[p] {
-                    for k in trees[p].intersect_aabb(&boxes[t as usize]) {
-                        let u = pt.triangles[p][k as usize];
-                        if u > t && disjoint(t, u) {
-                            if culled[p] {
-                                *skipped += 1;
-                            } else {
-                                pairs.push((t, u));
-                            }
-                        }
+        pairs.par_iter_mut().enumerate().for_each(|(p, pairs)| {
+            pairs.clear();
+            for &t in &pt.triangles[p] {
+                if culled[p] {
+                    break;
+                }
+                for k in trees[p].intersect_aabb(&boxes[t as usize]) {
+                    let u = pt.triangles[p][k as usize];
+                    if u > t && disjoint(t, u) {
+                        pairs.push((t, u));
                     }
                 }
-                for q in p + 1..pt.len() {
-                    if !patch_box[p].intersects(&patch_box[q]) {
+            }
+            for q in p + 1..pt.len() {
+                if !patch_box[p].intersects(&patch_box[q]) {
+                    continue;
+                }
+                for &t in &pt.triangles[p] {
+                    if !patch_box[q].intersects(&boxes[t as usize]) {
                         continue;
                     }
-                    for &t in &pt.triangles[p] {
-                        if !patch_box[q].intersects(&boxes[t as usize]) {
-                            continue;
-                        }
-                        for k in trees[q].intersect_aabb(&boxes[t as usize]) {
-                            let u = pt.triangles[q][k as usize];
-                            if disjoint(t, u) {
-                                pairs.push((t, u));
-                            }
+                    for k in trees[q].intersect_aabb(&boxes[t as usize]) {
+                        let u = pt.triangles[q][k as usize];
+                        if disjoint(t, u) {
+                            pairs.push((t, u));
                         }
                     }
                 }
-            });
+            }
+        });
     }
 
     /// The correction of one primitive pair, if it acts.
@@ -419,7 +420,7 @@ struct Fix {
 /// Every triangle pair of `s.pairs` as its 6 vertex-triangle and 9 edge-edge primitive
 /// pairs, into `s.prims` (unsorted, with repeats), each marked near unless its
 /// triangles are farther than `limit` apart in rest space; counts the pairs
-/// tested and culled.
+/// tested and the triangles.
 ///
 /// A primitive pair whose swept boxes, each inflated by the thickness, do not
 /// overlap is left out: its parts stay more than two thicknesses apart along
@@ -433,13 +434,15 @@ fn primitive_pairs(
     rest: &RestBounds,
     limit: Scalar,
 ) -> SelfStats {
-    let mut stats = SelfStats::default();
-    for (pairs, skipped) in &s.pairs {
-        stats.pairs_culled += skipped;
+    let mut stats = SelfStats {
+        triangles: tris.len() as u64,
+        ..SelfStats::default()
+    };
+    for pairs in &s.pairs {
         stats.pairs_tested += pairs.len() as u64;
     }
     s.prims.clear();
-    for (pairs, _) in &s.pairs {
+    for pairs in &s.pairs {
         for &(t, u) in pairs {
             let near = !rest.far(t, u, limit);
             pair_prims(tris, &s.vertex_boxes, t, u, near, &mut s.prims);
