@@ -16,6 +16,8 @@
 //! hold a pair closer than that, and their pairs are marked as kept. Only the
 //! pairs of the other triangle pairs are measured one by one.
 
+use rayon::prelude::*;
+
 use crate::math::{Scalar, Vector};
 
 use super::geometry::{closest_on_segments, closest_on_triangle};
@@ -23,6 +25,10 @@ use super::geometry::{closest_on_segments, closest_on_triangle};
 /// Bits of each vertex or triangle id in a packed pair.
 const ID_BITS: u32 = 31;
 const ID_MASK: u128 = (1 << ID_BITS) - 1;
+
+/// Bits of each id in a narrow key ([`sort_and_dedup`]): 4 ids, the kind and
+/// the rest mark fill 62 of 64 bits.
+const NARROW_ID_BITS: u32 = 15;
 
 /// A primitive pair, packed: kind (0: vertex `a` against triangle `b`; 1:
 /// edge `(a, b)` against edge `(c, d)`), the four ids, and a last bit set when
@@ -50,6 +56,25 @@ impl Prim {
     pub(super) fn edge_edge(e: [u32; 2], f: [u32; 2], near: bool) -> Prim {
         let (lo, hi) = if e <= f { (e, f) } else { (f, e) };
         Prim::pack(1, [lo[0], lo[1], hi[0], hi[1]], near)
+    }
+
+    /// The narrow key of a pair whose ids fit in [`NARROW_ID_BITS`] bits.
+    fn narrow(self) -> u64 {
+        let (kind, ids) = self.fields();
+        let mut key = u64::from(kind);
+        for i in ids {
+            key = (key << NARROW_ID_BITS) | u64::from(i);
+        }
+        (key << 1) | u64::from(self.near())
+    }
+
+    /// The pair of a narrow key ([`Prim::narrow`]).
+    fn widen(key: u64) -> Prim {
+        let mask = (1u64 << NARROW_ID_BITS) - 1;
+        let fields = key >> 1;
+        let id = |k: u32| ((fields >> (NARROW_ID_BITS * (3 - k))) & mask) as u32;
+        let kind = (fields >> (4 * NARROW_ID_BITS)) as u8;
+        Prim::pack(kind, [id(0), id(1), id(2), id(3)], key & 1 == 1)
     }
 
     /// Kind and ids.
@@ -135,6 +160,26 @@ impl RestBounds {
     }
 }
 
+/// Sorts `prims` and keeps the first of each pair's copies (the smallest rest
+/// mark: far before near). While every id fits in [`NARROW_ID_BITS`] bits
+/// (`id_bound`: larger than every vertex and triangle id), the pairs are
+/// sorted as 64-bit keys in `narrow` (scratch): the same fields in the same
+/// order, so the same order, at half the bytes moved and one comparison
+/// instead of two.
+pub(super) fn sort_and_dedup(prims: &mut Vec<Prim>, narrow: &mut Vec<u64>, id_bound: usize) {
+    if id_bound <= 1 << NARROW_ID_BITS {
+        narrow.clear();
+        narrow.par_extend(prims.par_iter().map(|p| p.narrow()));
+        narrow.par_sort_unstable();
+        narrow.dedup_by(|later, kept| *later >> 1 == *kept >> 1);
+        prims.clear();
+        prims.par_extend(narrow.par_iter().map(|&k| Prim::widen(k)));
+    } else {
+        prims.par_sort_unstable();
+        prims.dedup_by(|later, kept| later.same_pair(*kept));
+    }
+}
+
 /// The edge `(a, b)` with its smaller vertex first.
 pub(super) fn edge(a: u32, b: u32) -> [u32; 2] {
     [a.min(b), a.max(b)]
@@ -169,6 +214,33 @@ mod tests {
         packed.sort_unstable();
         let unpacked: Vec<(u8, [u32; 4])> = packed.iter().map(|p| p.fields()).collect();
         assert_eq!(unpacked, fields);
+    }
+
+    /// Sorted through narrow keys, pairs come out as the plain sort leaves
+    /// them, duplicates (whatever their rest mark) reduced to their first copy.
+    #[test]
+    fn narrow_keys_sort_and_deduplicate_like_the_packed_pairs() {
+        let mut seed = 777u64;
+        let mut next = |m: u32| {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((seed >> 33) as u32) % m
+        };
+        let bound = 1u32 << NARROW_ID_BITS;
+        let mut prims = Vec::new();
+        for _ in 0..2000 {
+            let big = if next(3) == 0 { bound } else { 9 };
+            let ids = [next(big), next(big), next(big), next(big)];
+            prims.push(Prim::pack(next(2) as u8, ids, next(2) == 1));
+        }
+        let mut plain = prims.clone();
+        plain.sort_unstable();
+        plain.dedup_by(|later, kept| later.same_pair(*kept));
+        let mut narrow = Vec::new();
+        sort_and_dedup(&mut prims, &mut narrow, bound as usize);
+        assert!(plain.len() < 2000, "no duplicates: the test checks nothing");
+        assert_eq!(prims, plain);
     }
 
     /// Triangles 0.2 m apart are not far at a limit of 0.2 m or 0.1 m (the
