@@ -83,6 +83,9 @@ struct Scratch {
     /// The pairs' narrow sort keys (`self_prims::sort_and_dedup`).
     narrow: Vec<u64>,
     fixes: Vec<Fix>,
+    /// Per primitive pair: its closest points at the start of the step (the same
+    /// for every repulsion pass), `None` when they coincide.
+    start: Vec<Option<StartSide>>,
     /// Per vertex: corrected by the latest repulsion pass.
     moved: Vec<bool>,
     dx: Vec<Vector>,
@@ -149,20 +152,31 @@ impl SelfCollider {
             }
         }));
         let mut stats = self.candidates(mesh, x0, x, &mut s);
+        let tris = &mesh.triangles;
+        s.prims
+            .par_iter()
+            .map(|p| StartSide::of(*p, tris, x0))
+            .collect_into_vec(&mut s.start);
         s.moved.clear();
         s.moved.resize(x.len(), true);
         for _ in 0..self.iterations {
             // A pair none of whose vertices the last pass moved gives what it
             // gave then: nothing (a pair that acted moved its vertices).
-            let tris = &mesh.triangles;
             let moved = &s.moved;
             // Only the pairs that act are kept, in pair order (few of them: a
             // list of every pair's outcome would be most of the step's traffic).
             s.fixes.clear();
-            s.fixes.par_extend(s.prims.par_iter().filter_map(|p| {
-                let touched = p.vertices(tris).iter().any(|&i| moved[i as usize]);
-                touched.then(|| self.fix(mesh, *p, x0, x, v, &s.inv_mass))?
-            }));
+            s.fixes
+                .par_extend(
+                    s.prims
+                        .par_iter()
+                        .zip(s.start.par_iter())
+                        .filter_map(|(p, start)| {
+                            let touched = p.vertices(tris).iter().any(|&i| moved[i as usize]);
+                            touched
+                                .then(|| self.fix(tris, *p, start.as_ref()?, x, v, &s.inv_mass))?
+                        }),
+                );
             for buf in [&mut s.dx, &mut s.dv] {
                 buf.clear();
                 buf.resize(x.len(), Vector::ZERO);
@@ -355,22 +369,19 @@ impl SelfCollider {
         });
     }
 
-    /// The correction of one primitive pair, if it acts.
+    /// The correction of one primitive pair, if it acts; `start`: its closest
+    /// points at the start of the step.
     fn fix(
         &self,
-        mesh: &Mesh,
+        tris: &[[u32; 3]],
         p: Prim,
-        x0: &[Vector],
+        start: &StartSide,
         x: &[Vector],
         v: &[Vector],
         inv_mass: &[Scalar],
     ) -> Option<Fix> {
-        let tris = &mesh.triangles;
-        let at0 = |i: u32| x0[i as usize];
         let at1 = |i: u32| x[i as usize];
-        let (ids0, w0) = p.weights(tris, &at0);
-        let r0: Vector = (0..4).map(|k| at0(ids0[k]) * w0[k]).sum();
-        let n0 = r0.try_normalize()?;
+        let (ids0, w0, n0) = (start.ids, start.weights, start.normal);
         let (ids1, w1) = p.weights(tris, &at1);
         let r1: Vector = (0..4).map(|k| at1(ids1[k]) * w1[k]).sum();
         let (ids, w, n, gap) = if r1.dot(n0) <= 0.0 {
@@ -408,6 +419,32 @@ impl SelfCollider {
             f.dv[k] = n * (s * mu);
         }
         Some(f)
+    }
+}
+
+/// A primitive pair's closest points at the start of the step: the four
+/// vertices, their weights ([`Prim::weights`]) and the unit normal from the
+/// second part to the first.
+#[derive(Debug, Clone, Copy)]
+struct StartSide {
+    ids: [u32; 4],
+    weights: [Scalar; 4],
+    normal: Vector,
+}
+
+impl StartSide {
+    /// `p`'s closest points at the start positions `x0`; `None` when they
+    /// coincide (no normal: the pair gives nothing).
+    fn of(p: Prim, tris: &[[u32; 3]], x0: &[Vector]) -> Option<StartSide> {
+        let at0 = |i: u32| x0[i as usize];
+        let (ids, weights) = p.weights(tris, &at0);
+        let r0: Vector = (0..4).map(|k| at0(ids[k]) * weights[k]).sum();
+        let normal = r0.try_normalize()?;
+        Some(StartSide {
+            ids,
+            weights,
+            normal,
+        })
     }
 }
 
