@@ -10,8 +10,10 @@ Run (Blender 3.4, Debian's `blender` package):
 Builds the scene from scratch (no .blend): a 65 x 65 vertex cloth grid dropped
 from z = 1.0 m onto a fixed UV sphere of radius 0.5 m, simulates it with
 Blender's cloth modifier, times exactly the simulation and writes a JSON
-summary. See README.md beside this file for the mapping to drape's scene and
-where the two models differ.
+summary. After the timed loop it reads every frame back from the point cache
+and measures how deep the cloth goes into the ball. See README.md beside this
+file for the mapping to drape's scene and where the two models differ; the
+code shared with tablecloth.py is in common.py.
 """
 
 import argparse
@@ -24,6 +26,9 @@ import sys
 import time
 
 import bpy
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import common  # noqa: E402  (the code shared with tablecloth.py)
 
 # ---------------------------------------------------------------- drape's scene
 # Copied from scenes/drape_sphere.toml; keep in sync.
@@ -42,20 +47,8 @@ FRICTION_STATIC = 0.5
 FRICTION_KINETIC = 0.3
 DURATION = 5.0  # s
 
-# Blender's cloth solver runs in frames, not seconds: dt = time_scale /
-# quality frames, and gravity enters as 0.001 * g per frame^2 (SIM_cloth_solve /
-# cloth_calc_force). Gravity is therefore physical when one solver time unit is
-# T = sqrt(0.001) s = 31.6 ms. Rates (damping, drag) and stiffnesses are
-# converted with that T in --model matched; see README.md.
-SOLVER_UNIT_S = math.sqrt(0.001)
-
-# Blender's minimum for the cloth's own object-collision distance
-# (collision_settings.distance_min); the collider's thickness_outer adds to it.
-BLENDER_DISTANCE_MIN_FLOOR = 0.001
-
 
 def parse_args():
-    argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
     p = argparse.ArgumentParser(prog="drape_sphere.py")
     p.add_argument("--quality", type=int, default=5, help="cloth steps per frame (default 5)")
     p.add_argument("--fps", type=float, default=30.0, help="scene frames per second (default 30)")
@@ -73,44 +66,7 @@ def parse_args():
     p.add_argument("--method", choices=["frame_set", "bake"], default="frame_set",
                    help="step frames with scene.frame_set (default) or bpy.ops.ptcache.bake")
     p.add_argument("--out", default=None, help="write the JSON summary here (also printed)")
-    return p.parse_args(argv)
-
-
-def clear_scene():
-    for ob in list(bpy.data.objects):
-        bpy.data.objects.remove(ob, do_unlink=True)
-    for me in list(bpy.data.meshes):
-        bpy.data.meshes.remove(me)
-
-
-def grid_mesh(diagonals):
-    """drape's rectangle generator (src/mesh/generate.rs): vertex (i, j) at index
-    j * 65 + i, u = -w/2 + w i / n; each square split along a-c (regular) or
-    checkerboard-alternating a-c / b-d; or left as a quad."""
-    n = RESOLUTION
-    verts = [(-0.5 * WIDTH + WIDTH * i / n, -0.5 * WIDTH + WIDTH * j / n, 0.0)
-             for j in range(n + 1) for i in range(n + 1)]
-
-    def vid(i, j):
-        return j * (n + 1) + i
-
-    faces = []
-    for j in range(n):
-        for i in range(n):
-            a, b, c, d = vid(i, j), vid(i + 1, j), vid(i + 1, j + 1), vid(i, j + 1)
-            if diagonals == "quads":
-                faces.append((a, b, c, d))
-                continue
-            along_ac = diagonals == "regular" or (i + j) % 2 == 0
-            if along_ac:
-                faces += [(a, b, c), (a, c, d)]
-            else:
-                faces += [(a, b, d), (b, c, d)]
-    me = bpy.data.meshes.new("cloth")
-    me.from_pydata(verts, [], faces)
-    me.validate()
-    me.update()
-    return me
+    return p.parse_args(common.script_argv())
 
 
 def main():
@@ -118,15 +74,8 @@ def main():
     frames = args.frames if args.frames is not None else int(round(args.duration * args.fps))
     sim_seconds = frames / args.fps
 
-    clear_scene()
-    scene = bpy.context.scene
-    # Integer fps through fps / fps_base.
-    scene.render.fps = int(round(args.fps * 1000))
-    scene.render.fps_base = 1000.0
-    scene.frame_start = 1
-    scene.frame_end = 1 + frames  # frame 1 is the rest state; frames 2..N+1 are simulated
-    scene.use_gravity = True
-    scene.gravity = (0.0, 0.0, GRAVITY)
+    common.clear_scene()
+    scene = common.set_up_scene(args.fps, frames, GRAVITY)
 
     # ---------------------------------------------------------------- obstacle
     seg = args.sphere_segments
@@ -134,17 +83,10 @@ def main():
                                          radius=SPHERE_RADIUS, location=(0.0, 0.0, 0.0))
     sphere = bpy.context.object
     sphere.name = "ball"
-    sphere.modifiers.new("Collision", "COLLISION")
-    coll = sphere.collision
-    # Contact distance = cloth distance_min + collider thickness_outer (collision.cc,
-    # min_distance = (epsilon1 + epsilon2) * 8/9). Split drape's 3 mm between them.
-    coll.thickness_outer = THICKNESS - BLENDER_DISTANCE_MIN_FLOOR
-    # Blender has one friction coefficient (cloth_friction * 0.01, Coulomb-like on
-    # the impulse); drape's kinetic one is used.
-    coll.cloth_friction = 100.0 * FRICTION_KINETIC
+    coll = common.make_collider(sphere, THICKNESS, FRICTION_KINETIC)
 
     # ------------------------------------------------------------------- cloth
-    me = grid_mesh(args.diagonals)
+    me = common.grid_mesh(WIDTH, RESOLUTION, args.diagonals)
     cloth = bpy.data.objects.new("cloth", me)
     scene.collection.objects.link(cloth)
     cloth.location = (0.0, 0.0, CENTRE_Z)
@@ -152,92 +94,35 @@ def main():
     n_tris = sum(len(p.vertices) - 2 for p in me.polygons)
     n_edges = len(me.edges)
     area = WIDTH * WIDTH
-    total_mass = DENSITY * area
-    area_per_vertex = area / n_verts
 
-    mod = cloth.modifiers.new("Cloth", "CLOTH")
-    s = mod.settings
-    c = mod.collision_settings
-    s.quality = args.quality
-    s.mass = total_mass / n_verts  # Blender's mass is per vertex (kg)
-    # Air: Blender's drag force is -0.01 * air_damping * v per vertex in solver units
-    # (SIM_mass_spring_force_drag). drape: -drag * area * v, per vertex area share.
-    drag_per_vertex = DRAG * area_per_vertex  # kg/s
-    s.air_damping = drag_per_vertex * SOLVER_UNIT_S / 0.01
-    c.use_collision = True
-    c.use_self_collision = False  # Blender's default; drape_sphere has no self-collision either
-    c.distance_min = BLENDER_DISTANCE_MIN_FLOOR
-
-    # avg spring length over structural springs (= mesh edges), as cloth.cc computes it
-    avg_len = sum((me.vertices[e.vertices[0]].co - me.vertices[e.vertices[1]].co).length
-                  for e in me.edges) / n_edges
-
-    time_scale = 1.0
-    if args.model == "matched":
-        # Make one solver unit SOLVER_UNIT_S seconds while a frame is 1/fps s.
-        time_scale = 1.0 / (args.fps * SOLVER_UNIT_S)
-        t2 = SOLVER_UNIT_S ** 2
-        # Linear spring: k = stiffness / avg_spring_len per spring (solver units).
-        # For axis-aligned grid springs the membrane stiffness ~= k, so k = STRETCH.
-        k_spring = STRETCH * t2
-        s.tension_stiffness = k_spring * avg_len
-        s.compression_stiffness = k_spring * avg_len
-        s.shear_stiffness = k_spring * avg_len
-        # Angular bending: torque = bending * restlen * 0.1 * angle. A discrete hinge of
-        # rigidity D on a right-triangle grid has about 3 D per radian.
-        h = WIDTH / RESOLUTION
-        s.bending_stiffness = 3.0 * BENDING * t2 / (0.1 * h)
-        # Damping: drape's is stiffness-proportional, c = DAMPING * k (kg/s per spring).
-        c_spring = DAMPING * STRETCH * SOLVER_UNIT_S
-        s.tension_damping = c_spring
-        s.compression_damping = c_spring
-        s.shear_damping = c_spring
-        # Angular bending is explicit in Blender (no Jacobian), so its default damping
-        # (0.5) explodes at this vertex mass. drape's bending damping is
-        # DAMPING * hinge stiffness, i.e. ~1e-9 in these units: use 0.
-        s.bending_damping = 0.0
-    s.time_scale = time_scale
+    mod, time_scale, avg_len = common.set_up_cloth(
+        cloth, quality=args.quality, total_mass=DENSITY * area, area=area, drag=DRAG,
+        model=args.model, fps=args.fps, stretch=STRETCH, bending=BENDING, damping=DAMPING,
+        hinge_spacing=WIDTH / RESOLUTION)
 
     cache = mod.point_cache
     cache.frame_start = scene.frame_start
     cache.frame_end = scene.frame_end
 
-    scene.frame_set(scene.frame_start)
-    depsgraph = bpy.context.evaluated_depsgraph_get()
-
-    def solver_result():
-        ev = cloth.evaluated_get(depsgraph)
-        r = ev.modifiers["Cloth"].solver_result
-        return r.status, r.avg_iterations, r.max_iterations
-
     # ---------------------------------------------------------------- simulate
-    per_frame = []
-    iters_avg = []
-    iters_max = 0
-    cpu0 = time.process_time()
     if args.method == "frame_set":
-        t0 = time.perf_counter()
-        for f in range(scene.frame_start + 1, scene.frame_end + 1):
-            tf = time.perf_counter()
-            scene.frame_set(f)
-            per_frame.append(time.perf_counter() - tf)
-            st, avg_it, max_it = solver_result()
-            iters_avg.append(avg_it)
-            iters_max = max(iters_max, max_it)
-        wall = time.perf_counter() - t0
+        timed = common.time_frames(scene, cloth)
+        wall, cpu, per_frame = timed["wall"], timed["cpu"], timed["per_frame"]
+        iters_avg, iters_max = timed["iters_avg"], timed["iters_max"]
         wall_frames_only = sum(per_frame)
     else:
+        scene.frame_set(scene.frame_start)
+        per_frame, iters_avg, iters_max = [], [], 0
         override = {"scene": scene, "active_object": cloth, "object": cloth,
                     "point_cache": cache}
+        cpu0 = time.process_time()
         with bpy.context.temp_override(**override):
             t0 = time.perf_counter()
             bpy.ops.ptcache.bake(bake=True)
             wall = time.perf_counter() - t0
+        cpu = time.process_time() - cpu0
         wall_frames_only = None
-    cpu = time.process_time() - cpu0
 
-    # Depsgraph overhead without the solver: step the same frames with the cloth
-    # modifier off (sphere collision modifier still evaluated). Not subtracted.
     # ------------------------------------------------------------------ result
     scene.frame_set(scene.frame_end)
     depsgraph = bpy.context.evaluated_depsgraph_get()
@@ -252,12 +137,22 @@ def main():
     in_contact = sum(1 for p in pts if p.length < SPHERE_RADIUS + 2 * THICKNESS)
     ev.to_mesh_clear()
 
-    mod.show_viewport = False
-    scene.frame_set(scene.frame_start)
-    t0 = time.perf_counter()
-    for f in range(scene.frame_start + 1, scene.frame_end + 1):
-        scene.frame_set(f)
-    overhead = time.perf_counter() - t0
+    # Penetration, every frame (read back from the cache, outside the timing): the
+    # depth of the deepest vertex inside drape's exact ball, radius - distance to
+    # the centre, and inside the contact shell of radius + contact distance
+    # (drape's thickness = the collider's thickness_outer + the cloth's distance_min).
+    contact_distance = THICKNESS
+    depth_per_frame, shell_per_frame, inside_per_frame = [], [], []
+    for _, frame_pts in common.read_back_frames(scene, cloth, cache):
+        r = [math.hypot(*p) for p in frame_pts]
+        r_min = min(r)
+        depth_per_frame.append(max(0.0, SPHERE_RADIUS - r_min))
+        shell_per_frame.append(max(0.0, SPHERE_RADIUS + contact_distance - r_min))
+        inside_per_frame.append(sum(1 for x in r if x < SPHERE_RADIUS))
+    # frame k = 0 is the rest state, k = frames the last (drape's frame numbers)
+    deepest = max(range(len(depth_per_frame)), key=depth_per_frame.__getitem__)
+
+    overhead = common.no_cloth_frame_stepping(scene, mod)
 
     cache_ok = cache.is_baked if args.method == "bake" else None
     out = {
@@ -283,24 +178,7 @@ def main():
         "time_scale": time_scale,
         "solver_time_units": frames * time_scale,
         "settings": {
-            "mass_per_vertex_kg": s.mass,
-            "total_mass_kg": s.mass * n_verts,
-            "air_damping": s.air_damping,
-            "tension_stiffness": s.tension_stiffness,
-            "compression_stiffness": s.compression_stiffness,
-            "shear_stiffness": s.shear_stiffness,
-            "bending_stiffness": s.bending_stiffness,
-            "bending_model": s.bending_model,
-            "tension_damping": s.tension_damping,
-            "compression_damping": s.compression_damping,
-            "shear_damping": s.shear_damping,
-            "bending_damping": s.bending_damping,
-            "use_internal_springs": s.use_internal_springs,
-            "use_pressure": s.use_pressure,
-            "collision_quality": c.collision_quality,
-            "distance_min": c.distance_min,
-            "use_self_collision": c.use_self_collision,
-            "impulse_clamp": c.impulse_clamp,
+            **common.cloth_settings(mod, n_verts),
             "collider_thickness_outer": coll.thickness_outer,
             "collider_cloth_friction": coll.cloth_friction,
             "collider_damping": coll.damping,
@@ -329,31 +207,23 @@ def main():
         "sphere_top_z": SPHERE_RADIUS,
         "min_distance_to_centre": min_r,
         "vertices_in_contact": in_contact,
-        "threads": {
-            "render_threads_mode": scene.render.threads_mode,
-            "render_threads": scene.render.threads,
-            "os_cpu_count": os.cpu_count(),
-            "sched_affinity": len(os.sched_getaffinity(0)),
-        },
+        "max_penetration_m": depth_per_frame[deepest],
+        "max_penetration_frame": deepest if depth_per_frame[deepest] > 0 else None,
+        "max_penetration_s": deepest / args.fps if depth_per_frame[deepest] > 0 else None,
+        "final_penetration_m": depth_per_frame[-1],
+        "contact_distance_m": contact_distance,
+        "max_penetration_of_contact_distance_m": max(shell_per_frame),
+        "penetration_per_frame_m": [round(x, 6) for x in depth_per_frame],
+        "vertices_inside_per_frame": inside_per_frame,
+        "threads": common.threads(scene),
         "host": platform.node(),
-        "cpu_model": _cpu_model(),
+        "cpu_model": common.cpu_model(),
     }
     text = json.dumps(out, indent=2)
     print("DRAPE_BLENDER_RESULT " + json.dumps(out))
     if args.out:
         with open(args.out, "w") as fh:
             fh.write(text + "\n")
-
-
-def _cpu_model():
-    try:
-        with open("/proc/cpuinfo") as fh:
-            for line in fh:
-                if line.startswith("model name"):
-                    return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor()
 
 
 if __name__ == "__main__":

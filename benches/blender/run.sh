@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Blender peer benchmark of scenes/drape_sphere.toml: runs drape_sphere.py N
-# times (no `nice`: this is the measurement) and prints the raw wall times, their
-# median, min and max. Usage:
+# times (no `nice`: this is the measurement) and prints each run's wall time and
+# largest penetration into the ball, then the raw wall times, their median, min
+# and max. (The tablecloth: tablecloth.sh.) Usage:
 #
 #   benches/blender/run.sh [-n RUNS] [-o OUTDIR] [-t THREADS] [-- drape_sphere.py options]
 #
@@ -23,7 +24,7 @@ while [[ $# -gt 0 ]]; do
     -o) outdir="$2"; shift 2 ;;
     -t) threads="$2"; shift 2 ;;
     --) shift; break ;;
-    -h|--help) sed -n '2,14p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,15p' "$0"; exit 0 ;;
     *) echo "unknown option $1 (script options go after --)" >&2; exit 2 ;;
   esac
 done
@@ -52,7 +53,9 @@ d = json.load(open(sys.argv[1]))
 print(f"run {sys.argv[2]}: wall_s={d['wall_s']:.3f} cpu_s={d['cpu_s']:.3f} "
       f"frames={d['frames']} fps={d['fps']:g} quality={d['quality']} "
       f"substeps={d['substeps_total']} lowest_z={d['lowest_z']:.4f} "
-      f"cg_iters_mean={d['cg_iterations']['per_frame_avg_mean']}")
+      f"cg_iters_mean={d['cg_iterations']['per_frame_avg_mean']} "
+      f"max_penetration_m={d['max_penetration_m']:.5f} "
+      f"(frame {d['max_penetration_frame'] if d['max_penetration_frame'] is not None else '-'})")
 EOF
 done
 
