@@ -6,33 +6,37 @@
 //! triangle the list of element terms that sum into it, in element order.
 //!
 //! # Assembly
-//! Each step assembles `A` in three passes, none with atomics, locks or
-//! allocation once the scratch has grown to the mesh:
-//! 1. [`BlockPattern::element_terms`], parallel over elements: every element
-//!    writes the blocks it adds to the lower triangle (pairs of its vertices
-//!    `(i, j)` with `j <= i`) into its own fixed-size stretch of a flat array
-//!    ([`ElementTerms`]), hinges first, then membrane triangles, then shape
-//!    triangles, each in element order. A shape triangle's blocks
-//!    `h^2 sum_ab M_ab J_ak J_bl^T` share the products `sum_b M_ab J_bl`, which
-//!    it computes once for all of its 21 blocks; so does it the Frobenius norms of
-//!    its blocks that the factorization drops (their diagonal compensation).
-//! 2. [`BlockPattern::gather`], parallel over blocks: each lower block sums, in
-//!    a fixed order, its springs' blocks (read where the linearisation left them:
-//!    added on the diagonal, subtracted off it) and then its entries of the flat
-//!    array, by a precomputed list of indices, sorted, so in element order.
-//!    Plain 3x3 additions: no dispatch on the element kind, nothing recomputed.
-//! 3. [`BlockPattern::project`], parallel over blocks: the projected system,
-//!    reading an upper block as the transpose of its lower mirror.
+//! Each step assembles the lower blocks of `A` ([`BlockPattern::gather`]) with
+//! no atomics, locks or allocation once the scratch has grown to the mesh:
+//! 1. Parallel over elements, every hinge and membrane triangle writes the
+//!    blocks it adds to the lower triangle (pairs of its vertices `(i, j)` with
+//!    `j <= i`) into its own fixed-size stretch of a flat array
+//!    ([`ElementTerms`]), hinges first, each kind in element order.
+//! 2. Parallel over bands of [`BAND_ROWS`] rows, each band owning its rows'
+//!    blocks: every lower block sums its springs' blocks (read where the
+//!    linearisation left them: added on the diagonal, subtracted off it) and
+//!    its hinge and membrane terms, by precomputed index lists of plain 3x3
+//!    additions (no dispatch on the element kind); then each shape triangle
+//!    with a slot in the band, in triangle order, forms its products
+//!    `sum_b M_ab J_bl` once and adds its blocks `h^2 sum_a J_ak (M J)_al^T`
+//!    with their row in the band straight into them, by its precomputed slots,
+//!    and the Frobenius norms of its dropped blocks there into the diagonal
+//!    compensation; last the mass on the diagonal.
 //!
-//! Every sum runs in an order fixed by the pattern, so the matrix is identical at
-//! any thread count; and it is the order (and the arithmetic) of summing each
-//! block's element terms one by one, as computed per block, so the values are
-//! the same to the last bit as that. Writing each term once and gathering it is
-//! what makes the pass cheap: summed per block, a shape triangle's block was
-//! computed from the Jacobians for every block it falls in, and again for the
-//! compensation of the dropped ones (`perf`: two thirds of a shape-operator
-//! sheet's assembly). The flat array costs memory traffic instead (72 bytes a
-//! term, about 25 terms a vertex), which the caches absorb at these sizes.
+//! The shape triangles are the bulk (21 blocks each, against 3 per spring), and
+//! adding them in place is what makes the pass cheap: summed per block from
+//! the Jacobians, a triangle's products were recomputed for every block it adds
+//! to and again for the compensation (`perf`: two thirds of a shape-operator
+//! sheet's assembly), and written once to a flat array they cost 12 MB of
+//! memory traffic a step at 4,096 vertices, where a band's blocks stay in the
+//! cache. A triangle with slots in two bands forms its products in both.
+//!
+//! Every block sums its terms in one fixed order (springs, hinges, membrane
+//! triangles, shape triangles, each in element order, then the mass), whatever
+//! the thread count; and it is the order and the arithmetic of summing each
+//! block's terms one by one, each computed alone, so the values are those to
+//! the last bit. The upper blocks are not stored: [`BlockPattern::project`]
+//! and [`BlockPattern::multiply_lower`] read one as its mirror's transpose.
 //!
 //! The pattern also carries the scalar compressed-column (CSC) structure of the
 //! lower triangle that the sparse Cholesky factorization reads ([`super::cholesky`]),
@@ -73,6 +77,13 @@ use crate::math::{Matrix3, Vector};
 use buckets::{group_by_key, sorted_unique_rows};
 use sources::TermLayout;
 
+/// Rows per band of the assembly (module docs, "Assembly"): a band's lower
+/// blocks (about 10 a row, 72 bytes each) stay in the L2 cache while its shape
+/// triangles add to them, and a triangle's slots span about three grid rows, so
+/// a band of 512 rows recomputes the products `M J` of few triangles twice.
+/// Fixed, not tied to the thread count, so that the sums are too.
+const BAND_ROWS: usize = 512;
+
 /// A fixed 3x3-block sparsity pattern for one mesh topology (module docs).
 #[derive(Debug, Clone, Default)]
 pub struct BlockPattern {
@@ -93,25 +104,28 @@ pub struct BlockPattern {
     /// dropped tip-tip coupling is compensated on this vertex's diagonal.
     compensation_start: Vec<u32>,
     compensation: Vec<u32>,
-    /// Per vertex, CSC-like: the shape-triangle blocks of row `i` that the
-    /// factorization drops, as indices of their Frobenius norms in
-    /// [`ElementTerms`]; each is compensated by its norm on the diagonal
-    /// (`[[s I, -B], [-B^T, s I]]` is positive semi-definite for `s >= |B|`), so
-    /// the factored matrix stays positive definite. The tighter rank-one
-    /// compensation `B B^T / |B|` (each such `B = u v^T` involves a tip) saves
-    /// about 1 % of the iterations, not worth its code.
-    shape_dropped_start: Vec<u32>,
-    shape_dropped: Vec<u32>,
     /// Per shape triangle: bit `6 k + l` set when the factorization drops its
-    /// block `(k, l)` (row `v[k]`), whose norm [`ElementTerms`] then holds.
+    /// block `(k, l)` (pair of used slots on distinct vertices, row `v[k]`). Each
+    /// dropped block is compensated by its Frobenius norm on the diagonal of
+    /// `v[k]` (`[[s I, -B], [-B^T, s I]]` is positive semi-definite for
+    /// `s >= |B|`), so the factored matrix stays positive definite. The tighter
+    /// rank-one compensation `B B^T / |B|` (each such `B = u v^T` involves a
+    /// tip) saves about 1 % of the iterations, not worth its code.
     shape_dropped_mask: Vec<u64>,
+    /// Per shape triangle, the slots of its lower blocks in
+    /// [`terms::lower_pairs`] order, `layout.shape` entries each.
+    shape_slots: Vec<u32>,
+    /// Per band of [`BAND_ROWS`] rows, CSC-like: the shape triangles with a
+    /// used slot in the band, ascending.
+    band_shape_start: Vec<u32>,
+    band_shapes: Vec<u32>,
     /// Per block (lower blocks only; empty range for upper ones): the springs
     /// whose block it adds (diagonal) or subtracts (coupling), in spring order.
     spring_start: Vec<u32>,
     springs: Vec<u32>,
-    /// Per block (lower blocks only): the indices of its other element terms
-    /// in [`ElementTerms`], ascending (hinges, membrane, shape triangles, each in
-    /// element order).
+    /// Per block (lower blocks only): the indices of its hinge and membrane
+    /// terms in [`ElementTerms`], ascending (hinges, then membrane triangles,
+    /// each in element order).
     term_start: Vec<u32>,
     terms: Vec<u32>,
     /// Where each element's terms lie in [`ElementTerms`].
@@ -216,6 +230,16 @@ impl BlockPattern {
     /// Number of vertices (block rows).
     pub fn vertices(&self) -> usize {
         self.row_start.len().saturating_sub(1)
+    }
+
+    /// Number of bands of [`BAND_ROWS`] rows.
+    fn bands(&self) -> usize {
+        self.vertices().div_ceil(BAND_ROWS)
+    }
+
+    /// The rows of band `b`.
+    fn band_rows(&self, b: usize) -> std::ops::Range<usize> {
+        b * BAND_ROWS..((b + 1) * BAND_ROWS).min(self.vertices())
     }
 
     /// Number of stored blocks (both triangles).

@@ -173,8 +173,7 @@ pub(super) fn assemble(st: &mut Stepper, held: &[bool]) -> Arc<BlockPattern> {
         membrane_blocks: &s.membrane_block,
     };
     let a = &mut s.direct;
-    pattern.element_terms(&terms, &mut a.element);
-    pattern.gather(&terms, &a.element, &mut a.lower);
+    pattern.gather(&terms, &mut a.element, &mut a.lower);
     pattern.compensation(&terms, &a.element, &a.projection, &mut a.compensation);
     let a = &mut s.direct;
     // b_s = S (b - A dv_c).
