@@ -143,13 +143,31 @@ pub(super) fn solve(
     outcome
 }
 
-/// Assembles `A` from the linearised step's element terms into the block pattern
-/// (built first for a new mesh), and `A_s` and `b_s` (module docs) from the first
-/// guess `dv` and `held`; timed as assembly. Returns the pattern.
-pub(super) fn assemble(st: &mut Stepper, held: &[bool]) -> Arc<BlockPattern> {
-    let started = Instant::now();
-    let n = st.implicit.dv.len();
-    let s = &mut st.implicit;
+/// The element terms of the linearised step in `s` ([`ElementBlocks`]), by
+/// field, so that `s.direct` stays free to borrow.
+macro_rules! element_blocks {
+    ($s:expr, $el:expr) => {
+        ElementBlocks {
+            springs: &$s.spring_block,
+            hinges: &$el.hinges,
+            hinge_gradients: &$s.hinge_grad,
+            hinge_coefficients: &$s.hinge_coef,
+            diagonal_mass: &$s.diag_mass,
+            shape_triangles: &$el.shape_triangles,
+            shape_jacobians: &$s.shape_grad,
+            h2: $s.h2,
+            membrane_triangles: &$el.membrane_triangles,
+            membrane_blocks: &$s.membrane_block,
+        }
+    };
+}
+
+/// Gathers the lower blocks of `A` from the element terms (all but the shape
+/// triangles' slots, which it does not read) into the block pattern, built
+/// first for a new mesh; the linearisation calls it while the fold splits are
+/// solved. Returns the pattern.
+pub(super) fn gather(s: &mut ImplicitScratch, el: &Elements) -> Arc<BlockPattern> {
+    let n = s.diag_mass.len();
     let a = &mut s.direct;
     if a.pattern.is_none() {
         a.factorization.reset();
@@ -157,25 +175,29 @@ pub(super) fn assemble(st: &mut Stepper, held: &[bool]) -> Arc<BlockPattern> {
     }
     let pattern = a
         .pattern
-        .get_or_insert_with(|| Arc::new(BlockPattern::build(n, &st.elements, a.factor_tips)))
+        .get_or_insert_with(|| Arc::new(BlockPattern::build(n, el, a.factor_tips)))
         .clone();
-    split_prescribed(s, held);
-    let terms = ElementBlocks {
-        springs: &s.spring_block,
-        hinges: &st.elements.hinges,
-        hinge_gradients: &s.hinge_grad,
-        hinge_coefficients: &s.hinge_coef,
-        diagonal_mass: &s.diag_mass,
-        shape_triangles: &st.elements.shape_triangles,
-        shape_jacobians: &s.shape_grad,
-        h2: s.h2,
-        membrane_triangles: &st.elements.membrane_triangles,
-        membrane_blocks: &s.membrane_block,
+    let terms = element_blocks!(s, el);
+    pattern.gather(&terms, &mut s.direct.element, &mut s.direct.lower);
+    pattern
+}
+
+/// Completes the assembly that the linearisation began ([`gather`]): `A_s` and
+/// `b_s` (module docs) from the first guess `dv` and `held`, and the diagonal
+/// compensation of the factored matrix; timed as assembly. Returns the pattern.
+pub(super) fn assemble(st: &mut Stepper, held: &[bool]) -> Arc<BlockPattern> {
+    let started = Instant::now();
+    let n = st.implicit.dv.len();
+    let s = &mut st.implicit;
+    let pattern = match &s.direct.pattern {
+        Some(pattern) => pattern.clone(),
+        // Not gathered yet (the linearisation always gathers first).
+        None => gather(s, &st.elements),
     };
+    split_prescribed(s, held);
+    let terms = element_blocks!(s, st.elements);
     let a = &mut s.direct;
-    pattern.gather(&terms, &mut a.element, &mut a.lower);
     pattern.compensation(&terms, &a.element, &a.projection, &mut a.compensation);
-    let a = &mut s.direct;
     // b_s = S (b - A dv_c).
     a.ap.resize(n, Vector::ZERO);
     pattern.multiply_lower(&a.lower, &a.prescribed, &mut a.ap);
