@@ -2,8 +2,9 @@
 //!
 //! [`BlockPattern`] is built once per mesh topology: one block per vertex pair
 //! coupled by a spring, a membrane triangle, a hinge or a shape triangle (both
-//! triangles stored, columns sorted per row), and for every block of the lower
-//! triangle the list of element terms that sum into it, in element order.
+//! triangles stored, columns sorted per row), and what the blocks of the lower
+//! triangle sum: per block its springs and its hinge and membrane terms, per
+//! band of rows its shape triangles (below), each in element order.
 //!
 //! # Assembly
 //! Each step assembles the lower blocks of `A` ([`BlockPattern::gather`]) with
@@ -23,13 +24,16 @@
 //!    and the Frobenius norms of its dropped blocks there into the diagonal
 //!    compensation; last the mass on the diagonal.
 //!
-//! The shape triangles are the bulk (21 blocks each, against 3 per spring), and
-//! adding them in place is what makes the pass cheap: summed per block from
-//! the Jacobians, a triangle's products were recomputed for every block it adds
-//! to and again for the compensation (`perf`: two thirds of a shape-operator
-//! sheet's assembly), and written once to a flat array they cost 12 MB of
-//! memory traffic a step at 4,096 vertices, where a band's blocks stay in the
-//! cache. A triangle with slots in two bands forms its products in both.
+//! The shape triangles are the bulk (21 blocks each, against 3 per spring).
+//! Summed per block from the Jacobians, a triangle's products would be formed
+//! again for every block it adds to, and once more for the compensation
+//! (`perf` put two thirds of a shape-operator sheet's assembly there). Formed
+//! once per triangle but written to a flat array like the hinges' terms, its
+//! blocks would cost 12 MB of memory traffic a step at 4,096 vertices, and
+//! gathering them took as long as computing them (measured). Added in place,
+//! they go straight into the band's blocks, which stay in the cache; a
+//! triangle with slots in two bands forms its products in both (a third of the
+//! triangles, with bands of 512 rows on a 65 x 65 grid).
 //!
 //! Every block sums its terms in one fixed order (springs, hinges, membrane
 //! triangles, shape triangles, each in element order, then the mass), whatever
@@ -77,11 +81,11 @@ use crate::math::{Matrix3, Vector};
 use buckets::{group_by_key, sorted_unique_rows};
 use sources::TermLayout;
 
-/// Rows per band of the assembly (module docs, "Assembly"): a band's lower
-/// blocks (about 10 a row, 72 bytes each) stay in the L2 cache while its shape
-/// triangles add to them, and a triangle's slots span about three grid rows, so
-/// a band of 512 rows recomputes the products `M J` of few triangles twice.
-/// Fixed, not tied to the thread count, so that the sums are too.
+/// Rows per band of the assembly (module docs, "Assembly"). Any size gives the
+/// same sums (a block's terms come in the same order whichever band holds its
+/// row); 512 rows share a 65 x 65 grid among 9 bands, enough to balance two to
+/// four threads, while the triangles that straddle two bands (their slots span
+/// about three grid rows) stay a third of them.
 const BAND_ROWS: usize = 512;
 
 /// A fixed 3x3-block sparsity pattern for one mesh topology (module docs).

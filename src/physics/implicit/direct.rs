@@ -59,9 +59,9 @@ mod assembly;
 
 pub(super) use assembly::{assemble, gather};
 
+use super::SolveFailure;
 use super::cg::dot;
 use super::refactor::RefactorPolicy;
-use super::SolveFailure;
 use crate::math::{Matrix3, Scalar, Vector};
 use crate::physics::block::{BlockPattern, ElementTerms};
 use crate::physics::cholesky::{FactorError, Factorization};

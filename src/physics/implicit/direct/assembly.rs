@@ -38,7 +38,10 @@ macro_rules! element_blocks {
 /// triangles' slots, which it does not read) into the block pattern, built
 /// first for a new mesh; the linearisation calls it while the fold splits are
 /// solved. Returns the pattern.
-pub(in crate::physics::implicit) fn gather(s: &mut ImplicitScratch, el: &Elements) -> Arc<BlockPattern> {
+pub(in crate::physics::implicit) fn gather(
+    s: &mut ImplicitScratch,
+    el: &Elements,
+) -> Arc<BlockPattern> {
     let n = s.diag_mass.len();
     let a = &mut s.direct;
     if a.pattern.is_none() {
