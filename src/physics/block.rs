@@ -88,6 +88,31 @@ use sources::TermLayout;
 /// about three grid rows) stay a third of them.
 const BAND_ROWS: usize = 512;
 
+/// One block `(k, l)` (slots) of a shape triangle that the assembly computes:
+/// a lower block, which it adds to block `slot`, or one that the
+/// factorization drops, whose Frobenius norm compensates the diagonal of `v[k]`
+/// (`[[s I, -B], [-B^T, s I]]` is positive semi-definite for `s >= |B|`, so the
+/// factored matrix stays positive definite; the tighter rank-one compensation
+/// `B B^T / |B|`, each such `B = u v^T` involving a tip, saves about 1 % of the
+/// iterations, not worth its code), or both.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct ShapeOp {
+    /// The lower block it adds to, or [`ShapeOp::UPPER`].
+    slot: u32,
+    /// Its row slot.
+    k: u8,
+    /// Its column slot.
+    l: u8,
+    /// Whether the factorization drops it (pair of used slots on distinct
+    /// vertices whose block is not factored).
+    dropped: bool,
+}
+
+impl ShapeOp {
+    /// The `slot` of an upper block (its norm alone is needed).
+    const UPPER: u32 = u32::MAX;
+}
+
 /// A fixed 3x3-block sparsity pattern for one mesh topology (module docs).
 #[derive(Debug, Clone, Default)]
 pub struct BlockPattern {
@@ -108,17 +133,10 @@ pub struct BlockPattern {
     /// dropped tip-tip coupling is compensated on this vertex's diagonal.
     compensation_start: Vec<u32>,
     compensation: Vec<u32>,
-    /// Per shape triangle: bit `6 k + l` set when the factorization drops its
-    /// block `(k, l)` (pair of used slots on distinct vertices, row `v[k]`). Each
-    /// dropped block is compensated by its Frobenius norm on the diagonal of
-    /// `v[k]` (`[[s I, -B], [-B^T, s I]]` is positive semi-definite for
-    /// `s >= |B|`), so the factored matrix stays positive definite. The tighter
-    /// rank-one compensation `B B^T / |B|` (each such `B = u v^T` involves a
-    /// tip) saves about 1 % of the iterations, not worth its code.
-    shape_dropped_mask: Vec<u64>,
-    /// Per shape triangle, the slots of its lower blocks in
-    /// [`terms::lower_pairs`] order, `layout.shape` entries each.
-    shape_slots: Vec<u32>,
+    /// Per shape triangle, CSC-like: the blocks the assembly computes
+    /// ([`ShapeOp`]), in the order of its slot pairs `(k, l)`.
+    shape_op_start: Vec<u32>,
+    shape_ops: Vec<ShapeOp>,
     /// Per band of [`BAND_ROWS`] rows, CSC-like: the shape triangles with a
     /// used slot in the band, ascending.
     band_shape_start: Vec<u32>,

@@ -99,15 +99,14 @@ impl BlockPattern {
         band.sigma.fill(0.0);
         let b = rows.start / BAND_ROWS;
         let shapes = self.band_shape_start[b] as usize..self.band_shape_start[b + 1] as usize;
-        let stride = self.layout.shape;
         for &tri in &self.band_shapes[shapes] {
             let tri = tri as usize;
+            let ops = self.shape_op_start[tri] as usize..self.shape_op_start[tri + 1] as usize;
             band.add_shape(
                 &terms.shape_triangles[tri],
                 &terms.shape_jacobians[tri],
                 terms.h2,
-                self.shape_dropped_mask[tri],
-                &self.shape_slots[tri * stride..(tri + 1) * stride],
+                &self.shape_ops[ops],
             );
         }
         for i in rows {

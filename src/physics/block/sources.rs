@@ -1,27 +1,25 @@
 //! What each lower block of a [`BlockPattern`] sums, built with the pattern:
 //! its springs and the indices of its hinge and membrane terms in
 //! [`super::ElementTerms`] (where each element's terms lie there:
-//! [`TermLayout`]); per shape triangle the slots of its lower blocks and the
-//! blocks that the factorization drops; per band the shape triangles that add
+//! [`TermLayout`]); per shape triangle the blocks that it adds or whose norm the
+//! factorization's compensation needs; per band the shape triangles that add
 //! to it.
 
 use super::buckets::group_by_key;
 use super::terms::{lower_pairs, shape_active};
-use super::{BAND_ROWS, BlockPattern, Elements};
+use super::{BAND_ROWS, BlockPattern, Elements, ShapeOp};
 use crate::physics::shape::SHAPE_SLOTS;
 
 /// Where each hinge's and membrane triangle's terms lie in
 /// [`super::ElementTerms`]: per kind, the length of one element's stretch (the
 /// most terms that an element of the kind has) and the start of the kind's
-/// section; and the same stretch for the shape triangles' slots.
+/// section.
 #[derive(Debug, Clone, Copy, Default)]
 pub(super) struct TermLayout {
     /// Terms per hinge (10 for four distinct vertices).
     pub hinge: usize,
     /// Terms per membrane triangle (6).
     pub membrane: usize,
-    /// Lower blocks per shape triangle (21 with six distinct slots in use).
-    pub shape: usize,
     /// Start of the membrane triangles' section (the hinges' starts at 0).
     pub membrane_start: usize,
     /// Length of the whole array.
@@ -56,19 +54,8 @@ impl BlockPattern {
         l.membrane = self.tag_lower_blocks(l.membrane_start, membrane, &mut tagged);
         l.len = l.membrane_start + l.membrane * elements.membrane_triangles.len();
         (self.term_start, self.terms) = group_by_key(self.blocks(), &tagged);
-        // The shape triangles' slots, tagged by triangle instead of by block.
-        let mut slots: Vec<(u32, u32)> = Vec::new();
-        let shapes = elements
-            .shape_triangles
-            .iter()
-            .map(|t| (&t.v[..], shape_active(t)));
-        l.shape = self.tag_lower_blocks(0, shapes, &mut slots);
-        self.shape_slots = vec![0; l.shape * elements.shape_triangles.len()];
-        for (slot, index) in slots {
-            self.shape_slots[index as usize] = slot;
-        }
         self.layout = l;
-        self.build_shape_dropped(elements);
+        self.build_shape_ops(elements);
         self.build_bands(elements);
     }
 
@@ -98,27 +85,39 @@ impl BlockPattern {
         stride
     }
 
-    /// Per shape triangle, the blocks that the factorization drops (pairs of
-    /// used slots on distinct vertices whose block is not factored; `factored`
-    /// is symmetric, so the lower block tells) as bits `6 k + l`.
-    fn build_shape_dropped(&mut self, elements: &Elements) {
-        self.shape_dropped_mask = elements
-            .shape_triangles
-            .iter()
-            .map(|t| {
-                let active = shape_active(t);
-                let mut mask = 0u64;
-                for k in (0..SHAPE_SLOTS).filter(|&k| active >> k & 1 != 0) {
-                    for l in (0..SHAPE_SLOTS).filter(|&l| active >> l & 1 != 0) {
-                        let (i, j) = (t.v[k], t.v[l]);
-                        if i != j && !self.factored[self.lower_slot(i, j) as usize] {
-                            mask |= 1 << (SHAPE_SLOTS * k + l);
-                        }
+    /// Per shape triangle, the blocks that the assembly computes ([`ShapeOp`]):
+    /// each pair of used slots `(k, l)` (`k` outer, `l` inner, ascending) whose
+    /// block is in the lower triangle (`v[l] <= v[k]`) or dropped by the
+    /// factorization (`factored` is symmetric, so the lower block tells).
+    fn build_shape_ops(&mut self, elements: &Elements) {
+        let shapes = &elements.shape_triangles;
+        let (mut start, mut ops) = (Vec::with_capacity(shapes.len() + 1), Vec::new());
+        start.push(0);
+        for t in shapes {
+            let active = shape_active(t);
+            for k in (0..SHAPE_SLOTS).filter(|&k| active >> k & 1 != 0) {
+                for l in (0..SHAPE_SLOTS).filter(|&l| active >> l & 1 != 0) {
+                    let (i, j) = (t.v[k], t.v[l]);
+                    let dropped = i != j && !self.factored[self.lower_slot(i, j) as usize];
+                    let slot = if j <= i {
+                        self.slot(i, j)
+                    } else {
+                        ShapeOp::UPPER
+                    };
+                    if slot != ShapeOp::UPPER || dropped {
+                        let (k, l) = (k as u8, l as u8);
+                        ops.push(ShapeOp {
+                            slot,
+                            k,
+                            l,
+                            dropped,
+                        });
                     }
                 }
-                mask
-            })
-            .collect();
+            }
+            start.push(ops.len() as u32);
+        }
+        (self.shape_op_start, self.shape_ops) = (start, ops);
     }
 
     /// Per band, the shape triangles with a used slot in it, ascending.

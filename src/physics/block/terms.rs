@@ -8,7 +8,7 @@
 use rayon::prelude::*;
 
 use super::super::forces::PAR_MIN;
-use super::{BlockPattern, outer};
+use super::{BlockPattern, ShapeOp, outer};
 use crate::math::{Matrix3, Scalar, Vector};
 use crate::physics::elements::Hinge;
 use crate::physics::membrane::{ColumnBlocks, MembraneTriangle};
@@ -107,9 +107,9 @@ pub(super) struct Band<'a> {
 }
 
 impl Band<'_> {
-    /// Adds shape triangle `t`'s lower blocks whose row is in the band (with
-    /// the triangle's Jacobian `jac`, its blocks' `slots` in [`lower_pairs`]
-    /// order and its `dropped` mask) and the norms of its dropped blocks there.
+    /// Computes shape triangle `t`'s blocks `ops` whose row is in the band
+    /// (with the triangle's Jacobian `jac`): adds the lower ones to their
+    /// blocks and the norms of the dropped ones to their rows' compensation.
     /// The products `M J` are formed once for all its blocks.
     #[inline(always)]
     pub fn add_shape(
@@ -117,29 +117,22 @@ impl Band<'_> {
         t: &ShapeTriangle,
         jac: &ShapeJacobian,
         h2: Scalar,
-        dropped: u64,
-        slots: &[u32],
+        ops: &[ShapeOp],
     ) {
-        let mj = times_m(&t.m, jac);
-        let active = shape_active(t);
+        let mut mj = [[Vector::ZERO; SHAPE_SLOTS]; 3];
+        times_m(&t.m, jac, &mut mj);
         let rows = self.first_row..self.first_row + self.sigma.len();
-        let mut w = 0;
-        for k in (0..SHAPE_SLOTS).filter(|&k| active >> k & 1 != 0) {
-            let row = t.v[k];
-            let here = rows.contains(&(row as usize));
-            for l in (0..SHAPE_SLOTS).filter(|&l| active >> l & 1 != 0) {
-                let lower = t.v[l] <= row;
-                let drop = dropped >> (SHAPE_SLOTS * k + l) & 1 != 0;
-                if here && (lower || drop) {
-                    let block = shape_block(jac, &mj, h2, k, l);
-                    if lower {
-                        self.lower[slots[w] as usize - self.base] += block;
-                    }
-                    if drop {
-                        self.sigma[row as usize - self.first_row] += frobenius(&block);
-                    }
-                }
-                w += usize::from(lower);
+        for op in ops {
+            let row = t.v[op.k as usize] as usize;
+            if !rows.contains(&row) {
+                continue;
+            }
+            let block = shape_block(jac, &mj, h2, op.k as usize, op.l as usize);
+            if op.slot != ShapeOp::UPPER {
+                self.lower[op.slot as usize - self.base] += block;
+            }
+            if op.dropped {
+                self.sigma[row - self.first_row] += frobenius(&block);
             }
         }
     }
@@ -173,9 +166,8 @@ pub(super) fn shape_active(t: &ShapeTriangle) -> u32 {
 /// one term; skipping the exact zeros leaves every value the same to the last
 /// bit.
 #[inline(always)]
-fn times_m(m: &[[Scalar; 3]; 3], jac: &ShapeJacobian) -> [[Vector; SHAPE_SLOTS]; 3] {
-    let mut mj = [[Vector::ZERO; SHAPE_SLOTS]; 3];
-    for (row, out) in m.iter().zip(&mut mj) {
+fn times_m(m: &[[Scalar; 3]; 3], jac: &ShapeJacobian, mj: &mut [[Vector; SHAPE_SLOTS]; 3]) {
+    for (row, out) in m.iter().zip(mj) {
         for (l, o) in out.iter_mut().enumerate() {
             *o = match l {
                 0..3 => jac[0][l] * row[0] + jac[1][l] * row[1] + jac[2][l] * row[2],
@@ -183,7 +175,6 @@ fn times_m(m: &[[Scalar; 3]; 3], jac: &ShapeJacobian) -> [[Vector; SHAPE_SLOTS];
             };
         }
     }
-    mj
 }
 
 /// Block `(k, l)` of a shape triangle, `h^2 sum_a J_ak (M J)_al^T`, over the

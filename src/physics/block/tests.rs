@@ -4,13 +4,13 @@
 //! term in element order (to the last bit), a dense sum of every element's
 //! full formula (to 1e-12), and the same matrix at one and two threads.
 
-use super::{BlockPattern, ElementBlocks, ElementTerms, outer};
+use super::{BlockPattern, ElementBlocks, ElementTerms, ShapeOp, outer};
 use crate::adapt::{AdaptConfig, Adapter};
 use crate::math::{Matrix3, Scalar, Vector};
 use crate::mesh::{Mesh, rectangle};
 use crate::physics::elements::{Elements, MaterialParams};
 use crate::physics::membrane::{ColumnBlocks, Membrane, Orthotropic};
-use crate::physics::shape::{SHAPE_SLOTS, ShapeJacobian};
+use crate::physics::shape::ShapeJacobian;
 use crate::physics::{Model, forces::PAR_MIN};
 use crate::scene::{BendingModel, DiagonalPattern, default_scene};
 use crate::world::World;
@@ -182,15 +182,24 @@ fn mirrors_and_dropped_blocks_match_the_searches() {
             }
             let mut bands = vec![Vec::new(); p.bands()];
             for (ti, t) in elements.shape_triangles.iter().enumerate() {
-                let mut mask = 0u64;
+                let mut ops = Vec::new();
                 for (k, i) in t.slots() {
                     for (l, j) in t.slots() {
-                        if i != j && !p.factored[p.slot(i, j) as usize] {
-                            mask |= 1 << (SHAPE_SLOTS * k + l);
+                        let dropped = i != j && !p.factored[p.slot(i, j) as usize];
+                        let slot = if j <= i { p.slot(i, j) } else { ShapeOp::UPPER };
+                        if j <= i || dropped {
+                            let (k, l) = (k as u8, l as u8);
+                            ops.push(ShapeOp {
+                                slot,
+                                k,
+                                l,
+                                dropped,
+                            });
                         }
                     }
                 }
-                assert_eq!(p.shape_dropped_mask[ti], mask, "triangle {ti}");
+                let range = p.shape_op_start[ti] as usize..p.shape_op_start[ti + 1] as usize;
+                assert_eq!(&p.shape_ops[range], &ops[..], "triangle {ti}");
                 for b in 0..p.bands() {
                     if t.slots()
                         .any(|(_, i)| p.band_rows(b).contains(&(i as usize)))
@@ -204,7 +213,7 @@ fn mirrors_and_dropped_blocks_match_the_searches() {
                 assert_eq!(&p.band_shapes[range], &expected[..], "band {b}");
             }
             assert_eq!(
-                p.shape_dropped_mask.iter().all(|&m| m == 0),
+                p.shape_ops.iter().all(|op| !op.dropped),
                 factor_tips,
                 "the reduced pattern drops tip blocks, the full one none"
             );
