@@ -2,8 +2,9 @@
 //!
 //! [`BlockPattern`] is built once per mesh topology: one block per vertex pair
 //! coupled by a spring, a membrane triangle, a hinge or a shape triangle (both
-//! triangles stored, columns sorted per row), and for every block of the lower
-//! triangle the list of element terms that sum into it, in element order.
+//! triangles stored, columns sorted per row), and what the blocks of the lower
+//! triangle sum: per block its springs and its hinge and membrane terms, per
+//! band of rows its shape triangles (below), each in element order.
 //!
 //! # Assembly
 //! Each step assembles the lower blocks of `A` ([`BlockPattern::gather`]) with
@@ -23,13 +24,16 @@
 //!    and the Frobenius norms of its dropped blocks there into the diagonal
 //!    compensation; last the mass on the diagonal.
 //!
-//! The shape triangles are the bulk (21 blocks each, against 3 per spring), and
-//! adding them in place is what makes the pass cheap: summed per block from
-//! the Jacobians, a triangle's products were recomputed for every block it adds
-//! to and again for the compensation (`perf`: two thirds of a shape-operator
-//! sheet's assembly), and written once to a flat array they cost 12 MB of
-//! memory traffic a step at 4,096 vertices, where a band's blocks stay in the
-//! cache. A triangle with slots in two bands forms its products in both.
+//! The shape triangles are the bulk (21 blocks each, against 3 per spring).
+//! Summed per block from the Jacobians, a triangle's products would be formed
+//! again for every block it adds to, and once more for the compensation
+//! (`perf` put two thirds of a shape-operator sheet's assembly there). Formed
+//! once per triangle but written to a flat array like the hinges' terms, its
+//! blocks would cost 12 MB of memory traffic a step at 4,096 vertices, and
+//! gathering them took as long as computing them (measured). Added in place,
+//! they go straight into the band's blocks, which stay in the cache; a
+//! triangle with slots in two bands forms its products in both (a third of the
+//! triangles, with bands of 512 rows on a 65 x 65 grid).
 //!
 //! Every block sums its terms in one fixed order (springs, hinges, membrane
 //! triangles, shape triangles, each in element order, then the mass), whatever
@@ -77,6 +81,38 @@ use crate::math::{Matrix3, Vector};
 use buckets::{group_by_key, sorted_unique_rows};
 use sources::TermLayout;
 
+/// Rows per band of the assembly (module docs, "Assembly"). Any size gives the
+/// same sums (a block's terms come in the same order whichever band holds its
+/// row); 512 rows share a 65 x 65 grid among 9 bands, enough to balance two to
+/// four threads, while the triangles that straddle two bands (their slots span
+/// about three grid rows) stay a third of them.
+const BAND_ROWS: usize = 512;
+
+/// One block `(k, l)` (slots) of a shape triangle that the assembly computes:
+/// a lower block, which it adds to block `slot`, or one that the
+/// factorization drops, whose Frobenius norm compensates the diagonal of `v[k]`
+/// (`[[s I, -B], [-B^T, s I]]` is positive semi-definite for `s >= |B|`, so the
+/// factored matrix stays positive definite; the tighter rank-one compensation
+/// `B B^T / |B|`, each such `B = u v^T` involving a tip, saves about 1 % of the
+/// iterations, not worth its code), or both.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct ShapeOp {
+    /// The lower block it adds to, or [`ShapeOp::UPPER`].
+    slot: u32,
+    /// Its row slot.
+    k: u8,
+    /// Its column slot.
+    l: u8,
+    /// Whether the factorization drops it (pair of used slots on distinct
+    /// vertices whose block is not factored).
+    dropped: bool,
+}
+
+impl ShapeOp {
+    /// The `slot` of an upper block (its norm alone is needed).
+    const UPPER: u32 = u32::MAX;
+}
+
 /// A fixed 3x3-block sparsity pattern for one mesh topology (module docs).
 #[derive(Debug, Clone, Default)]
 pub struct BlockPattern {
@@ -97,25 +133,21 @@ pub struct BlockPattern {
     /// dropped tip-tip coupling is compensated on this vertex's diagonal.
     compensation_start: Vec<u32>,
     compensation: Vec<u32>,
-    /// Per vertex, CSC-like: the shape-triangle blocks of row `i` that the
-    /// factorization drops, as indices of their Frobenius norms in
-    /// [`ElementTerms`]; each is compensated by its norm on the diagonal
-    /// (`[[s I, -B], [-B^T, s I]]` is positive semi-definite for `s >= |B|`), so
-    /// the factored matrix stays positive definite. The tighter rank-one
-    /// compensation `B B^T / |B|` (each such `B = u v^T` involves a tip) saves
-    /// about 1 % of the iterations, not worth its code.
-    shape_dropped_start: Vec<u32>,
-    shape_dropped: Vec<u32>,
-    /// Per shape triangle: bit `6 k + l` set when the factorization drops its
-    /// block `(k, l)` (row `v[k]`), whose norm [`ElementTerms`] then holds.
-    shape_dropped_mask: Vec<u64>,
+    /// Per shape triangle, CSC-like: the blocks the assembly computes
+    /// ([`ShapeOp`]), in the order of its slot pairs `(k, l)`.
+    shape_op_start: Vec<u32>,
+    shape_ops: Vec<ShapeOp>,
+    /// Per band of [`BAND_ROWS`] rows, CSC-like: the shape triangles with a
+    /// used slot in the band, ascending.
+    band_shape_start: Vec<u32>,
+    band_shapes: Vec<u32>,
     /// Per block (lower blocks only; empty range for upper ones): the springs
     /// whose block it adds (diagonal) or subtracts (coupling), in spring order.
     spring_start: Vec<u32>,
     springs: Vec<u32>,
-    /// Per block (lower blocks only): the indices of its other element terms
-    /// in [`ElementTerms`], ascending (hinges, membrane, shape triangles, each in
-    /// element order).
+    /// Per block (lower blocks only): the indices of its hinge and membrane
+    /// terms in [`ElementTerms`], ascending (hinges, then membrane triangles,
+    /// each in element order).
     term_start: Vec<u32>,
     terms: Vec<u32>,
     /// Where each element's terms lie in [`ElementTerms`].
@@ -220,6 +252,16 @@ impl BlockPattern {
     /// Number of vertices (block rows).
     pub fn vertices(&self) -> usize {
         self.row_start.len().saturating_sub(1)
+    }
+
+    /// Number of bands of [`BAND_ROWS`] rows.
+    fn bands(&self) -> usize {
+        self.vertices().div_ceil(BAND_ROWS)
+    }
+
+    /// The rows of band `b`.
+    fn band_rows(&self, b: usize) -> std::ops::Range<usize> {
+        b * BAND_ROWS..((b + 1) * BAND_ROWS).min(self.vertices())
     }
 
     /// Number of stored blocks (both triangles).

@@ -96,6 +96,18 @@ pub fn fold_angles_and_splits(
     gradients: &mut Vec<ShapeJacobian>,
     splits: &mut Vec<Scalar>,
 ) {
+    fold_angles(el, x, folds, gradients);
+    el.fold_splits.solve(&el.shape_triangles, folds, splits);
+}
+
+/// Into `folds` and `gradients`: each shape triangle's folds at `x` and their
+/// gradients by slot (the first half of [`fold_angles_and_splits`]).
+pub fn fold_angles(
+    el: &Elements,
+    x: &[Vector],
+    folds: &mut Vec<[Scalar; 3]>,
+    gradients: &mut Vec<ShapeJacobian>,
+) {
     let shapes = el.shape_triangles.len();
     folds.resize(shapes, [0.0; 3]);
     gradients.resize(shapes, [[Vector::ZERO; SHAPE_SLOTS]; 3]);
@@ -105,7 +117,6 @@ pub fn fold_angles_and_splits(
         .zip(el.shape_triangles.par_iter())
         .with_min_len(PAR_MIN / SHAPE_SLOTS)
         .for_each(|((folds, jac), t)| (*folds, *jac) = t.angles(x));
-    el.fold_splits.solve(&el.shape_triangles, folds, splits);
 }
 
 /// Into `folds` and `splits`: each shape triangle's folds at `x` and the

@@ -5,36 +5,82 @@
 use rayon::prelude::*;
 
 use super::super::forces::{PAR_MIN, PAR_MIN_ROWS};
-use super::{BlockPattern, ElementBlocks, ElementTerms, outer};
+use super::terms::Band;
+use super::{BAND_ROWS, BlockPattern, ElementBlocks, ElementTerms, outer};
 use crate::math::{Matrix3, Scalar, Vector};
 
 impl BlockPattern {
     /// Sums the lower blocks of `M + h D + h^2 K` into `lower` (one entry per
-    /// block; the upper ones are left as they are, zero when first grown): per
-    /// block its springs' blocks, then its terms in `element` (written by
-    /// [`Self::element_terms`] for `terms`), then the mass on the diagonal.
+    /// block; the upper ones are left as they are, zero when first grown), and
+    /// the norms of the dropped shape blocks per vertex into `element` (module
+    /// docs, "Assembly"): the hinges' and membrane triangles' blocks into
+    /// `element` first, then band by band, each lower block's springs and
+    /// hinge and membrane terms, its shape triangles' blocks, and the mass on the
+    /// diagonal.
     pub fn gather(
         &self,
         terms: &ElementBlocks<'_>,
-        element: &ElementTerms,
+        element: &mut ElementTerms,
         lower: &mut Vec<Matrix3>,
     ) {
+        self.element_terms(terms, element);
         lower.resize(self.blocks(), Matrix3::ZERO);
-        let blocks = element.blocks();
-        lower
-            .par_iter_mut()
-            .enumerate()
-            .with_min_len(PAR_MIN)
-            .for_each(|(slot, out)| {
-                let (i, j) = (self.rows[slot] as usize, self.columns[slot] as usize);
-                if j > i {
-                    return;
-                }
+        element.sigma.resize(self.vertices(), 0.0);
+        let flat = &element.blocks;
+        let band = |b: usize, lower: &mut [Matrix3], sigma: &mut [Scalar]| {
+            let rows = self.band_rows(b);
+            let mut band = Band {
+                first_row: rows.start,
+                base: self.row_start[rows.start] as usize,
+                lower,
+                sigma,
+            };
+            self.gather_band(terms, flat, &mut band);
+        };
+        self.for_each_band(0..self.bands(), lower, &mut element.sigma, &band);
+    }
+
+    /// Runs `f(band, lower, sigma)` for the bands in `bands`, in parallel, each
+    /// with the slices of its own rows (`lower` and `sigma` start at the first
+    /// band's first row), by halving the range: no allocation, and each band's
+    /// work the same at any thread count.
+    fn for_each_band<F>(
+        &self,
+        bands: std::ops::Range<usize>,
+        lower: &mut [Matrix3],
+        sigma: &mut [Scalar],
+        f: &F,
+    ) where
+        F: Fn(usize, &mut [Matrix3], &mut [Scalar]) + Sync,
+    {
+        match bands.len() {
+            0 => {}
+            1 => f(bands.start, lower, sigma),
+            len => {
+                let mid = bands.start + len / 2;
+                let (first, split) = (self.band_rows(bands.start).start, self.band_rows(mid).start);
+                let blocks = (self.row_start[split] - self.row_start[first]) as usize;
+                let (lower_a, lower_b) = lower.split_at_mut(blocks);
+                let (sigma_a, sigma_b) = sigma.split_at_mut(split - first);
+                rayon::join(
+                    || self.for_each_band(bands.start..mid, lower_a, sigma_a, f),
+                    || self.for_each_band(mid..bands.end, lower_b, sigma_b, f),
+                );
+            }
+        }
+    }
+
+    /// One band of [`Self::gather`].
+    fn gather_band(&self, terms: &ElementBlocks<'_>, flat: &[Matrix3], band: &mut Band<'_>) {
+        let rows = band.first_row..band.first_row + band.sigma.len();
+        for i in rows.clone() {
+            // The lower blocks lead each row (columns ascend to the diagonal).
+            for slot in self.row_start[i] as usize..=self.diagonal[i] as usize {
                 let mut m = Matrix3::ZERO;
                 let springs =
                     self.spring_start[slot] as usize..self.spring_start[slot + 1] as usize;
                 let springs = &self.springs[springs];
-                if i == j {
+                if self.columns[slot] as usize == i {
                     for &e in springs {
                         m += terms.springs[e as usize];
                     }
@@ -45,17 +91,33 @@ impl BlockPattern {
                 }
                 let range = self.term_start[slot] as usize..self.term_start[slot + 1] as usize;
                 for &t in &self.terms[range] {
-                    m += blocks[t as usize];
+                    m += flat[t as usize];
                 }
-                if i == j {
-                    m += Matrix3::from_diagonal(Vector::splat(terms.diagonal_mass[i]));
-                }
-                *out = m;
-            });
+                band.lower[slot - band.base] = m;
+            }
+        }
+        band.sigma.fill(0.0);
+        let b = rows.start / BAND_ROWS;
+        let shapes = self.band_shape_start[b] as usize..self.band_shape_start[b + 1] as usize;
+        for &tri in &self.band_shapes[shapes] {
+            let tri = tri as usize;
+            let ops = self.shape_op_start[tri] as usize..self.shape_op_start[tri + 1] as usize;
+            band.add_shape(
+                &terms.shape_triangles[tri],
+                &terms.shape_jacobians[tri],
+                terms.h2,
+                &self.shape_ops[ops],
+            );
+        }
+        for i in rows {
+            band.lower[self.diagonal[i] as usize - band.base] +=
+                Matrix3::from_diagonal(Vector::splat(terms.diagonal_mass[i]));
+        }
     }
 
     /// Per vertex: the diagonal compensation of the dropped tip-tip blocks (module
-    /// docs) and of the dropped shape blocks (their norms in `element`),
+    /// docs) and of the dropped shape blocks (their norms in `element`, from
+    /// [`Self::gather`]),
     /// projected like the system (`S c g g^T S`).
     pub fn compensation(
         &self,
@@ -65,7 +127,7 @@ impl BlockPattern {
         extra: &mut Vec<Matrix3>,
     ) {
         extra.resize(self.vertices(), Matrix3::ZERO);
-        let norms = element.norms();
+        let sigma = &element.sigma;
         extra
             .par_iter_mut()
             .enumerate()
@@ -78,13 +140,7 @@ impl BlockPattern {
                     let g = terms.hinge_gradients[k as usize];
                     m += outer(g, g) * terms.hinge_coefficients[k as usize / 4];
                 }
-                let range =
-                    self.shape_dropped_start[i] as usize..self.shape_dropped_start[i + 1] as usize;
-                let mut sigma = 0.0;
-                for &n in &self.shape_dropped[range] {
-                    sigma += norms[n as usize];
-                }
-                m += Matrix3::from_diagonal(Vector::splat(sigma));
+                m += Matrix3::from_diagonal(Vector::splat(sigma[i]));
                 *out = match projection[i] {
                     None => m,
                     Some(n) if n == Vector::ZERO => Matrix3::ZERO,
@@ -156,18 +212,6 @@ impl BlockPattern {
 
     /// `y = A x` with the blocks `a` of this pattern, by rows (deterministic).
     pub fn multiply(&self, a: &[Matrix3], x: &[Vector], y: &mut [Vector]) {
-        self.multiply_by(|slot| a[slot], x, y);
-    }
-
-    /// `y = A x` with `A` given by its lower blocks ([`Self::gather`]), by rows;
-    /// the same values as [`Self::multiply`] with every block stored.
-    pub fn multiply_lower(&self, lower: &[Matrix3], x: &[Vector], y: &mut [Vector]) {
-        self.multiply_by(|slot| self.full_block(lower, slot), x, y);
-    }
-
-    /// `y = A x` with block `slot` of `A` given by `block`.
-    #[inline(always)]
-    fn multiply_by(&self, block: impl Fn(usize) -> Matrix3 + Sync, x: &[Vector], y: &mut [Vector]) {
         y.par_iter_mut()
             .enumerate()
             .with_min_len(PAR_MIN_ROWS)
@@ -175,7 +219,29 @@ impl BlockPattern {
                 let range = self.row_start[i] as usize..self.row_start[i + 1] as usize;
                 let mut acc = Vector::ZERO;
                 for s in range {
-                    acc += block(s) * x[self.columns[s] as usize];
+                    acc += a[s] * x[self.columns[s] as usize];
+                }
+                *out = acc;
+            });
+    }
+
+    /// `y = A x` with `A` given by its lower blocks ([`Self::gather`]), by rows:
+    /// the same values as [`Self::multiply`] with every block stored. Blocks
+    /// that meet a zero `x_j` are skipped (the solver's prescribed velocity
+    /// change is zero but at pins and contacts): with finite blocks their
+    /// products are zeros, which leave the sums as they are.
+    pub fn multiply_lower(&self, lower: &[Matrix3], x: &[Vector], y: &mut [Vector]) {
+        y.par_iter_mut()
+            .enumerate()
+            .with_min_len(PAR_MIN_ROWS)
+            .for_each(|(i, out)| {
+                let range = self.row_start[i] as usize..self.row_start[i + 1] as usize;
+                let mut acc = Vector::ZERO;
+                for s in range {
+                    let xj = x[self.columns[s] as usize];
+                    if xj != Vector::ZERO {
+                        acc += self.full_block(lower, s) * xj;
+                    }
                 }
                 *out = acc;
             });

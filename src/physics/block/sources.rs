@@ -1,38 +1,35 @@
 //! What each lower block of a [`BlockPattern`] sums, built with the pattern:
-//! its springs, the indices of its other element terms in [`super::ElementTerms`]
-//! (and where each element's terms lie there, [`TermLayout`]), and per vertex the
-//! dropped shape blocks whose norms compensate its diagonal.
+//! its springs and the indices of its hinge and membrane terms in
+//! [`super::ElementTerms`] (where each element's terms lie there:
+//! [`TermLayout`]); per shape triangle the blocks that it adds or whose norm the
+//! factorization's compensation needs; per band the shape triangles that add
+//! to it.
 
 use super::buckets::group_by_key;
 use super::terms::{lower_pairs, shape_active};
-use super::{BlockPattern, Elements};
+use super::{BAND_ROWS, BlockPattern, Elements, ShapeOp};
 use crate::physics::shape::SHAPE_SLOTS;
 
-/// Where each element's terms lie in [`super::ElementTerms`]: per kind, the
-/// length of one element's stretch (the most terms that an element of the kind
-/// has) and the start of the kind's section.
+/// Where each hinge's and membrane triangle's terms lie in
+/// [`super::ElementTerms`]: per kind, the length of one element's stretch (the
+/// most terms that an element of the kind has) and the start of the kind's
+/// section.
 #[derive(Debug, Clone, Copy, Default)]
 pub(super) struct TermLayout {
     /// Terms per hinge (10 for four distinct vertices).
     pub hinge: usize,
     /// Terms per membrane triangle (6).
     pub membrane: usize,
-    /// Terms per shape triangle (21 with six distinct slots in use).
-    pub shape: usize,
     /// Start of the membrane triangles' section (the hinges' starts at 0).
     pub membrane_start: usize,
-    /// Start of the shape triangles' section.
-    pub shape_start: usize,
     /// Length of the whole array.
     pub len: usize,
-    /// Dropped-block norms per shape triangle.
-    pub shape_norms: usize,
 }
 
 impl BlockPattern {
-    /// The springs and element terms of every lower block, each list in element
-    /// order, their layout, and the shape triangles' dropped blocks. Needs the
-    /// blocks, the diagonal and `factored`.
+    /// The springs and hinge and membrane terms of every lower block, each
+    /// list in element order, their layout, and the shape triangles' slots,
+    /// dropped blocks and bands. Needs the blocks, the diagonal and `factored`.
     pub(super) fn build_sources(&mut self, elements: &Elements) {
         let mut springs: Vec<(u32, u32)> = Vec::with_capacity(3 * elements.springs.len());
         for (e, sp) in elements.springs.iter().enumerate() {
@@ -43,8 +40,8 @@ impl BlockPattern {
             springs.push((self.lower_slot(a, b), e));
         }
         (self.spring_start, self.springs) = group_by_key(self.blocks(), &springs);
-        // Hinges, membrane triangles, shape triangles: indices ascend with the
-        // pushes, so the grouping (stable) leaves each block's list ascending.
+        // Hinges, then membrane triangles: indices ascend with the pushes, so
+        // the grouping (stable) leaves each block's list ascending.
         let mut tagged: Vec<(u32, u32)> = Vec::new();
         let mut l = TermLayout::default();
         let hinges = elements.hinges.iter().map(|h| (&h.v[..], 0b1111));
@@ -55,16 +52,11 @@ impl BlockPattern {
             .iter()
             .map(|t| (&t.v[..], 0b111));
         l.membrane = self.tag_lower_blocks(l.membrane_start, membrane, &mut tagged);
-        l.shape_start = l.membrane_start + l.membrane * elements.membrane_triangles.len();
-        let shapes = elements
-            .shape_triangles
-            .iter()
-            .map(|t| (&t.v[..], shape_active(t)));
-        l.shape = self.tag_lower_blocks(l.shape_start, shapes, &mut tagged);
-        l.len = l.shape_start + l.shape * elements.shape_triangles.len();
+        l.len = l.membrane_start + l.membrane * elements.membrane_triangles.len();
         (self.term_start, self.terms) = group_by_key(self.blocks(), &tagged);
-        l.shape_norms = self.build_shape_dropped(elements);
         self.layout = l;
+        self.build_shape_ops(elements);
+        self.build_bands(elements);
     }
 
     /// Tags each lower block of the `elements` (vertices and active local
@@ -93,49 +85,61 @@ impl BlockPattern {
         stride
     }
 
-    /// The shape triangles' blocks that the factorization drops (pairs of used
-    /// slots on distinct vertices whose block is not factored; `factored` is
-    /// symmetric, so the lower block tells): per triangle their bits
-    /// `6 k + l`, and per vertex `v[k]` the indices of their norms, triangle
-    /// `t`'s `n`-th (by bit) at `t * stride + n`. Returns the stride, the most
-    /// of one triangle.
-    fn build_shape_dropped(&mut self, elements: &Elements) -> usize {
+    /// Per shape triangle, the blocks that the assembly computes ([`ShapeOp`]):
+    /// each pair of used slots `(k, l)` (`k` outer, `l` inner, ascending) whose
+    /// block is in the lower triangle (`v[l] <= v[k]`) or dropped by the
+    /// factorization (`factored` is symmetric, so the lower block tells).
+    fn build_shape_ops(&mut self, elements: &Elements) {
         let shapes = &elements.shape_triangles;
-        self.shape_dropped_mask = shapes
-            .iter()
-            .map(|t| {
-                let active = shape_active(t);
-                let mut mask = 0u64;
-                for k in (0..SHAPE_SLOTS).filter(|&k| active >> k & 1 != 0) {
-                    for l in (0..SHAPE_SLOTS).filter(|&l| active >> l & 1 != 0) {
-                        let (i, j) = (t.v[k], t.v[l]);
-                        if i != j && !self.factored[self.lower_slot(i, j) as usize] {
-                            mask |= 1 << (SHAPE_SLOTS * k + l);
-                        }
+        let (mut start, mut ops) = (Vec::with_capacity(shapes.len() + 1), Vec::new());
+        start.push(0);
+        for t in shapes {
+            let active = shape_active(t);
+            for k in (0..SHAPE_SLOTS).filter(|&k| active >> k & 1 != 0) {
+                for l in (0..SHAPE_SLOTS).filter(|&l| active >> l & 1 != 0) {
+                    let (i, j) = (t.v[k], t.v[l]);
+                    let dropped = i != j && !self.factored[self.lower_slot(i, j) as usize];
+                    let slot = if j <= i {
+                        self.slot(i, j)
+                    } else {
+                        ShapeOp::UPPER
+                    };
+                    if slot != ShapeOp::UPPER || dropped {
+                        let (k, l) = (k as u8, l as u8);
+                        ops.push(ShapeOp {
+                            slot,
+                            k,
+                            l,
+                            dropped,
+                        });
                     }
                 }
-                mask
-            })
-            .collect();
-        let stride = self
-            .shape_dropped_mask
-            .iter()
-            .map(|m| m.count_ones() as usize)
-            .max()
-            .unwrap_or(0)
-            .max(1);
-        let mut dropped: Vec<(u32, u32)> = Vec::new();
-        for (ti, (t, &mask)) in shapes.iter().zip(&self.shape_dropped_mask).enumerate() {
-            let mut bits = mask;
-            let mut index = ti * stride;
-            while bits != 0 {
-                let bit = bits.trailing_zeros() as usize;
-                dropped.push((t.v[bit / SHAPE_SLOTS], index as u32));
-                index += 1;
-                bits &= bits - 1;
+            }
+            start.push(ops.len() as u32);
+        }
+        (self.shape_op_start, self.shape_ops) = (start, ops);
+    }
+
+    /// Per band, the shape triangles with a used slot in it, ascending.
+    fn build_bands(&mut self, elements: &Elements) {
+        let mut tagged: Vec<(u32, u32)> = Vec::new();
+        for (ti, t) in elements.shape_triangles.iter().enumerate() {
+            let active = shape_active(t);
+            let mut bands = [u32::MAX; SHAPE_SLOTS];
+            for (k, band) in bands.iter_mut().enumerate() {
+                if active >> k & 1 != 0 {
+                    *band = (t.v[k] as usize / BAND_ROWS) as u32;
+                }
+            }
+            bands.sort_unstable();
+            let mut last = u32::MAX;
+            for band in bands.into_iter().filter(|&b| b != u32::MAX) {
+                if band != last {
+                    tagged.push((band, ti as u32));
+                    last = band;
+                }
             }
         }
-        (self.shape_dropped_start, self.shape_dropped) = group_by_key(self.vertices(), &dropped);
-        stride
+        (self.band_shape_start, self.band_shapes) = group_by_key(self.bands(), &tagged);
     }
 }

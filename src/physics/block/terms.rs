@@ -1,13 +1,14 @@
 //! The per-element matrix terms that [`super::BlockPattern::gather`] sums into
-//! its blocks: what the implicit step computed per element ([`ElementBlocks`]),
-//! and the lower blocks that each element adds, written once per step into a
-//! flat array in element order ([`ElementTerms`], the block module docs,
+//! its blocks: what the implicit step computed per element ([`ElementBlocks`]);
+//! the lower blocks of the hinges and membrane triangles, written once per step
+//! into a flat array in element order ([`ElementTerms`]); and the shape
+//! triangles' blocks, added band by band ([`Band`]; the block module docs,
 //! "Assembly").
 
 use rayon::prelude::*;
 
 use super::super::forces::PAR_MIN;
-use super::{BlockPattern, outer};
+use super::{BlockPattern, ShapeOp, outer};
 use crate::math::{Matrix3, Scalar, Vector};
 use crate::physics::elements::Hinge;
 use crate::physics::membrane::{ColumnBlocks, MembraneTriangle};
@@ -38,43 +39,29 @@ pub struct ElementBlocks<'a> {
     pub membrane_blocks: &'a [ColumnBlocks],
 }
 
-/// The lower blocks that the hinges, membrane triangles and shape triangles add
-/// to `A` in one step, and the norms of the shape blocks that the factorization
-/// drops, laid out by the pattern (block module docs, "Assembly"): each element
+/// The lower blocks that the hinges and membrane triangles add to `A` in one
+/// step, laid out by the pattern (block module docs, "Assembly"): each element
 /// owns a stretch of fixed length (the most that an element of its kind has),
 /// in element order, so that the elements fill it in parallel; entries past an
-/// element's own stay unread. Kept between steps (no allocation once grown).
+/// element's own stay unread. And per vertex, the sum of the norms of its
+/// dropped shape blocks. Kept between steps (no allocation once grown).
 #[derive(Debug, Clone, Default)]
 pub struct ElementTerms {
     /// Per element, its lower blocks in [`lower_pairs`] order.
-    blocks: Vec<Matrix3>,
-    /// Per shape triangle, the Frobenius norms of its dropped blocks, in the
-    /// order of their bits in the pattern's mask.
-    norms: Vec<Scalar>,
-}
-
-impl ElementTerms {
-    /// The element blocks (indexed by the pattern's term lists).
-    pub(super) fn blocks(&self) -> &[Matrix3] {
-        &self.blocks
-    }
-
-    /// The dropped shape blocks' norms (indexed by the pattern's dropped lists).
-    pub(super) fn norms(&self) -> &[Scalar] {
-        &self.norms
-    }
+    pub(super) blocks: Vec<Matrix3>,
+    /// Per vertex, the Frobenius norms of its row's dropped shape blocks,
+    /// summed (by triangle, then by slot pair).
+    pub(super) sigma: Vec<Scalar>,
 }
 
 impl BlockPattern {
-    /// Writes every element's lower blocks and the shape triangles' dropped
-    /// norms into `out`, parallel over the elements of each kind (module docs).
-    pub fn element_terms(&self, terms: &ElementBlocks<'_>, out: &mut ElementTerms) {
+    /// Writes every hinge's and membrane triangle's lower blocks into `out`,
+    /// parallel over the elements of each kind (module docs).
+    pub(super) fn element_terms(&self, terms: &ElementBlocks<'_>, out: &mut ElementTerms) {
         let l = &self.layout;
         out.blocks.resize(l.len, Matrix3::ZERO);
-        let (hinges, rest) = out.blocks.split_at_mut(l.membrane_start);
-        let (membrane, shape) = rest.split_at_mut(l.shape_start - l.membrane_start);
-        let hinge_count = terms.hinge_coefficients.len();
-        if hinge_count > 0 {
+        let (hinges, membrane) = out.blocks.split_at_mut(l.membrane_start);
+        if !terms.hinge_coefficients.is_empty() {
             hinges
                 .par_chunks_mut(l.hinge)
                 .zip(terms.hinge_gradients.par_chunks_exact(4))
@@ -103,20 +90,50 @@ impl BlockPattern {
                     });
                 });
         }
-        let norms = l.shape_norms.max(1);
-        out.norms.resize(norms * terms.shape_triangles.len(), 0.0);
-        if !terms.shape_triangles.is_empty() {
-            let h2 = terms.h2;
-            shape
-                .par_chunks_mut(l.shape)
-                .zip(out.norms.par_chunks_mut(norms))
-                .zip(terms.shape_triangles.par_iter())
-                .zip(terms.shape_jacobians.par_iter())
-                .zip(self.shape_dropped_mask.par_iter())
-                .with_min_len(PAR_MIN / SHAPE_SLOTS)
-                .for_each(|((((out, norms), t), jac), &mask)| {
-                    shape_terms(t, jac, h2, mask, out, norms);
-                });
+    }
+}
+
+/// One band's share of the assembly: its rows' lower blocks (the band's first
+/// block at `base`) and its vertices' dropped-block norms.
+pub(super) struct Band<'a> {
+    /// The band's first row.
+    pub first_row: usize,
+    /// The slot of the band's first block.
+    pub base: usize,
+    /// The band's blocks (lower ones filled, upper ones unused).
+    pub lower: &'a mut [Matrix3],
+    /// Per row of the band, the dropped shape blocks' norms.
+    pub sigma: &'a mut [Scalar],
+}
+
+impl Band<'_> {
+    /// Computes shape triangle `t`'s blocks `ops` whose row is in the band
+    /// (with the triangle's Jacobian `jac`): adds the lower ones to their
+    /// blocks and the norms of the dropped ones to their rows' compensation.
+    /// The products `M J` are formed once for all its blocks.
+    #[inline(always)]
+    pub fn add_shape(
+        &mut self,
+        t: &ShapeTriangle,
+        jac: &ShapeJacobian,
+        h2: Scalar,
+        ops: &[ShapeOp],
+    ) {
+        let mut mj = [[Vector::ZERO; SHAPE_SLOTS]; 3];
+        times_m(&t.m, jac, &mut mj);
+        let rows = self.first_row..self.first_row + self.sigma.len();
+        for op in ops {
+            let row = t.v[op.k as usize] as usize;
+            if !rows.contains(&row) {
+                continue;
+            }
+            let block = shape_block(jac, &mj, h2, op.k as usize, op.l as usize);
+            if op.slot != ShapeOp::UPPER {
+                self.lower[op.slot as usize - self.base] += block;
+            }
+            if op.dropped {
+                self.sigma[row - self.first_row] += frobenius(&block);
+            }
         }
     }
 }
@@ -144,49 +161,13 @@ pub(super) fn shape_active(t: &ShapeTriangle) -> u32 {
     (0..3).fold(0b111, |bits, a| bits | u32::from(t.interior[a]) << (3 + a))
 }
 
-/// One shape triangle's lower blocks into `out` (in [`lower_pairs`] order) and
-/// the norms of its blocks whose bit `6 k + l` is set in `dropped` into
-/// `norms`. The products `M J` are formed once for all its blocks.
-#[inline(always)]
-fn shape_terms(
-    t: &ShapeTriangle,
-    jac: &ShapeJacobian,
-    h2: Scalar,
-    dropped: u64,
-    out: &mut [Matrix3],
-    norms: &mut [Scalar],
-) {
-    let mj = times_m(&t.m, jac);
-    let active = shape_active(t);
-    let (mut w, mut n) = (0, 0);
-    for k in (0..SHAPE_SLOTS).filter(|&k| active >> k & 1 != 0) {
-        for l in (0..SHAPE_SLOTS).filter(|&l| active >> l & 1 != 0) {
-            let lower = t.v[l] <= t.v[k];
-            let drop = dropped >> (SHAPE_SLOTS * k + l) & 1 != 0;
-            if !lower && !drop {
-                continue;
-            }
-            let block = shape_block(jac, &mj, h2, k, l);
-            if lower {
-                out[w] = block;
-                w += 1;
-            }
-            if drop {
-                norms[n] = frobenius(&block);
-                n += 1;
-            }
-        }
-    }
-}
-
 /// `(M J)_al = sum_b M_ab J_bl` for every angle `a` and slot `l`. A tip slot
 /// `3 + b` moves angle `b` only (`shape.rs`, `HINGE_SLOTS`), so its column has
 /// one term; skipping the exact zeros leaves every value the same to the last
 /// bit.
 #[inline(always)]
-fn times_m(m: &[[Scalar; 3]; 3], jac: &ShapeJacobian) -> [[Vector; SHAPE_SLOTS]; 3] {
-    let mut mj = [[Vector::ZERO; SHAPE_SLOTS]; 3];
-    for (row, out) in m.iter().zip(&mut mj) {
+fn times_m(m: &[[Scalar; 3]; 3], jac: &ShapeJacobian, mj: &mut [[Vector; SHAPE_SLOTS]; 3]) {
+    for (row, out) in m.iter().zip(mj) {
         for (l, o) in out.iter_mut().enumerate() {
             *o = match l {
                 0..3 => jac[0][l] * row[0] + jac[1][l] * row[1] + jac[2][l] * row[2],
@@ -194,7 +175,6 @@ fn times_m(m: &[[Scalar; 3]; 3], jac: &ShapeJacobian) -> [[Vector; SHAPE_SLOTS];
             };
         }
     }
-    mj
 }
 
 /// Block `(k, l)` of a shape triangle, `h^2 sum_a J_ak (M J)_al^T`, over the

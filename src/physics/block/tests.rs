@@ -1,16 +1,16 @@
-//! The pattern's derived tables against the searches they replaced (mirrors by
+//! The pattern's derived tables against the searches they replace (mirrors by
 //! per-row cursors, the shape triangles' dropped blocks from one lookup per pair
-//! of slots), and the assembly against references: each block summed term by
+//! of slots, the bands' triangles), and the assembly against references: each block summed term by
 //! term in element order (to the last bit), a dense sum of every element's
 //! full formula (to 1e-12), and the same matrix at one and two threads.
 
-use super::{BlockPattern, ElementBlocks, ElementTerms, outer};
+use super::{BlockPattern, ElementBlocks, ElementTerms, ShapeOp, outer};
 use crate::adapt::{AdaptConfig, Adapter};
 use crate::math::{Matrix3, Scalar, Vector};
 use crate::mesh::{Mesh, rectangle};
 use crate::physics::elements::{Elements, MaterialParams};
 use crate::physics::membrane::{ColumnBlocks, Membrane, Orthotropic};
-use crate::physics::shape::{SHAPE_SLOTS, ShapeJacobian};
+use crate::physics::shape::ShapeJacobian;
 use crate::physics::{Model, forces::PAR_MIN};
 use crate::scene::{BendingModel, DiagonalPattern, default_scene};
 use crate::world::World;
@@ -155,8 +155,7 @@ fn assemble(p: &BlockPattern, terms: &ElementBlocks<'_>) -> [Vec<Matrix3>; 3] {
     let n = p.vertices();
     let mut element = ElementTerms::default();
     let (mut lower, mut extra, mut system) = (Vec::new(), Vec::new(), Vec::new());
-    p.element_terms(terms, &mut element);
-    p.gather(terms, &element, &mut lower);
+    p.gather(terms, &mut element, &mut lower);
     let projection: Vec<Option<Vector>> = (0..n)
         .map(|i| match i % 7 {
             0 => Some(Vector::ZERO),
@@ -181,34 +180,40 @@ fn mirrors_and_dropped_blocks_match_the_searches() {
             for b in 0..p.blocks() {
                 assert_eq!(p.mirror[b], p.slot(p.columns[b], p.rows[b]), "block {b}");
             }
-            let mut dropped: Vec<(u32, (u32, usize, usize))> = Vec::new();
+            let mut bands = vec![Vec::new(); p.bands()];
             for (ti, t) in elements.shape_triangles.iter().enumerate() {
+                let mut ops = Vec::new();
                 for (k, i) in t.slots() {
                     for (l, j) in t.slots() {
-                        if i != j && !p.factored[p.slot(i, j) as usize] {
-                            dropped.push((i, (ti as u32, k, l)));
+                        let dropped = i != j && !p.factored[p.slot(i, j) as usize];
+                        let slot = if j <= i { p.slot(i, j) } else { ShapeOp::UPPER };
+                        if j <= i || dropped {
+                            let (k, l) = (k as u8, l as u8);
+                            ops.push(ShapeOp {
+                                slot,
+                                k,
+                                l,
+                                dropped,
+                            });
                         }
                     }
                 }
+                let range = p.shape_op_start[ti] as usize..p.shape_op_start[ti + 1] as usize;
+                assert_eq!(&p.shape_ops[range], &ops[..], "triangle {ti}");
+                for b in 0..p.bands() {
+                    if t.slots()
+                        .any(|(_, i)| p.band_rows(b).contains(&(i as usize)))
+                    {
+                        bands[b].push(ti as u32);
+                    }
+                }
             }
-            let (start, items) = super::group_by_key(n, &dropped);
-            // Each norm index names a triangle and the n-th bit of its mask.
-            let stride = p.layout.shape_norms;
-            let decoded: Vec<(u32, usize, usize)> = p
-                .shape_dropped
-                .iter()
-                .map(|&index| {
-                    let (tri, nth) = (index as usize / stride, index as usize % stride);
-                    let mut bits = p.shape_dropped_mask[tri];
-                    (0..nth).for_each(|_| bits &= bits - 1);
-                    let bit = bits.trailing_zeros() as usize;
-                    (tri as u32, bit / SHAPE_SLOTS, bit % SHAPE_SLOTS)
-                })
-                .collect();
-            assert_eq!(p.shape_dropped_start, start);
-            assert_eq!(decoded, items);
+            for (b, expected) in bands.iter().enumerate() {
+                let range = p.band_shape_start[b] as usize..p.band_shape_start[b + 1] as usize;
+                assert_eq!(&p.band_shapes[range], &expected[..], "band {b}");
+            }
             assert_eq!(
-                p.shape_dropped.is_empty(),
+                p.shape_ops.iter().all(|op| !op.dropped),
                 factor_tips,
                 "the reduced pattern drops tip blocks, the full one none"
             );
@@ -264,38 +269,42 @@ fn per_term_sum(p: &BlockPattern, el: &Elements, t: &ElementBlocks<'_>) -> Vec<M
 }
 
 /// Every block of `A` (both triangles) from each element's full formula, and
-/// per block the sum of its terms' norms (the scale of its rounding).
+/// per block the sum of the norms of the products it adds (the scale of its
+/// rounding).
 fn dense(p: &BlockPattern, el: &Elements, t: &ElementBlocks<'_>) -> (Vec<Matrix3>, Vec<Scalar>) {
     let mut a = vec![Matrix3::ZERO; p.blocks()];
     let mut scale = vec![0.0; p.blocks()];
-    let mut add = |i: u32, j: u32, m: Matrix3| {
+    let norm = super::terms::frobenius;
+    let mut add = |i: u32, j: u32, m: Matrix3, size: Scalar| {
         let s = p.slot(i, j) as usize;
         a[s] += m;
-        scale[s] += super::terms::frobenius(&m);
+        scale[s] += size;
     };
     for (e, sp) in el.springs.iter().enumerate() {
         let [x, y] = sp.v;
         let k = t.springs[e];
         for (i, j, m) in [(x, x, k), (y, y, k), (x, y, -k), (y, x, -k)] {
-            add(i, j, m);
+            add(i, j, m, norm(&m));
         }
     }
     for (h, hg) in el.hinges.iter().enumerate() {
         let g = &t.hinge_gradients[4 * h..4 * h + 4];
         for k in 0..4 {
             for l in 0..4 {
-                add(
-                    hg.v[k],
-                    hg.v[l],
-                    outer(g[k], g[l]) * t.hinge_coefficients[h],
-                );
+                let m = outer(g[k], g[l]) * t.hinge_coefficients[h];
+                add(hg.v[k], hg.v[l], m, norm(&m));
             }
         }
     }
     for (ti, tri) in el.membrane_triangles.iter().enumerate() {
+        let (c, uv) = (&t.membrane_blocks[ti], [tri.du, tri.dv]);
         for k in 0..3 {
             for l in 0..3 {
-                add(tri.v[k], tri.v[l], tri.block(&t.membrane_blocks[ti], k, l));
+                let size = [(c.aa, 0, 0), (c.ab, 0, 1), (c.ab, 1, 0), (c.bb, 1, 1)]
+                    .map(|(m, x, y)| norm(&m) * (uv[x][k] * uv[y][l]).abs())
+                    .iter()
+                    .sum();
+                add(tri.v[k], tri.v[l], tri.block(c, k, l), size);
             }
         }
     }
@@ -303,29 +312,30 @@ fn dense(p: &BlockPattern, el: &Elements, t: &ElementBlocks<'_>) -> (Vec<Matrix3
         let jac = &t.shape_jacobians[ti];
         for (k, i) in tri.slots() {
             for (l, j) in tri.slots() {
-                let mut m = Matrix3::ZERO;
+                let (mut m, mut size) = (Matrix3::ZERO, 0.0);
                 for (x, row) in tri.m.iter().enumerate() {
                     for (y, &mxy) in row.iter().enumerate() {
-                        m += outer(jac[x][k], jac[y][l]) * (t.h2 * mxy);
+                        let term = outer(jac[x][k], jac[y][l]) * (t.h2 * mxy);
+                        m += term;
+                        size += norm(&term);
                     }
                 }
-                add(i, j, m);
+                add(i, j, m, size);
             }
         }
     }
     for i in 0..p.vertices() as u32 {
-        add(
-            i,
-            i,
-            Matrix3::from_diagonal(Vector::splat(t.diagonal_mass[i as usize])),
-        );
+        let m = Matrix3::from_diagonal(Vector::splat(t.diagonal_mass[i as usize]));
+        add(i, i, m, norm(&m));
     }
     (a, scale)
 }
 
 #[test]
 fn gather_matches_the_per_term_sum_and_a_dense_assembly() {
-    let (meshes, fabric) = meshes();
+    let (mut meshes, fabric) = meshes();
+    // Several bands, with triangles straddling their boundaries.
+    meshes.push(rectangle(1.0, 1.0, 48, DiagonalPattern::Alternating).expect("a grid"));
     for m in &meshes {
         let x = bent(m);
         for material in materials(fabric) {

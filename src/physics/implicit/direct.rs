@@ -55,11 +55,15 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 
+mod assembly;
+
+pub(super) use assembly::{assemble, gather};
+
+use super::SolveFailure;
 use super::cg::dot;
 use super::refactor::RefactorPolicy;
-use super::{ImplicitScratch, SolveFailure};
 use crate::math::{Matrix3, Scalar, Vector};
-use crate::physics::block::{BlockPattern, ElementBlocks, ElementTerms};
+use crate::physics::block::{BlockPattern, ElementTerms};
 use crate::physics::cholesky::{FactorError, Factorization};
 use crate::physics::elements::Elements;
 use crate::physics::forces::PAR_MIN;
@@ -141,91 +145,6 @@ pub(super) fn solve(
         contact_pressure(st, &pattern);
     }
     outcome
-}
-
-/// Assembles `A` from the linearised step's element terms into the block pattern
-/// (built first for a new mesh), and `A_s` and `b_s` (module docs) from the first
-/// guess `dv` and `held`; timed as assembly. Returns the pattern.
-pub(super) fn assemble(st: &mut Stepper, held: &[bool]) -> Arc<BlockPattern> {
-    let started = Instant::now();
-    let n = st.implicit.dv.len();
-    let s = &mut st.implicit;
-    let a = &mut s.direct;
-    if a.pattern.is_none() {
-        a.factorization.reset();
-        a.tips_break_even = None;
-    }
-    let pattern = a
-        .pattern
-        .get_or_insert_with(|| Arc::new(BlockPattern::build(n, &st.elements, a.factor_tips)))
-        .clone();
-    split_prescribed(s, held);
-    let terms = ElementBlocks {
-        springs: &s.spring_block,
-        hinges: &st.elements.hinges,
-        hinge_gradients: &s.hinge_grad,
-        hinge_coefficients: &s.hinge_coef,
-        diagonal_mass: &s.diag_mass,
-        shape_triangles: &st.elements.shape_triangles,
-        shape_jacobians: &s.shape_grad,
-        h2: s.h2,
-        membrane_triangles: &st.elements.membrane_triangles,
-        membrane_blocks: &s.membrane_block,
-    };
-    let a = &mut s.direct;
-    pattern.element_terms(&terms, &mut a.element);
-    pattern.gather(&terms, &a.element, &mut a.lower);
-    pattern.compensation(&terms, &a.element, &a.projection, &mut a.compensation);
-    let a = &mut s.direct;
-    // b_s = S (b - A dv_c).
-    a.ap.resize(n, Vector::ZERO);
-    pattern.multiply_lower(&a.lower, &a.prescribed, &mut a.ap);
-    a.rhs.resize(n, Vector::ZERO);
-    a.rhs
-        .par_iter_mut()
-        .zip(s.b.par_iter().zip(a.ap.par_iter()))
-        .zip(a.projection.par_iter())
-        .with_min_len(PAR_MIN)
-        .for_each(|((r, (b, ap)), proj)| *r = project(*proj, *b - *ap));
-    pattern.project(&a.lower, &a.projection, &st.elements.mass, &mut a.system);
-    st.stats.assembly_s += started.elapsed().as_secs_f64();
-    pattern
-}
-
-/// Splits the first guess `dv` into its prescribed part and the free first guess
-/// `y`, and sets the projections.
-fn split_prescribed(s: &mut ImplicitScratch, held: &[bool]) {
-    let n = s.dv.len();
-    let a = &mut s.direct;
-    a.projection.resize(n, None);
-    a.prescribed.resize(n, Vector::ZERO);
-    a.y.resize(n, Vector::ZERO);
-    a.projection
-        .par_iter_mut()
-        .zip(a.prescribed.par_iter_mut().zip(a.y.par_iter_mut()))
-        .zip(s.dv.par_iter().zip(s.filter.par_iter()))
-        .enumerate()
-        .with_min_len(PAR_MIN)
-        .for_each(|(i, ((proj, (c, y)), (dv, f)))| {
-            if held[i] {
-                (*proj, *c, *y) = (Some(Vector::ZERO), *dv, Vector::ZERO);
-            } else if *f != Vector::ZERO {
-                let normal = *f * f.dot(*dv);
-                (*proj, *c, *y) = (Some(*f), normal, *dv - normal);
-            } else {
-                (*proj, *c, *y) = (None, Vector::ZERO, *dv);
-            }
-        });
-}
-
-/// `S v` for one vertex's projection.
-#[inline(always)]
-fn project(proj: Option<Vector>, v: Vector) -> Vector {
-    match proj {
-        None => v,
-        Some(n) if n == Vector::ZERO => Vector::ZERO,
-        Some(n) => v - n * n.dot(v),
-    }
 }
 
 /// Preconditioned conjugate gradients on `A_s y = b_s`,

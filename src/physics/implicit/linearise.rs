@@ -1,13 +1,14 @@
 //! Linearisation of the implicit step, shared by both solvers: per-element blocks
 //! and slots (springs, hinges, shape triangles, membrane triangles, wind), then the per-vertex gather
 //! of the right-hand side `b`, the mass diagonal and the Jacobi diagonal, in a
-//! fixed order per vertex so the result is identical at any thread count.
+//! fixed order per vertex so the result is identical at any thread count; with
+//! the direct solver, the block matrix too, while the fold splits are solved.
 
 use rayon::prelude::*;
 
 use super::super::bending::dihedral_angle_and_gradient;
 use super::super::elements::Elements;
-use super::super::forces::{PAR_MIN, fold_angles_and_splits, spring_force, wind_share};
+use super::super::forces::{PAR_MIN, fold_angles, spring_force, wind_share};
 use super::super::membrane::{ColumnBlocks, MEMBRANE_SLOTS};
 use super::super::sewing::{capped_spring_force, capped_spring_stiffness};
 use super::super::shape::{SHAPE_SLOTS, rates, spread};
@@ -19,7 +20,8 @@ use crate::world::World;
 
 /// Builds the per-element blocks, the right-hand side `b` and the diagonal. With
 /// `newton`, `b` is the residual `h f(x, v) - M (v - v0)` at the current iterate
-/// instead of Baraff and Witkin's `h f(x0, v0) - h^2 K v0`.
+/// instead of Baraff and Witkin's `h f(x0, v0) - h^2 K v0`. With the direct
+/// solver, also gathers the block matrix ([`super::direct::gather`]).
 pub(super) fn linearise(st: &mut Stepper, model: &Model, w: &World, h: Scalar, newton: bool) {
     let started = std::time::Instant::now();
     let (el, ext) = (&st.elements, &model.external);
@@ -27,10 +29,37 @@ pub(super) fn linearise(st: &mut Stepper, model: &Model, w: &World, h: Scalar, n
     let s = &mut st.implicit;
     // The `-h^2 K v` term of the linearised step (none in a Newton residual).
     let k_term = if newton { 0.0 } else { 1.0 };
-    springs(s, el, x, v, h, k_term);
-    hinges(s, el, x, v, h, k_term);
-    shape_triangles(s, el, x, v, h, k_term);
-    membrane_triangles(s, el, x, v, h, k_term);
+    s.h2 = h * h;
+    fold_angles(el, x, &mut s.shape_folds, &mut s.shape_grad);
+    // The fold splits are a sequential sparse solve, which leaves the other
+    // cores idle: the other elements' terms and the direct solver's block
+    // matrix, which need no splits, are computed meanwhile. Each part's values
+    // are the same whichever runs first.
+    let folds = std::mem::take(&mut s.shape_folds);
+    let mut splits = std::mem::take(&mut s.shape_splits);
+    let direct = model.solver.solver == Solver::Direct;
+    rayon::join(
+        || {
+            el.fold_splits
+                .solve(&el.shape_triangles, &folds, &mut splits)
+        },
+        || {
+            springs(s, el, x, v, h, k_term);
+            hinges(s, el, x, v, h, k_term);
+            membrane_triangles(s, el, x, v, h, k_term);
+            if direct {
+                s.diag_mass.resize(x.len(), 0.0);
+                s.diag_mass
+                    .par_iter_mut()
+                    .enumerate()
+                    .with_min_len(PAR_MIN)
+                    .for_each(|(i, m)| *m = diagonal_mass(el, ext, h, i));
+                super::direct::gather(s, el);
+            }
+        },
+    );
+    (s.shape_folds, s.shape_splits) = (folds, splits);
+    shape_triangles(s, el, v, h, k_term);
     // Wind is explicit: its force at the start of the step serves every Newton
     // iteration (re-evaluated at each iterate, without its derivative in `A`, the
     // iterations diverged on a flag at 10 ms steps).
@@ -45,9 +74,18 @@ pub(super) fn linearise(st: &mut Stepper, model: &Model, w: &World, h: Scalar, n
             });
     }
     // The diagonal of `A` is the Jacobi preconditioner of `solver = "cg"` only.
-    let jacobi = model.solver.solver == Solver::Cg;
-    gather(s, el, ext, v, h, newton, jacobi);
+    gather(s, el, ext, v, h, newton, !direct);
     st.stats.assembly_s += started.elapsed().as_secs_f64();
+}
+
+/// Mass plus `h` times the drag coefficient of vertex `i`, kg: the diagonal of
+/// `M + h D` that no element adds to.
+#[inline(always)]
+fn diagonal_mass(el: &Elements, ext: &ExternalForces, h: Scalar, i: usize) -> Scalar {
+    match ext.drag {
+        Some(drag) => el.mass[i] + h * drag * el.vertex_area[i],
+        None => el.mass[i],
+    }
 }
 
 /// Per spring: the block `h^2 K_e + h D_e` and the slot `h f_e - h^2 K_e (v_a - v_b)`.
@@ -161,26 +199,17 @@ fn hinges(
         });
 }
 
-/// Per shape triangle: slot = J^T (-h dE/dtheta - h^2 M J v), and the
-/// Jacobian; the folds' splits are solved first (`shape.rs`).
+/// Per shape triangle: slot = J^T (-h dE/dtheta - h^2 M J v), from the folds,
+/// their Jacobian and the folds' splits (`shape.rs`), solved before.
 fn shape_triangles(
     s: &mut ImplicitScratch,
     el: &Elements,
-    x: &[Vector],
     v: &[Vector],
     h: Scalar,
     k_term: Scalar,
 ) {
-    s.h2 = h * h;
     let shapes = el.shape_triangles.len();
     s.shape_slot.resize(SHAPE_SLOTS * shapes, Vector::ZERO);
-    fold_angles_and_splits(
-        el,
-        x,
-        &mut s.shape_folds,
-        &mut s.shape_grad,
-        &mut s.shape_splits,
-    );
     let (folds, splits) = (&s.shape_folds, &s.shape_splits);
     s.shape_slot
         .par_chunks_exact_mut(SHAPE_SLOTS)
@@ -304,11 +333,10 @@ fn gather(
             if let Some(g) = ext.gravity {
                 rhs += g * (el.mass[i] * h);
             }
-            let mut m = el.mass[i];
             if let Some(drag) = ext.drag {
                 rhs -= (v[i] - ext.air_velocity) * (drag * el.vertex_area[i] * h);
-                m += h * drag * el.vertex_area[i];
             }
+            let m = diagonal_mass(el, ext, h, i);
             if newton {
                 rhs -= (v[i] - v0[i]) * el.mass[i];
             }
