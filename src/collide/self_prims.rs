@@ -189,18 +189,23 @@ pub(super) fn edge(a: u32, b: u32) -> [u32; 2] {
 mod tests {
     use super::*;
 
+    /// A seeded stream of numbers below a bound (a linear congruential
+    /// generator: the same stream on every machine).
+    fn numbers(mut seed: u64) -> impl FnMut(u32) -> u32 {
+        move |m: u32| {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((seed >> 33) as u32) % m
+        }
+    }
+
     /// Packed pairs sort as their fields do (kind, then the ids in order), and
     /// unpack to the same fields.
     #[test]
     fn packed_pairs_sort_like_their_fields() {
         let mut fields: Vec<(u8, [u32; 4])> = Vec::new();
-        let mut seed = 12345u64;
-        let mut next = |m: u32| {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((seed >> 33) as u32) % m
-        };
+        let mut next = numbers(12345);
         for _ in 0..500 {
             let big = if next(4) == 0 { (1 << ID_BITS) - 1 } else { 50 };
             let ids = [next(big), next(big), next(big), next(big)];
@@ -220,13 +225,7 @@ mod tests {
     /// them, duplicates (whatever their rest mark) reduced to their first copy.
     #[test]
     fn narrow_keys_sort_and_deduplicate_like_the_packed_pairs() {
-        let mut seed = 777u64;
-        let mut next = |m: u32| {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((seed >> 33) as u32) % m
-        };
+        let mut next = numbers(777);
         let bound = 1u32 << NARROW_ID_BITS;
         let mut prims = Vec::new();
         for _ in 0..2000 {
