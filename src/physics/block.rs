@@ -21,8 +21,9 @@
 //!    with a slot in the band, in triangle order, forms its products
 //!    `sum_b M_ab J_bl` once and adds its blocks `h^2 sum_a J_ak (M J)_al^T`
 //!    with their row in the band straight into them, by its precomputed slots,
-//!    and the Frobenius norms of its dropped blocks there into the diagonal
-//!    compensation; last the mass on the diagonal.
+//!    and the Frobenius norm of each dropped block into the diagonal
+//!    compensation of both its vertices that lie in the band (the lower block
+//!    serves its transpose too); last the mass on the diagonal.
 //!
 //! The shape triangles are the bulk (21 blocks each, against 3 per spring).
 //! Summed per block from the Jacobians, a triangle's products would be formed
@@ -78,7 +79,8 @@ pub use terms::{ElementBlocks, ElementTerms};
 
 use super::elements::Elements;
 use crate::math::{Matrix3, Vector};
-use buckets::{group_by_key, sorted_unique_rows};
+pub(crate) use buckets::group_by_key;
+use buckets::sorted_unique_rows;
 use sources::TermLayout;
 
 /// Rows per band of the assembly (module docs, "Assembly"). Any size gives the
@@ -88,16 +90,17 @@ use sources::TermLayout;
 /// about three grid rows) stay a third of them.
 const BAND_ROWS: usize = 512;
 
-/// One block `(k, l)` (slots) of a shape triangle that the assembly computes:
-/// a lower block, which it adds to block `slot`, or one that the
-/// factorization drops, whose Frobenius norm compensates the diagonal of `v[k]`
-/// (`[[s I, -B], [-B^T, s I]]` is positive semi-definite for `s >= |B|`, so the
-/// factored matrix stays positive definite; the tighter rank-one compensation
+/// One lower block `(k, l)` (slots) of a shape triangle, which the assembly
+/// computes and adds to block `slot`. When the factorization drops it, its
+/// Frobenius norm also compensates the diagonals of both its vertices, `v[k]`
+/// and `v[l]` (its transpose, the upper block, has the same norm):
+/// `[[s I, -B], [-B^T, s I]]` is positive semi-definite for `s >= |B|`, so the
+/// factored matrix stays positive definite (the tighter rank-one compensation
 /// `B B^T / |B|`, each such `B = u v^T` involving a tip, saves about 1 % of the
-/// iterations, not worth its code), or both.
+/// iterations, not worth its code).
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct ShapeOp {
-    /// The lower block it adds to, or [`ShapeOp::UPPER`].
+    /// The lower block it adds to.
     slot: u32,
     /// Its row slot.
     k: u8,
@@ -106,11 +109,6 @@ struct ShapeOp {
     /// Whether the factorization drops it (pair of used slots on distinct
     /// vertices whose block is not factored).
     dropped: bool,
-}
-
-impl ShapeOp {
-    /// The `slot` of an upper block (its norm alone is needed).
-    const UPPER: u32 = u32::MAX;
 }
 
 /// A fixed 3x3-block sparsity pattern for one mesh topology (module docs).

@@ -61,7 +61,7 @@ pub use reuse::RebuildCounts;
 use super::membrane::{MEMBRANE_SLOTS, Membrane, MembraneTriangle};
 use super::sewing::{SpringCap, sewing_springs};
 use super::shape::{
-    FoldSplits, SHAPE_SLOTS, ShapeScratch, ShapeTriangle, build_shape_triangles_into,
+    FoldEdges, FoldSplits, SHAPE_SLOTS, ShapeScratch, ShapeTriangle, build_shape_triangles_into,
 };
 use crate::math::{Scalar, Vector2};
 use crate::mesh::Mesh;
@@ -176,6 +176,9 @@ pub struct Elements {
     pub shape_triangles: Vec<ShapeTriangle>,
     /// The factored system of the shape triangles' fold splits.
     pub fold_splits: FoldSplits,
+    /// The shape triangles' interior edges, each once (their folds are
+    /// computed per edge).
+    pub fold_edges: FoldEdges,
     /// Springs where the vertex is the first end (`v[0]`).
     pub spring_first: Incidence,
     /// Springs where the vertex is the second end (`v[1]`).
@@ -285,6 +288,7 @@ impl Elements {
         std::mem::swap(&mut self.shape_triangles, &mut scratch.shapes);
         self.fold_splits = FoldSplits::new(&self.shape_triangles, splits)
             .expect("the plate matrices of a valid mesh are positive definite");
+        self.fold_edges = FoldEdges::build(&self.shape_triangles, n);
         edge_bending(mesh, mat, area, &mut self.springs, &mut self.hinges);
         sewing_springs(mesh, mat, &mut self.springs, &mut self.sewing_caps);
         self.fill_tables(n, mesh);

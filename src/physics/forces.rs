@@ -15,7 +15,7 @@ use super::bending::dihedral_angle_and_gradient;
 use super::elements::Elements;
 use super::membrane::MEMBRANE_SLOTS;
 use super::sewing::{cap_energy_change, cap_forces};
-use super::shape::{SHAPE_SLOTS, ShapeJacobian, spread};
+use super::shape::{EdgeFold, SHAPE_SLOTS, ShapeJacobian, spread};
 use crate::math::{Scalar, Vector, deterministic_sum};
 
 /// Element count below which a pass runs on one thread (splitting costs more).
@@ -68,6 +68,8 @@ pub struct ForceScratch {
     pub membrane: Vec<Vector>,
     /// A third of each triangle's wind force (the share of each of its vertices).
     pub triangle: Vec<Vector>,
+    /// Each interior edge's fold ([`crate::physics::shape::FoldEdges`]).
+    pub edge_folds: Vec<EdgeFold>,
     /// Each shape triangle's three folds.
     pub folds: Vec<[Scalar; 3]>,
     /// Each shape triangle's fold gradients by slot.
@@ -88,35 +90,41 @@ pub fn splits_at(el: &Elements, x: &[Vector]) -> Vec<Scalar> {
 
 /// Into `folds`, `gradients` and `splits`: each shape triangle's folds at
 /// `x` and their gradients by slot, then the splits that minimise the
-/// bending energy for them (`shape.rs`, "Splitting the folds").
+/// bending energy for them (`shape.rs`, "Splitting the folds"); `edges` is
+/// scratch ([`fold_angles`]).
 pub fn fold_angles_and_splits(
     el: &Elements,
     x: &[Vector],
+    edges: &mut Vec<EdgeFold>,
     folds: &mut Vec<[Scalar; 3]>,
     gradients: &mut Vec<ShapeJacobian>,
     splits: &mut Vec<Scalar>,
 ) {
-    fold_angles(el, x, folds, gradients);
+    fold_angles(el, x, edges, folds, gradients);
     el.fold_splits.solve(&el.shape_triangles, folds, splits);
 }
 
 /// Into `folds` and `gradients`: each shape triangle's folds at `x` and their
-/// gradients by slot (the first half of [`fold_angles_and_splits`]).
+/// gradients by slot (the first half of [`fold_angles_and_splits`]), read
+/// from each interior edge's fold, computed once into `edges`.
 pub fn fold_angles(
     el: &Elements,
     x: &[Vector],
+    edges: &mut Vec<EdgeFold>,
     folds: &mut Vec<[Scalar; 3]>,
     gradients: &mut Vec<ShapeJacobian>,
 ) {
     let shapes = el.shape_triangles.len();
+    el.fold_edges.compute(x, edges);
+    let edges = &*edges;
     folds.resize(shapes, [0.0; 3]);
     gradients.resize(shapes, [[Vector::ZERO; SHAPE_SLOTS]; 3]);
     folds
         .par_iter_mut()
         .zip(gradients.par_iter_mut())
-        .zip(el.shape_triangles.par_iter())
+        .enumerate()
         .with_min_len(PAR_MIN / SHAPE_SLOTS)
-        .for_each(|((folds, jac), t)| (*folds, *jac) = t.angles(x));
+        .for_each(|(t, (folds, jac))| (*folds, *jac) = el.fold_edges.angles(t, edges));
 }
 
 /// Into `folds` and `splits`: each shape triangle's folds at `x` and the
@@ -212,6 +220,7 @@ pub fn element_pass(
     fold_angles_and_splits(
         el,
         x,
+        &mut scratch.edge_folds,
         &mut scratch.folds,
         &mut scratch.fold_gradients,
         &mut scratch.splits,

@@ -74,7 +74,7 @@ use rayon::prelude::*;
 
 use super::forces::PAR_MIN;
 use super::membrane::ColumnBlocks;
-use super::shape::ShapeJacobian;
+use super::shape::{EdgeFold, ShapeJacobian};
 use super::{Contact, Model, Stepper};
 use crate::math::{Matrix3, Scalar, Vector, deterministic_sum};
 use crate::spec::Solver;
@@ -143,6 +143,8 @@ pub struct ImplicitScratch {
     hinge_slot: Vec<Vector>,
     shape_slot: Vec<Vector>,
     shape_grad: Vec<ShapeJacobian>,
+    /// Per interior edge: its fold (scratch of `fold_angles`).
+    edge_folds: Vec<EdgeFold>,
     /// Per shape triangle: its folds.
     shape_folds: Vec<[Scalar; 3]>,
     /// The fold splits at the step's start.

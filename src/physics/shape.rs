@@ -168,10 +168,12 @@
 //! with the part held at zero; -0.65 / -0.41 / -0.14 deg with it free.
 
 mod build;
+mod folds;
 mod split;
 
 pub use build::SPLIT_MIN_ANGLE_DEG;
 pub(crate) use build::{ShapeMatrix, ShapeScratch, build_shape_triangles_into};
+pub use folds::{EdgeFold, FoldEdges};
 pub use split::{FoldSplits, SplitError};
 
 use super::bending::{dihedral_angle, dihedral_angle_and_gradient};

@@ -11,7 +11,7 @@
 /// their original order: the result of a stable sort by key. Returns `start`
 /// (length `keys + 1`; the items of key `k` are `items[start[k]..start[k + 1]]`)
 /// and the items.
-pub(super) fn group_by_key<T: Copy>(keys: usize, pairs: &[(u32, T)]) -> (Vec<u32>, Vec<T>) {
+pub(crate) fn group_by_key<T: Copy>(keys: usize, pairs: &[(u32, T)]) -> (Vec<u32>, Vec<T>) {
     let mut start = vec![0u32; keys + 1];
     for &(k, _) in pairs {
         start[k as usize + 1] += 1;

@@ -87,8 +87,8 @@ impl BlockPattern {
 
     /// Per shape triangle, the blocks that the assembly computes ([`ShapeOp`]):
     /// each pair of used slots `(k, l)` (`k` outer, `l` inner, ascending) whose
-    /// block is in the lower triangle (`v[l] <= v[k]`) or dropped by the
-    /// factorization (`factored` is symmetric, so the lower block tells).
+    /// block is in the lower triangle (`v[l] <= v[k]`), marked when the
+    /// factorization drops it.
     fn build_shape_ops(&mut self, elements: &Elements) {
         let shapes = &elements.shape_triangles;
         let (mut start, mut ops) = (Vec::with_capacity(shapes.len() + 1), Vec::new());
@@ -98,13 +98,9 @@ impl BlockPattern {
             for k in (0..SHAPE_SLOTS).filter(|&k| active >> k & 1 != 0) {
                 for l in (0..SHAPE_SLOTS).filter(|&l| active >> l & 1 != 0) {
                     let (i, j) = (t.v[k], t.v[l]);
-                    let dropped = i != j && !self.factored[self.lower_slot(i, j) as usize];
-                    let slot = if j <= i {
-                        self.slot(i, j)
-                    } else {
-                        ShapeOp::UPPER
-                    };
-                    if slot != ShapeOp::UPPER || dropped {
+                    if j <= i {
+                        let slot = self.slot(i, j);
+                        let dropped = i != j && !self.factored[slot as usize];
                         let (k, l) = (k as u8, l as u8);
                         ops.push(ShapeOp {
                             slot,

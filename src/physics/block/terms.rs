@@ -49,8 +49,8 @@ pub struct ElementBlocks<'a> {
 pub struct ElementTerms {
     /// Per element, its lower blocks in [`lower_pairs`] order.
     pub(super) blocks: Vec<Matrix3>,
-    /// Per vertex, the Frobenius norms of its row's dropped shape blocks,
-    /// summed (by triangle, then by slot pair).
+    /// Per vertex, the Frobenius norms of the dropped shape blocks in its row
+    /// or column, summed (by triangle, then by lower slot pair).
     pub(super) sigma: Vec<Scalar>,
 }
 
@@ -107,10 +107,11 @@ pub(super) struct Band<'a> {
 }
 
 impl Band<'_> {
-    /// Computes shape triangle `t`'s blocks `ops` whose row is in the band
-    /// (with the triangle's Jacobian `jac`): adds the lower ones to their
-    /// blocks and the norms of the dropped ones to their rows' compensation.
-    /// The products `M J` are formed once for all its blocks.
+    /// Computes shape triangle `t`'s blocks `ops` with a vertex in the band
+    /// (with the triangle's Jacobian `jac`): adds each to its block when its
+    /// row is in the band, and a dropped one's norm to the compensation of
+    /// each of its two vertices in the band. The products `M J` are formed
+    /// once for all its blocks.
     #[inline(always)]
     pub fn add_shape(
         &mut self,
@@ -123,16 +124,23 @@ impl Band<'_> {
         times_m(&t.m, jac, &mut mj);
         let rows = self.first_row..self.first_row + self.sigma.len();
         for op in ops {
-            let row = t.v[op.k as usize] as usize;
-            if !rows.contains(&row) {
+            let (row, column) = (t.v[op.k as usize] as usize, t.v[op.l as usize] as usize);
+            let (in_row, in_column) = (rows.contains(&row), rows.contains(&column));
+            if !(in_row || op.dropped && in_column) {
                 continue;
             }
             let block = shape_block(jac, &mj, h2, op.k as usize, op.l as usize);
-            if op.slot != ShapeOp::UPPER {
+            if in_row {
                 self.lower[op.slot as usize - self.base] += block;
             }
             if op.dropped {
-                self.sigma[row - self.first_row] += frobenius(&block);
+                let norm = frobenius(&block);
+                if in_row {
+                    self.sigma[row - self.first_row] += norm;
+                }
+                if in_column {
+                    self.sigma[column - self.first_row] += norm;
+                }
             }
         }
     }

@@ -30,7 +30,13 @@ pub(super) fn linearise(st: &mut Stepper, model: &Model, w: &World, h: Scalar, n
     // The `-h^2 K v` term of the linearised step (none in a Newton residual).
     let k_term = if newton { 0.0 } else { 1.0 };
     s.h2 = h * h;
-    fold_angles(el, x, &mut s.shape_folds, &mut s.shape_grad);
+    fold_angles(
+        el,
+        x,
+        &mut s.edge_folds,
+        &mut s.shape_folds,
+        &mut s.shape_grad,
+    );
     // The fold splits are a sequential sparse solve, which leaves the other
     // cores idle: the other elements' terms and the direct solver's block
     // matrix, which need no splits, are computed meanwhile. Each part's values
