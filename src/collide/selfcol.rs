@@ -16,7 +16,7 @@ use parry3d_f64::bounding_volume::{Aabb, BoundingVolume};
 use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
 use rayon::prelude::*;
 
-use super::self_prims::{Prim, RestBounds, edge, sort_and_dedup};
+use super::self_prims::{PairSort, Prim, RestBounds, edge, sort_and_dedup};
 use super::volino::{Patches, ProjectedEdge};
 use crate::math::{Scalar, Vector};
 use crate::mesh::Mesh;
@@ -80,8 +80,8 @@ struct Scratch {
     /// Per patch: its box-overlapping triangle pairs.
     pairs: Vec<Vec<(u32, u32)>>,
     prims: Vec<Prim>,
-    /// The pairs' narrow sort keys (`self_prims::sort_and_dedup`).
-    narrow: Vec<u64>,
+    /// Scratch of `self_prims::sort_and_dedup`.
+    sort: PairSort,
     fixes: Vec<Fix>,
     /// Per primitive pair: its closest points at the start of the step (the same
     /// for every repulsion pass), `None` when they coincide.
@@ -243,7 +243,7 @@ impl SelfCollider {
         // copies the first is kept: one from a triangle pair far apart in rest
         // space, if any (`self_prims.rs`).
         let id_bound = x.len().max(tris.len());
-        sort_and_dedup(&mut s.prims, &mut s.narrow, id_bound);
+        sort_and_dedup(&mut s.prims, &mut s.sort, id_bound);
         // Parts that are close in the rest state cannot be held a thickness apart.
         let rest_points = &self.rest;
         let rest = |i: u32| rest_points[i as usize];
