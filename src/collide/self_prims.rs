@@ -94,15 +94,10 @@ impl Prim {
         self.0 >> 1 == other.0 >> 1
     }
 
-    /// The four vertices it moves.
-    pub(super) fn vertices(self, tris: &[[u32; 3]]) -> [u32; 4] {
-        match self.fields() {
-            (0, [v, t, ..]) => {
-                let [a, b, c] = tris[t as usize];
-                [v, a, b, c]
-            }
-            (_, ids) => ids,
-        }
+    /// How many of its four vertices ([`Prim::weights`]' order) make its
+    /// first part: 1 (the vertex) or 2 (the first edge).
+    pub(super) fn first_part(self) -> usize {
+        if self.fields().0 == 0 { 1 } else { 2 }
     }
 
     /// The four vertices of the pair and their weights: the relative position of

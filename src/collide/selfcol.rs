@@ -172,9 +172,10 @@ impl SelfCollider {
                         .par_iter()
                         .zip(s.start.par_iter())
                         .filter_map(|(p, start)| {
-                            let touched = p.vertices(tris).iter().any(|&i| moved[i as usize]);
-                            touched
-                                .then(|| self.fix(tris, *p, start.as_ref()?, x, v, &s.inv_mass))?
+                            // No start normal: the pair gives nothing.
+                            let start = start.as_ref()?;
+                            let touched = start.ids.iter().any(|&i| moved[i as usize]);
+                            touched.then(|| self.fix(tris, *p, start, x, v, &s.inv_mass))?
                         }),
                 );
             for buf in [&mut s.dx, &mut s.dv] {
@@ -380,6 +381,23 @@ impl SelfCollider {
         v: &[Vector],
         inv_mass: &[Scalar],
     ) -> Option<Fix> {
+        if self.apart_along(p, start, x) {
+            return None;
+        }
+        self.fix_measured(tris, p, start, x, v, inv_mass)
+    }
+
+    /// [`Self::fix`] from the pair's closest points at `x`, without the
+    /// test that spares them.
+    fn fix_measured(
+        &self,
+        tris: &[[u32; 3]],
+        p: Prim,
+        start: &StartSide,
+        x: &[Vector],
+        v: &[Vector],
+        inv_mass: &[Scalar],
+    ) -> Option<Fix> {
         let at1 = |i: u32| x[i as usize];
         let (ids0, w0, n0) = (start.ids, start.weights, start.normal);
         let (ids1, w1) = p.weights(tris, &at1);
@@ -419,6 +437,25 @@ impl SelfCollider {
             f.dv[k] = n * (s * mu);
         }
         Some(f)
+    }
+}
+
+impl SelfCollider {
+    /// True when at `x` every vertex of `p`'s first part lies more than a
+    /// thickness (with a margin for rounding) beyond every vertex of its
+    /// second part along the start normal. Then so do its closest points
+    /// (convex combinations of each part's vertices): the pair has not
+    /// crossed and is more than a thickness apart, and [`Self::fix`] would
+    /// find that after computing them.
+    #[inline(always)]
+    fn apart_along(&self, p: Prim, start: &StartSide, x: &[Vector]) -> bool {
+        let along = |k: usize| x[start.ids[k] as usize].dot(start.normal);
+        let first = p.first_part();
+        let low = (0..first).map(along).fold(Scalar::INFINITY, Scalar::min);
+        let high = (first..4)
+            .map(along)
+            .fold(Scalar::NEG_INFINITY, Scalar::max);
+        low - high > self.thickness * (1.0 + 1e-9)
     }
 }
 
