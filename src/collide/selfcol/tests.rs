@@ -14,6 +14,31 @@ fn strip() -> Mesh {
     Mesh::new(material, vec![[0, 1, 2], [1, 3, 2], [2, 3, 4], [3, 5, 4]]).expect("mesh")
 }
 
+/// A self-collider of thickness `thickness`, one pass, no culling.
+fn collider(thickness: Scalar) -> SelfCollider {
+    SelfCollider::new(&SelfCollision {
+        thickness,
+        iterations: 1,
+        culling: false,
+        patch_size: None,
+    })
+}
+
+/// The 15 primitive pairs of triangles `a` (id 0) and `b` (id 3) of [`strip`].
+fn every_prim(a: [u32; 3], b: [u32; 3]) -> Vec<Prim> {
+    let mut all = Vec::new();
+    for k in 0..3 {
+        all.push(Prim::vertex_triangle(a[k], 3, false));
+        all.push(Prim::vertex_triangle(b[k], 0, false));
+        for j in 0..3 {
+            let e = edge(a[k], a[(k + 1) % 3]);
+            let f = edge(b[j], b[(j + 1) % 3]);
+            all.push(Prim::edge_edge(e, f, false));
+        }
+    }
+    all
+}
+
 fn point() -> impl Strategy<Value = Vector> {
     (-1.0..1.0f64, -1.0..1.0f64, -1.0..1.0f64).prop_map(|(x, y, z)| Vector::new(x, y, z))
 }
@@ -32,12 +57,7 @@ proptest! {
         moves in proptest::collection::vec(point(), 6),
     ) {
         let thickness = 0.006;
-        let collider = SelfCollider::new(&SelfCollision {
-            thickness,
-            iterations: 1,
-            culling: false,
-            patch_size: None,
-        });
+        let collider = collider(thickness);
         let mesh = strip();
         let (a, b) = (mesh.triangles[0], mesh.triangles[3]);
         prop_assert!(!a.iter().any(|i| b.contains(i)));
@@ -56,16 +76,7 @@ proptest! {
             .collect();
         let mut kept = Vec::new();
         pair_prims(&mesh.triangles, &vb, 0, 3, false, &mut kept);
-        let mut all = Vec::new();
-        for k in 0..3 {
-            all.push(Prim::vertex_triangle(a[k], 3, false));
-            all.push(Prim::vertex_triangle(b[k], 0, false));
-            for j in 0..3 {
-                let e = edge(a[k], a[(k + 1) % 3]);
-                let f = edge(b[j], b[(j + 1) % 3]);
-                all.push(Prim::edge_edge(e, f, false));
-            }
-        }
+        let all = every_prim(a, b);
         prop_assert!(kept.iter().all(|p| all.contains(p)));
         for p in all {
             if !kept.contains(&p) {
@@ -109,12 +120,7 @@ fn side_by_side_triangles_keep_only_their_near_primitive_pairs() {
 #[test]
 fn a_pair_spared_by_the_normal_test_would_not_act() {
     let thickness = 0.006;
-    let collider = SelfCollider::new(&SelfCollision {
-        thickness,
-        iterations: 1,
-        culling: false,
-        patch_size: None,
-    });
+    let collider = collider(thickness);
     let mesh = strip();
     let (a, b) = (mesh.triangles[0], mesh.triangles[3]);
     let mut seed = 0x5eed_cafe_u64;
@@ -141,28 +147,18 @@ fn a_pair_spared_by_the_normal_test_would_not_act() {
         let x: Vec<Vector> = x0.iter().map(|p| *p + point() * 0.004).collect();
         let v: Vec<Vector> = (0..6).map(|_| point()).collect();
         let inv_mass = vec![1.0; 6];
-        for k in 0..3 {
-            let mut prims = vec![
-                Prim::vertex_triangle(a[k], 3, false),
-                Prim::vertex_triangle(b[k], 0, false),
-            ];
-            for j in 0..3 {
-                let e = edge(a[k], a[(k + 1) % 3]);
-                prims.push(Prim::edge_edge(e, edge(b[j], b[(j + 1) % 3]), false));
-            }
-            for p in prims {
-                let Some(start) = StartSide::of(p, &mesh.triangles, &x0) else {
-                    continue;
-                };
-                let measured = collider.fix_measured(&mesh.triangles, p, &start, &x, &v, &inv_mass);
-                acting += usize::from(measured.is_some());
-                if collider.apart_along(p, &start, &x) {
-                    spared += 1;
-                    assert!(
-                        measured.is_none(),
-                        "{p:?} was spared but acts: {measured:?}"
-                    );
-                }
+        for p in every_prim(a, b) {
+            let Some(start) = StartSide::of(p, &mesh.triangles, &x0) else {
+                continue;
+            };
+            let measured = collider.fix_measured(&mesh.triangles, p, &start, &x, &v, &inv_mass);
+            acting += usize::from(measured.is_some());
+            if collider.apart_along(p, &start, &x) {
+                spared += 1;
+                assert!(
+                    measured.is_none(),
+                    "{p:?} was spared but acts: {measured:?}"
+                );
             }
         }
     }
