@@ -1,4 +1,5 @@
-"""Blender-side code shared by the peer benchmarks drape_sphere.py and tablecloth.py.
+"""Blender-side code shared by the peer benchmarks drape_sphere.py and tablecloth.py
+(skirt.py uses the frame range, the timed loop and the read-back).
 
 Imported from inside Blender (`blender -b --python SCRIPT`): each script puts
 its own directory on sys.path first. Holds the command-line options both
@@ -226,8 +227,9 @@ def cloth_settings(mod, n_verts):
 def time_frames(scene, cloth):
     """The timed loop: scene.frame_set(f) for every simulated frame, from a
     cloth at rest on frame_start. Returns wall and process CPU time of the loop,
-    the wall time of each frame_set and the solver's CG iteration counts (its
-    per-frame average, read after each frame, and the largest)."""
+    the wall time of each frame_set, the solver's CG iteration counts (its
+    per-frame average, read after each frame, and the largest) and the set of
+    solver statuses seen."""
     scene.frame_set(scene.frame_start)
     depsgraph = bpy.context.evaluated_depsgraph_get()
 
@@ -239,6 +241,7 @@ def time_frames(scene, cloth):
     per_frame = []
     iters_avg = []
     iters_max = 0
+    statuses = set()
     cpu0 = time.process_time()
     t0 = time.perf_counter()
     for f in range(scene.frame_start + 1, scene.frame_end + 1):
@@ -246,12 +249,13 @@ def time_frames(scene, cloth):
         scene.frame_set(f)
         per_frame.append(time.perf_counter() - tf)
         st, avg_it, max_it = solver_result()
+        statuses.update(st)
         iters_avg.append(avg_it)
         iters_max = max(iters_max, max_it)
     wall = time.perf_counter() - t0
     cpu = time.process_time() - cpu0
     return {"wall": wall, "cpu": cpu, "per_frame": per_frame,
-            "iters_avg": iters_avg, "iters_max": iters_max}
+            "iters_avg": iters_avg, "iters_max": iters_max, "statuses": statuses}
 
 
 def world_positions(ob):
