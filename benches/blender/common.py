@@ -1,10 +1,13 @@
-"""Blender-side code shared by the peer benchmarks drape_sphere.py and tablecloth.py.
+"""Blender-side code shared by the peer benchmarks drape_sphere.py and tablecloth.py
+(skirt.py uses the frame range, the timed loop and the read-back).
 
 Imported from inside Blender (`blender -b --python SCRIPT`): each script puts
-its own directory on sys.path first. Holds the scene set-up both scenes share
-(the frame range, drape's rectangle grid, collider settings, drape's material
-in Blender's units), the timed frame loop and the read-back of every frame
-from the point cache. README.md beside this file explains each conversion.
+its own directory on sys.path first. Holds the command-line options both
+scripts share, the scene set-up both scenes share (the frame range, drape's
+rectangle grid, collider settings, drape's material in Blender's units), the
+timed frame loop and the read-back of every frame from the point cache.
+README.md beside this file explains each conversion. Without Blender (plain
+python3, tablecloth.py --obj-dir) only the options are usable.
 """
 
 import math
@@ -14,7 +17,10 @@ import sys
 import time
 from array import array
 
-import bpy
+try:
+    import bpy
+except ImportError:  # plain python3: only the command-line options
+    bpy = None
 
 # Blender's cloth solver runs in frames, not seconds: dt = time_scale /
 # quality frames, and gravity enters as 0.001 * g per frame^2 (SIM_cloth_solve /
@@ -31,6 +37,36 @@ BLENDER_DISTANCE_MIN_FLOOR = 0.001
 def script_argv():
     """The command line after Blender's `--`: the script's own options."""
     return sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
+
+
+def add_scene_options(p, *, toml, duration, quality_default, quality_help, fps=30.0):
+    """Adds the options of drape_sphere.py and tablecloth.py that are the same
+    in both, in this order: --quality (its default and help: the script's),
+    --fps, --frames, --duration, --diagonals (its help names `toml`, the scene
+    file) and --model. --out comes last: add_out_option."""
+    p.add_argument("--quality", type=int, default=quality_default, help=quality_help)
+    p.add_argument("--fps", type=float, default=fps,
+                   help=f"scene frames per second (default {fps:g})")
+    p.add_argument("--frames", type=int, default=None,
+                   help="simulated frames (default: round(duration * fps))")
+    p.add_argument("--duration", type=float, default=duration,
+                   help=f"simulated seconds (default {duration:g})")
+    p.add_argument("--diagonals", choices=["alternating", "regular", "quads"], default="alternating",
+                   help=f"grid triangulation: drape's default 'alternating' (what {toml} "
+                        "uses), drape's 'regular', or Blender quads")
+    p.add_argument("--model", choices=["default", "matched"], default="default",
+                   help="'default': Blender's default stiffness/damping, time_scale 1; "
+                        "'matched': stiffness, damping and time scale converted from drape")
+
+
+def add_out_option(p):
+    """Adds --out, the JSON summary's file."""
+    p.add_argument("--out", default=None, help="write the JSON summary here (also printed)")
+
+
+def frame_count(args):
+    """The simulated frames: --frames, or round(duration * fps)."""
+    return args.frames if args.frames is not None else int(round(args.duration * args.fps))
 
 
 def clear_scene():
@@ -191,8 +227,9 @@ def cloth_settings(mod, n_verts):
 def time_frames(scene, cloth):
     """The timed loop: scene.frame_set(f) for every simulated frame, from a
     cloth at rest on frame_start. Returns wall and process CPU time of the loop,
-    the wall time of each frame_set and the solver's CG iteration counts (its
-    per-frame average, read after each frame, and the largest)."""
+    the wall time of each frame_set, the solver's CG iteration counts (its
+    per-frame average, read after each frame, and the largest) and the set of
+    solver statuses seen."""
     scene.frame_set(scene.frame_start)
     depsgraph = bpy.context.evaluated_depsgraph_get()
 
@@ -204,6 +241,7 @@ def time_frames(scene, cloth):
     per_frame = []
     iters_avg = []
     iters_max = 0
+    statuses = set()
     cpu0 = time.process_time()
     t0 = time.perf_counter()
     for f in range(scene.frame_start + 1, scene.frame_end + 1):
@@ -211,12 +249,13 @@ def time_frames(scene, cloth):
         scene.frame_set(f)
         per_frame.append(time.perf_counter() - tf)
         st, avg_it, max_it = solver_result()
+        statuses.update(st)
         iters_avg.append(avg_it)
         iters_max = max(iters_max, max_it)
     wall = time.perf_counter() - t0
     cpu = time.process_time() - cpu0
     return {"wall": wall, "cpu": cpu, "per_frame": per_frame,
-            "iters_avg": iters_avg, "iters_max": iters_max}
+            "iters_avg": iters_avg, "iters_max": iters_max, "statuses": statuses}
 
 
 def world_positions(ob):

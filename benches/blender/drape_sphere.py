@@ -50,28 +50,19 @@ DURATION = 5.0  # s
 
 def parse_args():
     p = argparse.ArgumentParser(prog="drape_sphere.py")
-    p.add_argument("--quality", type=int, default=5, help="cloth steps per frame (default 5)")
-    p.add_argument("--fps", type=float, default=30.0, help="scene frames per second (default 30)")
-    p.add_argument("--frames", type=int, default=None,
-                   help="simulated frames (default: round(duration * fps))")
-    p.add_argument("--duration", type=float, default=DURATION, help="simulated seconds (default 5)")
-    p.add_argument("--diagonals", choices=["alternating", "regular", "quads"], default="alternating",
-                   help="grid triangulation: drape's default 'alternating' (what drape_sphere.toml "
-                        "uses), drape's 'regular', or Blender quads")
-    p.add_argument("--model", choices=["default", "matched"], default="default",
-                   help="'default': Blender's default stiffness/damping, time_scale 1; "
-                        "'matched': stiffness, damping and time scale converted from drape")
+    common.add_scene_options(p, toml="drape_sphere.toml", duration=DURATION, quality_default=5,
+                             quality_help="cloth steps per frame (default 5)")
     p.add_argument("--sphere-segments", type=int, default=64,
                    help="UV sphere segments (rings = half of it; default 64)")
     p.add_argument("--method", choices=["frame_set", "bake"], default="frame_set",
                    help="step frames with scene.frame_set (default) or bpy.ops.ptcache.bake")
-    p.add_argument("--out", default=None, help="write the JSON summary here (also printed)")
+    common.add_out_option(p)
     return p.parse_args(common.script_argv())
 
 
 def main():
     args = parse_args()
-    frames = args.frames if args.frames is not None else int(round(args.duration * args.fps))
+    frames = common.frame_count(args)
     sim_seconds = frames / args.fps
 
     common.clear_scene()

@@ -14,9 +14,10 @@ their pattern coordinates as `vt`, the side seams as `l` pairs, which become
 Blender's sewing edges: loose edges with `use_sewing_springs`) and the
 mannequin at rest as a Collision object. Pins the same waistband vertices,
 converts drape's material to Blender's units, times the `frame_set` loop
-(as drape_sphere.py does) and writes a JSON summary; with --frames-dir it
-also writes every frame (read back from the point cache after the timed
-loop) as an OBJ with the sewing pairs as `l` lines, for skirt_measure.py.
+(common.py's, as drape_sphere.py) and writes a JSON summary; with --frames-dir
+it also writes every frame (read back from the point cache after the timed
+loop, common.py's read-back) as an OBJ with the sewing pairs as `l` lines,
+for skirt_measure.py.
 README.md beside this file maps every setting and says where the models
 differ.
 """
@@ -28,11 +29,11 @@ import os
 import platform
 import statistics
 import sys
-import time
 
 import bpy
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import common  # noqa: E402  (the scene set-up, timed loop and read-back drape_sphere.py uses)
 from skirt_measure import read_obj  # noqa: E402  (the OBJ reader skirt_measure.py uses)
 
 # ------------------------------------------------- drape's scene, skirt_rest.toml
@@ -57,13 +58,10 @@ DURATION = 2.0  # s
 # physical; time_scale = 1 / (fps T) makes a frame 1/fps s. Stiffnesses (N/m =
 # kg/s^2) are multiplied by T^2, damping and drag coefficients (kg/s) by T,
 # forces (N) by T^2. See README.md (drape_sphere's `--model matched`).
-T = math.sqrt(0.001)
-
-BLENDER_DISTANCE_MIN_FLOOR = 0.001  # m, the cloth's smallest object distance
+T = common.SOLVER_UNIT_S
 
 
 def parse_args():
-    argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
     p = argparse.ArgumentParser(prog="skirt.py")
     p.add_argument("--skirt", required=True, help="the unsewn skirt OBJ (skirt/skirt.obj)")
     p.add_argument("--body", required=True, help="the body OBJ (skirt/body.obj)")
@@ -77,15 +75,8 @@ def parse_args():
                         "drape's largest initial pull of one sewn pair (stiffness x its share "
                         "of the seam x its gap in the OBJ); 0 = no cap (Blender's default)")
     p.add_argument("--frames-dir", default=None, help="write every frame here as an OBJ")
-    p.add_argument("--out", default=None, help="write the JSON summary here (also printed)")
-    return p.parse_args(argv)
-
-
-def clear_scene():
-    for ob in list(bpy.data.objects):
-        bpy.data.objects.remove(ob, do_unlink=True)
-    for me in list(bpy.data.meshes):
-        bpy.data.meshes.remove(me)
+    common.add_out_option(p)
+    return p.parse_args(common.script_argv())
 
 
 def vertex_patterns(obj):
@@ -129,14 +120,8 @@ def main():
     frames = int(round(args.duration * fps))
     quality = args.quality if args.quality is not None else math.ceil(1.0 / (fps * DT) - 1e-9)
 
-    clear_scene()
-    scene = bpy.context.scene
-    scene.render.fps = int(round(fps * 1000))
-    scene.render.fps_base = 1000.0
-    scene.frame_start = 1
-    scene.frame_end = 1 + frames  # frame 1 is the start; frames 2..N+1 are simulated
-    scene.use_gravity = True
-    scene.gravity = (0.0, 0.0, GRAVITY)
+    common.clear_scene()
+    scene = common.set_up_scene(fps, frames, GRAVITY)
 
     # ------------------------------------------------------------------ body
     body_obj = read_obj(args.body)
@@ -149,7 +134,7 @@ def main():
     body.modifiers.new("Collision", "COLLISION")
     coll = body.collision
     # Contact distance = cloth distance_min + collider thickness_outer = drape's 4 mm.
-    coll.thickness_outer = BODY_THICKNESS - BLENDER_DISTANCE_MIN_FLOOR
+    coll.thickness_outer = BODY_THICKNESS - common.BLENDER_DISTANCE_MIN_FLOOR
     coll.cloth_friction = 100.0 * FRICTION_KINETIC  # Blender's one coefficient is this x 0.01
 
     # ----------------------------------------------------------------- skirt
@@ -255,7 +240,7 @@ def main():
     s.shrink_min = 0.0
 
     c.use_collision = True
-    c.distance_min = BLENDER_DISTANCE_MIN_FLOOR
+    c.distance_min = common.BLENDER_DISTANCE_MIN_FLOOR
     c.collision_quality = args.collision_quality
     c.use_self_collision = True
     # Self contacts are triangle pairs closer than 2 x self_distance_min (collision.cc).
@@ -267,60 +252,22 @@ def main():
     cache.frame_start = scene.frame_start
     cache.frame_end = scene.frame_end
 
-    scene.frame_set(scene.frame_start)
-    depsgraph = bpy.context.evaluated_depsgraph_get()
-
-    def solver_result():
-        ev = cloth.evaluated_get(depsgraph)
-        r = ev.modifiers["Cloth"].solver_result
-        return r.status, r.avg_iterations, r.max_iterations
-
     # ---------------------------------------------------------------- simulate
-    per_frame = []
-    iters_avg = []
-    iters_max = 0
-    statuses = set()
-    cpu0 = time.process_time()
-    t0 = time.perf_counter()
-    for f in range(scene.frame_start + 1, scene.frame_end + 1):
-        tf = time.perf_counter()
-        scene.frame_set(f)
-        per_frame.append(time.perf_counter() - tf)
-        st, avg_it, max_it = solver_result()
-        statuses.update(st)
-        iters_avg.append(avg_it)
-        iters_max = max(iters_max, max_it)
-    wall = time.perf_counter() - t0
-    cpu = time.process_time() - cpu0
+    timed = common.time_frames(scene, cloth)
+    wall, cpu, per_frame = timed["wall"], timed["cpu"], timed["per_frame"]
+    iters_avg, iters_max = timed["iters_avg"], timed["iters_max"]
 
-    # ------------------------------------------- read back the cached frames
-    def positions():
-        dg = bpy.context.evaluated_depsgraph_get()
-        ev = cloth.evaluated_get(dg)
-        m = ev.to_mesh()
-        mw = ev.matrix_world
-        pts = [tuple(mw @ v.co) for v in m.vertices]
-        ev.to_mesh_clear()
-        return pts
-
+    # ---------------- read back the cached frames (outside the timing)
     gap_per_frame = []
     if args.frames_dir:
         os.makedirs(args.frames_dir, exist_ok=True)
-    for k, f in enumerate(range(scene.frame_start, scene.frame_end + 1)):
-        scene.frame_set(f)
-        pts = positions()
+    for k, pts in common.read_back_frames(scene, cloth, cache):
         gap_per_frame.append(max(math.dist(pts[a], pts[b]) for a, b in pairs))
         if args.frames_dir:
             write_frame(os.path.join(args.frames_dir, f"frame_{k:05d}.obj"), pts, sk)
     closed = next((k for k, g in enumerate(gap_per_frame) if g < WELD_GAP), None)
 
-    # Depsgraph cost of the same frames without the cloth modifier (not subtracted).
-    mod.show_viewport = False
-    scene.frame_set(scene.frame_start)
-    t1 = time.perf_counter()
-    for f in range(scene.frame_start + 1, scene.frame_end + 1):
-        scene.frame_set(f)
-    overhead = time.perf_counter() - t1
+    overhead = common.no_cloth_frame_stepping(scene, mod)
 
     out = {
         "engine": "blender",
@@ -387,20 +334,16 @@ def main():
             "max": max(per_frame),
             "all": [round(x, 5) for x in per_frame],
         },
-        "solver_status": sorted(statuses),
+        "solver_status": sorted(timed["statuses"]),
         "cg_iterations": {"per_frame_avg_mean": statistics.fmean(iters_avg), "max": iters_max},
         "initial_gap_max_m": gap_per_frame[0],
         "seams_closed_frame": closed,
         "seams_closed_s": closed / fps if closed is not None else None,
         "final_gap_max_m": gap_per_frame[-1],
         "gap_max_per_frame_m": [round(g, 6) for g in gap_per_frame],
-        "threads": {
-            "render_threads_mode": scene.render.threads_mode,
-            "render_threads": scene.render.threads,
-            "os_cpu_count": os.cpu_count(),
-        },
+        "threads": common.threads(scene),
         "host": platform.node(),
-        "cpu_model": _cpu_model(),
+        "cpu_model": common.cpu_model(),
     }
     text = json.dumps(out, indent=2)
     print("DRAPE_BLENDER_RESULT " + json.dumps({k: out[k] for k in (
@@ -431,17 +374,6 @@ def write_frame(path, pts, sk):
                 fh.write(f"# seam {s}\n")
                 seam = s
             fh.write(f"l {a + 1} {b + 1}\n")
-
-
-def _cpu_model():
-    try:
-        with open("/proc/cpuinfo") as fh:
-            for line in fh:
-                if line.startswith("model name"):
-                    return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor()
 
 
 if __name__ == "__main__":

@@ -41,6 +41,9 @@ try:
 except ImportError:  # plain python3: only the measure of OBJ frames (--obj-dir)
     bpy = None
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import common  # noqa: E402  (the code shared with drape_sphere.py; its options without Blender)
+
 # ---------------------------------------------------------------- drape's scene
 # Copied from scenes/tablecloth.toml; keep in sync.
 WIDTH = 1.6  # m
@@ -90,34 +93,22 @@ def default_quality(fps):
 
 
 def parse_args():
-    if bpy is not None:
-        argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
-    else:
-        argv = sys.argv[1:]
+    argv = common.script_argv() if bpy is not None else sys.argv[1:]
     p = argparse.ArgumentParser(prog="tablecloth.py")
     p.add_argument("--resolution", type=int, default=FINEST_RESOLUTION,
                    help=f"segments per side of the uniform cloth grid, even (default "
                         f"{FINEST_RESOLUTION}: the uniform mesh of drape's finest edges; "
                         f"{BASE_RESOLUTION} is drape's base mesh)")
-    p.add_argument("--quality", type=int, default=None,
-                   help="cloth steps per frame (default: drape's, ceil(1 / (fps dt)) with "
-                        "dt = 4 ms: 9 at 30 fps, a 3.70 ms substep)")
-    p.add_argument("--fps", type=float, default=FPS, help="scene frames per second (default 30)")
-    p.add_argument("--frames", type=int, default=None,
-                   help="simulated frames (default: round(duration * fps))")
-    p.add_argument("--duration", type=float, default=DURATION, help="simulated seconds (default 4)")
-    p.add_argument("--diagonals", choices=["alternating", "regular", "quads"], default="alternating",
-                   help="grid triangulation: drape's default 'alternating' (what tablecloth.toml "
-                        "uses), drape's 'regular', or Blender quads")
-    p.add_argument("--model", choices=["default", "matched"], default="default",
-                   help="'default': Blender's default stiffness/damping, time_scale 1; "
-                        "'matched': stiffness, damping and time scale converted from drape")
+    common.add_scene_options(
+        p, toml="tablecloth.toml", duration=DURATION, fps=FPS, quality_default=None,
+        quality_help="cloth steps per frame (default: drape's, ceil(1 / (fps dt)) with "
+                     "dt = 4 ms: 9 at 30 fps, a 3.70 ms substep)")
     p.add_argument("--collision-quality", type=int, default=2,
                    help="Blender's collision passes per substep (default 2, Blender's default)")
     p.add_argument("--obj-dir", default=None,
                    help="measure drape's OBJ frames (frame_*.obj) in this directory instead "
                         "of simulating; runs without Blender")
-    p.add_argument("--out", default=None, help="write the JSON summary here (also printed)")
+    common.add_out_option(p)
     args = p.parse_args(argv)
     if args.resolution < 2 or args.resolution % 2:
         p.error("--resolution must be even (the grid then has a vertex at the centre)")
@@ -348,12 +339,10 @@ def floor_object():
 def simulate(args):
     """Builds the scene in Blender, times the simulation, measures every frame
     and writes the JSON report."""
-    import common
-
     t_start = time.perf_counter()
     n = args.resolution
     fps = args.fps
-    frames = args.frames if args.frames is not None else int(round(args.duration * fps))
+    frames = common.frame_count(args)
     quality = args.quality if args.quality is not None else default_quality(fps)
 
     common.clear_scene()
@@ -480,7 +469,6 @@ def main():
     if args.obj_dir is not None:
         measure_obj_dir(args)
     else:
-        sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
         simulate(args)
 
 
