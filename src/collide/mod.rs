@@ -11,7 +11,9 @@
 //!    position against the shape; a path entering the solid is stopped at the entry point,
 //!    so no step size lets a vertex tunnel through a thin obstacle;
 //! 2. **proximity**: otherwise, a vertex closer than the obstacle's `thickness` to the
-//!    surface (or inside it) is in contact at its nearest surface point;
+//!    surface (or inside it) is in contact at its nearest surface point; one the
+//!    implicit solve held against a surface is in contact within 1.1 thicknesses
+//!    (the solve slides it along the tangent plane, off a curved surface);
 //! 3. **response**: the vertex is placed `thickness` outside the surface along the normal;
 //!    its velocity relative to the obstacle loses its approaching normal part `dvn`
 //!    (inelastic), and Coulomb friction acts on the tangential part `vt` (paper A; Bridson

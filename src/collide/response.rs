@@ -12,6 +12,15 @@ use crate::physics::Contact;
 /// contact (and of the implicit solve's contact filter).
 const CONTACT_MARGIN: Scalar = 1.0 + 1e-6;
 
+/// The contact margin, in thicknesses, of a vertex the implicit solve held
+/// against the surface (`pushed` > 0). The solve moves such a vertex along the
+/// surface's tangent plane, which leaves it off a curved or faceted surface by
+/// the square of its slide over twice the radius of curvature: it is still in
+/// contact, and is placed back a thickness out. Without this margin it would
+/// leave contact every other step on a ball, and the cloth it carries would
+/// jitter with a period of two steps.
+const PRESSED_MARGIN: Scalar = 1.1;
+
 /// Contact response of one vertex against one obstacle (module docs, steps 1-3).
 /// `p0` is the start-of-step position, `x`/`v` the state after the integrator;
 /// `start` and `end` are the obstacle at the two ends of the step. The path
@@ -43,7 +52,12 @@ pub(super) fn respond(
     let thick = b.thickness;
     // Signed distance of the start of the step from the surface.
     let start = b.probe(end, q0).signed;
-    let (n, offset) = contact_plane(b, end, q0, q1, start)?;
+    let margin = if pushed > 0.0 {
+        PRESSED_MARGIN
+    } else {
+        CONTACT_MARGIN
+    };
+    let (n, offset) = contact_plane(b, end, q0, q1, start, margin)?;
     let mut q = q1 + n * (offset + thick - n.dot(q1));
     let rot = pose1.rotation;
     let mut u = rot.inverse() * (*v - b.velocity_at(t1, end, pose1.transform_point(q)));
@@ -89,6 +103,7 @@ pub(super) fn respond(
     Some(Contact {
         normal,
         normal_speed: surface.dot(normal),
+        pressed: pushed > 0.0,
     })
 }
 
@@ -102,6 +117,7 @@ fn contact_plane(
     q0: Vector,
     q1: Vector,
     start: Scalar,
+    margin: Scalar,
 ) -> Option<(Vector, Scalar)> {
     if start >= 0.0
         && let Some((toi, n)) = b.first_entry(end, q0, q1)
@@ -109,7 +125,7 @@ fn contact_plane(
         return Some((n, n.dot(q0 + (q1 - q0) * toi)));
     }
     let p = b.probe(end, q1);
-    if p.signed < b.thickness * CONTACT_MARGIN {
+    if p.signed < b.thickness * margin {
         return Some((p.normal, p.normal.dot(q1) - p.signed));
     }
     None

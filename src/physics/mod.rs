@@ -153,6 +153,12 @@ pub struct Contact {
     pub normal: Vector,
     /// The obstacle surface's velocity along `normal` there, m/s.
     pub normal_speed: Scalar,
+    /// True when the step's implicit solve held the vertex against this
+    /// surface and the surface pushed (a compressive contact force): the next
+    /// step holds it again whatever its right-hand side says, and releases it
+    /// only once the surface would have to pull ([`crate::physics::implicit`],
+    /// "Pins and contacts").
+    pub pressed: bool,
 }
 
 /// Force elements of the current mesh plus scratch memory; no simulation state

@@ -801,6 +801,7 @@ fn remeshing_keeps_the_resting_contacts() {
     let on = |x: f64, z: f64, s: f64| Contact {
         normal: Vector::new(x, 0.0, z).normalize(),
         normal_speed: s,
+        pressed: false,
     };
     let free = Contact::default();
     let old = [on(0.0, 1.0, 0.0), on(1.0, 1.0, 0.2), free];

@@ -46,6 +46,7 @@ mod presets;
 mod recording;
 mod recording_run;
 mod remesh_ops;
+mod resting_contact;
 mod scene_errors;
 mod sewing_cap;
 mod sewing_cap_runs;
