@@ -7,8 +7,9 @@ use std::sync::atomic::AtomicBool;
 use drape::math::{Scalar, Vector};
 use drape::run::{RunOptions, run};
 use drape::scene::{SceneErrorKind as Kind, load_scene_str};
-use drape::sim::{SimParts, build};
 use drape::summary::Summary;
+
+use crate::common::Sim;
 
 /// A 1 m sheet at 8 segments, free: no pins, gravity and air drag only.
 const FALLING: &str = r#"name = "falling"
@@ -73,18 +74,9 @@ fn summary(text: &str, args: &[&str]) -> Summary {
 /// The run's final positions.
 fn final_positions(text: &str, args: &[&str]) -> Vec<Vector> {
     let scene = load_scene_str(text, "test.toml", &sets(args)).expect("scene");
-    let SimParts {
-        setup,
-        mut state,
-        mut pipeline,
-    } = build(&scene.resolve().expect("resolve")).expect("build");
-    let interval = scene.simulation.frame_interval();
-    for _ in 0..scene.simulation.frame_count() {
-        pipeline
-            .advance_frame(&setup, &mut state, interval)
-            .expect("frame");
-    }
-    state.world.x
+    let mut sim = Sim::new(&scene);
+    sim.run_frames(&scene);
+    sim.state.world.x
 }
 
 /// The height of a point falling from rest under gravity `g` against linear

@@ -183,6 +183,20 @@ impl Sim {
         Sim { setup, state, pipe }
     }
 
+    /// Every frame of `scene` (the one this simulation was built from), as a
+    /// run steps them (panics on a frame that fails).
+    pub fn run_frames(&mut self, scene: &Scene) {
+        let interval = scene.simulation.frame_interval();
+        for frame in 0..scene.simulation.frame_count() {
+            if let Err(e) = self
+                .pipe
+                .advance_frame(&self.setup, &mut self.state, interval)
+            {
+                panic!("frame {frame}: {e}");
+            }
+        }
+    }
+
     /// One step of `h` seconds (panics when it is rejected).
     pub fn step(&mut self, h: Scalar) {
         if let Err(e) = self.pipe.step(&self.setup, &mut self.state, h) {

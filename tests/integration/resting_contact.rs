@@ -4,7 +4,8 @@
 
 use drape::math::{Scalar, Vector};
 use drape::scene::load_scene_file;
-use drape::sim::{SimParts, build};
+
+use crate::common::Sim;
 
 /// `drape_sphere` (a sheet landing on a ball, 1/120 s steps) at 32 segments,
 /// run for `seconds`, then stepped `steps` more times at the scene's step.
@@ -19,27 +20,19 @@ fn jitter_on_the_ball(seconds: Scalar, steps: usize) -> (usize, Scalar) {
         "cloth.resolution=32".to_owned(),
     ];
     let scene = load_scene_file(std::path::Path::new(path), &sets).expect("scene");
-    let SimParts {
-        setup,
-        mut state,
-        mut pipeline,
-    } = build(&scene.resolve().expect("resolve")).expect("build");
-    let interval = scene.simulation.frame_interval();
-    for _ in 0..scene.simulation.frame_count() {
-        pipeline
-            .advance_frame(&setup, &mut state, interval)
-            .expect("frame");
-    }
+    let mut sim = Sim::new(&scene);
+    sim.run_frames(&scene);
     let h = 1.0 / 120.0;
-    let mut every_step = vec![true; state.world.v.len()];
-    let mut last: Vec<Vector> = state.world.v.clone();
+    let mut every_step = vec![true; sim.state.world.v.len()];
+    let mut last: Vec<Vector> = sim.state.world.v.clone();
     for _ in 0..steps {
-        pipeline.step(&setup, &mut state, h).expect("step");
-        for ((keeps, v), v0) in every_step.iter_mut().zip(&state.world.v).zip(&last) {
+        sim.step(h);
+        for ((keeps, v), v0) in every_step.iter_mut().zip(&sim.state.world.v).zip(&last) {
             *keeps &= v.length() > 0.01 && v.dot(*v0) < 0.0;
         }
-        last.clone_from(&state.world.v);
+        last.clone_from(&sim.state.world.v);
     }
+    let state = &sim.state;
     let reversing = every_step.iter().filter(|r| **r).count();
     let n = state.world.v.len() as Scalar;
     let rms = (state
