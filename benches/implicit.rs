@@ -9,7 +9,10 @@
 //! Cholesky reused as the preconditioner, refactored when its iterations cost more
 //! than a factorization worth 7 of them: the default), `direct_every_step`
 //! (`refactor_iterations = 1`: a factorization counted as one iteration, so nearly
-//! every step factors) and `cg` (matrix-free Jacobi CG).
+//! every step factors), `direct_single` (the same factor in single precision),
+//! `direct_laplacian` (one scalar factor of a weighted graph Laplacian plus the
+//! mass as the preconditioner, factored by the same rule) and `cg` (matrix-free
+//! Jacobi CG).
 //!
 //! After the Criterion groups, the time split per step (assembly, factorization,
 //! solve, the rest) of 60 further steps is printed for each case, and for the
@@ -35,17 +38,45 @@ use criterion::{BenchmarkId, Criterion, Throughput, criterion_group};
 use drape::physics::block::BlockPattern;
 use drape::physics::cholesky::{Factorization, Ordering};
 use drape::physics::elements::Elements;
-use drape::physics::{MaterialParams, Solver, StepStats};
+use drape::physics::{MaterialParams, Preconditioner, Solver, StepStats};
 use drape::scene::{BendingModel, DiagonalPattern, StiffnessRule};
 use drape::world::World;
 use sheet::setup;
 
-/// The solver cases: label, solver, refactor_iterations.
-const CASES: [(&str, Solver, u32); 3] = [
-    ("direct", Solver::Direct, 7),
-    ("direct_every_step", Solver::Direct, 1),
-    ("cg", Solver::Cg, 4),
+/// The solver cases: label, solver, refactor_iterations, preconditioner.
+const CASES: [(&str, Solver, u32, Preconditioner); 5] = [
+    ("direct", Solver::Direct, 7, Preconditioner::Factor),
+    (
+        "direct_every_step",
+        Solver::Direct,
+        1,
+        Preconditioner::Factor,
+    ),
+    (
+        "direct_single",
+        Solver::Direct,
+        7,
+        Preconditioner::FactorSingle,
+    ),
+    (
+        "direct_laplacian",
+        Solver::Direct,
+        7,
+        Preconditioner::Laplacian,
+    ),
+    ("cg", Solver::Cg, 4, Preconditioner::Factor),
 ];
+
+/// The sheet of a case with `bending`.
+fn case_sheet(
+    resolution: u32,
+    bending: BendingModel,
+    (solver, refactor, preconditioner): (Solver, u32, Preconditioner),
+) -> sheet::Sheet {
+    let mut sheet = setup(resolution, bending, solver, refactor);
+    sheet.model.solver.preconditioner = preconditioner;
+    sheet
+}
 
 fn implicit_step(c: &mut Criterion) {
     let mut group = c.benchmark_group("implicit_step");
@@ -54,8 +85,12 @@ fn implicit_step(c: &mut Criterion) {
         .measurement_time(Duration::from_secs(4))
         .sample_size(10);
     for resolution in [63u32, 127] {
-        for (label, solver, refactor) in CASES {
-            let mut sheet = setup(resolution, BendingModel::Dihedral, solver, refactor);
+        for (label, solver, refactor, preconditioner) in CASES {
+            let mut sheet = case_sheet(
+                resolution,
+                BendingModel::Dihedral,
+                (solver, refactor, preconditioner),
+            );
             let vertices = sheet.world.mesh.vertex_count() as u64;
             group.throughput(Throughput::Elements(vertices));
             group.bench_function(BenchmarkId::new(label, vertices), |b| {
@@ -72,16 +107,21 @@ fn implicit_step(c: &mut Criterion) {
 fn time_split() {
     println!("time split per step over 60 steps (after 30 warm-up steps), dt = 1/120 s:");
     for resolution in [63u32, 127] {
-        let dihedral = CASES
-            .map(|(label, solver, refactor)| (label, BendingModel::Dihedral, solver, refactor));
+        let dihedral = CASES.map(|(label, solver, refactor, p)| {
+            (label, BendingModel::Dihedral, (solver, refactor, p))
+        });
         let shape = (
             "direct shape_op",
             BendingModel::ShapeOperator,
-            Solver::Direct,
-            7,
+            (Solver::Direct, 7, Preconditioner::Factor),
         );
-        for (label, bending, solver, refactor) in dihedral.into_iter().chain([shape]) {
-            let mut sheet = setup(resolution, bending, solver, refactor);
+        let shape_single = (
+            "single shape_op",
+            BendingModel::ShapeOperator,
+            (Solver::Direct, 7, Preconditioner::FactorSingle),
+        );
+        for (label, bending, case) in dihedral.into_iter().chain([shape, shape_single]) {
+            let mut sheet = case_sheet(resolution, bending, case);
             let before = sheet.stepper.stats;
             let started = Instant::now();
             for _ in 0..60 {

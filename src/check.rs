@@ -9,8 +9,8 @@ use crate::physics::{Elements, ExternalForces, MaterialParams, Membrane, Model, 
 use crate::pins::PinPath;
 use crate::run::RunError;
 use crate::scene::{
-    AdaptCriterion, AdaptMethod, BendingModel, ClothShape, Integrator, PinMotion, Refactor, Scene,
-    Simulation, Solver, StiffnessRule, TimeStep,
+    AdaptCriterion, AdaptMethod, BendingModel, ClothShape, Integrator, PinMotion, Preconditioner,
+    Refactor, Scene, Simulation, Solver, StiffnessRule, TimeStep,
 };
 use crate::sim::SimBuildError;
 use crate::world::World;
@@ -420,6 +420,16 @@ fn describe_implicit_solver(s: &mut String, sim: &Simulation) {
         Solver::Cg => "cg (matrix-free, Jacobi preconditioner)".to_string(),
     };
     let _ = writeln!(s, "  linear solver: {solver}");
+    if sim.solver == Solver::Direct {
+        let factor = match sim.preconditioner {
+            Preconditioner::Factor => "the 3x3-block Cholesky factor, double precision",
+            Preconditioner::FactorSingle => "the 3x3-block Cholesky factor, single precision",
+            Preconditioner::Laplacian => {
+                "one scalar Cholesky factor of a weighted graph Laplacian plus the mass, for x, y and z"
+            }
+        };
+        let _ = writeln!(s, "  factored preconditioner: {factor}");
+    }
     let _ = writeln!(
         s,
         "  linear solves: relative residual {:e}, at most {} iterations (else the step fails and is retried)",

@@ -168,6 +168,21 @@ pub enum Refactor {
     PerMesh,
 }
 
+/// What the direct solver factors as the preconditioner of its conjugate
+/// gradients (`docs/model.md`, "The linear solver").
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum Preconditioner {
+    /// The 3x3-block Cholesky factor of the system matrix, in double precision.
+    #[default]
+    Factor,
+    /// The same factor with its values in single precision.
+    FactorSingle,
+    /// One scalar factor of a weighted graph Laplacian plus the mass, applied
+    /// to x, y and z alike.
+    Laplacian,
+}
+
 /// The time integrator.
 #[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq, Default)]
 #[serde(rename_all = "snake_case")]

@@ -28,6 +28,18 @@
 //! `ordering_by_vertex_fills_no_more_than_scalar_amd`). Most of what remains is
 //! faer's symbolic factorization on the scalar pattern.
 //!
+//! # Single precision
+//! A [`Precision::Single`] factor stores `L` in `f32`: half the memory traffic in
+//! the factorization and in every solve with it, which is what both are bound
+//! by on meshes of thousands of vertices. It serves only as the preconditioner
+//! of conjugate gradients that run in double precision, so a solve still
+//! reaches its tolerance; a less exact factor can only cost iterations. Before
+//! rounding, the matrix is scaled to unit diagonal, `D A D` with
+//! `D = diag(A)^-1/2`, and the solve applies `D (L L^T)^-1 D`: the rows of held
+//! and contact vertices (their mass alone on the diagonal) and of stretched
+//! cloth (its stiffness) differ by orders of magnitude, and unscaled the
+//! rounding of the large ones swamps the small.
+//!
 //! Why faer: it is pure Rust (no system BLAS or SuiteSparse to install), maintained,
 //! has a supernodal LL^T and LDL^T with AMD, and exposes the symbolic and numeric
 //! phases separately. The alternatives on crates.io either wrap C libraries
@@ -74,7 +86,7 @@ pub enum Ordering {
 }
 
 /// Scratch memory for faer, recreated (empty) when cloned.
-struct Workspace {
+pub(crate) struct Workspace {
     req: StackReq,
     buffer: MemBuffer,
 }
@@ -108,24 +120,143 @@ impl std::fmt::Debug for Workspace {
     }
 }
 
+/// The floating-point type of a factor's stored values (module docs, "Single
+/// precision").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Precision {
+    /// `f64`, the simulation's own precision.
+    #[default]
+    Double,
+    /// `f32`: half the memory traffic in the factorization and the solves.
+    Single,
+}
+
+/// A floating-point type faer factors in.
+pub(crate) trait FactorScalar: faer::traits::ComplexField + Copy + Default {
+    /// Neither infinite nor NaN.
+    fn finite(self) -> bool;
+}
+
+impl FactorScalar for f64 {
+    fn finite(self) -> bool {
+        self.is_finite()
+    }
+}
+
+impl FactorScalar for f32 {
+    fn finite(self) -> bool {
+        self.is_finite()
+    }
+}
+
+/// The numerical values of a factor `L` in one precision.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Numeric<T> {
+    factor: Vec<T>,
+}
+
+impl<T: FactorScalar> Numeric<T> {
+    /// Factors the `n x n` lower-triangle CSC matrix (`col_ptr`, `rows`) with
+    /// `values` on `symbolic`. Ok only when every stored value is finite.
+    pub(crate) fn factor(
+        &mut self,
+        symbolic: &SymbolicCholesky<u32>,
+        (n, col_ptr, rows): (usize, &[u32], &[u32]),
+        values: &[T],
+        workspace: &mut Option<Workspace>,
+    ) -> Result<(), FactorError> {
+        let structure = SymbolicSparseColMatRef::new_checked(n, n, col_ptr, None, rows);
+        let matrix = SparseColMatRef::new(structure, values);
+        let req = symbolic.factorize_numeric_llt_scratch::<T>(Par::Seq, Default::default());
+        let stack = workspace
+            .get_or_insert_with(|| Workspace::new(req))
+            .stack(req);
+        self.factor.resize(symbolic.len_val(), T::default());
+        let result = symbolic
+            .factorize_numeric_llt(
+                &mut self.factor,
+                matrix,
+                Side::Lower,
+                Default::default(),
+                Par::Seq,
+                stack,
+                Default::default(),
+            )
+            .map(|_| ());
+        // A pivot that is not positive (faer's only numerical failure), or one
+        // so small that the factor overflowed.
+        if result.is_err() || !self.factor.iter().all(|v| v.finite()) {
+            return Err(FactorError::NotPositiveDefinite);
+        }
+        Ok(())
+    }
+
+    /// Solves in place for the `columns` right-hand sides `rhs` holds, column
+    /// after column, with the factor on `symbolic`.
+    pub(crate) fn solve(
+        &self,
+        symbolic: &SymbolicCholesky<u32>,
+        rhs: &mut [T],
+        columns: usize,
+        workspace: &mut Option<Workspace>,
+    ) {
+        let n = rhs.len() / columns.max(1);
+        let llt = LltRef::<u32, T>::new(symbolic, &self.factor);
+        let req = symbolic.solve_in_place_scratch::<T>(columns, Par::Seq);
+        let stack = workspace
+            .get_or_insert_with(|| Workspace::new(req))
+            .stack(req);
+        let matrix = MatMut::from_column_major_slice_mut(rhs, n, columns);
+        llt.solve_in_place_with_conj(Conj::No, matrix, Par::Seq, stack);
+    }
+
+    /// Forgets the values (kept allocated).
+    fn clear(&mut self) {
+        self.factor.clear();
+    }
+}
+
 /// A Cholesky factor `A = L L^T` of the (projected) implicit system matrix, and the
 /// symbolic analysis of its pattern (module docs).
 #[derive(Debug, Clone, Default)]
 pub struct Factorization {
     /// Symbolic analysis of the current pattern (`None`: not analysed yet).
     symbolic: Option<Arc<SymbolicCholesky<u32>>>,
-    /// Numerical values of `L`.
-    factor: Vec<Scalar>,
-    /// True when `factor` holds a successful factorization.
+    /// The precision of the numerical factor.
+    precision: Precision,
+    /// The numerical factor in double precision.
+    double: Numeric<f64>,
+    /// The numerical factor in single precision.
+    single: Numeric<f32>,
+    /// True when the factor of `precision` holds a successful factorization.
     valid: bool,
     /// The CSC values of the matrix being factored.
     values: Vec<Scalar>,
     /// A right-hand side, flattened.
     rhs: Vec<Scalar>,
+    /// Single precision: per unknown, the scale `1 / sqrt(A_ii)` of the
+    /// factored matrix `D A D` (module docs, "Single precision").
+    scale: Vec<Scalar>,
+    /// `D A D`'s values and `D r` rounded to single precision.
+    values_single: Vec<f32>,
+    rhs_single: Vec<f32>,
     workspace: Option<Workspace>,
 }
 
 impl Factorization {
+    /// An empty factorization whose numerical factors will be of `precision`.
+    pub fn with_precision(precision: Precision) -> Factorization {
+        Factorization {
+            precision,
+            ..Default::default()
+        }
+    }
+
+    /// The precision of the numerical factor.
+    pub fn precision(&self) -> Precision {
+        self.precision
+    }
+
     /// Forgets the factor and the symbolic analysis (the pattern changed).
     pub fn reset(&mut self) {
         self.symbolic = None;
@@ -172,21 +303,11 @@ impl Factorization {
             }
             None => SymmetricOrdering::Amd,
         };
-        let symbolic = factorize_symbolic_cholesky(
-            structure,
-            Side::Lower,
-            ordering,
-            CholeskySymbolicParams {
-                // Module docs, "Supernodal always".
-                supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
-                ..Default::default()
-            },
-        )
-        .map_err(|_| FactorError::Setup)?;
-        // The values are sized by `factor`: an analysis that is only measured (the
-        // direct solver's choice of factor) allocates none.
-        self.factor.clear();
-        self.symbolic = Some(Arc::new(symbolic));
+        self.symbolic = Some(Arc::new(analyse_structure(structure, ordering)?));
+        // The values are sized by the numerical factorization: an analysis that
+        // is only measured (the direct solver's choice of factor) allocates none.
+        self.double.clear();
+        self.single.clear();
         self.valid = false;
         Ok(())
     }
@@ -205,36 +326,29 @@ impl Factorization {
         };
         pattern.csc_values(blocks, extra, &mut self.values);
         let (col_ptr, rows) = pattern.csc_structure();
-        let n = 3 * pattern.vertices();
-        let structure = SymbolicSparseColMatRef::new_checked(n, n, col_ptr, None, rows);
-        let matrix = SparseColMatRef::new(structure, &self.values);
-        let req = symbolic.factorize_numeric_llt_scratch::<Scalar>(Par::Seq, Default::default());
-        let stack = self
-            .workspace
-            .get_or_insert_with(|| Workspace::new(req))
-            .stack(req);
-        self.factor.resize(symbolic.len_val(), 0.0);
-        let result = symbolic.factorize_numeric_llt(
-            &mut self.factor,
-            matrix,
-            Side::Lower,
-            Default::default(),
-            Par::Seq,
-            stack,
-            Default::default(),
-        );
-        match result {
-            Ok(_) => {
-                self.valid = self.factor.iter().all(|v| v.is_finite());
-                if self.valid {
-                    Ok(())
-                } else {
-                    Err(FactorError::NotPositiveDefinite)
-                }
+        let structure = (3 * pattern.vertices(), col_ptr, rows);
+        let result = match self.precision {
+            Precision::Double => {
+                self.double
+                    .factor(&symbolic, structure, &self.values, &mut self.workspace)
             }
-            // The only numerical failure: a pivot that is not positive.
-            Err(_) => Err(FactorError::NotPositiveDefinite),
-        }
+            Precision::Single => {
+                equilibrate(
+                    (col_ptr, rows),
+                    &self.values,
+                    &mut self.scale,
+                    &mut self.values_single,
+                );
+                self.single.factor(
+                    &symbolic,
+                    structure,
+                    &self.values_single,
+                    &mut self.workspace,
+                )
+            }
+        };
+        self.valid = result.is_ok();
+        result
     }
 
     /// `z = A_f^-1 r` with the current factor (which must be valid).
@@ -245,19 +359,73 @@ impl Factorization {
         };
         self.rhs.clear();
         self.rhs.extend(r.iter().flat_map(|v| v.to_array()));
-        let n = self.rhs.len();
-        let llt = LltRef::<u32, Scalar>::new(&symbolic, &self.factor);
-        let req = symbolic.solve_in_place_scratch::<Scalar>(1, Par::Seq);
-        let stack = self
-            .workspace
-            .get_or_insert_with(|| Workspace::new(req))
-            .stack(req);
-        let rhs = MatMut::from_column_major_slice_mut(&mut self.rhs, n, 1);
-        llt.solve_in_place_with_conj(Conj::No, rhs, Par::Seq, stack);
+        match self.precision {
+            Precision::Double => {
+                self.double
+                    .solve(&symbolic, &mut self.rhs, 1, &mut self.workspace)
+            }
+            Precision::Single => {
+                self.rhs_single.clear();
+                self.rhs_single.extend(
+                    self.rhs
+                        .iter()
+                        .zip(&self.scale)
+                        .map(|(r, d)| (r * d) as f32),
+                );
+                self.single
+                    .solve(&symbolic, &mut self.rhs_single, 1, &mut self.workspace);
+                for ((out, v), d) in self.rhs.iter_mut().zip(&self.rhs_single).zip(&self.scale) {
+                    *out = Scalar::from(*v) * d;
+                }
+            }
+        }
         for (out, c) in z.iter_mut().zip(self.rhs.chunks_exact(3)) {
             *out = Vector::new(c[0], c[1], c[2]);
         }
     }
+}
+
+/// The lower-triangle CSC matrix (`col_ptr`, `rows`, `values`; each column's
+/// diagonal first) scaled to unit diagonal, `D A D` with `D = diag(A)^-1/2`,
+/// rounded to single precision into `out`, and `D` into `scale`.
+fn equilibrate(
+    (col_ptr, rows): (&[u32], &[u32]),
+    values: &[Scalar],
+    scale: &mut Vec<Scalar>,
+    out: &mut Vec<f32>,
+) {
+    let n = col_ptr.len() - 1;
+    scale.clear();
+    scale.extend((0..n).map(|c| {
+        let d = values[col_ptr[c] as usize];
+        if d > 0.0 { 1.0 / d.sqrt() } else { 1.0 }
+    }));
+    out.clear();
+    for c in 0..n {
+        let (s, e) = (col_ptr[c] as usize, col_ptr[c + 1] as usize);
+        for k in s..e {
+            out.push((values[k] * scale[rows[k] as usize] * scale[c]) as f32);
+        }
+    }
+}
+
+/// faer's symbolic analysis of a lower-triangle structure with `ordering`,
+/// supernodal always (module docs).
+pub(crate) fn analyse_structure(
+    structure: SymbolicSparseColMatRef<'_, u32>,
+    ordering: SymmetricOrdering<'_, u32>,
+) -> Result<SymbolicCholesky<u32>, FactorError> {
+    factorize_symbolic_cholesky(
+        structure,
+        Side::Lower,
+        ordering,
+        CholeskySymbolicParams {
+            // Module docs, "Supernodal always".
+            supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+            ..Default::default()
+        },
+    )
+    .map_err(|_| FactorError::Setup)
 }
 
 /// The fill-reducing ordering of `pattern`'s scalar unknowns (module docs,

@@ -13,6 +13,7 @@ pub mod elements;
 pub mod explicit;
 pub mod forces;
 pub mod implicit;
+pub mod laplacian;
 pub mod membrane;
 pub mod multirate;
 /// Pinned vertices (a top-level module, [`crate::pins`], so that `world` needs nothing
@@ -23,7 +24,7 @@ pub mod shape;
 pub mod timestep;
 pub mod work;
 
-pub use crate::spec::{Refactor, Solver};
+pub use crate::spec::{Preconditioner, Refactor, Solver};
 pub use elements::{Elements, Hinge, MaterialParams, Spring};
 pub use forces::{Energy, ExternalForces, WindForce};
 pub use implicit::SolveFailure;
@@ -63,6 +64,8 @@ pub struct SolverSettings {
     pub refactor_iterations: u32,
     /// Direct solver: when it factors anew.
     pub refactor: Refactor,
+    /// Direct solver: what it factors as its preconditioner.
+    pub preconditioner: Preconditioner,
     /// Newton iterations per step (1: Baraff and Witkin's linearised step).
     pub newton_iterations: u32,
     /// Relative residual at which Newton iterations stop.
@@ -77,6 +80,7 @@ impl Default for SolverSettings {
             solver: Solver::Direct,
             refactor_iterations: 7,
             refactor: Refactor::Cost,
+            preconditioner: Preconditioner::Factor,
             newton_iterations: 1,
             newton_tolerance: 1e-3,
         }
@@ -116,6 +120,14 @@ pub struct StepStats {
     pub factorization_s: f64,
     /// Wall time spent in the iterations of the linear solves, s.
     pub solve_s: f64,
+    /// Wall time in the remeshing passes (the criterion, the operations and the
+    /// transfer of the state onto the new mesh, rollbacks' refinements
+    /// included), s.
+    pub remesh_s: f64,
+    /// Wall time rebuilding the force elements, the fold splits' factor and
+    /// the solver's tables after the mesh changed, s (the new matrix's
+    /// ordering and factorization count in `factorization_s`).
+    pub rebuild_s: f64,
 }
 
 impl StepStats {
@@ -140,6 +152,12 @@ impl StepStats {
                 self.assembly_s,
                 self.factorization_s,
                 self.solve_s
+            );
+        }
+        if self.remesh_s > 0.0 || self.rebuild_s > 0.0 {
+            s += &format!(
+                "; remeshing {:.2} s, rebuilding after it {:.2} s",
+                self.remesh_s, self.rebuild_s
             );
         }
         s + &format!(", {} failed solves", self.failed_solves)

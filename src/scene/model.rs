@@ -11,8 +11,8 @@ use crate::physics::membrane::{Membrane, Orthotropic};
 pub use crate::spec::{
     Adapt, AdaptCriterion, AdaptEvery, AdaptMethod, BendingModel, BodySurface, ClothShape,
     DEFAULT_THICKNESS, DiagonalPattern, Integrator, Keyframe, KeyframeAfter, KeyframeEasing,
-    Measurement, MembraneModel, Obstacle, ObstacleShape, Part, Pin, PinMotion, Refactor,
-    SelfCollision, SequenceFiles, Solver, StiffnessRule,
+    Measurement, MembraneModel, Obstacle, ObstacleShape, Part, Pin, PinMotion, Preconditioner,
+    Refactor, SelfCollision, SequenceFiles, Solver, StiffnessRule,
 };
 
 /// A whole scene file.
@@ -168,6 +168,10 @@ pub struct Simulation {
     /// Direct solver: when it factors its matrix anew.
     #[serde(default)]
     pub refactor: Refactor,
+    /// Direct solver: what it factors as the preconditioner of its conjugate
+    /// gradients.
+    #[serde(default)]
+    pub preconditioner: Preconditioner,
     /// Newton iterations per implicit step (1: the linearised step of Baraff and Witkin).
     #[serde(default = "default_newton_iterations")]
     pub newton_iterations: u32,

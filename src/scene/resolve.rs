@@ -192,6 +192,7 @@ impl Model {
                 solver: scene.simulation.solver,
                 refactor_iterations: scene.simulation.refactor_iterations,
                 refactor: scene.simulation.refactor,
+                preconditioner: scene.simulation.preconditioner,
                 newton_iterations: scene.simulation.newton_iterations,
                 newton_tolerance: scene.simulation.newton_tolerance,
             },

@@ -526,6 +526,8 @@ fn absorb(total: &mut StepStats, step: &mut StepStats) {
         assembly_s,
         factorization_s,
         solve_s,
+        remesh_s,
+        rebuild_s,
     } = std::mem::take(step);
     total.steps += steps;
     total.cg_iterations += cg_iterations;
@@ -539,6 +541,8 @@ fn absorb(total: &mut StepStats, step: &mut StepStats) {
     total.assembly_s += assembly_s;
     total.factorization_s += factorization_s;
     total.solve_s += solve_s;
+    total.remesh_s += remesh_s;
+    total.rebuild_s += rebuild_s;
 }
 
 /// The step at most `target` long (to a relative 1e-12) that divides `span`

@@ -88,3 +88,22 @@ impl BlockPattern {
             });
     }
 }
+
+impl BlockPattern {
+    /// Per entry of [`BlockPattern::vertex_structure`], in its order: the lower
+    /// block it reads.
+    pub fn vertex_structure_blocks(&self) -> Vec<u32> {
+        let n = self.vertices();
+        let mut blocks = Vec::new();
+        for j in 0..n {
+            let (s, e) = (self.row_start[j] as usize, self.row_start[j + 1] as usize);
+            for slot in s..e {
+                let i = self.columns[slot];
+                if i as usize >= j && self.factored[slot] {
+                    blocks.push(slot as u32);
+                }
+            }
+        }
+        blocks
+    }
+}

@@ -56,18 +56,20 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 mod assembly;
+mod factors;
 
 pub(super) use assembly::{assemble, gather};
+use factors::{precision, refactor, switch_to_full_factor};
 
 use super::SolveFailure;
 use super::cg::dot;
 use super::refactor::RefactorPolicy;
 use crate::math::{Matrix3, Scalar, Vector};
 use crate::physics::block::{BlockPattern, ElementTerms};
-use crate::physics::cholesky::{FactorError, Factorization};
-use crate::physics::elements::Elements;
+use crate::physics::cholesky::Factorization;
 use crate::physics::forces::PAR_MIN;
-use crate::physics::{Model, Refactor, StepStats, Stepper};
+use crate::physics::laplacian::LaplacianFactor;
+use crate::physics::{Model, Preconditioner, Refactor, StepStats, Stepper};
 
 /// Iterations with a fresh factor of the reduced matrix (block module docs) at
 /// which the solver first asks whether factoring the tip-tip blocks too would be
@@ -102,6 +104,10 @@ pub(super) struct DirectScratch {
     /// Per vertex: `None` free, `Some(0)` held, `Some(n)` contact normal.
     projection: Vec<Option<Vector>>,
     factorization: Factorization,
+    /// What is factored: the block factor `factorization` (in its precision) or
+    /// the scalar `laplacian`.
+    preconditioner: Preconditioner,
+    laplacian: LaplacianFactor,
     /// When to factor anew (its module docs).
     policy: RefactorPolicy,
     prescribed: Vec<Vector>,
@@ -120,6 +126,37 @@ impl DirectScratch {
         self.pattern = None;
         self.tips_break_even = None;
         self.factorization.reset();
+        self.laplacian.reset();
+    }
+
+    /// Makes `preconditioner` the one factored from now on (a change forgets
+    /// the factor).
+    fn choose(&mut self, preconditioner: Preconditioner) {
+        if preconditioner == self.preconditioner
+            && self.factorization.precision() == precision(preconditioner)
+        {
+            return;
+        }
+        self.preconditioner = preconditioner;
+        self.factorization = Factorization::with_precision(precision(preconditioner));
+        self.laplacian.reset();
+    }
+
+    /// True when the chosen preconditioner holds a factor.
+    fn factor_valid(&self) -> bool {
+        match self.preconditioner {
+            Preconditioner::Laplacian => self.laplacian.is_valid(),
+            _ => self.factorization.is_valid(),
+        }
+    }
+
+    /// `z = P^-1 r` with the chosen preconditioner's factor.
+    fn precondition(&mut self) {
+        self.z.resize(self.r.len(), Vector::ZERO);
+        match self.preconditioner {
+            Preconditioner::Laplacian => self.laplacian.solve(&self.r, &mut self.z),
+            _ => self.factorization.solve(&self.r, &mut self.z),
+        }
     }
 }
 
@@ -161,9 +198,11 @@ fn iterate(
     let cap = model.cg_max_iterations;
     let rule = model.solver.refactor;
     let a = &mut st.implicit.direct;
-    let mut fresh = !a.factorization.is_valid() || renew_at_start(a, rule, factorization_cost);
+    a.choose(model.solver.preconditioner);
+    let mass = &st.elements.mass;
+    let mut fresh = !a.factor_valid() || renew_at_start(a, rule, factorization_cost);
     if fresh {
-        refactor(a, pattern, &mut st.stats)?;
+        refactor(a, pattern, mass, &mut st.stats)?;
         a.policy.factored(false);
     }
     let mut started = Instant::now();
@@ -183,7 +222,11 @@ fn iterate(
                 let failure = SolveFailure::not_converged(total, norm, reference, tolerance);
                 break 'restart Err(failure);
             }
-            if fresh && since_factor >= TIPS_CONSIDER && !a.factor_tips {
+            if fresh
+                && since_factor >= TIPS_CONSIDER
+                && !a.factor_tips
+                && a.preconditioner != Preconditioner::Laplacian
+            {
                 st.stats.solve_s += started.elapsed().as_secs_f64();
                 let switched = switch_to_full_factor(
                     a,
@@ -210,7 +253,7 @@ fn iterate(
                 )
             {
                 st.stats.solve_s += started.elapsed().as_secs_f64();
-                refactor(a, pattern, &mut st.stats)?;
+                refactor(a, pattern, mass, &mut st.stats)?;
                 a.policy.factored(true);
                 started = Instant::now();
                 fresh = true;
@@ -268,57 +311,12 @@ fn give_up(
 /// Starts (or restarts) the preconditioned iteration from the residual `r`:
 /// `z = M^-1 r` (one solve with the factor), `p = z`. Returns `r.z` and `r.r`.
 fn pcg_start(a: &mut DirectScratch, stats: &mut StepStats) -> (Scalar, Scalar) {
-    a.z.resize(a.r.len(), Vector::ZERO);
-    a.factorization.solve(&a.r, &mut a.z);
+    a.precondition();
     stats.factor_solves += 1;
     a.p.clone_from(&a.z);
     let rz = dot(&a.r, &a.z);
     let rr = dot(&a.r, &a.r);
     (rz, rr)
-}
-
-/// Asked once a fresh reduced factor has needed `since_factor` (at least
-/// [`TIPS_CONSIDER`]) iterations: is it so poor a preconditioner here that the
-/// full one is cheaper (module docs, "Which factor")? If so, switches to factoring
-/// every block for the rest of the run, factors `A_s` that way and returns true.
-fn switch_to_full_factor(
-    a: &mut DirectScratch,
-    pattern: &BlockPattern,
-    elements: &Elements,
-    factorization_cost: Scalar,
-    since_factor: u32,
-    stats: &mut StepStats,
-) -> Result<bool, SolveFailure> {
-    let mut full = None;
-    let break_even = match a.tips_break_even {
-        Some(k) => k,
-        None => {
-            let (k, pattern, analysed) =
-                tips_break_even(a, pattern, elements, factorization_cost, stats)?;
-            a.tips_break_even = Some(k);
-            full = Some((pattern, analysed));
-            k
-        }
-    };
-    if Scalar::from(since_factor) >= break_even {
-        // Factor every block from now on (same blocks, so `pattern` still serves
-        // the products).
-        let (full, analysed) = match full {
-            Some(f) => f,
-            None => (
-                Arc::new(BlockPattern::build(pattern.vertices(), elements, true)),
-                Factorization::default(),
-            ),
-        };
-        a.factor_tips = true;
-        a.pattern = Some(full.clone());
-        a.compensation.iter_mut().for_each(|m| *m = Matrix3::ZERO);
-        a.factorization = analysed;
-        refactor(a, &full, stats)?;
-        a.policy.factored(false);
-        return Ok(true);
-    }
-    Ok(false)
 }
 
 /// One conjugate-gradient step from `p` and `rz = r.z`: `A_s p`, then the update
@@ -346,7 +344,7 @@ fn pcg_update(a: &mut DirectScratch, alpha: Scalar, rz: Scalar) -> Scalar {
             *y += *p * alpha;
             *r -= *ap * alpha;
         });
-    a.factorization.solve(&a.r, &mut a.z);
+    a.precondition();
     let rz_new = dot(&a.r, &a.z);
     let beta = rz_new / rz;
     a.p.par_iter_mut()
@@ -366,57 +364,6 @@ fn residual(a: &mut DirectScratch, pattern: &BlockPattern) {
         .zip(a.rhs.par_iter().zip(a.ap.par_iter()))
         .with_min_len(PAR_MIN)
         .for_each(|(r, (b, ap))| *r = *b - *ap);
-}
-
-/// The break-even of module docs, "Which factor": `F (rho - 1) + rho` for the
-/// current pattern, with the full pattern and its analysis (kept in case the
-/// solver switches at once). Counts as one symbolic analysis, timed with the
-/// factorizations.
-fn tips_break_even(
-    a: &DirectScratch,
-    pattern: &BlockPattern,
-    elements: &Elements,
-    factorization_cost: Scalar,
-    stats: &mut StepStats,
-) -> Result<(Scalar, Arc<BlockPattern>, Factorization), SolveFailure> {
-    let started = Instant::now();
-    let full = Arc::new(BlockPattern::build(pattern.vertices(), elements, true));
-    let mut analysed = Factorization::default();
-    analysed.analyse(&full).map_err(|_| SolveFailure::Setup)?;
-    stats.symbolic_analyses += 1;
-    stats.factorization_s += started.elapsed().as_secs_f64();
-    let rho = match (analysed.stored_values(), a.factorization.stored_values()) {
-        (Some(f), Some(r)) if r > 0 => f as Scalar / r as Scalar,
-        _ => return Err(SolveFailure::Setup),
-    };
-    Ok((factorization_cost * (rho - 1.0) + rho, full, analysed))
-}
-
-/// Factors `A_s`, analysing the pattern first when needed.
-fn refactor(
-    a: &mut DirectScratch,
-    pattern: &BlockPattern,
-    stats: &mut StepStats,
-) -> Result<(), SolveFailure> {
-    let started = Instant::now();
-    let map = |e: FactorError| match e {
-        FactorError::NotPositiveDefinite => SolveFailure::NotPositiveDefinite,
-        FactorError::Setup => SolveFailure::Setup,
-    };
-    if !a.factorization.is_analysed() {
-        a.factorization.analyse(pattern).map_err(map)?;
-        stats.symbolic_analyses += 1;
-    }
-    let result = a
-        .factorization
-        .factor(pattern, &a.system, &a.compensation)
-        .map_err(map);
-    stats.factorizations += 1;
-    if a.factor_tips {
-        stats.full_factorizations += 1;
-    }
-    stats.factorization_s += started.elapsed().as_secs_f64();
-    result
 }
 
 /// The contacts' normal impulses from the linear residual `A dv - b`, with the

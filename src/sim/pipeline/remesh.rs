@@ -3,6 +3,8 @@
 //! end of a frame.
 
 use super::Pipeline;
+use std::time::Instant;
+
 use crate::adapt::transfer::carry_contacts;
 use crate::adapt::{Measured, edge_angles_into};
 use crate::math::{Scalar, Vector};
@@ -102,11 +104,13 @@ impl Pipeline {
         let old_vertices = state.world.x.len();
         let had_contacts = !start_contacts.is_empty();
         let steps_done = state.ledger.steps_done;
+        let started = Instant::now();
         let carried = if ad.refine(config, &mut state.world, &marks, steps_done)? {
             carry_contacts(&start_contacts, old_vertices, ad.last_origins())
         } else {
             Some(start_contacts).filter(|c| c.len() == old_vertices)
         };
+        state.effort.solver.remesh_s += started.elapsed().as_secs_f64();
         self.mesh_changed_with(setup, state, carried, had_contacts);
         *tries += 1;
         Ok(true)
@@ -156,13 +160,18 @@ impl Pipeline {
             obstacle_planes: &self.obstacle_planes,
         };
         let old_vertices = state.world.x.len();
+        let started = Instant::now();
         let changed = ad.remesh_with(config, &mut state.world, step, known)?;
         self.angles_fresh = false;
+        if !changed {
+            state.effort.solver.remesh_s += started.elapsed().as_secs_f64();
+        }
         if changed {
             // The contacts the last step ended in, carried onto the new mesh:
             // the next implicit step filters them as it would have (see
             // `crate::adapt::transfer::carry_contacts`).
             let carried = carry_contacts(&state.contacts, old_vertices, ad.last_origins());
+            state.effort.solver.remesh_s += started.elapsed().as_secs_f64();
             let had_contacts = !state.contacts.is_empty();
             self.mesh_changed_with(setup, state, carried, had_contacts);
         }
@@ -185,7 +194,9 @@ impl Pipeline {
             carried.is_some() || !had_contacts,
             "resting contacts that do not fit the mesh they were carried from"
         );
+        let started = Instant::now();
         self.mesh_changed(setup, state);
+        state.effort.solver.rebuild_s += started.elapsed().as_secs_f64();
         if let Some(contacts) = carried {
             state.contacts = contacts;
         }
