@@ -68,6 +68,17 @@ pub fn load_scene_str(text: &str, origin: &str, overrides: &[String]) -> Result<
     parse::load(text, origin, None, overrides)
 }
 
+/// Parses, overrides and validates scene `text`; `origin` names it in messages
+/// and `cloth.path` (and an obstacle's files) are taken relative to `dir`.
+pub fn load_scene_str_in(
+    text: &str,
+    origin: &str,
+    dir: &Path,
+    overrides: &[String],
+) -> Result<Scene, SceneError> {
+    parse::load(text, origin, Some(dir), overrides)
+}
+
 /// The built-in default scene ([`DEFAULT_SCENE_TOML`]) with `overrides` applied.
 pub fn default_scene(overrides: &[String]) -> Result<Scene, SceneError> {
     load_scene_str(DEFAULT_SCENE_TOML, DEFAULT_SCENE_ORIGIN, overrides)
