@@ -55,4 +55,5 @@ mod solver;
 mod stability;
 mod stability_cli;
 mod statics;
+mod summary_steps;
 mod transitions;
