@@ -27,6 +27,7 @@ mod validate_garment;
 mod validate_material;
 mod validate_measure;
 mod validate_motion;
+mod validate_region;
 mod validate_step;
 
 use std::path::Path;
