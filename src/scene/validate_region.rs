@@ -44,51 +44,66 @@ pub(super) fn check_pin_region(
         .because(keys(&["cloth", "shape"])));
     }
     if region == "box" {
-        let (Some(lo), Some(hi)) = (p.box_min, p.box_max) else {
-            let k = if p.box_min.is_none() {
-                "box_min"
-            } else {
-                "box_max"
-            };
-            let allowed = allowed_for(&at(k));
-            return Err(Issue::new(
-                at(k),
-                Kind::MissingKey,
-                format!("missing required key `{k}` for region = \"box\""),
-            )
-            .allowed(allowed)
-            .because(at("region")));
-        };
-        all_finite(at("box_min"), &lo)?;
-        all_finite(at("box_max"), &hi)?;
-        if !(lo[0] < hi[0] && lo[1] < hi[1]) {
-            return Err(out_of_range(
-                at("box_max"),
-                format!("box_max {hi:?} is not above box_min {lo:?} in both coordinates"),
-            ));
-        }
+        check_box(p, at)?;
     } else if let Some(k) = ["box_min", "box_max"].into_iter().find(|k| has(k)) {
         return Err(not_for_region(at(k), k, "box", at("region")));
     }
     if region == "disk" {
-        let Some(r) = p.disk_radius else {
-            let allowed = allowed_for(&at("disk_radius"));
-            return Err(Issue::new(
-                at("disk_radius"),
-                Kind::MissingKey,
-                "missing required key `disk_radius` for region = \"disk\"",
-            )
-            .allowed(allowed)
-            .because(at("region")));
-        };
-        positive(at("disk_radius"), r)?;
-        if let Some(c) = p.disk_center {
-            all_finite(at("disk_center"), &c)?;
-        }
+        check_disk(p, at)?;
     } else if let Some(k) = ["disk_center", "disk_radius"].into_iter().find(|k| has(k)) {
         return Err(not_for_region(at(k), k, "disk", at("region")));
     }
     Ok(())
+}
+
+/// A `box` region's corners: both given, finite, the second above the first.
+fn check_box(p: &Pin, at: &dyn Fn(&str) -> Vec<Seg>) -> Result<(), Issue> {
+    let (Some(lo), Some(hi)) = (p.box_min, p.box_max) else {
+        let k = if p.box_min.is_none() {
+            "box_min"
+        } else {
+            "box_max"
+        };
+        return Err(missing(at(k), k, "box", at("region")));
+    };
+    all_finite(at("box_min"), &lo)?;
+    all_finite(at("box_max"), &hi)?;
+    if !(lo[0] < hi[0] && lo[1] < hi[1]) {
+        return Err(out_of_range(
+            at("box_max"),
+            format!("box_max {hi:?} is not above box_min {lo:?} in both coordinates"),
+        ));
+    }
+    Ok(())
+}
+
+/// A `disk` region's radius (given, positive) and centre (finite).
+fn check_disk(p: &Pin, at: &dyn Fn(&str) -> Vec<Seg>) -> Result<(), Issue> {
+    let Some(r) = p.disk_radius else {
+        return Err(missing(
+            at("disk_radius"),
+            "disk_radius",
+            "disk",
+            at("region"),
+        ));
+    };
+    positive(at("disk_radius"), r)?;
+    match p.disk_center {
+        Some(c) => all_finite(at("disk_center"), &c),
+        None => Ok(()),
+    }
+}
+
+/// Key `k` (at `path`), which `region` needs, missing.
+fn missing(path: KeyPath, k: &str, region: &str, because: KeyPath) -> Issue {
+    let allowed = allowed_for(&path);
+    Issue::new(
+        path,
+        Kind::MissingKey,
+        format!("missing required key `{k}` for region = \"{region}\""),
+    )
+    .allowed(allowed)
+    .because(because)
 }
 
 /// Key `k` (at `path`) written for a region other than `region`.

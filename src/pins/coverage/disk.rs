@@ -57,8 +57,9 @@ pub(super) fn measure(
     }
     for e in &mesh.edges {
         let [a, b] = e.vertices;
-        if !(held[a as usize] && held[b as usize]) || !e.triangles.iter().any(|&t| borders_free(t))
-        {
+        let bounds_held =
+            held[a as usize] && held[b as usize] && e.triangles.iter().any(|&t| borders_free(t));
+        if !bounds_held {
             continue;
         }
         let len = mesh.material[a as usize].distance(mesh.material[b as usize]);
