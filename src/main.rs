@@ -41,7 +41,8 @@ enum Command {
     /// write DIR/SCENE.csv, DIR/SCENE-frames.csv, DIR/SCENE.md and DIR/SCENE.svg;
     /// `bench plan` writes the runs as a job list, `bench collect` reads them back.
     Bench(BenchArgs),
-    /// Run the hard-case stability suite (scenes/hard/) and print a pass/fail table.
+    /// Run the hard-case stability suite (built in; `--suite DIR` for another
+    /// folder of scenes) and print a pass/fail table.
     Stability(StabilityArgs),
     /// Write a scene's deforming mesh obstacle (an articulated body with
     /// surface = "skinned_mesh") as one OBJ file per recorded frame,
@@ -63,9 +64,10 @@ struct StabilityArgs {
     /// Also write the table (Markdown) to this file.
     #[arg(long, value_name = "FILE.md")]
     markdown: Option<PathBuf>,
-    /// Directory of the hard-case scenes.
-    #[arg(long, value_name = "DIR", default_value = "scenes/hard")]
-    scenes: PathBuf,
+    /// Run the scenes (`*.toml`) of this folder instead of the built-in hard cases;
+    /// a scene named after a hard case runs with that case's settings.
+    #[arg(long, value_name = "DIR")]
+    suite: Option<PathBuf>,
 }
 
 #[derive(Args)]
@@ -241,11 +243,12 @@ fn non_negative_degrees(s: &str) -> Result<f64, String> {
 }
 
 fn cmd_stability(args: StabilityArgs) -> Result<ExitCode> {
-    use drape::stability::{
-        all_passed, integrator_name, run_variant, scene_for, select, table, variants,
+    use drape::stability::{Suite, all_passed, integrator_name, run_variant, table};
+    let suite = match &args.suite {
+        Some(dir) => Suite::from_dir(dir, &args.cases)?,
+        None => Suite::embedded(&args.cases)?,
     };
-    let cases = select(&args.cases)?;
-    let variants = variants(&cases, args.quick);
+    let variants = suite.variants(args.quick);
     // Open the Markdown file first so that an unwritable path fails before the runs.
     let markdown = match &args.markdown {
         Some(path) => Some(
@@ -264,7 +267,7 @@ fn cmd_stability(args: StabilityArgs) -> Result<ExitCode> {
             integrator_name(variant.integrator),
             if variant.adaptive { "on" } else { "off" }
         );
-        let scene = scene_for(&args.scenes, variant, args.quick)?;
+        let scene = variant.scene(args.quick);
         let row = run_variant(&scene, variant, args.threads.map(|n| n as usize))?;
         eprintln!(
             "{} in {:.1} s",

@@ -31,7 +31,7 @@ pub fn box_cuts(pins: &[Pin]) -> GridCuts {
 pub enum PinError {
     /// The region string is not understood.
     #[error(
-        "pin {pin}: unknown region `{region}`; allowed: corner:top_left|top_right|bottom_left|bottom_right, edge:top|bottom|left|right, box, all"
+        "pin {pin}: unknown region `{region}`; allowed: corner:top_left|top_right|bottom_left|bottom_right, edge:top|bottom|left|right, box, disk, all"
     )]
     UnknownRegion {
         /// Pin index.
@@ -42,6 +42,12 @@ pub enum PinError {
     /// A `box` region without both corners.
     #[error("pin {pin}: region `box` needs box_min and box_max")]
     MissingBox {
+        /// Pin index.
+        pin: usize,
+    },
+    /// A `disk` region without its radius.
+    #[error("pin {pin}: region `disk` needs disk_radius")]
+    MissingRadius {
         /// Pin index.
         pin: usize,
     },
@@ -302,6 +308,8 @@ enum Region {
     Side(u8),
     /// The vertices inside a material-space box (inclusive).
     Box(Vector2, Vector2),
+    /// The vertices inside a material-space disk, centre and radius (inclusive).
+    Disk(Vector2, Scalar),
     /// Every vertex.
     All,
 }
@@ -322,6 +330,12 @@ impl Region {
                 (Some(a), Some(b)) => Region::Box(Vector2::from_array(a), Vector2::from_array(b)),
                 _ => return Err(PinError::MissingBox { pin: p }),
             },
+            "disk" => match pin.disk_radius {
+                Some(r) => {
+                    Region::Disk(Vector2::from_array(pin.disk_center.unwrap_or([0.0; 2])), r)
+                }
+                None => return Err(PinError::MissingRadius { pin: p }),
+            },
             _ => {
                 return Err(PinError::UnknownRegion {
                     pin: p,
@@ -340,6 +354,7 @@ impl Region {
             Region::Side(2) => m.y <= lo.y + tol,
             Region::Side(_) => m.y >= hi.y - tol,
             Region::Box(a, b) => m.cmpge(a - tol).all() && m.cmple(b + tol).all(),
+            Region::Disk(c, r) => m.distance(c) <= r + tol,
             Region::All => true,
         }
     }

@@ -3,21 +3,25 @@
 //! no numerical failure, no energy gain beyond the external work (within a
 //! tolerance), no tunneling through obstacles, and mass conserved.
 //!
-//! The cases are the scenes of `scenes/hard/`; [`CASES`] says which integrators
-//! each allows and how `--quick` shortens it. See `docs/stability.md`.
+//! The cases are the scenes of `scenes/hard/`, built into the binary; [`CASES`]
+//! says which integrators each allows and how `--quick` shortens it. A
+//! [`Suite`] is those cases or the scenes of another folder. See
+//! `docs/stability.md`.
 
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
 mod cases;
+mod suite;
 
-pub use cases::{CASES, Case};
+pub use cases::{CASES, Case, OTHER};
+pub use suite::{Suite, SuiteCase};
 
 use crate::math::Scalar;
 use crate::run::{FrameState, RunError, RunOptions, run_observed};
-use crate::scene::{Integrator, Scene, SceneError, TimeStep, load_scene_file};
+use crate::scene::{Integrator, Scene, SceneError, TimeStep};
 use crate::summary::Summary;
 
 /// Largest allowed energy excess `E(t) - E(0) - W(t)`, as a share of the
@@ -38,6 +42,28 @@ pub enum StabilityError {
         /// The case names, comma-separated.
         known: String,
     },
+    /// The `--suite` folder could not be listed.
+    #[error("cannot read the suite folder {}: {source}", dir.display())]
+    ReadSuite {
+        /// The folder.
+        dir: PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// The `--suite` folder holds no scene file.
+    #[error("the suite folder {} holds no scene file (*.toml)", dir.display())]
+    EmptySuite {
+        /// The folder.
+        dir: PathBuf,
+    },
+    /// A file a built-in scene reads could not be written to the temporary folder.
+    #[error("cannot write {}: {source}", path.display())]
+    Files {
+        /// The file or folder.
+        path: PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
     /// A case's scene file could not be loaded.
     #[error("{0}")]
     Scene(#[from] SceneError),
@@ -53,9 +79,9 @@ pub enum StabilityError {
 
 /// One run of the suite: a case with one integrator and adaptivity on or off.
 #[derive(Debug, Clone, Copy)]
-pub struct Variant {
+pub struct Variant<'a> {
     /// The case.
-    pub case: &'static Case,
+    pub case: &'a SuiteCase,
     /// The integrator.
     pub integrator: Integrator,
     /// Adaptivity on (the scene's `[adapt]`) or off.
@@ -149,67 +175,28 @@ pub fn integrator_name(i: Integrator) -> &'static str {
     }
 }
 
-/// The cases named in `names` (all when empty), in suite order.
-pub fn select(names: &[String]) -> Result<Vec<&'static Case>, StabilityError> {
-    for name in names {
-        if !CASES.iter().any(|c| c.name == name) {
-            return Err(StabilityError::UnknownCase {
-                name: name.clone(),
-                known: CASES.iter().map(|c| c.name).collect::<Vec<_>>().join(", "),
-            });
-        }
-    }
-    Ok(CASES
-        .iter()
-        .filter(|c| names.is_empty() || names.iter().any(|n| n == c.name))
-        .collect())
-}
-
-/// Every variant of `cases`: each allowed integrator (those of `--quick` with
-/// `quick`), adaptivity on, then off where allowed.
-pub fn variants(cases: &[&'static Case], quick: bool) -> Vec<Variant> {
-    let mut out = Vec::new();
-    for &case in cases {
-        let integrators = if quick {
-            case.quick_integrators
-        } else {
-            case.integrators
-        };
-        for &integrator in integrators {
-            for adaptive in [true, false] {
-                if adaptive || case.adapt_off {
-                    out.push(Variant {
-                        case,
-                        integrator,
-                        adaptive,
-                    });
-                }
+impl Variant<'_> {
+    /// The scene of this run, shortened with `quick`. The explicit integrators
+    /// always take their automatic (stable) step; the implicit one keeps the
+    /// scene's step.
+    pub fn scene(&self, quick: bool) -> Scene {
+        let plan = self.case.plan;
+        let mut scene = self.case.scene.clone();
+        if quick {
+            scene.simulation.duration = scene.simulation.duration.min(plan.quick_duration);
+            if let Some(r) = plan.quick_resolution {
+                scene.cloth.resolution = Some(r);
             }
         }
-    }
-    out
-}
-
-/// The scene of `variant`, loaded from `dir`, shortened with `quick`. The
-/// explicit integrators always take their automatic (stable) step; the
-/// implicit one keeps the scene's step.
-pub fn scene_for(dir: &Path, variant: &Variant, quick: bool) -> Result<Scene, StabilityError> {
-    let path: PathBuf = dir.join(format!("{}.toml", variant.case.name));
-    let mut scene = load_scene_file(&path, &[])?;
-    if quick {
-        scene.simulation.duration = variant.case.quick_duration;
-        if let Some(r) = variant.case.quick_resolution {
-            scene.cloth.resolution = Some(r);
+        scene.simulation.integrator = self.integrator;
+        if self.integrator != Integrator::Implicit {
+            scene.simulation.dt = TimeStep::Auto;
         }
+        if !self.adaptive {
+            scene.adapt = None;
+        }
+        scene
     }
-    scene.simulation.integrator = variant.integrator;
-    if variant.integrator != Integrator::Implicit {
-        scene.simulation.dt = TimeStep::Auto;
-    }
-    if !variant.adaptive {
-        scene.adapt = None;
-    }
-    Ok(scene)
 }
 
 /// The energy scale of a run: `S = |E(0)| + m |g| D`, with m the cloth's mass,
@@ -232,7 +219,7 @@ fn fnv(hash: u64, word: u64) -> u64 {
 /// Runs one variant of `scene` with `threads` worker threads and judges it.
 pub fn run_variant(
     scene: &Scene,
-    variant: &Variant,
+    variant: &Variant<'_>,
     threads: Option<usize>,
 ) -> Result<Row, StabilityError> {
     let opts = RunOptions {
@@ -279,7 +266,7 @@ pub fn run_variant(
             ),
             _ => {
                 return Err(StabilityError::Run {
-                    case: variant.case.name.to_string(),
+                    case: variant.case.name.clone(),
                     source: e,
                 });
             }
@@ -292,7 +279,7 @@ pub fn run_variant(
         .map(|o| o.thickness)
         .reduce(Scalar::min);
     Ok(Row {
-        case: variant.case.name.to_string(),
+        case: variant.case.name.clone(),
         integrator: integrator_name(variant.integrator).to_string(),
         adaptive: variant.adaptive,
         steps: summary.steps,
@@ -309,14 +296,18 @@ pub fn run_variant(
 }
 
 /// The FAIL row of a run that panicked (an engine bug).
-fn panicked_row(variant: &Variant, wall_s: Scalar, payload: &(dyn std::any::Any + Send)) -> Row {
+fn panicked_row(
+    variant: &Variant<'_>,
+    wall_s: Scalar,
+    payload: &(dyn std::any::Any + Send),
+) -> Row {
     let message = payload
         .downcast_ref::<String>()
         .map(String::as_str)
         .or_else(|| payload.downcast_ref::<&str>().copied())
         .unwrap_or("(no message)");
     Row {
-        case: variant.case.name.to_string(),
+        case: variant.case.name.clone(),
         integrator: integrator_name(variant.integrator).to_string(),
         adaptive: variant.adaptive,
         steps: 0,

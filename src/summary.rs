@@ -102,6 +102,14 @@ pub struct Summary {
     /// The smallest time step taken, s (with `dt = "auto"` and adaptivity the
     /// step follows the finest triangles).
     pub dt: Scalar,
+    /// The largest time step taken, s.
+    pub dt_max: Scalar,
+    /// Steps accepted: those the simulated time is made of (`steps` counts
+    /// the retried and refused ones too).
+    pub steps_accepted: u64,
+    /// The mean accepted step, `sim_time / steps_accepted`, s (0 before the
+    /// first step).
+    pub dt_mean: Scalar,
     /// The adaptive step's figures, with `dt = "adaptive"`.
     pub adaptive_dt: Option<AdaptiveDtSummary>,
     /// Steps times mean vertices per second of stepping wall time.
@@ -216,22 +224,47 @@ impl SeamSummary {
 }
 
 impl Summary {
-    /// The steps taken, in words: the fixed or smallest step, or the adaptive
-    /// step's range and refusals.
-    fn step_sizes(&self) -> String {
-        match &self.adaptive_dt {
-            None => format!("{:.3e} s", self.dt),
+    /// True when the steps taken differ in size (by more than rounding): by
+    /// level, automatic step, retried frames or the adaptive step.
+    pub fn step_varied(&self) -> bool {
+        self.dt_max - self.dt > 1e-9 * self.dt_max
+    }
+
+    /// The steps taken, in words: `N steps of DT s` for a steady step; for a
+    /// varying one the range and the mean step. The count is of the accepted
+    /// steps, so that it times the step (or the mean) is the simulated time;
+    /// steps retried or refused are counted besides, and the adaptive step's
+    /// refusals given.
+    fn steps_in_words(&self) -> String {
+        let redone = self.steps.saturating_sub(self.steps_accepted);
+        if !self.step_varied() {
+            return match redone {
+                0 => format!("{} steps of {:.3e} s", self.steps, self.dt),
+                n => format!(
+                    "{} steps of {:.3e} s ({n} more retried or refused)",
+                    self.steps_accepted, self.dt
+                ),
+            };
+        }
+        let besides = match redone {
+            0 => String::new(),
+            n => format!("; {n} more retried or refused"),
+        };
+        let adaptive = match &self.adaptive_dt {
+            None => String::new(),
             Some(a) => format!(
-                "{:.3e} to {:.3e} s (adaptive: {} refused, {} for the error, {} for penetration, {} failed; largest accepted error estimate {:.3e} m)",
-                self.dt,
-                a.max_dt,
+                "; adaptive: {} refused, {} for the error, {} for penetration, {} failed; largest accepted error estimate {:.3e} m",
                 a.refused.total(),
                 a.refused.error,
                 a.refused.penetration,
                 a.refused.failed,
                 a.largest_error
             ),
-        }
+        };
+        format!(
+            "{} steps of {:.3e} to {:.3e} s (mean {:.3e} s{besides}{adaptive})",
+            self.steps_accepted, self.dt, self.dt_max, self.dt_mean
+        )
     }
 
     /// The one-paragraph summary printed at the end of a run.
@@ -250,14 +283,13 @@ impl Summary {
             ""
         };
         format!(
-            "{}: {} frames, {} steps of {} to t = {:.3} s in {:.2} s wall ({:.2} s stepping, {:.2} s recording); \
+            "{}: {} frames, {} to t = {:.3} s in {:.2} s wall ({:.2} s stepping, {:.2} s recording); \
              {:.0} vertices, {:.0} triangles; {:.3e} vertex-steps/s. Mass {:.6} -> {:.6} kg; \
              energy {:.4e} -> {:.4e} J (max {:.4e}; external work {:.3e} J; largest excess over initial + work {:.3e} J); \
              {} recoveries (frame attempts retried with halved steps, {} for energy gain); {}.{}{}{}{} {}",
             self.scene,
             self.frames,
-            self.steps,
-            self.step_sizes(),
+            self.steps_in_words(),
             self.sim_time,
             self.wall_time_s,
             self.simulation_wall_s,

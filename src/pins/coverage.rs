@@ -1,4 +1,5 @@
-//! How far the vertices a box pin holds are from the box the scene names.
+//! How far the vertices a box or disk pin holds are from the region the
+//! scene names.
 //!
 //! A pin holds vertices, so a box region holds exactly the cloth inside it
 //! only where mesh edges run along the box's edges. A generated rectangle
@@ -8,7 +9,10 @@
 //! the bounding box of the held vertices against the bounding box of the
 //! cloth inside the region (each side's gap), and the length of the region's
 //! edges inside the cloth along which no mesh edge between held vertices
-//! runs.
+//! runs. A disk region is compared on the held cloth's edge instead
+//! ([`disk`]).
+
+mod disk;
 
 use serde::Serialize;
 
@@ -17,24 +21,30 @@ use crate::math::{Scalar, Vector2};
 use crate::mesh::Mesh;
 use crate::spec::Pin;
 
-/// A box pin region whose held vertices are not the cloth the region names.
+/// A box or disk pin region whose held vertices are not the cloth the region names.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PinMismatch {
     /// Index of the `[[pin]]` section.
     pub pin: usize,
-    /// Bounding box of the cloth inside the region, `[u_min, v_min, u_max,
-    /// v_max]` in material coordinates, m.
+    /// The region: `box` or `disk`.
+    pub region: &'static str,
+    /// Bounding box of the cloth inside the region (a disk: of the disk,
+    /// within the cloth's bounds), `[u_min, v_min, u_max, v_max]` in material
+    /// coordinates, m.
     pub region_box: [Scalar; 4],
     /// Bounding box of the vertices inside the region (those it holds), same
     /// layout, m.
     pub held_box: [Scalar; 4],
-    /// Largest distance between a side of `held_box` and the same side of
-    /// `region_box`, m.
+    /// A box: the largest distance between a side of `held_box` and the same
+    /// side of `region_box`; a disk: how far inside its circle the deepest
+    /// held vertex next to free cloth lies, m.
     pub largest_gap: Scalar,
-    /// Length of the region's edges that lie inside the cloth, m.
+    /// A box: length of its edges that lie inside the cloth; a disk: length
+    /// of the mesh edges between held vertices that bound the held cloth, m.
     pub edge_length: Scalar,
-    /// Of `edge_length`, the length along which no mesh edge between two held
-    /// vertices runs, m.
+    /// A box: of `edge_length`, the length along which no mesh edge between
+    /// two held vertices runs; a disk: of `edge_length`, the length of the
+    /// edges with an end off the circle, m.
     pub uncovered_length: Scalar,
 }
 
@@ -50,6 +60,19 @@ impl PinMismatch {
                 b[3] * 1e3
             )
         };
+        if self.region == "disk" {
+            return format!(
+                "pin {}: the disk holds vertices over {} where it spans {}; held vertices next to \
+                 free cloth lie up to {:.2} mm inside its edge, and {:.2} of the {:.2} mm of mesh \
+                 edges that bound the held cloth have an end off that edge",
+                self.pin,
+                mm(&self.held_box),
+                mm(&self.region_box),
+                self.largest_gap * 1e3,
+                self.uncovered_length * 1e3,
+                self.edge_length * 1e3
+            );
+        }
         format!(
             "pin {}: the box holds vertices over {} where the cloth inside it spans {} \
              (largest gap {:.2} mm); {:.2} of its {:.2} mm of edges inside the cloth lie on no mesh edge",
@@ -63,10 +86,11 @@ impl PinMismatch {
     }
 }
 
-/// The box pins of `pins` (the scene's `[[pin]]` sections) whose vertices on
-/// `mesh` are not the cloth inside their box, measured at a tolerance of 1e-9
-/// of the cloth's size. Other regions, and pins that cannot be parsed, are
-/// skipped: a corner, a side and `all` are held exactly by construction.
+/// The box and disk pins of `pins` (the scene's `[[pin]]` sections) whose
+/// vertices on `mesh` are not the cloth inside their region, measured at a
+/// tolerance of 1e-9 of the cloth's size. Other regions, and pins that cannot
+/// be parsed, are skipped: a corner, a side and `all` are held exactly by
+/// construction.
 pub fn mismatches(pins: &[Pin], mesh: &Mesh) -> Vec<PinMismatch> {
     let (lo, hi) = mesh.material_bounds();
     let tol = 1e-9 * (hi - lo).max_element().max(Scalar::MIN_POSITIVE);
@@ -74,6 +98,7 @@ pub fn mismatches(pins: &[Pin], mesh: &Mesh) -> Vec<PinMismatch> {
         .enumerate()
         .filter_map(|(p, pin)| match Region::parse(p, pin) {
             Ok(Region::Box(a, b)) => measure(p, a, b, mesh, tol),
+            Ok(Region::Disk(c, r)) => disk::measure(p, c, r, mesh, tol),
             _ => None,
         })
         .filter(|m| m.largest_gap > m_tol(tol) || m.uncovered_length > m_tol(tol))
@@ -131,6 +156,7 @@ fn measure(p: usize, a: Vector2, b: Vector2, mesh: &Mesh, tol: Scalar) -> Option
     }
     Some(PinMismatch {
         pin: p,
+        region: "box",
         region_box,
         held_box,
         largest_gap,
@@ -275,6 +301,8 @@ mod tests {
             region: "box".into(),
             box_min: Some(a),
             box_max: Some(b),
+            disk_center: None,
+            disk_radius: None,
             motion: crate::spec::PinMotion::Fixed,
             velocity: [0.0; 3],
             acceleration: [0.0; 3],
@@ -309,6 +337,43 @@ mod tests {
         // no mesh edge runs along it.
         assert!((f.edge_length - 1.0).abs() < 1e-9, "{f:?}");
         assert!((f.uncovered_length - 1.0).abs() < 1e-9, "{f:?}");
+    }
+
+    fn disk_pin(r: Scalar) -> Pin {
+        Pin {
+            region: "disk".into(),
+            box_min: None,
+            box_max: None,
+            disk_radius: Some(r),
+            ..box_pin([0.0; 2], [0.0; 2])
+        }
+    }
+
+    #[test]
+    fn a_disk_on_a_ring_matches() {
+        // 25 rings 6 mm apart: ring 15 lies at 90 mm.
+        let m = crate::mesh::disk(0.15, 50).unwrap();
+        assert!(mismatches(&[disk_pin(0.09)], &m).is_empty());
+    }
+
+    #[test]
+    fn a_disk_between_rings_is_measured() {
+        let m = crate::mesh::disk(0.15, 50).unwrap();
+        let found = mismatches(&[disk_pin(0.093)], &m);
+        assert_eq!(found.len(), 1);
+        let f = &found[0];
+        assert_eq!(f.region, "disk");
+        // Ring 15 at 90 mm is held, ring 16 at 96 mm free.
+        assert!((f.largest_gap - 0.003).abs() < 1e-12, "{f:?}");
+        assert!(
+            f.uncovered_length > 0.0 && f.uncovered_length == f.edge_length,
+            "{f:?}"
+        );
+        assert!(
+            f.describe().contains("lie up to 3.00 mm inside its edge"),
+            "{}",
+            f.describe()
+        );
     }
 
     #[test]

@@ -305,6 +305,7 @@ impl<'a> FrameLoop<'a> {
             sim_wall_s: self.sim_seconds,
             record_wall_s: self.record_seconds,
             dt,
+            dt_max: state.effort.max_dt.max(dt),
             adaptive_dt: matches!(self.setup.settings.step, StepSize::Adaptive(_)),
             interrupted: self.interrupted,
             recording,

@@ -30,6 +30,8 @@ pub(super) struct TallyEnd<'a> {
     pub(super) sim_wall_s: Scalar,
     pub(super) record_wall_s: Scalar,
     pub(super) dt: Scalar,
+    /// The largest step taken, s.
+    pub(super) dt_max: Scalar,
     /// True with `dt = "adaptive"`.
     pub(super) adaptive_dt: bool,
     pub(super) interrupted: bool,
@@ -82,6 +84,13 @@ impl Tally {
             simulation_wall_s: end.sim_wall_s,
             recording_wall_s: end.record_wall_s,
             dt: end.dt,
+            dt_max: end.dt_max,
+            steps_accepted: ledger.steps_done,
+            dt_mean: if ledger.steps_done > 0 {
+                end.sim_time / ledger.steps_done as Scalar
+            } else {
+                0.0
+            },
             adaptive_dt: end.adaptive_dt.then_some(AdaptiveDtSummary {
                 max_dt: effort.max_dt,
                 refused: effort.refused,

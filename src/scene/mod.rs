@@ -27,6 +27,7 @@ mod validate_garment;
 mod validate_material;
 mod validate_measure;
 mod validate_motion;
+mod validate_region;
 mod validate_step;
 
 use std::path::Path;
@@ -66,6 +67,17 @@ pub fn load_scene_file(path: &Path, overrides: &[String]) -> Result<Scene, Scene
 /// `cloth.path` is taken relative to the current directory.
 pub fn load_scene_str(text: &str, origin: &str, overrides: &[String]) -> Result<Scene, SceneError> {
     parse::load(text, origin, None, overrides)
+}
+
+/// Parses, overrides and validates scene `text`; `origin` names it in messages
+/// and `cloth.path` (and an obstacle's files) are taken relative to `dir`.
+pub fn load_scene_str_in(
+    text: &str,
+    origin: &str,
+    dir: &Path,
+    overrides: &[String],
+) -> Result<Scene, SceneError> {
+    parse::load(text, origin, Some(dir), overrides)
 }
 
 /// The built-in default scene ([`DEFAULT_SCENE_TOML`]) with `overrides` applied.

@@ -66,6 +66,8 @@ pub(crate) fn allowed(path: &str) -> Option<&'static str> {
         "pin.box_min" | "pin.box_max" => {
             "an array of 2 finite numbers (material coordinates, m), box_min < box_max"
         }
+        "pin.disk_center" => "an array of 2 finite numbers (material coordinates, m)",
+        "pin.disk_radius" => "a finite number > 0 (m)",
         "pin.motion" => "\"fixed\", \"linear\", \"circular\" or \"keyframed\" (not with `attach`)",
         "pin.attach" => {
             "the `name` of an [[obstacle]] that is not a mesh_sequence (\"NAME\"), or \"NAME/PART\" for a part of an articulated one"
@@ -173,4 +175,5 @@ pub(crate) fn allowed(path: &str) -> Option<&'static str> {
 /// The pin region syntax.
 pub(crate) const REGIONS: &str = "\"corner:top_left\", \"corner:top_right\", \
 \"corner:bottom_left\", \"corner:bottom_right\", \"edge:top\", \"edge:bottom\", \
-\"edge:left\", \"edge:right\", \"box\" (with box_min and box_max) or \"all\"";
+\"edge:left\", \"edge:right\", \"box\" (with box_min and box_max), \"disk\" (with disk_radius) \
+or \"all\"";

@@ -324,83 +324,11 @@ fn cloth(c: &Cloth, written: Option<&Table>) -> Result<(), Issue> {
 fn check_pin(i: usize, p: &Pin, shape: ClothShape, written: Option<&Table>) -> Result<(), Issue> {
     let at = |k: &str| vec![Seg::Key("pin".into()), Seg::Index(i), Seg::Key(k.into())];
     let has = |k: &str| written.is_some_and(|t| t.contains_key(k));
-    check_pin_region(p, shape, &at, &has)?;
+    super::validate_region::check_pin_region(p, shape, &at, &has)?;
     if p.attach.is_some() {
         return super::validate_attach::pin_keys(p, &at, &has);
     }
     check_pin_motion(p, &at, &has)
-}
-
-/// A pin's `region` and, for a box, its corners.
-fn check_pin_region(
-    p: &Pin,
-    shape: ClothShape,
-    at: &dyn Fn(&str) -> Vec<Seg>,
-    has: &dyn Fn(&str) -> bool,
-) -> Result<(), Issue> {
-    let region = p.region.as_str();
-    let corner_or_edge = matches!(
-        region,
-        "corner:top_left"
-            | "corner:top_right"
-            | "corner:bottom_left"
-            | "corner:bottom_right"
-            | "edge:top"
-            | "edge:bottom"
-            | "edge:left"
-            | "edge:right"
-    );
-    if !corner_or_edge && region != "box" && region != "all" {
-        return Err(Issue::new(
-            at("region"),
-            Kind::BadValue,
-            format!("{region:?} is not a pin region"),
-        )
-        .allowed(schema::REGIONS));
-    }
-    if corner_or_edge && shape != ClothShape::Rectangle {
-        return Err(Issue::new(
-            at("region"),
-            Kind::BadValue,
-            format!("{region:?} needs shape = \"rectangle\" (corners and edges are named on a rectangle only)"),
-        )
-        .allowed("\"box\" (with box_min and box_max) or \"all\" for this shape")
-        .because(keys(&["cloth", "shape"])));
-    }
-    if region == "box" {
-        let (Some(lo), Some(hi)) = (p.box_min, p.box_max) else {
-            let k = if p.box_min.is_none() {
-                "box_min"
-            } else {
-                "box_max"
-            };
-            let allowed = allowed_for(&at(k));
-            return Err(Issue::new(
-                at(k),
-                Kind::MissingKey,
-                format!("missing required key `{k}` for region = \"box\""),
-            )
-            .allowed(allowed)
-            .because(at("region")));
-        };
-        all_finite(at("box_min"), &lo)?;
-        all_finite(at("box_max"), &hi)?;
-        if !(lo[0] < hi[0] && lo[1] < hi[1]) {
-            return Err(out_of_range(
-                at("box_max"),
-                format!("box_max {hi:?} is not above box_min {lo:?} in both coordinates"),
-            ));
-        }
-    } else if let Some(k) = ["box_min", "box_max"].into_iter().find(|k| has(k)) {
-        return Err(Issue::new(
-            at(k),
-            Kind::NotApplicable,
-            format!("`{k}` applies only to region = \"box\""),
-        )
-        .allowed("remove it, or set region = \"box\"")
-        .because(at("region")));
-    }
-    Ok(())
 }
 
 /// A pin's motion and the keys that belong to it.

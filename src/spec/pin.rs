@@ -9,12 +9,16 @@ use super::{Keyframe, KeyframeAfter, KeyframeEasing, default_axis};
 #[serde(deny_unknown_fields)]
 pub struct Pin {
     /// `corner:top_left|top_right|bottom_left|bottom_right`, `edge:top|bottom|left|right`,
-    /// `box` (with `box_min`/`box_max`) or `all`.
+    /// `box` (with `box_min`/`box_max`), `disk` (with `disk_radius`) or `all`.
     pub region: String,
     /// Lower corner of a `box` region in material coordinates (m).
     pub box_min: Option<[f64; 2]>,
     /// Upper corner of a `box` region in material coordinates (m).
     pub box_max: Option<[f64; 2]>,
+    /// Centre of a `disk` region in material coordinates (m; absent: the origin).
+    pub disk_center: Option<[f64; 2]>,
+    /// Radius of a `disk` region (m).
+    pub disk_radius: Option<f64>,
     /// How the pinned vertices move (without `attach`).
     #[serde(default)]
     pub motion: PinMotion,

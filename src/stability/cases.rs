@@ -1,5 +1,6 @@
 //! The hard cases of the suite: which scenes, with which integrators, and how a
-//! `--quick` run shortens them.
+//! `--quick` run shortens them. Each case's scene is built into the binary, so
+//! the suite runs from any directory.
 
 use crate::math::Scalar;
 use crate::scene::Integrator;
@@ -15,6 +16,10 @@ const ALL: &[Integrator] = &[
 pub struct Case {
     /// Short name (`--case NAME`); the scene file is `NAME.toml`.
     pub name: &'static str,
+    /// The text of `scenes/hard/NAME.toml`, built in (empty for [`OTHER`]).
+    pub toml: &'static str,
+    /// Other files the scene reads (`cloth.path`), built in: name and text.
+    pub files: &'static [(&'static str, &'static str)],
     /// What the case stresses, one line.
     pub stresses: &'static str,
     /// The integrators the case is run with.
@@ -23,7 +28,7 @@ pub struct Case {
     pub quick_integrators: &'static [Integrator],
     /// Whether the case is also run with adaptivity off (the scenes all adapt).
     pub adapt_off: bool,
-    /// `--quick`: simulated duration, s.
+    /// `--quick`: the longest simulated duration, s (the scene's own when shorter).
     pub quick_duration: Scalar,
     /// `--quick`: cloth resolution (`None`: the scene's, e.g. an OBJ mesh).
     pub quick_resolution: Option<u32>,
@@ -33,6 +38,8 @@ pub struct Case {
 pub const CASES: &[Case] = &[
     Case {
         name: "stiff",
+        toml: include_str!("../../scenes/hard/stiff.toml"),
+        files: &[],
         stresses: "stretch 1e4 N/m, 0.1 kg/m^2; implicit at one step per frame",
         integrators: ALL,
         quick_integrators: ALL,
@@ -42,6 +49,8 @@ pub const CASES: &[Case] = &[
     },
     Case {
         name: "impact",
+        toml: include_str!("../../scenes/hard/impact.toml"),
+        files: &[],
         stresses: "20 m/s impact on a 5 mm box",
         integrators: ALL,
         quick_integrators: ALL,
@@ -51,6 +60,8 @@ pub const CASES: &[Case] = &[
     },
     Case {
         name: "wind",
+        toml: include_str!("../../scenes/hard/wind.toml"),
+        files: &[],
         stresses: "30 m/s wind on a flag for 10 s",
         integrators: ALL,
         quick_integrators: ALL,
@@ -60,6 +71,8 @@ pub const CASES: &[Case] = &[
     },
     Case {
         name: "yank",
+        toml: include_str!("../../scenes/hard/yank.toml"),
+        files: &[],
         stresses: "pinned corner yanked at 50 m/s^2",
         integrators: ALL,
         quick_integrators: ALL,
@@ -69,6 +82,8 @@ pub const CASES: &[Case] = &[
     },
     Case {
         name: "sliver",
+        toml: include_str!("../../scenes/hard/sliver.toml"),
+        files: &[("sliver.obj", include_str!("../../scenes/hard/sliver.obj"))],
         stresses: "input mesh with sliver triangles (aspect 1e-3)",
         integrators: &[Integrator::Implicit],
         quick_integrators: &[Integrator::Implicit],
@@ -78,6 +93,8 @@ pub const CASES: &[Case] = &[
     },
     Case {
         name: "long",
+        toml: include_str!("../../scenes/hard/long.toml"),
+        files: &[],
         stresses: "20 s run",
         integrators: ALL,
         quick_integrators: ALL,
@@ -87,6 +104,8 @@ pub const CASES: &[Case] = &[
     },
     Case {
         name: "thrash",
+        toml: include_str!("../../scenes/hard/thrash.toml"),
+        files: &[],
         stresses: "refine 10 deg / coarsen 9.9 deg, every step, rollback",
         integrators: ALL,
         quick_integrators: ALL,
@@ -96,6 +115,8 @@ pub const CASES: &[Case] = &[
     },
     Case {
         name: "crumple",
+        toml: include_str!("../../scenes/hard/crumple.toml"),
+        files: &[],
         stresses: "crumpling on the floor with self-contact",
         integrators: ALL,
         quick_integrators: &[Integrator::Implicit],
@@ -104,3 +125,18 @@ pub const CASES: &[Case] = &[
         quick_resolution: Some(10),
     },
 ];
+
+/// How the suite runs a scene of a `--suite` folder that names no hard case:
+/// every integrator, adaptivity on (when the scene adapts) and off, and
+/// `--quick` cuts it to at most 1 s at its own resolution.
+pub const OTHER: Case = Case {
+    name: "",
+    toml: "",
+    files: &[],
+    stresses: "a scene of a --suite folder",
+    integrators: ALL,
+    quick_integrators: ALL,
+    adapt_off: true,
+    quick_duration: 1.0,
+    quick_resolution: None,
+};

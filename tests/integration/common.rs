@@ -35,6 +35,8 @@ pub fn pin(region: &str) -> Pin {
         region: region.into(),
         box_min: None,
         box_max: None,
+        disk_center: None,
+        disk_radius: None,
         motion: PinMotion::Fixed,
         velocity: [0.0; 3],
         acceleration: [0.0; 3],

@@ -53,5 +53,7 @@ mod sewing_cap_runs;
 mod sim;
 mod solver;
 mod stability;
+mod stability_cli;
 mod statics;
+mod summary_steps;
 mod transitions;

@@ -12,7 +12,7 @@ use drape::cantilever::elastica_chord_angle_deg;
 use drape::math::{Scalar, Vector, Vector2};
 use drape::mesh;
 use drape::run::{RunOptions, run};
-use drape::scene::{AdaptMethod, DiagonalPattern, Pin, load_scene_file};
+use drape::scene::{AdaptMethod, DiagonalPattern, Pin, load_scene_file, load_scene_str};
 use drape::spec::{ClothMesh, ClothSpec};
 use drape::world::World;
 
@@ -250,12 +250,25 @@ fn an_obj_pin_box_between_mesh_lines_is_reported_by_check_with_its_gap() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// The run's summary carries the same comparison: the Cusick scene's square
-/// clamp on the disk's rings holds a staircase inside the square.
+/// The Cusick scene with its disk clamp swapped for the square inscribed in it.
+fn cusick_with_a_square_clamp() -> String {
+    let text = std::fs::read_to_string("scenes/cusick.toml").expect("cusick scene");
+    text.lines()
+        .filter(|l| !l.starts_with("disk_radius"))
+        .map(|l| match l.starts_with("region = \"disk\"") {
+            true => "region = \"box\"\nbox_min = [-0.0636, -0.0636]\nbox_max = [0.0636, 0.0636]",
+            false => l,
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+/// The run's summary carries the same comparison: a square clamp on the
+/// disk's rings holds a staircase inside the square.
 #[test]
 fn a_run_summary_reports_a_pin_box_the_disk_mesh_cannot_follow() {
     let sets = ["cloth.resolution=16", "simulation.duration=0.034"].map(str::to_owned);
-    let scene = load_scene_file(Path::new("scenes/cusick.toml"), &sets).expect("scene");
+    let scene = load_scene_str(&cusick_with_a_square_clamp(), "square.toml", &sets).expect("scene");
     let summary = run(
         &scene,
         &RunOptions::default(),
@@ -265,7 +278,7 @@ fn a_run_summary_reports_a_pin_box_the_disk_mesh_cannot_follow() {
     .expect("the run");
     println!("{}", summary.paragraph());
     let m = summary.pin_mismatches.first().expect("the clamp differs");
-    assert_eq!(m.pin, 0);
+    assert_eq!((m.pin, m.region), (0, "box"));
     assert!((m.region_box[2] - 0.0636).abs() < 1e-9, "{m:?}");
     assert!(m.held_box[2] < 0.0636 && m.largest_gap > 0.0, "{m:?}");
     assert!((m.edge_length - 4.0 * 0.1272).abs() < 1e-9, "{m:?}");
@@ -275,4 +288,29 @@ fn a_run_summary_reports_a_pin_box_the_disk_mesh_cannot_follow() {
             .paragraph()
             .contains("Pin region differs from the scene: pin 0")
     );
+}
+
+/// The Cusick clamp is a disk on one of the specimen's rings: it holds the
+/// ring's polygon and no warning; at a resolution whose rings miss its edge
+/// the held vertices next to free cloth are measured inside it.
+#[test]
+fn a_disk_clamp_on_a_ring_holds_exactly_and_off_a_ring_is_measured() {
+    let path = Path::new("scenes/cusick.toml");
+    let on_ring = load_scene_file(path, &[]).expect("scene");
+    let w = World::from_scene(&on_ring).expect("world");
+    assert!(drape::pins::mismatches(&on_ring.pin, &w.mesh).is_empty());
+    let held = w.pins.anchors.len();
+    // 1 + 6 (1 + 2 + ... + 15) vertices: the centre and rings 1 to 15.
+    assert_eq!(held, 1 + 6 * 15 * 16 / 2);
+
+    let sets = ["cloth.resolution=48".to_owned()];
+    let off_ring = load_scene_file(path, &sets).expect("scene");
+    let w = World::from_scene(&off_ring).expect("world");
+    let found = drape::pins::mismatches(&off_ring.pin, &w.mesh);
+    let m = found.first().expect("the clamp misses the rings");
+    println!("{}", m.describe());
+    assert_eq!(m.region, "disk");
+    // Rings 6.25 mm apart: the 14th, at 87.5 mm, is the last one held.
+    assert!((m.largest_gap - 0.0025).abs() < 1e-9, "{m:?}");
+    assert!(m.uncovered_length > 0.0, "{m:?}");
 }

@@ -3,26 +3,16 @@
 //! and off, must finish without a numerical failure, without energy above its
 //! initial value plus the external work (5% of the energy scale), without
 //! tunneling and with its mass; every case must give bit-identical positions at
-//! 1 and 2 threads; and `drape stability` prints the table and sets its exit
-//! status from it.
+//! 1 and 2 threads. The command itself is tested in `stability_cli.rs`.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
-
-use drape::stability::{
-    CASES, Row, Variant, all_passed, run_variant, scene_for, select, table, variants,
-};
-
-fn hard_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/hard")
-}
+use drape::stability::{CASES, Row, Suite, Variant, all_passed, run_variant, table};
 
 /// Test length: the `--quick` duration, cut further to keep the module short.
 const TEST_DURATION_CAP: f64 = 0.5;
 
 /// Runs `variant` shortened for tests with `threads`.
-fn run_short(variant: &Variant, threads: usize) -> Row {
-    let mut scene = scene_for(&hard_dir(), variant, true).expect("hard scene loads");
+fn run_short(variant: &Variant<'_>, threads: usize) -> Row {
+    let mut scene = variant.scene(true);
     // The impact needs its whole fall (2.04 s) to reach 20 m/s.
     if variant.case.name != "impact" {
         scene.simulation.duration = scene.simulation.duration.min(TEST_DURATION_CAP);
@@ -31,8 +21,9 @@ fn run_short(variant: &Variant, threads: usize) -> Row {
 }
 
 fn check_case(name: &str) {
-    let cases = select(&[name.to_string()]).expect("known case");
-    let rows: Vec<Row> = variants(&cases, true)
+    let suite = Suite::embedded(&[name.to_string()]).expect("known case");
+    let rows: Vec<Row> = suite
+        .variants(true)
         .iter()
         .map(|v| run_short(v, 2))
         .collect();
@@ -93,13 +84,12 @@ fn hard_crumple() {
 /// bit-identical positions in every frame at 1 and 2 threads.
 #[test]
 fn hard_cases_deterministic_across_threads() {
-    for case in CASES {
-        let scene =
-            drape::scene::load_scene_file(&hard_dir().join(format!("{}.toml", case.name)), &[])
-                .expect("scene");
+    let suite = Suite::embedded(&[]).expect("built-in suite");
+    assert_eq!(suite.cases.len(), CASES.len());
+    for case in &suite.cases {
         let variant = Variant {
             case,
-            integrator: scene.simulation.integrator,
+            integrator: case.scene.simulation.integrator,
             adaptive: true,
         };
         let one = run_short(&variant, 1);
@@ -169,54 +159,19 @@ fn failing_rows_fail_the_suite() {
     }
 }
 
-/// `drape stability --quick --case sliver` prints the table and exits 0; an
-/// unknown case is an error naming the cases.
-#[test]
-fn stability_cli() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let out = Command::new(env!("CARGO_BIN_EXE_drape"))
-        .args(["stability", "--quick", "--case", "sliver", "--threads", "2"])
-        .current_dir(root)
-        .output()
-        .expect("run drape");
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{stdout}{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    assert!(
-        stdout.contains("| case | integrator | adaptive |"),
-        "{stdout}"
-    );
-    assert!(stdout.contains("| sliver | implicit | on |"), "{stdout}");
-    assert!(stdout.contains("| sliver | implicit | off |"), "{stdout}");
-    assert!(stdout.contains("2 runs, 2 passed, 0 failed"), "{stdout}");
-
-    let out = Command::new(env!("CARGO_BIN_EXE_drape"))
-        .args(["stability", "--case", "nosuch"])
-        .current_dir(root)
-        .output()
-        .expect("run drape");
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{stderr}");
-    assert!(stderr.contains("no hard case named `nosuch`"), "{stderr}");
-    assert!(stderr.contains("stiff, impact"), "{stderr}");
-}
-
 /// Regression: the full `crumple` case (resolution 16, 2 s) with its own
 /// integrator and adaptivity on panicked inside parry's BVH (`key not present`,
 /// from `SelfCollider::resolve`) after about 1 s of wall time: a self-collision
 /// patch of one or two triangles on the adapted mesh. Fixed in `collide/selfcol.rs`.
 #[test]
 fn the_full_adaptive_crumple_case_runs_without_panicking() {
+    let suite = Suite::embedded(&["crumple".to_string()]).expect("known case");
     let variant = Variant {
-        case: select(&["crumple".to_string()]).expect("known case")[0],
+        case: &suite.cases[0],
         integrator: drape::scene::Integrator::Implicit,
         adaptive: true,
     };
-    let scene = scene_for(&hard_dir(), &variant, false).expect("scene");
+    let scene = variant.scene(false);
     let row = run_variant(&scene, &variant, Some(2)).expect("run");
     assert!(row.passed(), "{:?}", row.failures());
 }
