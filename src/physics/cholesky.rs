@@ -38,7 +38,13 @@
 //! `D = diag(A)^-1/2`, and the solve applies `D (L L^T)^-1 D`: the rows of held
 //! and contact vertices (their mass alone on the diagonal) and of stretched
 //! cloth (its stiffness) differ by orders of magnitude, and unscaled the
-//! rounding of the large ones swamps the small.
+//! rounding of the large ones swamps the small. Where the matrix is stiff
+//! enough (a cloth pressed against an obstacle, a stiff strip) some pivots
+//! still lose most of their digits to cancellation and can come out zero or
+//! negative; a pivot below `sqrt(f32::EPSILON)` (of the unit diagonal) is set
+//! to that value (faer's dynamic regularization), so the factor stays positive
+//! definite, a preconditioner that conjugate gradients can use, only a less
+//! exact one there.
 //!
 //! Why faer: it is pure Rust (no system BLAS or SuiteSparse to install), maintained,
 //! has a supernodal LL^T and LDL^T with AMD, and exposes the symbolic and numeric
@@ -49,6 +55,7 @@
 use std::sync::Arc;
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::perm::PermRef;
 use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::linalg::amd;
@@ -132,20 +139,38 @@ pub enum Precision {
 }
 
 /// A floating-point type faer factors in.
-pub(crate) trait FactorScalar: faer::traits::ComplexField + Copy + Default {
+pub(crate) trait FactorScalar:
+    faer::traits::ComplexField<Real = Self> + Copy + Default
+{
     /// Neither infinite nor NaN.
     fn finite(self) -> bool;
+    /// How faer treats a pivot that is not clearly positive.
+    fn regularization() -> LltRegularization<Self>;
 }
 
 impl FactorScalar for f64 {
     fn finite(self) -> bool {
         self.is_finite()
     }
+    /// None: a pivot that is not positive fails the factorization (the
+    /// matrix is not positive definite).
+    fn regularization() -> LltRegularization<f64> {
+        LltRegularization::default()
+    }
 }
 
 impl FactorScalar for f32 {
     fn finite(self) -> bool {
         self.is_finite()
+    }
+    /// A pivot below `sqrt(f32::EPSILON)` of the unit diagonal (module docs,
+    /// "Single precision") is set to that value.
+    fn regularization() -> LltRegularization<f32> {
+        let floor = f32::EPSILON.sqrt();
+        LltRegularization {
+            dynamic_regularization_delta: floor,
+            dynamic_regularization_epsilon: floor,
+        }
     }
 }
 
@@ -177,7 +202,7 @@ impl<T: FactorScalar> Numeric<T> {
                 &mut self.factor,
                 matrix,
                 Side::Lower,
-                Default::default(),
+                T::regularization(),
                 Par::Seq,
                 stack,
                 Default::default(),
@@ -365,17 +390,26 @@ impl Factorization {
                     .solve(&symbolic, &mut self.rhs, 1, &mut self.workspace)
             }
             Precision::Single => {
+                // `D r` divided by its largest entry, so that rounding it to
+                // single precision neither underflows nor overflows however
+                // small or large the residual has become.
+                let largest = self
+                    .rhs
+                    .iter()
+                    .zip(&self.scale)
+                    .fold(0.0, |m: Scalar, (r, d)| m.max((r * d).abs()));
+                let back = if largest > 0.0 { largest } else { 1.0 };
                 self.rhs_single.clear();
                 self.rhs_single.extend(
                     self.rhs
                         .iter()
                         .zip(&self.scale)
-                        .map(|(r, d)| (r * d) as f32),
+                        .map(|(r, d)| (r * d / back) as f32),
                 );
                 self.single
                     .solve(&symbolic, &mut self.rhs_single, 1, &mut self.workspace);
                 for ((out, v), d) in self.rhs.iter_mut().zip(&self.rhs_single).zip(&self.scale) {
-                    *out = Scalar::from(*v) * d;
+                    *out = Scalar::from(*v) * d * back;
                 }
             }
         }

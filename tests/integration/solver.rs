@@ -544,3 +544,76 @@ fn each_preconditioner_reaches_the_same_state() {
         assert!(x.iter().all(|p| p.is_finite()), "{preconditioner}");
     }
 }
+
+/// A single-precision factor solves a residual of any size: the residual is
+/// scaled before it is rounded to `f32`, so one of 1e-50 (below `f32`'s
+/// range, where the rounding once gave a zero preconditioned residual and a
+/// failed step on a sheet coming to rest) or 1e40 (above it) gives the same
+/// solution scaled, and the same as the double-precision factor's to single
+/// precision.
+#[test]
+fn a_single_precision_factor_solves_residuals_of_any_size() {
+    use drape::math::Matrix3;
+    use drape::physics::block::BlockPattern;
+    use drape::physics::cholesky::{Factorization, Precision};
+    use drape::physics::elements::Elements;
+
+    let grid = mesh::rectangle(1.0, 1.0, 8, DiagonalPattern::Alternating).expect("grid");
+    let elements = Elements::build(&grid, &fabric(200.0));
+    let pattern = BlockPattern::build(grid.vertex_count(), &elements, false);
+    let n = grid.vertex_count();
+    // An SPD block matrix on the pattern: a graph Laplacian times I plus I.
+    let (column_start, rows) = pattern.vertex_structure();
+    let mut blocks = vec![Matrix3::ZERO; pattern.blocks()];
+    let mut degree = vec![0.0; n];
+    for j in 0..n {
+        for k in column_start[j] as usize..column_start[j + 1] as usize {
+            if rows[k] as usize != j {
+                degree[j] += 1.0;
+                degree[rows[k] as usize] += 1.0;
+            }
+        }
+    }
+    let slots = pattern.vertex_structure_blocks();
+    for j in 0..n {
+        for k in column_start[j] as usize..column_start[j + 1] as usize {
+            let (i, slot) = (rows[k] as usize, slots[k] as usize);
+            blocks[slot] = if i == j {
+                Matrix3::from_diagonal(Vector::splat(degree[i] + 1.0))
+            } else {
+                Matrix3::from_diagonal(Vector::splat(-1.0))
+            };
+        }
+    }
+    let extra = vec![Matrix3::ZERO; n];
+    let r: Vec<Vector> = (0..n)
+        .map(|i| Vector::new(i as f64 + 1.0, (i % 3) as f64 - 1.0, 0.5))
+        .collect();
+    let solve = |precision: Precision, scale: f64| {
+        let mut f = Factorization::with_precision(precision);
+        f.analyse(&pattern).expect("analysed");
+        f.factor(&pattern, &blocks, &extra).expect("factored");
+        let scaled: Vec<Vector> = r.iter().map(|v| *v * scale).collect();
+        let mut z = vec![Vector::ZERO; n];
+        f.solve(&scaled, &mut z);
+        z.iter().map(|v| *v / scale).collect::<Vec<_>>()
+    };
+    let exact = solve(Precision::Double, 1.0);
+    let norm = exact.iter().map(|v| v.length()).fold(0.0, f64::max);
+    for scale in [1.0, 1e-50, 1e40] {
+        let z = solve(Precision::Single, scale);
+        let largest = z
+            .iter()
+            .zip(&exact)
+            .map(|(a, b)| (*a - *b).length())
+            .fold(0.0, f64::max);
+        println!(
+            "residual scaled by {scale:e}: largest difference {:.3e} of the solution's size",
+            largest / norm
+        );
+        assert!(
+            largest <= 1e-4 * norm,
+            "scale {scale:e}: {largest:e} against {norm:e}"
+        );
+    }
+}
