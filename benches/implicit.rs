@@ -26,6 +26,10 @@
 //! place (`Elements::rebuild`), and the symbolic analysis of the new pattern
 //! (ordered by vertex, as drape does, and by scalar unknown, as faer does alone).
 //!
+//! Then `orderings` prints, for the sheet's factored pattern at both
+//! resolutions, the factor's stored values and a factorization's time with
+//! AMD on the vertex graph (drape's) and with nested dissection.
+//!
 //! Run with `cargo bench --bench implicit`; the figures at commit 03aac28 are in that
 //! commit's `docs/performance.md`.
 
@@ -274,10 +278,85 @@ fn creased(mesh: &drape::mesh::Mesh) -> drape::mesh::Mesh {
 
 criterion_group!(benches, implicit_step, remesh_tables);
 
+/// The fill-reducing orderings side by side on the sheet's pattern (shape
+/// operator, reduced factor): the factor's stored values and the median of 7
+/// numerical factorizations of a positive definite matrix on that pattern
+/// (a graph Laplacian plus the identity in every block: the time of a
+/// supernodal factorization depends on the pattern, not on the values).
+fn orderings() {
+    println!("orderings of the factored pattern (median of 7 factorizations):");
+    for resolution in [63u32, 127] {
+        let mesh = drape::mesh::rectangle(1.0, 1.0, resolution, DiagonalPattern::Alternating)
+            .expect("valid rectangle");
+        let material = MaterialParams {
+            density: 0.15,
+            stretch: 200.0,
+            membrane: drape::physics::Membrane::Springs,
+            bending: 1e-5,
+            damping: 0.001,
+            bending_model: BendingModel::ShapeOperator,
+            stiffness_rule: StiffnessRule::Consistent,
+        };
+        let elements = Elements::build(&mesh, &material);
+        let pattern = BlockPattern::build(mesh.vertex_count(), &elements, false);
+        let blocks = laplacian_blocks(&pattern);
+        let extra = vec![drape::math::Matrix3::ZERO; pattern.vertices()];
+        for ordering in [Ordering::ByVertex, Ordering::NestedDissection] {
+            let mut f = Factorization::default();
+            let started = Instant::now();
+            f.analyse_with(&pattern, ordering).expect("analysed");
+            let analysis = started.elapsed().as_secs_f64();
+            let mut times: Vec<f64> = (0..7)
+                .map(|_| {
+                    let started = Instant::now();
+                    f.factor(&pattern, &blocks, &extra).expect("factored");
+                    started.elapsed().as_secs_f64()
+                })
+                .collect();
+            times.sort_by(f64::total_cmp);
+            println!(
+                "  {:>5} vertices {ordering:?}: {} stored values, analysis {:.1} ms, factorization {:.2} ms",
+                pattern.vertices(),
+                f.stored_values().unwrap_or(0),
+                1e3 * analysis,
+                1e3 * times[3]
+            );
+        }
+    }
+}
+
+/// Blocks of `L (x) I + I` on `pattern`, `L` the graph Laplacian of its
+/// factored blocks.
+fn laplacian_blocks(pattern: &BlockPattern) -> Vec<drape::math::Matrix3> {
+    use drape::math::{Matrix3, Vector};
+    let (column_start, rows) = pattern.vertex_structure();
+    let slots = pattern.vertex_structure_blocks();
+    let n = pattern.vertices();
+    let mut degree = vec![0.0; n];
+    for j in 0..n {
+        for &i in &rows[column_start[j] as usize..column_start[j + 1] as usize] {
+            if i as usize != j {
+                degree[i as usize] += 1.0;
+                degree[j] += 1.0;
+            }
+        }
+    }
+    let mut blocks = vec![Matrix3::ZERO; pattern.blocks()];
+    for j in 0..n {
+        for k in column_start[j] as usize..column_start[j + 1] as usize {
+            let i = rows[k] as usize;
+            let value = if i == j { degree[i] + 1.0 } else { -1.0 };
+            blocks[slots[k] as usize] = Matrix3::from_diagonal(Vector::splat(value));
+        }
+    }
+    blocks
+}
+
 fn main() {
     if std::env::var_os("DRAPE_BENCH_SPLIT_ONLY").is_none() {
         benches();
         Criterion::default().configure_from_args().final_summary();
     }
+    orderings();
     time_split();
 }
