@@ -68,6 +68,7 @@
 //! factor", in the implicit module).
 //!
 mod assemble;
+mod band;
 mod buckets;
 mod csc;
 mod sources;
