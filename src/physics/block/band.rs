@@ -1,28 +1,11 @@
 //! One band's share of the assembly (block module docs, "Assembly"): its
 //! rows' lower blocks summed from their springs and element terms, the shape
 //! triangles' blocks added in place, and the mass on the diagonal.
-//!
-//! A shape triangle's block `(k, l)` is `h^2 sum_a J_ak (M J)_al^T`, entry
-//! `(r, c)` the sum over the angles `a` of `J_ak[r] (M J)_al[c]`. The pass
-//! holds each gradient `J_ak` repeated down the three columns of a block and
-//! each product `(M J)_al` spread along its rows ([`Lanes`]), so that every
-//! block is whole-array products and sums, which the compiler turns into
-//! vector instructions; each entry is the same products summed in the same
-//! order as one 3x3 outer product after another (`Matrix3::ZERO`, then
-//! `+= outer(J_ak, (M J)_al)` for each angle, then `* h^2`), so the values
-//! are those to the last bit. On x86-64 processors with AVX2 the pass runs
-//! as code compiled for it (four lanes a vector instead of two); vector
-//! instructions round each lane as the scalar ones do, and no product is
-//! fused with a sum, so the values do not depend on which code runs.
 
 use super::terms::frobenius;
 use super::{BAND_ROWS, BlockPattern, ElementBlocks, ShapeOp};
 use crate::math::{Matrix3, Scalar, Vector};
 use crate::physics::shape::{SHAPE_SLOTS, ShapeJacobian, ShapeTriangle};
-
-/// A 3x3 block as an array: column-major in lanes `0..9`, then three lanes
-/// of padding (a whole number of vectors of two or four lanes).
-type Lanes = [Scalar; 12];
 
 /// One band's share of the assembly: its rows' lower blocks (the band's first
 /// block at `base`) and its vertices' dropped-block norms.
@@ -40,35 +23,14 @@ pub(super) struct Band<'a> {
 impl BlockPattern {
     /// Sums band `band`'s lower blocks (block module docs, "Assembly"), from
     /// the element terms `terms` and the hinges' and membrane triangles'
-    /// blocks `flat`: with the code compiled for AVX2 where the processor
-    /// has it (module docs), the same values either way.
+    /// blocks `flat`: each lower block's springs and hinge and membrane
+    /// terms, then the shape triangles' blocks, then the mass.
     pub(super) fn gather_band(
         &self,
         terms: &ElementBlocks<'_>,
         flat: &[Matrix3],
         band: &mut Band<'_>,
     ) {
-        #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the processor has AVX2 (checked just above).
-            unsafe { self.gather_band_avx2(terms, flat, band) };
-            return;
-        }
-        self.gather_band_lanes(terms, flat, band);
-    }
-
-    /// [`Self::gather_band`] compiled for AVX2.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn gather_band_avx2(&self, terms: &ElementBlocks<'_>, flat: &[Matrix3], band: &mut Band<'_>) {
-        self.gather_band_lanes(terms, flat, band);
-    }
-
-    /// The body of [`Self::gather_band`]: each lower block's springs and
-    /// hinge and membrane terms, then the shape triangles' blocks, then the
-    /// mass.
-    #[inline(always)]
-    fn gather_band_lanes(&self, terms: &ElementBlocks<'_>, flat: &[Matrix3], band: &mut Band<'_>) {
         let rows = band.first_row..band.first_row + band.sigma.len();
         for i in rows.clone() {
             // The lower blocks lead each row (columns ascend to the diagonal).
@@ -131,24 +93,16 @@ impl Band<'_> {
                 continue;
             }
             let (k, l) = (op.k as usize, op.l as usize);
-            let mut block: Lanes = [0.0; 12];
+            let mut block = Matrix3::ZERO;
             for a in moved_angles(k) {
-                let (u, w) = (down_columns(jac[a][k]), along_rows(mj[a][l]));
-                for x in 0..12 {
-                    block[x] += u[x] * w[x];
-                }
+                block += super::outer(jac[a][k], mj[a][l]);
             }
-            for x in &mut block {
-                *x *= h2;
-            }
+            block *= h2;
             if in_row {
-                let out: &mut [Scalar; 9] = self.lower[op.slot as usize - self.base].as_mut();
-                for x in 0..9 {
-                    out[x] += block[x];
-                }
+                self.lower[op.slot as usize - self.base] += block;
             }
             if op.dropped {
-                let norm = frobenius(&Matrix3::from_cols_slice(&block[..9]));
+                let norm = frobenius(&block);
                 if in_row {
                     self.sigma[row - self.first_row] += norm;
                 }
@@ -158,20 +112,6 @@ impl Band<'_> {
             }
         }
     }
-}
-
-/// `u` repeated down the three columns of a block: lane `3 c + r` is `u[r]`.
-#[inline(always)]
-fn down_columns(u: Vector) -> Lanes {
-    let (x, y, z) = (u.x, u.y, u.z);
-    [x, y, z, x, y, z, x, y, z, 0.0, 0.0, 0.0]
-}
-
-/// `w` spread along the three rows of a block: lane `3 c + r` is `w[c]`.
-#[inline(always)]
-fn along_rows(w: Vector) -> Lanes {
-    let (x, y, z) = (w.x, w.y, w.z);
-    [x, x, x, y, y, y, z, z, z, 0.0, 0.0, 0.0]
 }
 
 /// `(M J)_al = sum_b M_ab J_bl` for every angle `a` and slot `l`. A tip slot
