@@ -23,7 +23,8 @@
 //!    with their row in the band straight into them, by its precomputed slots,
 //!    and the Frobenius norm of each dropped block into the diagonal
 //!    compensation of both its vertices that lie in the band (the lower block
-//!    serves its transpose too); last the mass on the diagonal.
+//!    serves its transpose too); last the mass on the diagonal. A triangle's
+//!    Jacobian is read from its edges' folds ([`ElementBlocks::shape_jacobian`]).
 //!
 //! The shape triangles are the bulk (21 blocks each, against 3 per spring).
 //! Summed per block from the Jacobians, a triangle's products would be formed
@@ -68,6 +69,7 @@
 //! factor", in the implicit module).
 //!
 mod assemble;
+mod band;
 mod buckets;
 mod csc;
 mod sources;

@@ -127,6 +127,26 @@ pub fn fold_angles(
         .for_each(|(t, (folds, jac))| (*folds, *jac) = el.fold_edges.angles(t, edges));
 }
 
+/// Into `edges` and `folds`: each interior edge's fold at `x` and each shape
+/// triangle's folds read from them ([`fold_angles`] without the gradients by
+/// slot, which a pass that needs them reads from `edges` with
+/// [`super::shape::FoldEdges::angles`]).
+pub fn edge_folds(
+    el: &Elements,
+    x: &[Vector],
+    edges: &mut Vec<EdgeFold>,
+    folds: &mut Vec<[Scalar; 3]>,
+) {
+    el.fold_edges.compute(x, edges);
+    let edges = &*edges;
+    folds.resize(el.shape_triangles.len(), [0.0; 3]);
+    folds
+        .par_iter_mut()
+        .enumerate()
+        .with_min_len(PAR_MIN)
+        .for_each(|(t, folds)| *folds = el.fold_edges.folds(t, edges));
+}
+
 /// Into `folds` and `splits`: each shape triangle's folds at `x` and the
 /// splits that minimise the bending energy for them (`shape.rs`, "Splitting
 /// the folds").

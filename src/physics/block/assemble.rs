@@ -4,9 +4,9 @@
 
 use rayon::prelude::*;
 
-use super::super::forces::{PAR_MIN, PAR_MIN_ROWS};
-use super::terms::Band;
-use super::{BAND_ROWS, BlockPattern, ElementBlocks, ElementTerms, outer};
+use super::super::forces::PAR_MIN_ROWS;
+use super::band::Band;
+use super::{BlockPattern, ElementBlocks, ElementTerms, outer};
 use crate::math::{Matrix3, Scalar, Vector};
 
 impl BlockPattern {
@@ -70,51 +70,6 @@ impl BlockPattern {
         }
     }
 
-    /// One band of [`Self::gather`].
-    fn gather_band(&self, terms: &ElementBlocks<'_>, flat: &[Matrix3], band: &mut Band<'_>) {
-        let rows = band.first_row..band.first_row + band.sigma.len();
-        for i in rows.clone() {
-            // The lower blocks lead each row (columns ascend to the diagonal).
-            for slot in self.row_start[i] as usize..=self.diagonal[i] as usize {
-                let mut m = Matrix3::ZERO;
-                let springs =
-                    self.spring_start[slot] as usize..self.spring_start[slot + 1] as usize;
-                let springs = &self.springs[springs];
-                if self.columns[slot] as usize == i {
-                    for &e in springs {
-                        m += terms.springs[e as usize];
-                    }
-                } else {
-                    for &e in springs {
-                        m -= terms.springs[e as usize];
-                    }
-                }
-                let range = self.term_start[slot] as usize..self.term_start[slot + 1] as usize;
-                for &t in &self.terms[range] {
-                    m += flat[t as usize];
-                }
-                band.lower[slot - band.base] = m;
-            }
-        }
-        band.sigma.fill(0.0);
-        let b = rows.start / BAND_ROWS;
-        let shapes = self.band_shape_start[b] as usize..self.band_shape_start[b + 1] as usize;
-        for &tri in &self.band_shapes[shapes] {
-            let tri = tri as usize;
-            let ops = self.shape_op_start[tri] as usize..self.shape_op_start[tri + 1] as usize;
-            band.add_shape(
-                &terms.shape_triangles[tri],
-                &terms.shape_jacobians[tri],
-                terms.h2,
-                &self.shape_ops[ops],
-            );
-        }
-        for i in rows {
-            band.lower[self.diagonal[i] as usize - band.base] +=
-                Matrix3::from_diagonal(Vector::splat(terms.diagonal_mass[i]));
-        }
-    }
-
     /// Per vertex: the diagonal compensation of the dropped tip-tip blocks (module
     /// docs) and of the dropped shape blocks (their norms in `element`, from
     /// [`Self::gather`]),
@@ -169,6 +124,8 @@ impl BlockPattern {
     /// a held one (all three directions prescribed) and `Some(n)` for a contact
     /// whose normal `n` is prescribed. `scale[i]` is the diagonal put back on the
     /// prescribed directions (the vertex's mass, so the matrix keeps its scale).
+    /// By rows: a row's lower blocks are copied and its upper ones are their
+    /// mirrors' transposes, projected where either vertex is.
     pub fn project(
         &self,
         lower: &[Matrix3],
@@ -177,37 +134,84 @@ impl BlockPattern {
         out: &mut Vec<Matrix3>,
     ) {
         out.resize(lower.len(), Matrix3::ZERO);
+        let rows = |rows: std::ops::Range<usize>, out: &mut [Matrix3]| {
+            let base = self.row_start[rows.start] as usize;
+            for i in rows {
+                let (start, diagonal, end) = (
+                    self.row_start[i] as usize,
+                    self.diagonal[i] as usize,
+                    self.row_start[i + 1] as usize,
+                );
+                let out = &mut out[start - base..end - base];
+                let (own, upper) = out.split_at_mut(diagonal + 1 - start);
+                own.copy_from_slice(&lower[start..=diagonal]);
+                for (o, &m) in upper.iter_mut().zip(&self.mirror[diagonal + 1..end]) {
+                    *o = lower[m as usize].transpose();
+                }
+                let projected = |slot: usize| projection[self.columns[slot] as usize].is_some();
+                if projection[i].is_some() || (start..end).any(projected) {
+                    for (o, slot) in out.iter_mut().zip(start..) {
+                        self.project_block(projection, scale, slot, o);
+                    }
+                }
+            }
+        };
+        self.for_each_row_chunk(0..self.vertices(), out, &rows);
+    }
+
+    /// Block `slot` of the projected system in place, `out` holding the block
+    /// of `A` ([`Self::project`]).
+    #[inline(always)]
+    fn project_block(
+        &self,
+        projection: &[Option<Vector>],
+        scale: &[Scalar],
+        slot: usize,
+        out: &mut Matrix3,
+    ) {
         let s = |i: usize| match projection[i] {
             None => None,
             Some(n) if n == Vector::ZERO => Some(Matrix3::ZERO),
             Some(n) => Some(Matrix3::IDENTITY - outer(n, n)),
         };
-        out.par_iter_mut()
-            .enumerate()
-            .with_min_len(PAR_MIN)
-            .for_each(|(slot, out)| {
-                let (i, j) = (self.rows[slot] as usize, self.columns[slot] as usize);
-                let mut m = self.full_block(lower, slot);
-                let (si, sj) = match (projection[i], projection[j]) {
-                    (None, None) => {
-                        *out = m;
-                        return;
-                    }
-                    _ => (s(i), s(j)),
-                };
-                if let Some(si) = si {
-                    m = si * m;
-                }
-                if let Some(sj) = sj {
-                    m *= sj;
-                }
-                if i == j
-                    && let Some(si) = si
-                {
-                    m += (Matrix3::IDENTITY - si) * scale[i];
-                }
-                *out = m;
-            });
+        let (i, j) = (self.rows[slot] as usize, self.columns[slot] as usize);
+        if projection[i].is_none() && projection[j].is_none() {
+            return;
+        }
+        let (si, sj) = (s(i), s(j));
+        let mut m = *out;
+        if let Some(si) = si {
+            m = si * m;
+        }
+        if let Some(sj) = sj {
+            m *= sj;
+        }
+        if i == j
+            && let Some(si) = si
+        {
+            m += (Matrix3::IDENTITY - si) * scale[i];
+        }
+        *out = m;
+    }
+
+    /// Runs `f(rows, out)` over chunks of at most [`PAR_MIN_ROWS`] rows in
+    /// parallel, `out` holding the chunk's blocks, by halving the range: no
+    /// allocation, and each block's work the same at any thread count.
+    fn for_each_row_chunk<F>(&self, rows: std::ops::Range<usize>, out: &mut [Matrix3], f: &F)
+    where
+        F: Fn(std::ops::Range<usize>, &mut [Matrix3]) + Sync,
+    {
+        if rows.len() <= PAR_MIN_ROWS {
+            f(rows, out);
+            return;
+        }
+        let mid = rows.start + rows.len() / 2;
+        let blocks = (self.row_start[mid] - self.row_start[rows.start]) as usize;
+        let (a, b) = out.split_at_mut(blocks);
+        rayon::join(
+            || self.for_each_row_chunk(rows.start..mid, a, f),
+            || self.for_each_row_chunk(mid..rows.end, b, f),
+        );
     }
 
     /// `y = A x` with the blocks `a` of this pattern, by rows (deterministic).

@@ -2,17 +2,17 @@
 //! its blocks: what the implicit step computed per element ([`ElementBlocks`]);
 //! the lower blocks of the hinges and membrane triangles, written once per step
 //! into a flat array in element order ([`ElementTerms`]); and the shape
-//! triangles' blocks, added band by band ([`Band`]; the block module docs,
+//! triangles' blocks, added band by band ([`super::band::Band`]; the block module docs,
 //! "Assembly").
 
 use rayon::prelude::*;
 
 use super::super::forces::PAR_MIN;
-use super::{BlockPattern, ShapeOp, outer};
+use super::{BlockPattern, outer};
 use crate::math::{Matrix3, Scalar, Vector};
 use crate::physics::elements::Hinge;
 use crate::physics::membrane::{ColumnBlocks, MembraneTriangle};
-use crate::physics::shape::{SHAPE_SLOTS, ShapeJacobian, ShapeTriangle};
+use crate::physics::shape::{EdgeFold, FoldEdges, ShapeJacobian, ShapeTriangle};
 
 /// The per-element matrix terms of one implicit step, computed by the caller.
 #[derive(Debug, Clone, Copy)]
@@ -29,14 +29,26 @@ pub struct ElementBlocks<'a> {
     pub diagonal_mass: &'a [Scalar],
     /// The shape triangles (constant `M`) and, per triangle, the angle gradients.
     pub shape_triangles: &'a [ShapeTriangle],
-    /// Per shape triangle: the gradients of its three angles.
-    pub shape_jacobians: &'a [ShapeJacobian],
+    /// The shape triangles' interior edges, where each triangle reads the
+    /// gradients of its three angles ([`ElementBlocks::shape_jacobian`]).
+    pub fold_edges: &'a FoldEdges,
+    /// Per interior edge: its fold and the fold's gradient.
+    pub edge_folds: &'a [EdgeFold],
     /// `h^2`, the scale of the shape triangles' blocks.
     pub h2: Scalar,
     /// The membrane triangles.
     pub membrane_triangles: &'a [MembraneTriangle],
     /// Per membrane triangle: `h^2 K_t + h D_t` over its columns.
     pub membrane_blocks: &'a [ColumnBlocks],
+}
+
+impl ElementBlocks<'_> {
+    /// Shape triangle `t`'s angle gradients by slot, read from its edges'
+    /// folds.
+    #[inline(always)]
+    pub fn shape_jacobian(&self, t: usize) -> ShapeJacobian {
+        self.fold_edges.angles(t, self.edge_folds).1
+    }
 }
 
 /// The lower blocks that the hinges and membrane triangles add to `A` in one
@@ -93,59 +105,6 @@ impl BlockPattern {
     }
 }
 
-/// One band's share of the assembly: its rows' lower blocks (the band's first
-/// block at `base`) and its vertices' dropped-block norms.
-pub(super) struct Band<'a> {
-    /// The band's first row.
-    pub first_row: usize,
-    /// The slot of the band's first block.
-    pub base: usize,
-    /// The band's blocks (lower ones filled, upper ones unused).
-    pub lower: &'a mut [Matrix3],
-    /// Per row of the band, the dropped shape blocks' norms.
-    pub sigma: &'a mut [Scalar],
-}
-
-impl Band<'_> {
-    /// Computes shape triangle `t`'s blocks `ops` with a vertex in the band
-    /// (with the triangle's Jacobian `jac`): adds each to its block when its
-    /// row is in the band, and a dropped one's norm to the compensation of
-    /// each of its two vertices in the band. The products `M J` are formed
-    /// once for all its blocks.
-    #[inline(always)]
-    pub fn add_shape(
-        &mut self,
-        t: &ShapeTriangle,
-        jac: &ShapeJacobian,
-        h2: Scalar,
-        ops: &[ShapeOp],
-    ) {
-        let mut mj = [[Vector::ZERO; SHAPE_SLOTS]; 3];
-        times_m(&t.m, jac, &mut mj);
-        let rows = self.first_row..self.first_row + self.sigma.len();
-        for op in ops {
-            let (row, column) = (t.v[op.k as usize] as usize, t.v[op.l as usize] as usize);
-            let (in_row, in_column) = (rows.contains(&row), rows.contains(&column));
-            if !(in_row || op.dropped && in_column) {
-                continue;
-            }
-            let block = shape_block(jac, &mj, h2, op.k as usize, op.l as usize);
-            if in_row {
-                self.lower[op.slot as usize - self.base] += block;
-            }
-            if op.dropped {
-                let norm = frobenius(&block);
-                if in_row {
-                    self.sigma[row - self.first_row] += norm;
-                }
-                if in_column {
-                    self.sigma[column - self.first_row] += norm;
-                }
-            }
-        }
-    }
-}
-
 /// Calls `f(k, l)` for every block that an element with vertices `v` adds to
 /// the lower triangle: local vertices `k` and `l`, both set in `active` (bit
 /// `k`), with `v[l] <= v[k]`; `k` outer and `l` inner, each ascending. The
@@ -169,51 +128,10 @@ pub(super) fn shape_active(t: &ShapeTriangle) -> u32 {
     (0..3).fold(0b111, |bits, a| bits | u32::from(t.interior[a]) << (3 + a))
 }
 
-/// `(M J)_al = sum_b M_ab J_bl` for every angle `a` and slot `l`. A tip slot
-/// `3 + b` moves angle `b` only (`shape.rs`, `HINGE_SLOTS`), so its column has
-/// one term; skipping the exact zeros leaves every value the same to the last
-/// bit.
-#[inline(always)]
-fn times_m(m: &[[Scalar; 3]; 3], jac: &ShapeJacobian, mj: &mut [[Vector; SHAPE_SLOTS]; 3]) {
-    for (row, out) in m.iter().zip(mj) {
-        for (l, o) in out.iter_mut().enumerate() {
-            *o = match l {
-                0..3 => jac[0][l] * row[0] + jac[1][l] * row[1] + jac[2][l] * row[2],
-                _ => jac[l - 3][l] * row[l - 3],
-            };
-        }
-    }
-}
-
-/// Block `(k, l)` of a shape triangle, `h^2 sum_a J_ak (M J)_al^T`, over the
-/// angles that slot `k` moves (a tip's block sums one outer product instead of
-/// three).
-#[inline(always)]
-fn shape_block(
-    jac: &ShapeJacobian,
-    mj: &[[Vector; SHAPE_SLOTS]; 3],
-    h2: Scalar,
-    k: usize,
-    l: usize,
-) -> Matrix3 {
-    let mut out = Matrix3::ZERO;
-    for a in moved_angles(k) {
-        out += outer(jac[a][k], mj[a][l]);
-    }
-    out * h2
-}
-
 /// The Frobenius norm of `b`.
 #[inline(always)]
 pub(super) fn frobenius(b: &Matrix3) -> Scalar {
     (b.x_axis.length_squared() + b.y_axis.length_squared() + b.z_axis.length_squared()).sqrt()
-}
-
-/// The angles of a shape triangle that slot `k` moves: all three for one of
-/// its own vertices, angle `a` alone for the tip across edge `a` (slot `3 + a`).
-#[inline(always)]
-fn moved_angles(k: usize) -> std::ops::Range<usize> {
-    if k < 3 { 0..3 } else { k - 3..k - 2 }
 }
 
 #[cfg(test)]
@@ -222,9 +140,9 @@ impl ElementBlocks<'_> {
     /// Jacobians: `h^2 sum_ab M_ab J_ak J_bl^T`, summed as the per-triangle pass
     /// does (the tests' reference).
     pub(super) fn shape_block(&self, tri: usize, k: usize, l: usize) -> Matrix3 {
-        let (m, jac) = (&self.shape_triangles[tri].m, &self.shape_jacobians[tri]);
+        let (m, jac) = (&self.shape_triangles[tri].m, &self.shape_jacobian(tri));
         let mut out = Matrix3::ZERO;
-        for a in moved_angles(k) {
+        for a in super::band::moved_angles(k) {
             let row = &m[a];
             let right = match l {
                 0..3 => jac[0][l] * row[0] + jac[1][l] * row[1] + jac[2][l] * row[2],

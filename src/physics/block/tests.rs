@@ -10,10 +10,12 @@ use crate::math::{Matrix3, Scalar, Vector};
 use crate::mesh::{Mesh, rectangle};
 use crate::physics::elements::{Elements, MaterialParams};
 use crate::physics::membrane::{ColumnBlocks, Membrane, Orthotropic};
-use crate::physics::shape::ShapeJacobian;
+use crate::physics::shape::EdgeFold;
 use crate::physics::{Model, forces::PAR_MIN};
 use crate::scene::{BendingModel, DiagonalPattern, default_scene};
 use crate::world::World;
+
+mod projection;
 
 /// The default scene's sheet at 12 x 12 and its fabric, and the same grid
 /// refined by red-green (the papers' angle criterion) along a crease, so that
@@ -98,7 +100,7 @@ struct Terms {
     hinge_gradients: Vec<Vector>,
     hinge_coefficients: Vec<Scalar>,
     diagonal_mass: Vec<Scalar>,
-    shape_jacobians: Vec<ShapeJacobian>,
+    edge_folds: Vec<EdgeFold>,
     membrane_blocks: Vec<ColumnBlocks>,
 }
 
@@ -115,11 +117,11 @@ impl Terms {
                 .map(|h| 1.5 + noise(h, 3))
                 .collect(),
             diagonal_mass: (0..x.len()).map(|i| 2.0 + noise(i, 4)).collect(),
-            shape_jacobians: elements
-                .shape_triangles
-                .iter()
-                .map(|t| t.angles(x).1)
-                .collect(),
+            edge_folds: {
+                let mut edges = Vec::new();
+                elements.fold_edges.compute(x, &mut edges);
+                edges
+            },
             membrane_blocks: (0..elements.membrane_triangles.len())
                 .map(|t| ColumnBlocks {
                     aa: noise_symmetric(t, 5),
@@ -142,7 +144,8 @@ impl Terms {
             hinge_coefficients: &self.hinge_coefficients,
             diagonal_mass: &self.diagonal_mass,
             shape_triangles: &elements.shape_triangles,
-            shape_jacobians: &self.shape_jacobians,
+            fold_edges: &elements.fold_edges,
+            edge_folds: &self.edge_folds,
             h2: 0.7e-4,
             membrane_triangles: &elements.membrane_triangles,
             membrane_blocks: &self.membrane_blocks,
@@ -309,7 +312,7 @@ fn dense(p: &BlockPattern, el: &Elements, t: &ElementBlocks<'_>) -> (Vec<Matrix3
         }
     }
     for (ti, tri) in el.shape_triangles.iter().enumerate() {
-        let jac = &t.shape_jacobians[ti];
+        let jac = &t.shape_jacobian(ti);
         for (k, i) in tri.slots() {
             for (l, j) in tri.slots() {
                 let (mut m, mut size) = (Matrix3::ZERO, 0.0);

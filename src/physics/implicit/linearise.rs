@@ -8,7 +8,7 @@ use rayon::prelude::*;
 
 use super::super::bending::dihedral_angle_and_gradient;
 use super::super::elements::Elements;
-use super::super::forces::{PAR_MIN, fold_angles, spring_force, wind_share};
+use super::super::forces::{PAR_MIN, edge_folds, fold_angles, spring_force, wind_share};
 use super::super::membrane::{ColumnBlocks, MEMBRANE_SLOTS};
 use super::super::sewing::{capped_spring_force, capped_spring_stiffness};
 use super::super::shape::{SHAPE_SLOTS, rates, spread};
@@ -30,20 +30,26 @@ pub(super) fn linearise(st: &mut Stepper, model: &Model, w: &World, h: Scalar, n
     // The `-h^2 K v` term of the linearised step (none in a Newton residual).
     let k_term = if newton { 0.0 } else { 1.0 };
     s.h2 = h * h;
-    fold_angles(
-        el,
-        x,
-        &mut s.edge_folds,
-        &mut s.shape_folds,
-        &mut s.shape_grad,
-    );
+    // The direct solver's passes read each triangle's gradients from its
+    // edges' folds; the CG solver's products read them by triangle.
+    let direct = model.solver.solver == Solver::Direct;
+    if direct {
+        edge_folds(el, x, &mut s.edge_folds, &mut s.shape_folds);
+    } else {
+        fold_angles(
+            el,
+            x,
+            &mut s.edge_folds,
+            &mut s.shape_folds,
+            &mut s.shape_grad,
+        );
+    }
     // The fold splits are a sequential sparse solve, which leaves the other
     // cores idle: the other elements' terms and the direct solver's block
     // matrix, which need no splits, are computed meanwhile. Each part's values
     // are the same whichever runs first.
     let folds = std::mem::take(&mut s.shape_folds);
     let mut splits = std::mem::take(&mut s.shape_splits);
-    let direct = model.solver.solver == Solver::Direct;
     rayon::join(
         || {
             el.fold_splits
@@ -205,8 +211,9 @@ fn hinges(
         });
 }
 
-/// Per shape triangle: slot = J^T (-h dE/dtheta - h^2 M J v), from the folds,
-/// their Jacobian and the folds' splits (`shape.rs`), solved before.
+/// Per shape triangle: slot = J^T (-h dE/dtheta - h^2 M J v), from the folds
+/// and their Jacobian (read from the edges' folds) and the folds' splits
+/// (`shape.rs`), solved before.
 fn shape_triangles(
     s: &mut ImplicitScratch,
     el: &Elements,
@@ -216,16 +223,17 @@ fn shape_triangles(
 ) {
     let shapes = el.shape_triangles.len();
     s.shape_slot.resize(SHAPE_SLOTS * shapes, Vector::ZERO);
-    let (folds, splits) = (&s.shape_folds, &s.shape_splits);
+    let (edges, splits) = (&s.edge_folds, &s.shape_splits);
     s.shape_slot
         .par_chunks_exact_mut(SHAPE_SLOTS)
-        .zip(s.shape_grad.par_iter())
-        .zip(folds.par_iter())
         .zip(el.shape_triangles.par_iter())
+        .enumerate()
         .with_min_len(PAR_MIN / SHAPE_SLOTS)
-        .for_each(|(((slot, jac), theta), t)| {
+        .for_each(|(i, (slot, t))| {
+            let (theta, jac) = el.fold_edges.angles(i, edges);
+            let jac = &jac;
             let jv = t.times_m(rates(t, jac, v));
-            let moment = t.moments(*theta, splits);
+            let moment = t.moments(theta, splits);
             let c = [0, 1, 2].map(|a| -h * moment[a] - h * h * jv[a] * k_term);
             spread(jac, c, slot);
         });
@@ -263,8 +271,9 @@ fn membrane_triangles(
 }
 
 /// Per vertex, in a fixed order: `b` (the slots of its elements, gravity, drag,
-/// the Newton residual's inertia), the mass plus drag diagonal, and the inverse
-/// Jacobi diagonal (`jacobi`: the CG solver's preconditioner).
+/// the Newton residual's inertia), the mass plus drag diagonal, and with
+/// `jacobi` the inverse Jacobi diagonal (the CG solver's preconditioner; the
+/// direct solver reads none of it, and it is left as it was).
 fn gather(
     s: &mut ImplicitScratch,
     el: &Elements,
@@ -299,16 +308,22 @@ fn gather(
             let mut diag = Vector::ZERO;
             for &e in el.spring_first.of(i) {
                 rhs += spring_slot[e as usize];
-                diag += matrix_diagonal(&block[e as usize]);
+                if jacobi {
+                    diag += matrix_diagonal(&block[e as usize]);
+                }
             }
             for &e in el.spring_second.of(i) {
                 rhs -= spring_slot[e as usize];
-                diag += matrix_diagonal(&block[e as usize]);
+                if jacobi {
+                    diag += matrix_diagonal(&block[e as usize]);
+                }
             }
             for &k in el.hinge_slots.of(i) {
                 rhs += hinge_slot[k as usize];
-                let g = hinge_grad[k as usize];
-                diag += g * g * hinge_coef[k as usize / 4];
+                if jacobi {
+                    let g = hinge_grad[k as usize];
+                    diag += g * g * hinge_coef[k as usize / 4];
+                }
             }
             for &k in el.shape_slots.of(i) {
                 rhs += shape_slot[k as usize];
@@ -348,7 +363,9 @@ fn gather(
             }
             *b = rhs;
             *dm = m;
-            *inv = Vector::ONE / (diag + Vector::splat(m));
+            if jacobi {
+                *inv = Vector::ONE / (diag + Vector::splat(m));
+            }
         });
 }
 

@@ -113,6 +113,19 @@ impl FoldEdges {
         (theta, jac)
     }
 
+    /// Shape triangle `t`'s three folds alone, from the edges' folds `edges`:
+    /// the angles of [`FoldEdges::angles`].
+    #[inline(always)]
+    pub fn folds(&self, t: usize, edges: &[EdgeFold]) -> [Scalar; 3] {
+        self.refs[t].map(|r| {
+            if r == Self::NONE {
+                0.0
+            } else {
+                edges[r as usize / 2].0
+            }
+        })
+    }
+
     /// Number of edges.
     pub fn len(&self) -> usize {
         self.hinges.len()
