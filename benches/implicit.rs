@@ -161,6 +161,19 @@ fn difference(a: &StepStats, b: &StepStats) -> StepStats {
     }
 }
 
+/// The sheet's fabric with the shape-operator bending (the scenes' default).
+fn shape_operator_fabric() -> MaterialParams {
+    MaterialParams {
+        density: 0.15,
+        stretch: 200.0,
+        membrane: drape::physics::Membrane::Springs,
+        bending: 1e-5,
+        damping: 0.001,
+        bending_model: BendingModel::ShapeOperator,
+        stiffness_rule: StiffnessRule::Consistent,
+    }
+}
+
 /// What a remesh costs the implicit solver before its symbolic factorization:
 /// the element tables and the block pattern of the new mesh, with the default
 /// shape-operator bending (`pattern_build`: `BlockPattern::build` alone).
@@ -173,15 +186,7 @@ fn remesh_tables(c: &mut Criterion) {
     for resolution in [63u32, 127] {
         let mesh = drape::mesh::rectangle(1.0, 1.0, resolution, DiagonalPattern::Alternating)
             .expect("valid rectangle");
-        let material = MaterialParams {
-            density: 0.15,
-            stretch: 200.0,
-            membrane: drape::physics::Membrane::Springs,
-            bending: 1e-5,
-            damping: 0.001,
-            bending_model: BendingModel::ShapeOperator,
-            stiffness_rule: StiffnessRule::Consistent,
-        };
+        let material = shape_operator_fabric();
         let vertices = mesh.vertex_count();
         group.throughput(Throughput::Elements(vertices as u64));
         group.bench_function(BenchmarkId::new("elements_build", vertices), |b| {
@@ -288,15 +293,7 @@ fn orderings() {
     for resolution in [63u32, 127] {
         let mesh = drape::mesh::rectangle(1.0, 1.0, resolution, DiagonalPattern::Alternating)
             .expect("valid rectangle");
-        let material = MaterialParams {
-            density: 0.15,
-            stretch: 200.0,
-            membrane: drape::physics::Membrane::Springs,
-            bending: 1e-5,
-            damping: 0.001,
-            bending_model: BendingModel::ShapeOperator,
-            stiffness_rule: StiffnessRule::Consistent,
-        };
+        let material = shape_operator_fabric();
         let elements = Elements::build(&mesh, &material);
         let pattern = BlockPattern::build(mesh.vertex_count(), &elements, false);
         let blocks = laplacian_blocks(&pattern);

@@ -4,11 +4,7 @@
 //! search's middle level is such a separator, of about the square root of the
 //! vertices. Parts of at most [`LEAF`] vertices are ordered by AMD.
 
-use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::sparse::SymbolicSparseColMatRef;
-use faer::sparse::linalg::amd;
-
-use super::FactorError;
+use super::{FactorError, amd_order};
 
 /// The largest part ordered by AMD instead of dissected further.
 const LEAF: usize = 256;
@@ -205,18 +201,7 @@ impl Graph {
             rows.extend_from_slice(&column);
             column_start.push(rows.len() as u32);
         }
-        let graph = SymbolicSparseColMatRef::new_checked(n, n, &column_start, None, &rows);
-        let (mut forward, mut inverse) = (vec![0u32; n], vec![0u32; n]);
-        let mut buffer = MemBuffer::try_new(amd::order_scratch::<u32>(n, rows.len()))
-            .map_err(|_| FactorError::Setup)?;
-        amd::order(
-            &mut forward,
-            &mut inverse,
-            graph,
-            amd::Control::default(),
-            MemStack::new(&mut buffer),
-        )
-        .map_err(|_| FactorError::Setup)?;
+        let forward = amd_order(n, &column_start, &rows)?;
         order.extend(forward.iter().map(|&local| set[local as usize]));
         Ok(())
     }
