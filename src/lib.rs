@@ -1,6 +1,6 @@
 //! drape: adaptive mass-spring cloth simulation recorded to Rerun `.rrd` files.
 //!
-//! Data flows one way (SPEC section 2):
+//! Data flows one way (`docs/architecture.md`, "Data flow"):
 //! scene file -> [`scene::Scene`] -> [`sim::build`] -> [`sim::SimParts`]: the
 //! [`sim::Setup`] (the [`physics::Model`], the obstacles and the
 //! [`sim::Settings`], fixed for the run), a [`sim::SimState`] and the

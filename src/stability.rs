@@ -1,7 +1,7 @@
-//! The stability suite (SPEC section 8): hard cases run with every integrator
-//! they allow and with adaptivity on and off, each judged on four criteria:
-//! no numerical failure, no energy gain beyond the external work (within a
-//! tolerance), no tunneling through obstacles, and mass conserved.
+//! The stability suite (`docs/stability.md`, "Criteria"): hard cases run with
+//! every integrator they allow and with adaptivity on and off, each judged on
+//! four criteria: no numerical failure, no energy gain beyond the external work
+//! (within a tolerance), no tunneling through obstacles, and mass conserved.
 //!
 //! The cases are the scenes of `scenes/hard/`, built into the binary; [`CASES`]
 //! says which integrators each allows and how `--quick` shortens it. A

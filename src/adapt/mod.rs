@@ -1,6 +1,7 @@
-//! Adaptive meshing (SPEC section 4): the papers' `angle` criterion (refine where
-//! the angle between the normals at an interior edge exceeds the upper threshold,
-//! coarsen where every angle around is below the lower one) or `sizing.rs`.
+//! Adaptive meshing (`docs/model.md`, "Adaptive meshing"): the papers' `angle`
+//! criterion (refine where the angle between the normals at an interior edge
+//! exceeds the upper threshold, coarsen where every angle around is below the
+//! lower one) or `sizing.rs`.
 //!
 //! An adaptation pass: measure angles -> choose operations -> apply them to the
 //! refinement hierarchy -> close the mesh -> transfer the state onto the new

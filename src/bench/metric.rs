@@ -1,4 +1,4 @@
-//! The error metric of SPEC section 8.
+//! The error metric (`docs/bench.md`, "The error").
 //!
 //! Fixed sample points in material space are located in each mesh through the
 //! material coordinates (the same cloth point on any mesh, uniform or adapted),

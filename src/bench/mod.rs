@@ -1,4 +1,4 @@
-//! Speed against error (SPEC section 8): `drape bench` runs a ladder of
+//! Speed against error (`docs/bench.md`): `drape bench` runs a ladder of
 //! uniform and adaptive settings on a scene without recording, measures each
 //! run's wall time and vertex counts and its error against a cached fine
 //! reference, and writes a CSV, a short Markdown report and an SVG chart.

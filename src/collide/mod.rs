@@ -1,4 +1,5 @@
-//! Collisions (SPEC section 5): cloth against rigid obstacles and against itself.
+//! Collisions (`docs/model.md`, "Collisions"): cloth against rigid obstacles and
+//! against itself.
 //!
 //! This is the only module that imports `parry3d_f64`. Engine vectors are glam 0.33
 //! `DVec3`, which is parry's own `Vector`, so no conversion happens at the boundary.

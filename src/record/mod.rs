@@ -1,4 +1,4 @@
-//! Recording of a run to a Rerun `.rrd` file or a live viewer (SPEC section 7), the `drape
+//! Recording of a run to a Rerun `.rrd` file or a live viewer (`docs/recording.md`), the `drape
 //! inspect` decoder, and OBJ frame export.
 //!
 //! This is the only module that imports `rerun`. The engine hands each frame over as plain

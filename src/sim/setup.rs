@@ -9,10 +9,10 @@ use crate::spec::SelfCollision;
 
 use super::step_control::AdaptiveStep;
 
-/// Everything a run holds fixed (SPEC section 2's model): given to every call
-/// that advances a state, next to the state (`pipeline.step(&setup, &mut
-/// state, h)`), so that the state holds only what changes and the pipeline
-/// only scratch.
+/// Everything a run holds fixed (`docs/architecture.md`, "The simulation as
+/// three values"): given to every call that advances a state, next to the
+/// state (`pipeline.step(&setup, &mut state, h)`), so that the state holds only
+/// what changes and the pipeline only scratch.
 #[derive(Debug)]
 pub struct Setup {
     /// The physics: material, external forces, and the integrator and solver
