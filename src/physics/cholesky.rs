@@ -59,17 +59,15 @@ pub(crate) use numeric::{Numeric, Workspace};
 
 use std::sync::Arc;
 
-use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
-use faer::linalg::cholesky::llt::factor::LltRegularization;
+use faer::Side;
+use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::perm::PermRef;
+use faer::sparse::SymbolicSparseColMatRef;
 use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::linalg::amd;
 use faer::sparse::linalg::cholesky::{
-    CholeskySymbolicParams, LltRef, SymbolicCholesky, SymmetricOrdering,
-    factorize_symbolic_cholesky,
+    CholeskySymbolicParams, SymbolicCholesky, SymmetricOrdering, factorize_symbolic_cholesky,
 };
-use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
-use faer::{Conj, MatMut, Par, Side};
 
 use super::block::BlockPattern;
 use crate::math::{Matrix3, Scalar, Vector};
@@ -101,7 +99,6 @@ pub enum Ordering {
     NestedDissection,
 }
 
-
 /// The floating-point type of a factor's stored values (module docs, "Single
 /// precision").
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -112,7 +109,6 @@ pub enum Precision {
     /// `f32`: half the memory traffic in the factorization and the solves.
     Single,
 }
-
 
 /// A Cholesky factor `A = L L^T` of the (projected) implicit system matrix, and the
 /// symbolic analysis of its pattern (module docs).

@@ -141,7 +141,7 @@ impl<T: FactorScalar> Numeric<T> {
     }
 
     /// Forgets the values (kept allocated).
-    fn clear(&mut self) {
+    pub(crate) fn clear(&mut self) {
         self.factor.clear();
     }
 }
