@@ -17,6 +17,7 @@ pub mod cantilever;
 pub mod check;
 pub mod collide;
 pub mod garment;
+pub mod kinematics;
 pub mod math;
 pub mod mesh;
 pub mod physics;

@@ -1,13 +1,13 @@
 //! Pinned vertices: selected by named region in material space (so a selection
 //! means the same cloth points on any mesh) and moved by a script, or carried
-//! by an obstacle or a part of one (`attach`, `crate::collide::carrier`).
+//! by an obstacle or a part of one (`attach`, `crate::kinematics::carrier`).
 
 mod coverage;
 
 pub use coverage::{PinMismatch, mismatches};
 
-use crate::collide::carrier::{AttachError, Carrier};
-use crate::collide::motion::Track;
+use crate::kinematics::carrier::{AttachError, Carrier};
+use crate::kinematics::motion::Track;
 use crate::math::{Matrix3, Scalar, Vector, Vector2};
 use crate::mesh::{GridCuts, Mesh};
 use crate::spec::{Obstacle, Pin, PinMotion};

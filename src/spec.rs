@@ -11,6 +11,8 @@
 
 use serde::Deserialize;
 
+use crate::math::Scalar;
+
 mod part;
 mod pin;
 mod sequence;
@@ -137,7 +139,21 @@ pub struct SeamSide {
     pub side: usize,
 }
 
-pub use crate::mesh::Sewing;
+/// How a seam is sewn: the pull of its springs, its cap, and the gap at which
+/// it is welded.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sewing {
+    /// Sewing stiffness per metre of seam, N/m per m: each pair's zero-length
+    /// spring gets this times its share of the seam's length.
+    pub stiffness: Scalar,
+    /// The seam is welded once every pair is closer than this, m.
+    pub weld_gap: Scalar,
+    /// The largest pull per metre of seam, N/m (`None`: no cap): each pair's
+    /// spring pulls with at most this times its share of the seam's length,
+    /// and beyond the gap where it reaches that force its energy grows
+    /// linearly (`physics::sewing`).
+    pub max_force: Option<Scalar>,
+}
 
 /// The linear solver of the implicit integrator.
 #[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq, Default)]
@@ -318,7 +334,7 @@ pub struct Obstacle {
     pub axis: [f64; 3],
     /// Keyframed motion instead of `velocity` and `angular_velocity`: poses
     /// relative to the placement at rest, at increasing times (at least two;
-    /// none: no keyframes). See `src/collide/motion.rs`.
+    /// none: no keyframes). See `src/kinematics/motion.rs`.
     #[serde(default)]
     pub keyframes: Vec<Keyframe>,
     /// How poses between keyframes are interpolated.
@@ -405,6 +421,22 @@ pub enum ObstacleShape {
     /// A triangle mesh deformed by a sequence of OBJ files of one topology
     /// (`files`, `frame_rate`, `scale`), interpolated between frames.
     MeshSequence,
+}
+
+impl ObstacleShape {
+    /// The scene's word for the shape, for names and messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            ObstacleShape::Sphere => "sphere",
+            ObstacleShape::Box => "box",
+            ObstacleShape::Plane => "plane",
+            ObstacleShape::Capsule => "capsule",
+            ObstacleShape::Cylinder => "cylinder",
+            ObstacleShape::Mesh => "mesh",
+            ObstacleShape::Articulated => "articulated",
+            ObstacleShape::MeshSequence => "mesh sequence",
+        }
+    }
 }
 
 /// `[self_collision]`: contacts of the cloth with itself.

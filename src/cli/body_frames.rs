@@ -9,8 +9,8 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 
 use crate::emit;
-use drape::collide::skin::obj_text;
 use drape::collide::{Drawn, Obstacles};
+use drape::kinematics::skin::obj_text;
 use drape::math::Vector;
 use drape::scene::load_scene_file;
 

@@ -4,7 +4,7 @@
 //! A deforming body gives, at any time `t`, every vertex's world position and
 //! velocity: an OBJ sequence interpolated between frames
 //! ([`super::sequence`]), or the parts of an articulated body tessellated
-//! and skinned to them ([`super::skin`]). The collision passes query its
+//! and skinned to them ([`crate::kinematics::skin`]). The collision passes query its
 //! surface at the two ends of each step, a parry [`TriMesh`] built from the
 //! positions at that time (its bounding volume hierarchy and pseudo-normals
 //! rebuilt, not refitted), kept in a small cache so that each time is built
@@ -29,7 +29,7 @@ use parry3d_f64::query::PointQueryWithLocation;
 use parry3d_f64::shape::{TriMesh, TriMeshFlags};
 
 use super::sequence::Sequence;
-use super::skin::Skin;
+use crate::kinematics::skin::Skin;
 use crate::math::{Scalar, Vector};
 
 /// Where a deforming mesh's vertex positions and velocities come from.

@@ -34,20 +34,16 @@
 //! and every reduction is exact (integer sums, maxima), so results are the same at any
 //! thread count.
 
-pub mod carrier;
 pub mod cusick;
 pub mod deform;
 mod display;
 pub mod geometry;
-pub mod motion;
 pub mod obstacle;
 mod response;
 mod self_prims;
 pub mod selfcol;
 pub mod sequence;
 mod shapes;
-pub mod skeleton;
-pub mod skin;
 pub mod volino;
 
 use std::time::Instant;
@@ -70,6 +66,9 @@ pub use display::{Drawn, ObstacleMesh, ObstaclePose};
 /// Why the collision setup of a scene failed.
 #[derive(Debug, thiserror::Error)]
 pub enum CollideError {
+    /// An articulated body's joints are invalid.
+    #[error(transparent)]
+    Kinematics(#[from] crate::kinematics::KinematicsError),
     /// An obstacle's OBJ file is unreadable or unusable.
     #[error("obstacle {index}: {path}: cannot use the OBJ mesh: {reason}")]
     Obj {

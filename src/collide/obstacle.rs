@@ -11,12 +11,12 @@ use parry3d_f64::shape::{Ball, Capsule, Cuboid, Cylinder, HalfSpace, Shape, TriM
 
 use super::CollideError;
 use super::deform::{Animation, At, Deforming};
-use super::motion::{Motion, Track};
 use super::sequence::{Sequence, load_frames};
-use super::shapes::{load_mesh, primitive, shape_name};
-use super::skeleton::Skeleton;
-use super::skin::Skin;
+use super::shapes::{load_mesh, primitive};
 use crate::adapt::proximity::ObstaclePlane;
+use crate::kinematics::motion::{Motion, obstacle_motion};
+use crate::kinematics::skeleton::Skeleton;
+use crate::kinematics::skin::Skin;
 use crate::math::{Scalar, Vector, rotation_from_euler_deg};
 use crate::spec::{BodySurface, Obstacle, ObstacleShape, Part, SequenceFiles};
 
@@ -67,7 +67,7 @@ impl Body {
     pub fn from_spec(index: usize, o: &Obstacle) -> Result<Vec<Body>, CollideError> {
         let axis = Vector::from_array(o.axis).normalize_or_zero();
         if o.shape == ObstacleShape::Articulated {
-            let skeleton = Arc::new(Skeleton::new(index, o, motion(o, axis))?);
+            let skeleton = Arc::new(Skeleton::new(index, o, obstacle_motion(o, axis))?);
             if o.surface == BodySurface::SkinnedMesh {
                 return Ok(vec![Body::skinned(index, o, skeleton)?]);
             }
@@ -108,8 +108,14 @@ impl Body {
         let rot = glam::DQuat::from_mat3(&rotation_from_euler_deg(o.rotation));
         let origin = Vector::from_array(o.position);
         let pose0 = Pose::from_parts(origin, rot * fix);
-        let name = format!("obstacle {index} ({})", shape_name(o.shape));
-        Ok(vec![Body::rigid(name, o, shape, pose0, motion(o, axis))])
+        let name = format!("obstacle {index} ({})", o.shape.name());
+        Ok(vec![Body::rigid(
+            name,
+            o,
+            shape,
+            pose0,
+            obstacle_motion(o, axis),
+        )])
     }
 
     /// Part `i` (`p`) of articulated obstacle `index` (`o`), moved by `skeleton`.
@@ -405,20 +411,5 @@ impl Body {
         let axis = pose.rotation * Vector::Y;
         (axis.z.abs() > 1.0 - 1e-9)
             .then(|| (pose.translation + Vector::Z * c.half_height, c.radius))
-    }
-}
-
-/// The motion an obstacle's keys ask for: keyframes, else a constant velocity
-/// and spin about `axis` (normalised), else none.
-pub(super) fn motion(o: &Obstacle, axis: Vector) -> Motion {
-    if !o.keyframes.is_empty() {
-        return Motion::Keyframed(Track::new(&o.keyframes, o.easing, o.after_last));
-    }
-    let velocity = Vector::from_array(o.velocity);
-    let omega = axis * o.angular_velocity;
-    if velocity == Vector::ZERO && omega == Vector::ZERO {
-        Motion::Fixed
-    } else {
-        Motion::Constant { velocity, omega }
     }
 }

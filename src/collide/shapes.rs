@@ -37,25 +37,11 @@ pub(super) fn primitive(
                 index,
                 reason: format!(
                     "a part cannot be a {}: parts are spheres, capsules or boxes",
-                    shape_name(other)
+                    other.name()
                 ),
             });
         }
     })
-}
-
-/// The scene's word for a shape, for names and messages.
-pub(super) fn shape_name(s: ObstacleShape) -> &'static str {
-    match s {
-        ObstacleShape::Sphere => "sphere",
-        ObstacleShape::Box => "box",
-        ObstacleShape::Plane => "plane",
-        ObstacleShape::Capsule => "capsule",
-        ObstacleShape::Cylinder => "cylinder",
-        ObstacleShape::Mesh => "mesh",
-        ObstacleShape::Articulated => "articulated",
-        ObstacleShape::MeshSequence => "mesh sequence",
-    }
 }
 
 /// Loads an obstacle mesh from OBJ (every object of the file, triangulated), scaled.

@@ -23,7 +23,7 @@ pub use outline::{
 };
 pub use pairmap::{PairHasher, PairMap, PairSet};
 pub use panels::{
-    DEFAULT_SEWING_STIFFNESS, DEFAULT_WELD_GAP, Panels, Pattern, Seam, SeamState, Sewing, Weld,
+    DEFAULT_SEWING_STIFFNESS, DEFAULT_WELD_GAP, Panels, Pattern, Seam, SeamState, Weld,
 };
 pub use topology::{Edge, NO_TRIANGLE};
 

@@ -17,6 +17,7 @@
 
 use super::{Mesh, MeshError, topology};
 use crate::math::{Scalar, Vector, Vector2};
+use crate::spec::Sewing;
 
 /// The sewing stiffness a seam gets unless told otherwise, N/m per m of seam:
 /// a 1 m seam's springs together pull with 50 N per metre of gap.
@@ -65,22 +66,6 @@ pub struct Seam {
     pub state: SeamState,
     /// How the seam is sewn and when it is welded.
     pub sewing: Sewing,
-}
-
-/// How a seam is sewn: the pull of its springs, its cap, and the gap at which
-/// it is welded.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Sewing {
-    /// Sewing stiffness per metre of seam, N/m per m: each pair's zero-length
-    /// spring gets this times its share of the seam's length.
-    pub stiffness: Scalar,
-    /// The seam is welded once every pair is closer than this, m.
-    pub weld_gap: Scalar,
-    /// The largest pull per metre of seam, N/m (`None`: no cap): each pair's
-    /// spring pulls with at most this times its share of the seam's length,
-    /// and beyond the gap where it reaches that force its energy grows
-    /// linearly (`physics::sewing`).
-    pub max_force: Option<Scalar>,
 }
 
 /// Whether a seam is open (sewing springs pull it) or welded into one surface.

@@ -6,7 +6,7 @@
 use super::error::{Issue, KeyPath, SceneErrorKind as Kind, Seg};
 use super::validate::{allowed_for, non_negative};
 use super::{Obstacle, Pin};
-use crate::collide::carrier::{locate, targets};
+use crate::kinematics::carrier::{locate, targets};
 
 /// The keys of a pin's own motion, which an attached pin does not have.
 const MOTION_KEYS: [&str; 9] = [

@@ -13,7 +13,7 @@ use super::{Keyframe, KeyframeAfter, KeyframeEasing, ObstacleShape};
 /// without a parent), turned by `rotation` at rest and further by the joint
 /// rotation its `keyframes` give at each time. The shape sits at `center` in
 /// the part's frame, with its axes along the part's (round shapes along local
-/// z). See `src/collide/skeleton.rs`.
+/// z). See `src/kinematics/skeleton.rs`.
 #[derive(Debug, Clone, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct Part {

@@ -67,6 +67,6 @@ pub enum PinMotion {
     /// Rotation about `axis` through `center` at `angular_velocity`.
     Circular,
     /// Along `keyframes`: moved by each key's translation and turned by its
-    /// rotation about `center` (see `src/collide/motion.rs`).
+    /// rotation about `center` (see `src/kinematics/motion.rs`).
     Keyframed,
 }

@@ -1,4 +1,4 @@
-//! Articulated obstacles (`src/collide/skeleton.rs`): forward kinematics
+//! Articulated obstacles (`src/kinematics/skeleton.rs`): forward kinematics
 //! against hand-computed poses, exact surface velocities against finite
 //! differences, a cloth carried by a turning part, the scene's errors, and
 //! the cape demo.

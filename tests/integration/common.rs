@@ -2,11 +2,12 @@
 
 use drape::adapt::AdaptConfig;
 use drape::math::{Scalar, Vector};
-use drape::mesh::{DEFAULT_SEWING_STIFFNESS, DEFAULT_WELD_GAP, Sewing};
+use drape::mesh::{DEFAULT_SEWING_STIFFNESS, DEFAULT_WELD_GAP};
 use drape::physics::{Energy, Model, SolveFailure, Stepper};
 use drape::scene::Scene;
 use drape::scene::{AdaptCriterion, AdaptMethod, Pin, PinMotion};
 use drape::sim::{Pipeline, Setup, SimParts, SimState, build};
+use drape::spec::Sewing;
 use drape::world::World;
 
 /// Overrides of `scenes/hanging_sheet_rest.toml` that made the sizing

@@ -8,11 +8,12 @@ use std::f64::consts::PI;
 
 use drape::garment::{self, BuiltGarment};
 use drape::math::{Scalar, Vector};
-use drape::mesh::{DEFAULT_SEWING_STIFFNESS, DEFAULT_WELD_GAP, SeamState, Sewing};
+use drape::mesh::{DEFAULT_SEWING_STIFFNESS, DEFAULT_WELD_GAP, SeamState};
 use drape::physics::forces::energy;
 use drape::physics::{Elements, ExternalForces, MaterialParams, Membrane};
 use drape::scene::{BendingModel, StiffnessRule, load_scene_str};
 use drape::sim::build;
+use drape::spec::Sewing;
 use drape::spec::{Garment, PanelSpec, Placement, SeamSide, SeamSpec};
 use drape::world::World;
 

@@ -1,9 +1,9 @@
-//! Keyframed obstacles (`src/collide/motion.rs`): the interpolation, its exact
+//! Keyframed obstacles (`src/kinematics/motion.rs`): the interpolation, its exact
 //! velocities, friction carrying a cloth along, and the scene's errors.
 
 use std::sync::atomic::AtomicBool;
 
-use drape::collide::motion::{RigidState, Track};
+use drape::kinematics::motion::{RigidState, Track};
 use drape::math::Vector;
 use drape::scene::{Keyframe, KeyframeAfter, KeyframeEasing, load_scene_str};
 

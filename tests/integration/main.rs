@@ -30,6 +30,7 @@ mod garments;
 mod gradient;
 mod inspect_cli;
 mod keyframes;
+mod layers;
 mod membrane;
 mod membrane_cantilever;
 mod membrane_runs;

@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
 use drape::collide::obstacle::Body;
-use drape::collide::skin::obj_text;
 use drape::collide::{Drawn, Obstacles};
+use drape::kinematics::skin::obj_text;
 use drape::math::Vector;
 use drape::scene::{Scene, load_scene_file};
 

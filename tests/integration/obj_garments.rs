@@ -8,7 +8,8 @@
 use std::path::PathBuf;
 
 use drape::math::Vector2;
-use drape::mesh::{self, ObjCloth, ObjError, Panels, Pattern, SeamState, Sewing};
+use drape::mesh::{self, ObjCloth, ObjError, Panels, Pattern, SeamState};
+use drape::spec::Sewing;
 
 use crate::common::SEWING;
 

@@ -1,5 +1,5 @@
 //! Pins attached to an obstacle or a part of one (`attach`,
-//! `src/collide/carrier.rs`): the held vertices follow the part's pose
+//! `src/kinematics/carrier.rs`): the held vertices follow the part's pose
 //! exactly, with its exact velocity, under both kinds of integrator; they let
 //! go at their release time; and the scene's mistakes name file, line and key.
 

@@ -43,8 +43,9 @@ mod text;
 
 use std::path::Path;
 
-use super::{Mesh, MeshError, Sewing, topology};
+use super::{Mesh, MeshError, topology};
 use crate::math::{Scalar, Vector, Vector2};
+use crate::spec::Sewing;
 use merge::{MergedObj, merge_models, planar_rest_shape};
 use pieces::{Pieces, find_pieces};
 use seams::{SeamMesh, read_seams};

@@ -6,7 +6,8 @@ use std::collections::{HashMap, HashSet};
 use super::ObjError;
 use super::merge::{MergedObj, position_key};
 use super::text::{LineElement, ObjText};
-use crate::mesh::{Edge, Seam, SeamState, Sewing};
+use crate::mesh::{Edge, Seam, SeamState};
+use crate::spec::Sewing;
 
 /// A sewing pair read from the file.
 struct Pair {

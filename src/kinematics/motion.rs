@@ -40,7 +40,7 @@ use glam::DQuat;
 use super::skeleton::Skeleton;
 
 use crate::math::{Scalar, Vector, rotation_from_euler_deg};
-use crate::spec::{Keyframe, KeyframeAfter, KeyframeEasing};
+use crate::spec::{Keyframe, KeyframeAfter, KeyframeEasing, Obstacle};
 
 /// The obstacle's motion relative to its placement at rest.
 #[derive(Debug, Clone, PartialEq)]
@@ -224,5 +224,20 @@ impl Motion {
             Motion::Keyframed(track) => track.state(t),
             Motion::Articulated { skeleton, part } => skeleton.state(*part, t),
         }
+    }
+}
+
+/// The motion an obstacle's keys ask for: keyframes, else a constant velocity
+/// and spin about `axis` (normalised), else none.
+pub fn obstacle_motion(o: &Obstacle, axis: Vector) -> Motion {
+    if !o.keyframes.is_empty() {
+        return Motion::Keyframed(Track::new(&o.keyframes, o.easing, o.after_last));
+    }
+    let velocity = Vector::from_array(o.velocity);
+    let omega = axis * o.angular_velocity;
+    if velocity == Vector::ZERO && omega == Vector::ZERO {
+        Motion::Fixed
+    } else {
+        Motion::Constant { velocity, omega }
     }
 }

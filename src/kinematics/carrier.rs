@@ -23,9 +23,7 @@
 
 use std::sync::Arc;
 
-use super::motion::{Motion, RigidState};
-use super::obstacle::motion;
-use super::shapes::shape_name;
+use super::motion::{Motion, RigidState, obstacle_motion};
 use super::skeleton::Skeleton;
 use crate::math::{Scalar, Vector};
 use crate::spec::{Obstacle, ObstacleShape};
@@ -126,7 +124,7 @@ pub fn locate(obstacles: &[Obstacle], attach: &str) -> Result<AttachTarget, Atta
     if o.shape != ObstacleShape::Articulated {
         return Err(AttachError::NoParts {
             obstacle: name.into(),
-            shape: shape_name(o.shape),
+            shape: o.shape.name(),
         });
     }
     let found = o.part.iter().position(|p| p.name == part);
@@ -174,7 +172,7 @@ impl Carrier {
     pub fn new(obstacles: &[Obstacle], attach: &str) -> Result<Carrier, AttachError> {
         let target = locate(obstacles, attach)?;
         let o = &obstacles[target.obstacle];
-        let root = motion(o, Vector::from_array(o.axis).normalize_or_zero());
+        let root = obstacle_motion(o, Vector::from_array(o.axis).normalize_or_zero());
         let (origin, motion) = match target.part {
             None => (Vector::from_array(o.position), root),
             Some(part) => {

@@ -26,7 +26,7 @@
 
 use glam::DQuat;
 
-use super::CollideError;
+use super::KinematicsError;
 use super::motion::{Motion, RigidState, Track};
 use crate::math::{Scalar, Vector, rotation_from_euler_deg};
 use crate::spec::{Obstacle, Part};
@@ -78,7 +78,7 @@ impl Skeleton {
     /// The hierarchy of `o`'s parts (obstacle `index`), whose root moves as
     /// `root` says. Fails on a parent that names no part or a cycle
     /// (validation normally catches both first).
-    pub fn new(index: usize, o: &Obstacle, root: Motion) -> Result<Skeleton, CollideError> {
+    pub fn new(index: usize, o: &Obstacle, root: Motion) -> Result<Skeleton, KinematicsError> {
         let names: Vec<String> = o.part.iter().map(|p| p.name.clone()).collect();
         let joints = o
             .part
@@ -102,7 +102,7 @@ impl Skeleton {
                 }
             }
             if sk.joints[at].parent.is_some() {
-                return Err(CollideError::Hierarchy {
+                return Err(KinematicsError::Hierarchy {
                     index,
                     reason: format!(
                         "the chain of parents from part `{}` never reaches the root: the hierarchy has a cycle",
@@ -220,17 +220,16 @@ impl Skeleton {
 }
 
 /// Part `p`'s joint, its parent looked up among `names`.
-fn joint(index: usize, p: &Part, names: &[String]) -> Result<Joint, CollideError> {
-    let parent =
-        match &p.parent {
-            None => None,
-            Some(name) => Some(names.iter().position(|n| n == name).ok_or_else(|| {
-                CollideError::Hierarchy {
-                    index,
-                    reason: format!("part `{}` names an unknown parent `{name}`", p.name),
-                }
-            })?),
-        };
+fn joint(index: usize, p: &Part, names: &[String]) -> Result<Joint, KinematicsError> {
+    let parent = match &p.parent {
+        None => None,
+        Some(name) => Some(names.iter().position(|n| n == name).ok_or_else(|| {
+            KinematicsError::Hierarchy {
+                index,
+                reason: format!("part `{}` names an unknown parent `{name}`", p.name),
+            }
+        })?),
+    };
     let track = (!p.keyframes.is_empty()).then(|| Track::new(&p.keyframes, p.easing, p.after_last));
     Ok(Joint {
         parent,
