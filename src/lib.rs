@@ -11,22 +11,31 @@
 //! solver's warm start included); the pipeline holds only scratch, as in rapier's
 //! parameters, sets and pipeline.
 
+// The layers (`docs/architecture.md`, "What each layer may import"; test
+// `layers` holds them): each imports only its own layer and those above it
+// in this list.
+
+// Vocabulary: numbers and the engine's specifications.
+pub mod math;
+pub mod spec;
+
+// Engine: the cloth, its physics, moving bodies, collisions and remeshing.
 pub mod adapt;
-pub mod bench;
-pub mod cantilever;
-pub mod check;
 pub mod collide;
 pub mod garment;
 pub mod kinematics;
-pub mod math;
 pub mod mesh;
 pub mod physics;
 pub mod pins;
+pub mod sim;
+pub mod world;
+
+// Application: scene files, runs, recordings, reports and the tools.
+pub mod bench;
+pub mod cantilever;
+pub mod check;
 pub mod record;
 pub mod run;
 pub mod scene;
-pub mod sim;
-pub mod spec;
 pub mod stability;
 pub mod summary;
-pub mod world;

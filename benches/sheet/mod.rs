@@ -49,7 +49,7 @@ pub fn setup(
     let x = mesh.material.iter().map(|p| p.extend(1.0)).collect();
     let mut world = World::new(mesh, x);
     let pins = [corner("corner:top_left"), corner("corner:top_right")];
-    world.pins = drape::physics::pins::Pins::select(&pins, &world.mesh, &world.x).expect("pins");
+    world.pins = drape::pins::Pins::select(&pins, &world.mesh, &world.x).expect("pins");
     let model = Model {
         material: MaterialParams {
             density: 0.15,

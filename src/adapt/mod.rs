@@ -245,7 +245,7 @@ pub struct Measured<'a> {
     /// vertices (one per vertex, from `Obstacles::nearest_planes`; empty: no
     /// obstacles), which the sizing criterion's obstacle term measures
     /// (`proximity.rs`; unused without `refine_obstacle`).
-    pub obstacle_planes: &'a [proximity::ObstaclePlane],
+    pub obstacle_planes: &'a [crate::collide::ObstaclePlane],
 }
 
 /// Why adaptive remeshing cannot start on a world's mesh.

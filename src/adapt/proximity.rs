@@ -40,20 +40,9 @@
 //! Red-green with the sizing criterion only. The rollback check does not see
 //! it (it is measured in the adaptation pass, where the obstacles are known).
 
+use crate::collide::ObstaclePlane;
 use crate::math::{Scalar, Vector};
 use crate::mesh::Edge;
-
-/// The tangent plane of the obstacle surface point nearest to one cloth vertex.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ObstaclePlane {
-    /// The nearest surface point, world coordinates, m.
-    pub point: Vector,
-    /// The outward unit normal there.
-    pub normal: Vector,
-    /// The obstacle's contact thickness, m: the smallest height the measure
-    /// divides by.
-    pub thickness: Scalar,
-}
 
 /// How far edge `e` leans towards the obstacle nearest to its ends, relative
 /// to its height above it (module docs): the larger over both ends of

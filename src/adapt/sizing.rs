@@ -136,8 +136,9 @@
 use std::collections::HashMap;
 
 use super::AdaptConfig;
-use super::proximity::{ObstaclePlane, edge_obstacle_lean};
+use super::proximity::edge_obstacle_lean;
 use super::red_green_pass::RedGreenState;
+use crate::collide::ObstaclePlane;
 use crate::math::{Scalar, Vector2};
 use crate::mesh::{Edge, Mesh, NO_TRIANGLE};
 use crate::world::World;

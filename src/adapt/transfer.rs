@@ -41,7 +41,7 @@ use super::transfer_panels::panels_after_remesh;
 use crate::math::{Scalar, Vector, Vector2};
 use crate::mesh::{Mesh, MeshError, signed_area};
 use crate::physics::Contact;
-use crate::physics::pins::Anchor;
+use crate::pins::Anchor;
 use crate::world::World;
 
 /// Where a vertex of the new mesh comes from.

@@ -51,7 +51,6 @@ use std::time::Instant;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::adapt::proximity::ObstaclePlane;
 use crate::math::{Scalar, Vector};
 use crate::physics::Contact;
 use crate::spec::{Obstacle, SelfCollision};
@@ -62,6 +61,20 @@ use response::{contact_work, depth_below, push_out, respond};
 use selfcol::SelfCollider;
 
 pub use display::{Drawn, ObstacleMesh, ObstaclePose};
+
+/// The tangent plane of the obstacle surface point nearest to one cloth
+/// vertex: what the collision code finds (`Obstacles::nearest_planes`) and
+/// the sizing criterion's obstacle term reads (`crate::adapt::proximity`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ObstaclePlane {
+    /// The nearest surface point, world coordinates, m.
+    pub point: Vector,
+    /// The outward unit normal there.
+    pub normal: Vector,
+    /// The obstacle's contact thickness, m: the smallest height the measure
+    /// divides by.
+    pub thickness: Scalar,
+}
 
 /// Why the collision setup of a scene failed.
 #[derive(Debug, thiserror::Error)]

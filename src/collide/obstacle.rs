@@ -10,10 +10,10 @@ use parry3d_f64::query::Ray;
 use parry3d_f64::shape::{Ball, Capsule, Cuboid, Cylinder, HalfSpace, Shape, TriMesh};
 
 use super::CollideError;
+use super::ObstaclePlane;
 use super::deform::{Animation, At, Deforming};
 use super::sequence::{Sequence, load_frames};
 use super::shapes::{load_mesh, primitive};
-use crate::adapt::proximity::ObstaclePlane;
 use crate::kinematics::motion::{Motion, obstacle_motion};
 use crate::kinematics::skeleton::Skeleton;
 use crate::kinematics::skin::Skin;

@@ -18,7 +18,6 @@ pub mod membrane;
 pub mod multirate;
 /// Pinned vertices (a top-level module, [`crate::pins`], so that `world` needs nothing
 /// from `physics`); kept reachable here.
-pub use crate::pins;
 pub mod sewing;
 pub mod shape;
 pub mod timestep;

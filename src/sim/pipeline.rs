@@ -115,7 +115,7 @@ pub struct Pipeline {
     angles_fresh: bool,
     /// Per vertex, the tangent plane of the nearest obstacle point, measured for
     /// the adaptation pass's obstacle term (buffer reused pass to pass).
-    obstacle_planes: Vec<crate::adapt::proximity::ObstaclePlane>,
+    obstacle_planes: Vec<crate::collide::ObstaclePlane>,
     /// The size of the last accepted step (for the recording's step plot).
     last_step: Option<Scalar>,
     /// The energy of the state as the last successful frame left it, when the

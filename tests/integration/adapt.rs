@@ -6,7 +6,7 @@ use drape::adapt::transfer::lumped_masses;
 use drape::adapt::{AdaptConfig, Adapter, check_consistency};
 use drape::math::{Scalar, Vector};
 use drape::mesh;
-use drape::physics::pins::Pins;
+use drape::pins::Pins;
 use drape::scene::DiagonalPattern;
 use drape::world::World;
 

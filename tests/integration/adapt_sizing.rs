@@ -373,7 +373,7 @@ fn a_sheet_at_rest_stops_remeshing() {
 /// counts are printed.
 #[test]
 fn an_edge_leaning_towards_an_obstacle_refines_near_it_only() {
-    use drape::adapt::proximity::ObstaclePlane;
+    use drape::collide::ObstaclePlane;
     let ground = ObstaclePlane {
         point: Vector::ZERO,
         normal: Vector::Z,

@@ -374,7 +374,7 @@ fn pins_min_edge_and_events() {
     };
     w.pins.anchors = top(&w)
         .into_iter()
-        .map(|v| drape::physics::pins::Anchor {
+        .map(|v| drape::pins::Anchor {
             vertex: v,
             pin: 0,
             start: w.x[v as usize],

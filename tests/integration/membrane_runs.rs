@@ -155,7 +155,7 @@ fn held_sheet(
         .map(|p| Vector::new(0.1 * p.y, 0.0, -0.5 * p.x))
         .collect();
     let pins = ["edge:left", "edge:right", "edge:top", "edge:bottom"].map(crate::common::pin);
-    world.pins = drape::physics::pins::Pins::select(&pins, &world.mesh, &world.x).unwrap();
+    world.pins = drape::pins::Pins::select(&pins, &world.mesh, &world.x).unwrap();
     let material = drape::physics::MaterialParams {
         bending,
         damping,

@@ -320,7 +320,7 @@ fn total_mass_is_density_times_area_on_every_generated_mesh() {
 #[test]
 fn symplectic_euler_keeps_energy_bounded_over_ten_thousand_steps() {
     let mut w = flat_world(1.0, 12, 1.0);
-    w.pins = drape::physics::pins::Pins::select(
+    w.pins = drape::pins::Pins::select(
         &[pin("corner:top_left"), pin("corner:top_right")],
         &w.mesh,
         &w.x,
@@ -370,7 +370,7 @@ fn symplectic_euler_keeps_energy_bounded_over_ten_thousand_steps() {
 #[test]
 fn implicit_is_stable_at_a_sixtieth_of_a_second_on_stiff_fabric() {
     let mut w = flat_world(1.0, 24, 1.0);
-    w.pins = drape::physics::pins::Pins::select(
+    w.pins = drape::pins::Pins::select(
         &[pin("corner:top_left"), pin("corner:top_right")],
         &w.mesh,
         &w.x,
@@ -428,7 +428,7 @@ fn final_state(threads: usize, integrator: Integrator, membrane: Membrane) -> Ve
         .unwrap();
     pool.install(|| {
         let mut w = flat_world(1.0, 48, 1.0);
-        w.pins = drape::physics::pins::Pins::select(&[pin("edge:left")], &w.mesh, &w.x).unwrap();
+        w.pins = drape::pins::Pins::select(&[pin("edge:left")], &w.mesh, &w.x).unwrap();
         let wind = WindForce {
             velocity: Vector::new(4.0, 1.0, 0.5),
             coefficient: 1.0,

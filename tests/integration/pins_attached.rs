@@ -5,7 +5,7 @@
 
 use drape::collide::obstacle::Body;
 use drape::math::{Scalar, Vector};
-use drape::physics::pins::Pins;
+use drape::pins::Pins;
 use drape::scene::{Scene, load_scene_str};
 
 use crate::common::Sim;

@@ -60,7 +60,7 @@ fn bent_sheet(res: u32) -> World {
         .collect();
     let mut w = World::new(m, x);
     w.v = v;
-    w.pins = drape::physics::pins::Pins::select(&[pin("edge:left")], &w.mesh, &w.x).unwrap();
+    w.pins = drape::pins::Pins::select(&[pin("edge:left")], &w.mesh, &w.x).unwrap();
     w
 }
 
