@@ -8,6 +8,8 @@
 //! [`SceneError`] and `docs/scenes.md`.
 
 mod error;
+#[cfg(test)]
+mod key_table_tests;
 mod limits;
 pub mod model;
 mod overrides;
