@@ -49,6 +49,15 @@
 //! The factorization's flop count is no better a proxy than the stored values:
 //! it overstates the full factor's cost (dense kernels run faster on its larger
 //! supernodes), by as much as the stored values understate it.
+//!
+//! # Which preconditioner
+//! The scene's `preconditioner` chooses what is factored: the block factor
+//! above in double precision (the default) or single precision
+//! ([`crate::physics::cholesky`], "Single precision"), or one scalar factor of
+//! a weighted graph Laplacian ([`crate::physics::laplacian`]), which is never
+//! switched to a full form. The conjugate gradients and the rule for when to
+//! factor anew are the same for all three (`docs/model.md`, "Which
+//! preconditioner, measured").
 
 use std::sync::Arc;
 use std::time::Instant;
