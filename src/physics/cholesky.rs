@@ -238,7 +238,7 @@ impl Factorization {
                     &self.values,
                     &mut self.scale,
                     &mut self.values_single,
-                );
+                )?;
                 self.single.factor(
                     &symbolic,
                     structure,
@@ -296,19 +296,25 @@ impl Factorization {
 
 /// The lower-triangle CSC matrix (`col_ptr`, `rows`, `values`; each column's
 /// diagonal first) scaled to unit diagonal, `D A D` with `D = diag(A)^-1/2`,
-/// rounded to single precision into `out`, and `D` into `scale`.
+/// rounded to single precision into `out`, and `D` into `scale`. A diagonal
+/// entry that is not positive (nor finite) makes the matrix not positive
+/// definite: an error, as the double-precision factorization reports it, not a
+/// pivot for the regularization to paper over.
 fn equilibrate(
     (col_ptr, rows): (&[u32], &[u32]),
     values: &[Scalar],
     scale: &mut Vec<Scalar>,
     out: &mut Vec<f32>,
-) {
+) -> Result<(), FactorError> {
     let n = col_ptr.len() - 1;
     scale.clear();
-    scale.extend((0..n).map(|c| {
+    for c in 0..n {
         let d = values[col_ptr[c] as usize];
-        if d > 0.0 { 1.0 / d.sqrt() } else { 1.0 }
-    }));
+        if !(d > 0.0 && d.is_finite()) {
+            return Err(FactorError::NotPositiveDefinite);
+        }
+        scale.push(1.0 / d.sqrt());
+    }
     out.clear();
     for c in 0..n {
         let (s, e) = (col_ptr[c] as usize, col_ptr[c + 1] as usize);
@@ -316,6 +322,7 @@ fn equilibrate(
             out.push((values[k] * scale[rows[k] as usize] * scale[c]) as f32);
         }
     }
+    Ok(())
 }
 
 /// faer's symbolic analysis of a lower-triangle structure with `ordering`,

@@ -114,18 +114,8 @@ fn m_tol(tol: Scalar) -> Scalar {
 /// The comparison for the box `a`..`b` of pin `p`; `None` when the box holds
 /// no vertex or contains no cloth.
 fn measure(p: usize, a: Vector2, b: Vector2, mesh: &Mesh, tol: Scalar) -> Option<PinMismatch> {
-    let held: Vec<bool> = mesh
-        .material
-        .iter()
-        .map(|m| m.cmpge(a - tol).all() && m.cmple(b + tol).all())
-        .collect();
-    let held_box = bounding_box(
-        mesh.material
-            .iter()
-            .zip(&held)
-            .filter(|(_, h)| **h)
-            .map(|(m, _)| *m),
-    )?;
+    let (held, held_box) = held_by(mesh, |m| m.cmpge(a - tol).all() && m.cmple(b + tol).all());
+    let held_box = held_box?;
     let region_box = bounding_box(
         mesh.triangles
             .iter()
@@ -163,6 +153,20 @@ fn measure(p: usize, a: Vector2, b: Vector2, mesh: &Mesh, tol: Scalar) -> Option
         edge_length,
         uncovered_length: (edge_length - covered).max(0.0),
     })
+}
+
+/// Per vertex of `mesh`, whether its material point is `inside` the region,
+/// and the bounding box of those that are (`None`: none is).
+fn held_by(mesh: &Mesh, inside: impl Fn(Vector2) -> bool) -> (Vec<bool>, Option<[Scalar; 4]>) {
+    let held: Vec<bool> = mesh.material.iter().map(|m| inside(*m)).collect();
+    let held_box = bounding_box(
+        mesh.material
+            .iter()
+            .zip(&held)
+            .filter(|(_, h)| **h)
+            .map(|(m, _)| *m),
+    );
+    (held, held_box)
 }
 
 /// `[u_min, v_min, u_max, v_max]` of the points, `None` for none.

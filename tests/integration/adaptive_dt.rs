@@ -60,7 +60,8 @@ fn sets(args: &[&str]) -> Vec<String> {
     args.iter().map(|s| (*s).to_owned()).collect()
 }
 
-fn summary(text: &str, args: &[&str]) -> Summary {
+/// The run summary of the scene `text` with the overrides `args`.
+pub(crate) fn summary(text: &str, args: &[&str]) -> Summary {
     let scene = load_scene_str(text, "test.toml", &sets(args)).expect("scene");
     run(
         &scene,

@@ -29,7 +29,7 @@ fn temp_dir(name: &str) -> PathBuf {
 }
 
 /// Runs `drape ARGS` in `cwd` and prints what it said.
-fn drape(args: &[&str], cwd: &Path) -> Output {
+pub(crate) fn drape(args: &[&str], cwd: &Path) -> Output {
     let out = Command::new(env!("CARGO_BIN_EXE_drape"))
         .args(args)
         .current_dir(cwd)

@@ -3,28 +3,11 @@
 //! name, a missing or empty folder or a bad scene is an error that says so.
 
 use std::path::Path;
-use std::process::{Command, Output};
 
 use drape::stability::CASES;
 
 use crate::bad_input::temp_dir;
-
-/// Runs `drape ARGS` in `cwd` and prints what it said.
-fn drape(args: &[&str], cwd: &Path) -> Output {
-    let out = Command::new(env!("CARGO_BIN_EXE_drape"))
-        .args(args)
-        .current_dir(cwd)
-        .output()
-        .expect("run drape");
-    println!(
-        "drape {}: exit {:?}\n{}{}",
-        args.join(" "),
-        out.status.code(),
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
-}
+use crate::cli::drape;
 
 /// A small sheet hanging from its top edge for 0.1 s, without adaptivity.
 const TINY: &str = "name = \"tiny\"\n\

@@ -2,10 +2,6 @@
 //! steady step prints one size, a varying one its range and its mean, and the
 //! count printed is of the steps the time is made of.
 
-use std::sync::atomic::AtomicBool;
-
-use drape::run::{RunOptions, run};
-use drape::scene::load_scene_str;
 use drape::summary::Summary;
 
 /// A 1 m sheet at 8 segments hanging from its top edge for 0.3 s.
@@ -26,16 +22,10 @@ bending = 1.0e-5
 region = "edge:top"
 "#;
 
+/// The hanging sheet's run summary with `simulation.dt` set to `dt`.
 fn summary(dt: &str) -> Summary {
-    let set = [format!("simulation.dt={dt}")];
-    let scene = load_scene_str(HANGING, "hanging.toml", &set).expect("scene");
-    run(
-        &scene,
-        &RunOptions::default(),
-        &AtomicBool::new(false),
-        &mut |_| {},
-    )
-    .expect("run")
+    let set = format!("simulation.dt={dt}");
+    crate::adaptive_dt::summary(HANGING, &[set.as_str()])
 }
 
 /// The numbers of the paragraph's step clause, from `frames, ` to `to t = T s`:

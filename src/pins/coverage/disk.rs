@@ -4,7 +4,7 @@
 //! edge: every held vertex next to free cloth lies on the circle, and every
 //! mesh edge that bounds the held cloth runs between two such vertices.
 
-use super::{PinMismatch, bounding_box, m_tol};
+use super::{PinMismatch, held_by, m_tol};
 use crate::math::{Scalar, Vector2};
 use crate::mesh::{Mesh, NO_TRIANGLE};
 
@@ -17,18 +17,8 @@ pub(super) fn measure(
     mesh: &Mesh,
     tol: Scalar,
 ) -> Option<PinMismatch> {
-    let held: Vec<bool> = mesh
-        .material
-        .iter()
-        .map(|m| m.distance(c) <= r + tol)
-        .collect();
-    let held_box = bounding_box(
-        mesh.material
-            .iter()
-            .zip(&held)
-            .filter(|(_, h)| **h)
-            .map(|(m, _)| *m),
-    )?;
+    let (held, held_box) = held_by(mesh, |m| m.distance(c) <= r + tol);
+    let held_box = held_box?;
     let (lo, hi) = mesh.material_bounds();
     let region_box = [
         (c.x - r).max(lo.x),

@@ -58,7 +58,7 @@ pub(super) fn switch_to_full_factor(
         a.pattern = Some(full.clone());
         a.compensation.iter_mut().for_each(|m| *m = Matrix3::ZERO);
         a.factorization = analysed;
-        refactor(a, &full, &[], stats)?;
+        refactor(a, &full, &elements.mass, stats)?;
         a.policy.factored(false);
         return Ok(true);
     }
