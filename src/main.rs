@@ -10,6 +10,7 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 use cli::bench::{BenchArgs, cmd_bench};
 use cli::body_frames::{BodyFramesArgs, cmd_body_frames};
 use cli::run::cmd_run;
+use drape::record::history::history_at;
 use drape::record::inspect::inspect;
 use drape::scene::{Scene, default_scene, load_scene_file};
 
@@ -74,9 +75,15 @@ struct StabilityArgs {
 struct InspectArgs {
     /// The recording to read.
     file: PathBuf,
-    /// Print this frame's mesh statistics, plots and events instead of the overview.
+    /// Print this frame's mesh statistics, plots and events instead of the overview (with
+    /// --at: the frame the point is taken at; default the last).
     #[arg(long, value_name = "N", conflicts_with = "frames")]
     frame: Option<i64>,
+    /// Print the history of the triangle under the point X,Y,Z (m) instead: its level,
+    /// refinement ratio, term and state where they change, and every remeshing event on it
+    /// with its reason.
+    #[arg(long, value_name = "X,Y,Z", value_parser = point, conflicts_with = "frames")]
+    at: Option<[f64; 3]>,
     /// Print one line per frame instead of the overview: time, vertices, triangles,
     /// triangles at the finest level, splits, merges, rollbacks, contacts and the
     /// frame's stepping time, summed at the end.
@@ -127,10 +134,16 @@ struct RunArgs {
     edge_threshold: Option<f64>,
     /// What colours the cloth's triangles: `level` (default) the refinement level, `panel`
     /// the garment panel (each panel in its own colour, named in the legend; a cloth without
-    /// panels is one panel, `cloth`).
+    /// panels is one panel, `cloth`), `ratio` the refinement criterion's value against its
+    /// threshold, `state` what holds the triangle (both of an adaptive run's decisions;
+    /// hovering a triangle then shows its ratio, term and state).
     #[arg(long = "colour-by", alias = "color-by", value_enum, value_name = "WHAT",
           default_value_t = ColourChoice::Level)]
     colour_by: ColourChoice,
+    /// Leave out each triangle's refinement decision (`decision_ratio`, `decision_term`,
+    /// `decision_state` on `cloth/mesh`), recorded every frame of an adaptive run by default.
+    #[arg(long)]
+    no_decisions: bool,
     /// Also start a Rerun viewer (`rerun` 0.36.3 on PATH) and stream the run to it live.
     #[arg(long, conflicts_with = "connect")]
     spawn: bool,
@@ -225,12 +238,29 @@ enum ColourChoice {
     Level,
     /// The garment panel.
     Panel,
+    /// The refinement criterion's ratio.
+    Ratio,
+    /// The refinement decision's state.
+    State,
 }
 
 fn cmd_check(args: SceneArgs) -> Result<ExitCode> {
     let scene = load(&args)?;
     emit(&drape::check::describe(&scene)?)?;
     Ok(ExitCode::SUCCESS)
+}
+
+/// A point `X,Y,Z` of three finite numbers (for `--at`).
+fn point(s: &str) -> Result<[f64; 3], String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    let [x, y, z] = parts[..] else {
+        return Err(format!("{s} is not a point X,Y,Z (three numbers separated by commas)"));
+    };
+    let number = |v: &str| match v.parse::<f64>() {
+        Ok(n) if n.is_finite() => Ok(n),
+        _ => Err(format!("{v} in {s} is not a finite number")),
+    };
+    Ok([number(x)?, number(y)?, number(z)?])
 }
 
 /// A finite angle in degrees, at least 0 (for `--edge-threshold`).
@@ -290,6 +320,10 @@ fn cmd_stability(args: StabilityArgs) -> Result<ExitCode> {
 }
 
 fn cmd_inspect(args: InspectArgs) -> Result<ExitCode> {
+    if let Some(at) = args.at {
+        emit(&history_at(&args.file, at, args.frame)?.report())?;
+        return Ok(ExitCode::SUCCESS);
+    }
     let inspection = inspect(&args.file)?;
     match args.frame {
         Some(n) => emit(&inspection.frame_report(n)?)?,

@@ -18,7 +18,7 @@ pub use crate::sim::{
 };
 
 use crate::math::{Scalar, Vector};
-use crate::record::{ColourBy, EdgeDisplay, LiveViewer, RecordError};
+use crate::record::{ColourBy, DecisionData, EdgeDisplay, LiveViewer, RecordError};
 use crate::scene::Scene;
 use crate::sim::{SimBuildError, SimParts};
 use crate::summary::Summary;
@@ -43,8 +43,11 @@ pub struct RunOptions {
     /// against the scene's refine threshold.
     pub edges: EdgeDisplay,
     /// What the triangles of `cloth/mesh` are coloured by: refinement level (the default)
-    /// or garment panel.
+    /// or garment panel, or the refinement decisions' ratio or state.
     pub colour_by: ColourBy,
+    /// Whether the recording holds each triangle's refinement decision (recorded by
+    /// default; `--no-decisions`).
+    pub decisions: DecisionData,
 }
 
 /// Progress report after each frame.

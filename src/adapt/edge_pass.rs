@@ -4,7 +4,9 @@
 use std::collections::HashMap;
 
 use super::transfer::{PanelCorners, VertexOrder, compact, transfer};
-use super::{AdaptConfig, AdaptEvent, Adapter, EventKind, MethodState, edge, edge_angles};
+use super::{
+    AdaptConfig, AdaptEvent, Adapter, EventKind, MethodState, Reading, Reason, edge, edge_angles,
+};
 use crate::math::{Scalar, Vector};
 use crate::mesh::MeshError;
 use crate::spec::AdaptCriterion;
@@ -72,7 +74,7 @@ impl Adapter {
             panic!("edge method soup after {} operations: {e}", ops.len());
         }
         let map = self.rebuild_from_soup(world, &soup)?;
-        self.report_edge_ops(world, &ops, &map, &asked, step);
+        self.report_edge_ops(world, &ops, &map, &asked, (c.refine_angle, step));
         self.stats.changed_passes += 1;
         self.stats.max_ops_per_pass = self.stats.max_ops_per_pass.max(ops.len() as u64);
         self.stats.note_levels(world, max_level);
@@ -88,7 +90,7 @@ impl Adapter {
         ops: &[edge::EdgeOp],
         map: &[u32],
         asked: &HashMap<(u32, u32), Scalar>,
-        step: u64,
+        (refine_angle, step): (Scalar, u64),
     ) {
         for op in ops {
             let at = |v: u32| {
@@ -116,6 +118,15 @@ impl Adapter {
                     (EventKind::Collapse, at(u), None)
                 }
             };
+            let reason = match (kind, angle) {
+                (EventKind::Flip, _) => Reason::Quality,
+                (EventKind::Collapse, _) => Reason::Flat,
+                (_, Some(a)) => Reason::Criterion {
+                    reading: Reading::of_angle(a, refine_angle),
+                    limit: 1.0,
+                },
+                (_, None) => Reason::Given { angle: None },
+            };
             let level = world.mesh.levels.iter().copied().max().unwrap_or(0);
             self.events.push(AdaptEvent {
                 kind,
@@ -123,6 +134,8 @@ impl Adapter {
                 level,
                 angle,
                 step,
+                reason,
+                corners: None,
             });
         }
     }

@@ -5,6 +5,7 @@
 
 use rayon::prelude::*;
 
+use super::decision::Reading;
 use super::red_green_pass::RedGreenState;
 use super::{AdaptConfig, Adapter, MethodState, sizing};
 use crate::math::Scalar;
@@ -52,6 +53,20 @@ impl Adapter {
         world: &World,
         angles: &[Scalar],
     ) -> Vec<(u32, Scalar)> {
+        self.rollback_marks(config, world, angles)
+            .into_iter()
+            .map(|(l, r)| (l, r.angle))
+            .collect()
+    }
+
+    /// [`Adapter::refinement_marks`] with the criterion's reading at each leaf
+    /// (what [`Adapter::note_rollback`] takes).
+    pub fn rollback_marks(
+        &self,
+        config: &AdaptConfig,
+        world: &World,
+        angles: &[Scalar],
+    ) -> Vec<(u32, Reading)> {
         match &self.method {
             MethodState::RedGreen(rg) => {
                 debug_assert_eq!(
@@ -118,11 +133,11 @@ impl RedGreenState {
         c: &AdaptConfig,
         world: &World,
         angles: &[Scalar],
-    ) -> Vec<(u32, Scalar)> {
+    ) -> Vec<(u32, Reading)> {
         if c.criterion == AdaptCriterion::Sizing {
             return self.sizing_refinement_marks(c, &self.leaf_curvatures(c, world, angles, &[]));
         }
-        let mut marks: Vec<(u32, Scalar)> = Vec::new();
+        let mut marks: Vec<(u32, Reading)> = Vec::new();
         for (e, edge) in world.mesh.edges.iter().enumerate() {
             if angles[e] <= c.refine_angle {
                 continue;
@@ -130,25 +145,51 @@ impl RedGreenState {
             for &t in &edge.triangles {
                 let leaf = self.owner[t as usize];
                 if self.may_split(c, leaf) {
-                    marks.push((leaf, angles[e]));
+                    marks.push((leaf, Reading::of_angle(angles[e], c.refine_angle)));
                 }
             }
         }
-        marks.sort_by(|a, b| a.0.cmp(&b.0).then(b.1.total_cmp(&a.1)));
+        marks.sort_by(|a, b| a.0.cmp(&b.0).then(b.1.angle.total_cmp(&a.1.angle)));
         marks.dedup_by_key(|m| m.0);
         marks
     }
 
-    /// Parents whose children may merge: every angle at the edges of their
-    /// triangles is below the lower threshold, and below half the upper one (a
-    /// merge about doubles the angles, so this keeps a merge from being split
-    /// again at once when the thresholds are close).
+    /// Of `parents` (nodes whose children are leaves), those whose children may
+    /// merge: every angle at the edges of their triangles is below the lower
+    /// threshold, and below half the upper one (a merge about doubles the
+    /// angles, so this keeps a merge from being split again at once when the
+    /// thresholds are close). Each with the children's reading and the ratio
+    /// it stays under.
     pub(super) fn merge_marks(
         &self,
         c: &AdaptConfig,
         world: &World,
         angles: &[Scalar],
-    ) -> Vec<(u32, Scalar)> {
+        parents: &[u32],
+    ) -> Vec<(u32, Reading, Scalar)> {
+        let leaf_max = self.leaf_max_angles(world, angles);
+        let limit = c.coarsen_angle.min(0.5 * c.refine_angle);
+        let mut out = Vec::new();
+        for &p in parents {
+            let children = self.hierarchy.children(p).unwrap_or_default();
+            let worst = children
+                .iter()
+                .map(|c| leaf_max.get(c).copied().unwrap_or(0.0))
+                .fold(0.0, Scalar::max);
+            if worst < limit {
+                let reading = Reading::of_angle(worst, c.refine_angle);
+                out.push((p, reading, limit / c.refine_angle));
+            }
+        }
+        out
+    }
+
+    /// The largest angle at the edges of each leaf's world triangles, degrees.
+    pub(super) fn leaf_max_angles(
+        &self,
+        world: &World,
+        angles: &[Scalar],
+    ) -> std::collections::HashMap<u32, Scalar> {
         let mut leaf_max: std::collections::HashMap<u32, Scalar> = std::collections::HashMap::new();
         for (e, edge) in world.mesh.edges.iter().enumerate() {
             for &t in edge
@@ -160,18 +201,6 @@ impl RedGreenState {
                 *m = m.max(angles[e]);
             }
         }
-        let limit = c.coarsen_angle.min(0.5 * c.refine_angle);
-        let mut out = Vec::new();
-        for p in self.hierarchy.mergeable_parents() {
-            let children = self.hierarchy.children(p).unwrap_or_default();
-            let worst = children
-                .iter()
-                .map(|c| leaf_max.get(c).copied().unwrap_or(0.0))
-                .fold(0.0, Scalar::max);
-            if worst < limit {
-                out.push((p, worst));
-            }
-        }
-        out
+        leaf_max
     }
 }

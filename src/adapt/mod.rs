@@ -8,12 +8,15 @@
 //! topology -> report events. The stepper must rebuild its elements afterwards.
 
 mod check;
+pub mod decision;
 pub mod edge;
 mod edge_collapse;
 mod edge_pass;
 mod marks;
 pub mod proximity;
+mod readings;
 pub mod red_green;
+mod red_green_apply;
 mod red_green_pass;
 pub mod sizing;
 pub mod soup;
@@ -24,6 +27,7 @@ mod transfer_panels;
 mod tri_list;
 
 pub use check::{ConsistencyError, boundary_length, check_consistency};
+pub use decision::{Reading, Reason, Refusal, Term, TriangleDecision, TriangleState};
 pub use marks::{edge_angles, edge_angles_into};
 
 use crate::math::{Scalar, Vector};
@@ -49,6 +53,9 @@ pub enum EventKind {
     Bounce,
     /// Four children merged back into their parent.
     Merge,
+    /// A merge the criterion asked for that the level rule refused (logged
+    /// when a parent is first refused, not again while it stays refused).
+    MergeRefused,
     /// A step restored, refined and integrated again.
     Rollback,
     /// An edge flipped for quality (edge method).
@@ -71,6 +78,11 @@ pub struct AdaptEvent {
     pub angle: Option<Scalar>,
     /// The step after which it happened.
     pub step: u64,
+    /// Why it happened.
+    pub reason: Reason,
+    /// The world positions of the corners of the triangle it split, merged
+    /// into or refused (red-green; the leaf that triggered a rollback), m.
+    pub corners: Option<[Vector; 3]>,
 }
 
 /// Counters over a run.
@@ -429,16 +441,38 @@ impl Adapter {
         }
     }
 
-    /// Records a rollback of step `step`.
-    pub fn note_rollback(&mut self, world: &World, step: u64) {
+    /// Records a rollback of step `step`, triggered by the leaves `marks` (from
+    /// [`Adapter::rollback_marks`]): the event sits at the leaf with the largest
+    /// reading (at the cloth's centre when there is none).
+    pub fn note_rollback(&mut self, world: &World, marks: &[(u32, Reading)], step: u64) {
         self.stats.rollbacks += 1;
-        let centre = world.x.iter().copied().sum::<Vector>() / world.x.len().max(1) as Scalar;
+        let worst = marks
+            .iter()
+            .max_by(|a, b| a.1.ratio.total_cmp(&b.1.ratio).then(b.0.cmp(&a.0)));
+        let corners = match (&self.method, worst) {
+            (MethodState::RedGreen(rg), Some(&(leaf, _))) => Some(
+                rg.hierarchy
+                    .vertices(leaf)
+                    .map(|v| world.x[v as usize]),
+            ),
+            _ => None,
+        };
+        let position = match corners {
+            Some(c) => (c[0] + c[1] + c[2]) / 3.0,
+            None => world.x.iter().copied().sum::<Vector>() / world.x.len().max(1) as Scalar,
+        };
+        let reading = worst.map(|m| m.1).unwrap_or_default();
         self.events.push(AdaptEvent {
             kind: EventKind::Rollback,
-            position: centre,
+            position,
             level: 0,
-            angle: None,
+            angle: worst.map(|m| m.1.angle),
             step,
+            reason: Reason::Rollback {
+                reading,
+                marked: marks.len(),
+            },
+            corners,
         });
     }
 }

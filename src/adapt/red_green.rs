@@ -85,6 +85,9 @@ pub struct Applied {
     pub level: u8,
     /// True for a split forced by closure or 1-irregularity rather than asked for.
     pub forced: bool,
+    /// For a split forced by 1-irregularity: the finer neighbour whose split
+    /// forced it (`None` for every other operation).
+    pub neighbour: Option<u32>,
     /// The four children the split made or the merge freed.
     pub children: [u32; 4],
     /// Midpoint entries (sorted edge, vertex) the split created (each with a
@@ -113,6 +116,17 @@ pub struct RedGreen {
     /// For each vertex made in this pass (id `first_new + k`), its parent edge.
     created: Vec<(u32, u32)>,
     first_new: u32,
+}
+
+/// Why [`RedGreen::split`] splits a leaf.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Forcing {
+    /// Asked for by an operation.
+    Asked,
+    /// Forced by 1-irregularity: the finer neighbour being split.
+    Neighbour(u32),
+    /// Forced by closure: two or more hanging nodes.
+    Closure,
 }
 
 fn sorted(a: u32, b: u32) -> (u32, u32) {
@@ -265,13 +279,13 @@ impl RedGreen {
         self.merge_batch(&merges, out);
         for op in ops {
             if let RedGreenOp::Split(n) = *op {
-                self.split(n, false, out);
+                self.split(n, Forcing::Asked, out);
             }
         }
     }
 
     /// 1-4 split of leaf `t`, splitting coarser neighbours first.
-    fn split(&mut self, t: u32, forced: bool, out: &mut Vec<Applied>) {
+    fn split(&mut self, t: u32, forcing: Forcing, out: &mut Vec<Applied>) {
         if !self.is_leaf(t) {
             return;
         }
@@ -282,7 +296,7 @@ impl RedGreen {
             if let Some(&(pp, qq)) = self.half_of.get(&(p, q))
                 && let Some(&coarse) = self.leaf_by_edge.get(&(qq, pp))
             {
-                self.split(coarse, true, out);
+                self.split(coarse, Forcing::Neighbour(t), out);
             }
         }
         let [a, b, c] = self.vertices(t);
@@ -335,7 +349,11 @@ impl RedGreen {
             op: RedGreenOp::Split(t),
             vertices: [a, b, c],
             level,
-            forced,
+            forced: forcing != Forcing::Asked,
+            neighbour: match forcing {
+                Forcing::Neighbour(n) => Some(n),
+                Forcing::Asked | Forcing::Closure => None,
+            },
             children: ids,
             midpoints,
             nodes_before,
@@ -376,7 +394,7 @@ impl RedGreen {
                 return;
             }
             for t in crowded {
-                self.split(t, true, out);
+                self.split(t, Forcing::Closure, out);
             }
         }
     }

@@ -1,19 +1,32 @@
-//! Paper A's pass on the adapter: the criterion's marks, the operations on the
-//! refinement hierarchy (`red_green.rs`), closure, and the world moved onto the
-//! conforming mesh built from it.
+//! Paper A's state between passes: the refinement hierarchy (`red_green.rs`),
+//! the criterion's marks for a pass with the merges the level rule refuses,
+//! the world rebuilt from the hierarchy, and the counters of what a pass did
+//! (`red_green_apply.rs` runs the pass).
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
+use super::decision::{Reading, Reason, Refusal};
 use super::red_green::{Applied, RedGreen, RedGreenOp};
 use super::transfer::{Origin, PanelCorners, VertexOrder, compact, transfer};
-use super::{AdaptConfig, AdaptEvent, Adapter, EventKind, Measured, MethodState, edge_angles};
+use super::{AdaptConfig, AdaptEvent, EventKind, Measured};
 use crate::math::{Scalar, Vector};
 use crate::mesh::MeshError;
 use crate::spec::AdaptCriterion;
 use crate::world::World;
 
-/// Nodes of the hierarchy to merge or split, each with the angle that asked.
-type Marks = Vec<(u32, Scalar)>;
+/// Nodes of the hierarchy to merge or split, each with why.
+pub(super) type Marks = Vec<(u32, Reason)>;
+
+/// What the criterion asks of one pass.
+pub(super) struct PassMarks {
+    /// Parents to merge (their children may merge by the level rule).
+    pub(super) merges: Marks,
+    /// Leaves to split.
+    pub(super) splits: Marks,
+    /// Parents the criterion would merge that a neighbour two splits finer
+    /// keeps, each with the parent's reading.
+    pub(super) kept: Vec<(u32, Reading)>,
+}
 
 /// What the red-green method keeps between passes: the hierarchy, which leaf
 /// owns each triangle of the world's mesh, and what decides bounces.
@@ -30,6 +43,11 @@ pub(super) struct RedGreenState {
     /// Per parent: how many of its merges bounced (its sizing hysteresis is
     /// doubled that many times; dropped when the parent itself merges away).
     pub(super) bounces: HashMap<u32, u32>,
+    /// The parents whose merge the level rule refused in the latest pass,
+    /// sorted (a refusal is logged when it is new).
+    refused_last_pass: Vec<u32>,
+    /// The nodes a rollback's refinement split that no merge has undone.
+    pub(super) rollback_parents: HashSet<u32>,
 }
 
 impl RedGreenState {
@@ -48,34 +66,101 @@ impl RedGreenState {
             merged_last_pass: Vec::new(),
             pass_merges: Vec::new(),
             bounces: HashMap::new(),
+            refused_last_pass: Vec::new(),
+            rollback_parents: HashSet::new(),
         }
     }
 
-    /// The merges and the splits the criterion asks for, each with its angle.
-    fn marks(
-        &self,
-        c: &AdaptConfig,
-        world: &World,
-        angles: &[Scalar],
-        known: Measured,
-    ) -> (Marks, Marks) {
-        match c.criterion {
+    /// The merges and the splits the criterion asks for, each with its reason,
+    /// and the merges it asks for that a finer neighbour keeps.
+    pub(super) fn marks(&self, c: &AdaptConfig, world: &World, angles: &[Scalar], known: Measured) -> PassMarks {
+        let parents = self.hierarchy.leaf_parents();
+        let all: Vec<u32> = parents.iter().map(|p| p.0).collect();
+        let (merge_ok, splits) = match c.criterion {
             AdaptCriterion::Angle => (
-                self.merge_marks(c, world, angles),
+                self.merge_marks(c, world, angles, &all),
                 self.refinement_marks(c, world, angles),
             ),
             AdaptCriterion::Sizing => {
                 let curv = self.leaf_curvatures(c, world, angles, known.obstacle_planes);
-                let merges = self.sizing_merge_marks(c, &curv);
+                let merges = self.sizing_merge_marks(c, &curv, &all);
                 (merges, self.sizing_refinement_marks(c, &curv))
             }
+        };
+        // `merge_ok` follows `parents`' order.
+        let mut mergeable = parents.iter().filter(|p| merge_ok.iter().any(|m| m.0 == p.0));
+        let mut marks = PassMarks {
+            merges: Vec::new(),
+            splits: splits
+                .into_iter()
+                .map(|(l, reading)| (l, Reason::Criterion { reading, limit: 1.0 }))
+                .collect(),
+            kept: Vec::new(),
+        };
+        for &(p, reading, limit) in &merge_ok {
+            let alone = mergeable.find(|q| q.0 == p).is_some_and(|q| q.1);
+            match alone {
+                true => marks.merges.push((p, Reason::Criterion { reading, limit })),
+                false => marks.kept.push((p, reading)),
+            }
         }
+        marks
+    }
+
+    /// The events of the merges the level rule refuses this pass that it did
+    /// not refuse in the previous one (the criterion's merges a finer
+    /// neighbour keeps, and those [`RedGreen::select_merges`] drops), at the
+    /// world's positions before the pass.
+    pub(super) fn refusal_events(&mut self, world: &World, marks: &PassMarks, step: u64) -> Vec<AdaptEvent> {
+        let candidates: Vec<u32> = marks.merges.iter().map(|m| m.0).collect();
+        let (_, dropped) = self.hierarchy.select_merges(&candidates);
+        let reading_of = |p: u32| match marks.merges.iter().find(|m| m.0 == p) {
+            Some((_, Reason::Criterion { reading, .. })) => *reading,
+            _ => Reading::default(),
+        };
+        let mut refused: Vec<(u32, Refusal, Reading)> = marks
+            .kept
+            .iter()
+            .map(|&(p, r)| (p, Refusal::NeighbourTwoFiner, r))
+            .collect();
+        refused.extend(
+            dropped
+                .iter()
+                .map(|&(p, n)| (p, Refusal::MidpointsInUse(n), reading_of(p))),
+        );
+        refused.sort_by_key(|r| r.0);
+        let events = refused
+            .iter()
+            .filter(|r| self.refused_last_pass.binary_search(&r.0).is_err())
+            .map(|&(p, refusal, reading)| {
+                let corners = self.node_corners(world, p);
+                AdaptEvent {
+                    kind: EventKind::MergeRefused,
+                    position: (corners[0] + corners[1] + corners[2]) / 3.0,
+                    level: self.hierarchy.level(p),
+                    angle: Some(reading.angle),
+                    step,
+                    reason: Reason::Refused(refusal),
+                    corners: Some(corners),
+                }
+            })
+            .collect();
+        self.refused_last_pass = refused.iter().map(|r| r.0).collect();
+        events
+    }
+
+    /// The world positions of node `n`'s corners, before the pass's remesh: a
+    /// vertex the pass made sits at the midpoint of its parent edge.
+    pub(super) fn node_corners(&self, world: &World, n: u32) -> [Vector; 3] {
+        self.hierarchy
+            .vertices(n)
+            .map(|v| vertex_position(world, &self.hierarchy, v))
     }
 
     /// Builds the conforming mesh from the hierarchy, compacts the vertices and
     /// transfers the world's state onto it; returns where the new vertices came
     /// from (the world and the hierarchy are unchanged on error).
-    fn rebuild_world(
+    pub(super) fn rebuild_world(
         &mut self,
         world: &mut World,
         density: Scalar,
@@ -103,30 +188,44 @@ impl RedGreenState {
         Ok(origins)
     }
 
-    /// Counts the applied operations (merges, splits, bounces) and turns the
-    /// events of the criterion's splits that undo a merge into bounces.
-    fn count(
+    /// Counts the applied operations (merges, splits, bounces), turns the
+    /// events of the criterion's splits that undo a merge into bounces, and
+    /// keeps track of the nodes a rollback (`rollback`) split.
+    pub(super) fn count(
         &mut self,
         applied: &[Applied],
         events: &mut [AdaptEvent],
         stats: &mut super::AdaptStats,
+        rollback: bool,
     ) {
         for (a, event) in applied.iter().zip(events.iter_mut()) {
             match a.op {
                 RedGreenOp::Merge(n) => {
                     stats.merges += 1;
                     self.pass_merges.push(n);
+                    self.rollback_parents.remove(&n);
                     for c in a.children {
                         self.bounces.remove(&c);
+                        self.rollback_parents.remove(&c);
                     }
                 }
                 RedGreenOp::Split(l) => {
                     stats.splits += 1;
                     stats.closure_splits += a.forced as u64;
+                    if rollback {
+                        self.rollback_parents.insert(l);
+                    }
                     if !a.forced && self.merged_last_pass.binary_search(&l).is_ok() {
-                        *self.bounces.entry(l).or_default() += 1;
+                        let bounces = self.bounces.entry(l).or_default();
+                        *bounces += 1;
                         stats.bounces += 1;
                         event.kind = EventKind::Bounce;
+                        if let Reason::Criterion { reading, .. } = event.reason {
+                            event.reason = Reason::Bounce {
+                                reading,
+                                bounces: *bounces,
+                            };
+                        }
                     }
                 }
             }
@@ -134,137 +233,17 @@ impl RedGreenState {
     }
 }
 
-impl Adapter {
-    /// One pass of paper A's method: the criterion's merges, then its splits,
-    /// then closure.
-    pub(super) fn red_green_pass(
-        &mut self,
-        c: &AdaptConfig,
-        world: &mut World,
-        step: u64,
-        known: Measured,
-    ) -> Result<bool, MeshError> {
-        let measured;
-        let angles = match known.angles {
-            Some(a) => a,
-            None => {
-                measured = edge_angles(world);
-                &measured
-            }
-        };
-        debug_assert_eq!(angles.len(), world.mesh.edges.len(), "stale edge angles");
-        let (merges, splits) = self.red_green().marks(c, world, angles, known);
-        self.stats.passes += 1;
-        self.red_green().pass_merges.clear();
-        let mut ops: Vec<(RedGreenOp, Option<Scalar>)> = merges
-            .iter()
-            .map(|&(p, a)| (RedGreenOp::Merge(p), Some(a)))
-            .collect();
-        ops.extend(splits.iter().map(|&(l, a)| (RedGreenOp::Split(l), Some(a))));
-        let changed = self.apply(c, world, &ops, step);
-        let rg = self.red_green();
-        rg.merged_last_pass = std::mem::take(&mut rg.pass_merges);
-        rg.merged_last_pass.sort_unstable();
-        self.stats.note_levels(world, c.max_level);
-        changed
+/// The world position of vertex `v` of the hierarchy before the pass's
+/// remesh: its own for a vertex of the world's mesh, the midpoint of its
+/// parent edge for one the pass made.
+pub(super) fn vertex_position(world: &World, h: &RedGreen, v: u32) -> Vector {
+    if let Some(&x) = world.x.get(v as usize) {
+        return x;
     }
-
-    /// The red-green state. Panics on an adapter of another method.
-    fn red_green(&mut self) -> &mut RedGreenState {
-        match &mut self.method {
-            MethodState::RedGreen(rg) => rg,
-            _ => panic!("red-green operations on an adapter of the edge or tensor method"),
-        }
-    }
-
-    /// Refines the leaves in `marks` (from [`Adapter::refinement_marks`]) and
-    /// rebuilds the world; used by rollback on the restored state.
-    pub fn refine(
-        &mut self,
-        config: &AdaptConfig,
-        world: &mut World,
-        marks: &[(u32, Scalar)],
-        step: u64,
-    ) -> Result<bool, MeshError> {
-        let ops: Vec<_> = marks
-            .iter()
-            .map(|&(l, a)| (RedGreenOp::Split(l), Some(a)))
-            .collect();
-        self.apply(config, world, &ops, step)
-    }
-
-    /// Applies operations (each with the angle that asked for it), closes the
-    /// mesh and moves the world onto it. Atomic: if the world cannot take the
-    /// new mesh, the hierarchy's operations are undone (newest first, see
-    /// [`RedGreen::undo`]) and the world, the counters and the events stay as
-    /// they were. Red-green only: panics on an adapter of another method.
-    pub fn apply(
-        &mut self,
-        config: &AdaptConfig,
-        world: &mut World,
-        ops: &[(RedGreenOp, Option<Scalar>)],
-        step: u64,
-    ) -> Result<bool, MeshError> {
-        let density = self.density;
-        let rg = self.red_green();
-        let mut applied: Vec<Applied> = Vec::new();
-        let plain: Vec<RedGreenOp> = ops.iter().map(|o| o.0).collect();
-        rg.hierarchy.apply(&plain, &mut applied);
-        // The angle that asked for each operation (forced splits have none).
-        let asked_for = |op: RedGreenOp| ops.iter().find(|o| o.0 == op).and_then(|o| o.1);
-        let mut asked: Vec<Option<Scalar>> = applied.iter().map(|a| asked_for(a.op)).collect();
-        let before = applied.len();
-        rg.hierarchy.close(&mut applied);
-        asked.extend(std::iter::repeat_n(None, applied.len() - before));
-        if applied.is_empty() {
-            return Ok(false);
-        }
-        let mut events: Vec<AdaptEvent> = applied
-            .iter()
-            .zip(asked)
-            .map(|(a, angle)| red_green_event(world, a, angle, step))
-            .collect();
-        match rg.rebuild_world(world, density, config.alternate_diagonals) {
-            Ok(origins) => self.last_origins = origins,
-            Err(e) => {
-                let rg = self.red_green();
-                for a in applied.iter().rev() {
-                    rg.hierarchy.undo(a);
-                }
-                return Err(e);
-            }
-        }
-        let MethodState::RedGreen(rg) = &mut self.method else {
-            unreachable!("checked above");
-        };
-        rg.count(&applied, &mut events, &mut self.stats);
-        self.events.extend(events);
-        self.stats.changed_passes += 1;
-        self.stats.max_ops_per_pass = self.stats.max_ops_per_pass.max(applied.len() as u64);
-        self.debug_check(world);
-        Ok(true)
-    }
-}
-
-/// The event of one red-green operation, at the world's positions before the
-/// remesh (the node's corners are vertices of the old mesh).
-fn red_green_event(world: &World, a: &Applied, angle: Option<Scalar>, step: u64) -> AdaptEvent {
-    let centre = a
-        .vertices
-        .iter()
-        .map(|&v| world.x[v as usize])
-        .sum::<Vector>()
-        / 3.0;
-    let kind = match a.op {
-        RedGreenOp::Merge(_) => EventKind::Merge,
-        RedGreenOp::Split(_) if a.forced => EventKind::ClosureSplit,
-        RedGreenOp::Split(_) => EventKind::Split,
-    };
-    AdaptEvent {
-        kind,
-        position: centre,
-        level: a.level,
-        angle: if a.forced { None } else { angle },
-        step,
+    let (first_new, created) = h.created();
+    match v.checked_sub(first_new).and_then(|k| created.get(k as usize)) {
+        Some(&(a, b)) => 0.5 * (vertex_position(world, h, a) + vertex_position(world, h, b)),
+        // Every vertex of the hierarchy is the world's or made by the pass.
+        None => unreachable!("vertex {v} is neither the world's nor made by the pass"),
     }
 }

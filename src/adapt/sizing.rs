@@ -136,6 +136,7 @@
 use std::collections::HashMap;
 
 use super::AdaptConfig;
+use super::decision::{Reading, Term};
 use super::proximity::edge_obstacle_lean;
 use super::red_green_pass::RedGreenState;
 use crate::collide::ObstaclePlane;
@@ -311,29 +312,55 @@ impl RedGreenState {
     }
 
     /// Centroid spacing of hierarchy node `n`, m.
-    fn node_spacing(&self, n: u32) -> Scalar {
+    pub(super) fn node_spacing(&self, n: u32) -> Scalar {
         spacing(self.hierarchy.corners(n))
     }
 
     /// Leaves coarser than their target (`kappa * D > refine_angle`, or a strain
-    /// jump above `refine_strain`) that may still split, each with its largest
-    /// measured angle (degrees).
+    /// jump above `refine_strain`) that may still split, each with its reading.
     pub(super) fn sizing_refinement_marks(
         &self,
         c: &AdaptConfig,
         curv: &LeafCurvature,
-    ) -> Vec<(u32, Scalar)> {
-        let mut marks: Vec<(u32, Scalar)> = curv
+    ) -> Vec<(u32, Reading)> {
+        let mut marks: Vec<(u32, Reading)> = curv
             .by_leaf
             .iter()
-            .filter(|&(&l, m)| {
-                (self.sizing_wants_split(c, l, m.kappa, m.jump) || obstacle_wants_split(c, m.lean))
-                    && self.may_split(c, l)
-            })
-            .map(|(&l, m)| (l, m.angle))
+            .filter(|&(&l, m)| self.sizing_leaf_wants_split(c, l, m) && self.may_split(c, l))
+            .map(|(&l, m)| (l, self.sizing_reading(c, m, self.node_spacing(l), 1.0)))
             .collect();
         marks.sort_by_key(|m| m.0);
         marks
+    }
+
+    /// True when the sizing criterion asks to split leaf `l`, measured `m`: one
+    /// of [`RedGreenState::sizing_wants_split`] and the obstacle term.
+    pub(super) fn sizing_leaf_wants_split(&self, c: &AdaptConfig, l: u32, m: &LeafMeasure) -> bool {
+        self.sizing_wants_split(c, l, m.kappa, m.jump) || obstacle_wants_split(c, m.lean)
+    }
+
+    /// The sizing criterion's reading of a node of centroid spacing `spacing`
+    /// whose edges measured `m`, each term over its threshold; the strain and
+    /// obstacle terms scaled by `scale` (2 for a merged parent, whose spacing
+    /// the jumps span doubles).
+    pub(super) fn sizing_reading(
+        &self,
+        c: &AdaptConfig,
+        m: &LeafMeasure,
+        spacing: Scalar,
+        scale: Scalar,
+    ) -> Reading {
+        let mut terms = vec![(
+            Term::Curvature,
+            m.kappa * spacing / c.refine_angle.to_radians(),
+        )];
+        if let Some(s) = c.refine_strain {
+            terms.push((Term::Strain, scale * m.jump / s));
+        }
+        if let Some(r) = c.refine_obstacle {
+            terms.push((Term::Obstacle, scale * m.lean / r));
+        }
+        Reading::largest(&terms, m.angle)
     }
 
     /// True when leaf `l`, with curvature `kappa` (rad/m) and strain jump `jump`
@@ -355,6 +382,8 @@ impl RedGreenState {
     /// their target by the hysteresis: `kappa_p * 2 D_child <= refine_angle / H`,
     /// and with `refine_strain` set, twice the children's largest strain jump
     /// (a merge doubles the spacing the jump spans) at most `refine_strain / H`.
+    /// Of `parents` (nodes whose children are leaves), each with the merged
+    /// parent's reading and the ratio it stays under (`1 / H`).
     ///
     /// A parent whose merges bounced (module docs, "Bounces") is held to `H`
     /// doubled once per bounce.
@@ -362,9 +391,10 @@ impl RedGreenState {
         &self,
         c: &AdaptConfig,
         curv: &LeafCurvature,
-    ) -> Vec<(u32, Scalar)> {
+        parents: &[u32],
+    ) -> Vec<(u32, Reading, Scalar)> {
         let mut out = Vec::new();
-        for p in self.hierarchy.mergeable_parents() {
+        for &p in parents {
             let bounced = self.bounces.get(&p).copied().unwrap_or(0);
             let h = c.hysteresis * Scalar::powi(2.0, bounced.min(MAX_DOUBLINGS) as i32);
             let limit = c.refine_angle.to_radians() / h;
@@ -375,8 +405,9 @@ impl RedGreenState {
                 .fold(LeafMeasure::default(), LeafMeasure::max);
             let strain_ok = c.refine_strain.is_none_or(|s| 2.0 * m.jump <= s / h);
             let obstacle_ok = c.refine_obstacle.is_none_or(|r| 2.0 * m.lean <= r / h);
-            if m.kappa * self.node_spacing(p) <= limit && strain_ok && obstacle_ok {
-                out.push((p, m.angle));
+            let spacing = self.node_spacing(p);
+            if m.kappa * spacing <= limit && strain_ok && obstacle_ok {
+                out.push((p, self.sizing_reading(c, &m, spacing, 2.0), 1.0 / h));
             }
         }
         out

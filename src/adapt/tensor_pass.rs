@@ -4,7 +4,7 @@
 
 use super::tensor::{AxisOps, Thresholds};
 use super::transfer::transfer;
-use super::{AdaptConfig, AdaptEvent, Adapter, EventKind, MethodState};
+use super::{AdaptConfig, AdaptEvent, Adapter, EventKind, MethodState, Reading, Reason};
 use crate::math::{Scalar, Vector};
 use crate::mesh::MeshError;
 use crate::spec::AdaptCriterion;
@@ -53,7 +53,7 @@ impl Adapter {
             self.stats.note_levels(world, top);
             return Ok(false);
         }
-        let events = line_events(world, &ops, grid, step);
+        let events = line_events(world, &ops, grid, (refine, step));
         let before = grid.clone();
         let remeshed = grid.apply(&ops);
         match transfer(world, self.density, remeshed) {
@@ -98,7 +98,7 @@ fn line_events(
     world: &World,
     ops: &(AxisOps, AxisOps),
     grid: &super::tensor::TensorGrid,
-    step: u64,
+    (refine, step): (Scalar, u64),
 ) -> Vec<AdaptEvent> {
     let (nu, nv) = grid.counts();
     let mean_u = |lines: &[usize]| {
@@ -116,15 +116,16 @@ fn line_events(
     };
     let (lu, lv) = grid.column_levels();
     let mut events = Vec::new();
-    axis_events(&ops.0, &lu, mean_u, step, &mut events);
-    axis_events(&ops.1, &lv, mean_v, step, &mut events);
+    axis_events((&ops.0, refine), &lu, mean_u, step, &mut events);
+    axis_events((&ops.1, refine), &lv, mean_v, step, &mut events);
     events
 }
 
 /// The events of one axis's operations (`level`: each column's level before
-/// the pass, in halvings; `mean`: the mean old position along some lines).
+/// the pass, in halvings; `mean`: the mean old position along some lines;
+/// `refine`: the threshold a split's measure is read against, radians).
 fn axis_events(
-    ops: &AxisOps,
+    (ops, refine): (&AxisOps, Scalar),
     level: &[u8],
     mean: impl Fn(&[usize]) -> Vector,
     step: u64,
@@ -141,6 +142,14 @@ fn axis_events(
             level: (level[col] + 1).saturating_mul(2),
             angle: asked.map(Scalar::to_degrees),
             step,
+            reason: match asked {
+                Some(a) => Reason::Criterion {
+                    reading: Reading::of_angle(a, refine),
+                    limit: 1.0,
+                },
+                None => Reason::Closure,
+            },
+            corners: None,
         });
     }
     // A removed line's columns are at its level; their parent one coarser.
@@ -151,6 +160,8 @@ fn axis_events(
             level: level[m - 1].saturating_sub(1).saturating_mul(2),
             angle: None,
             step,
+            reason: Reason::Flat,
+            corners: None,
         });
     }
 }

@@ -11,7 +11,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::{ColourChoice, EdgeChoice, RunArgs, load};
 use drape::bench::sampling::{SamplePoints, Sampler};
-use drape::record::{ColourBy, EdgeDisplay, LiveViewer};
+use drape::record::{ColourBy, DecisionData, EdgeDisplay, LiveViewer};
 use drape::run::{FrameState, Progress, RunError, RunOptions, run_built};
 use drape::scene::Scene;
 use drape::summary::Summary;
@@ -137,6 +137,12 @@ fn run_options(args: &RunArgs, scene: &Scene) -> RunOptions {
         colour_by: match args.colour_by {
             ColourChoice::Level => ColourBy::Level,
             ColourChoice::Panel => ColourBy::Panel,
+            ColourChoice::Ratio => ColourBy::Ratio,
+            ColourChoice::State => ColourBy::State,
+        },
+        decisions: match args.no_decisions {
+            true => DecisionData::Off,
+            false => DecisionData::Recorded,
         },
     }
 }

@@ -196,7 +196,7 @@ impl MeshRows {
 }
 
 /// A list cell of fixed-size-3 lists as triples, or `None` when it is not one.
-fn triples<T, V>(cell: &ArrayRef) -> Option<Vec<[V; 3]>>
+pub(super) fn triples<T, V>(cell: &ArrayRef) -> Option<Vec<[V; 3]>>
 where
     T: rerun::external::arrow::datatypes::ArrowPrimitiveType<Native = V>,
     V: rerun::external::arrow::datatypes::ArrowNativeType,

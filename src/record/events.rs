@@ -11,6 +11,7 @@ use super::{EventMark, convert};
 /// | `closure_split` | yellow `#FFD54F` |
 /// | `bounce` | purple `#AB47BC` |
 /// | `merge`, `collapse` | blue `#42A5F5` |
+/// | `merge_refused` | light blue `#90CAF9` |
 /// | `flip` | grey `#BDBDBD` |
 /// | `rollback` | red `#E53935` |
 /// | `weld` | green `#00C853` (the welded seams' colour) |
@@ -21,6 +22,7 @@ pub fn event_rgb(kind: &str) -> [u8; 3] {
         "closure_split" => [0xFF, 0xD5, 0x4F],
         "bounce" => [0xAB, 0x47, 0xBC],
         "merge" | "collapse" => [0x42, 0xA5, 0xF5],
+        "merge_refused" => [0x90, 0xCA, 0xF9],
         "flip" => [0xBD, 0xBD, 0xBD],
         _ => [0xE5, 0x39, 0x35],
     }
@@ -77,10 +79,33 @@ fn point_label(e: &EventMark) -> String {
     }
 }
 
-/// One event's log line: `KIND after step S: level L[, angle A deg], at (x, y, z) m`, or for a
-/// weld `weld after step S: seam NAME, gap G mm, at (x, y, z) m`, at level `WARN` for
-/// rollbacks and `INFO` otherwise. `drape inspect` reads the kind back from the first word.
-pub(super) fn event_line(e: &EventMark) -> rerun::TextLog {
+/// Component name of the corners of an event's triangle on its `events/log` row (nine `f32`,
+/// three corners' x, y, z in metres; absent where the event is not one triangle's).
+pub const EVENT_CORNERS_COMPONENT: &str = "event_corners";
+
+/// One event's log row: the line `KIND after step S: level L[, angle A deg], at (x, y, z) m;
+/// REASON`, or for a weld `weld after step S: seam NAME, gap G mm, at (x, y, z) m`, at level
+/// `WARN` for rollbacks and `INFO` otherwise, and the corners of the event's triangle
+/// ([`EVENT_CORNERS_COMPONENT`]) where it has one. `drape inspect` reads the kind back from the
+/// first word.
+pub(super) fn event_row(e: &EventMark) -> (rerun::TextLog, rerun::AnyValues) {
+    let corners: Vec<f32> = e
+        .corners
+        .iter()
+        .flat_map(|c| c.iter().flat_map(|&p| convert::f32x3(p)))
+        .collect();
+    let data = match e.corners {
+        Some(_) => rerun::AnyValues::default().with_component_from_data(
+            EVENT_CORNERS_COMPONENT,
+            std::sync::Arc::new(rerun::external::arrow::array::Float32Array::from(corners)),
+        ),
+        None => rerun::AnyValues::default(),
+    };
+    (event_line(e), data)
+}
+
+/// One event's log line (see [`event_row`]).
+fn event_line(e: &EventMark) -> rerun::TextLog {
     let what = match &e.weld {
         Some(w) => format!("seam {}, gap {:.2} mm", w.seam, 1e3 * w.gap),
         None => {
@@ -91,8 +116,12 @@ pub(super) fn event_line(e: &EventMark) -> rerun::TextLog {
             format!("level {}{angle}", e.level)
         }
     };
+    let reason = match e.reason.is_empty() {
+        true => String::new(),
+        false => format!("; {}", e.reason),
+    };
     let line = format!(
-        "{} after step {}: {what}, at ({:.3}, {:.3}, {:.3}) m",
+        "{} after step {}: {what}, at ({:.3}, {:.3}, {:.3}) m{reason}",
         e.kind, e.step, e.position.x, e.position.y, e.position.z
     );
     let level = if e.kind == "rollback" { "WARN" } else { "INFO" };

@@ -32,6 +32,20 @@ pub struct FrameView<'a> {
     /// The garment's panels and seams (`None`: a cloth without panels, which has
     /// no `cloth/seams` and colours as one panel named `cloth`).
     pub garment: Option<GarmentView<'a>>,
+    /// The refinement decision at every triangle (`None`: a cloth that does not adapt, or
+    /// decisions not recorded).
+    pub decisions: Option<DecisionView<'a>>,
+}
+
+/// The refinement decision at every triangle of a frame, as plain data for `cloth/mesh`.
+#[derive(Debug, Clone, Copy)]
+pub struct DecisionView<'a> {
+    /// The criterion's value against its threshold (refines above 1), per triangle.
+    pub ratio: &'a [f32],
+    /// The term that gave the ratio, per triangle (a code of [`super::decisions::TERM_NAMES`]).
+    pub term: &'a [u8],
+    /// What holds the triangle, per triangle (a code of [`super::decisions::STATE_NAMES`]).
+    pub state: &'a [u8],
 }
 
 /// A garment's panels and seams at one frame, as plain data for the recording.
@@ -70,8 +84,8 @@ pub struct WeldMark {
 /// One remeshing event or seam weld, as plain data for the recording.
 #[derive(Debug, Clone, PartialEq)]
 pub struct EventMark {
-    /// What happened: `split`, `closure_split`, `bounce`, `merge`, `flip`, `collapse`,
-    /// `rollback` or `weld`.
+    /// What happened: `split`, `closure_split`, `bounce`, `merge`, `merge_refused`, `flip`,
+    /// `collapse`, `rollback` or `weld`.
     pub kind: &'static str,
     /// Where, in world coordinates (m).
     pub position: Vector,
@@ -83,6 +97,11 @@ pub struct EventMark {
     pub step: u64,
     /// For a `weld`: the seam and its gap (`None` for remeshing events).
     pub weld: Option<WeldMark>,
+    /// Why it happened, in words (empty for a weld).
+    pub reason: String,
+    /// The corners of the triangle it split, merged into or refused, in world coordinates
+    /// (m), where the event is one triangle's.
+    pub corners: Option<[Vector; 3]>,
 }
 
 /// Checks the frame's slices against each other; returns the frame index for the timeline.
@@ -144,6 +163,9 @@ pub(super) fn validate(frame: &FrameView) -> Result<i64, RecordError> {
     if let Some(g) = &frame.garment {
         validate_garment(g, n, frame.triangles.len()).map_err(invalid)?;
     }
+    if let Some(d) = &frame.decisions {
+        validate_decisions(d, frame.triangles.len()).map_err(invalid)?;
+    }
     Ok(index)
 }
 
@@ -169,6 +191,28 @@ fn validate_garment(g: &GarmentView, n: usize, triangles: usize) -> Result<(), S
             "seam {} segment {:?} refers to a vertex past the {n} vertices",
             s.seam, s.vertices
         ));
+    }
+    Ok(())
+}
+
+/// Checks the decisions against the frame's `triangles`: one of each per triangle, codes in
+/// range; the reason when they do not fit.
+fn validate_decisions(d: &DecisionView, triangles: usize) -> Result<(), String> {
+    use super::decisions::{STATE_NAMES, TERM_NAMES};
+    for (what, len) in [
+        ("ratios", d.ratio.len()),
+        ("terms", d.term.len()),
+        ("states", d.state.len()),
+    ] {
+        if len != triangles {
+            return Err(format!("{len} decision {what} for {triangles} triangles"));
+        }
+    }
+    if let Some(t) = d.term.iter().find(|&&t| usize::from(t) >= TERM_NAMES.len()) {
+        return Err(format!("decision term {t} is past the {} terms", TERM_NAMES.len()));
+    }
+    if let Some(s) = d.state.iter().find(|&&s| usize::from(s) >= STATE_NAMES.len()) {
+        return Err(format!("decision state {s} is past the {} states", STATE_NAMES.len()));
     }
     Ok(())
 }

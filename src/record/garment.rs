@@ -17,6 +17,12 @@ pub enum ColourBy {
     /// The garment panel ([`PANEL_PALETTE`]): class id = panel index; a cloth without
     /// panels is one panel named `cloth`.
     Panel,
+    /// The criterion's ratio ([`super::decisions::RATIO_PALETTE`]): class id =
+    /// [`super::decisions::decision_class`], labelled with the ratio band, term and state.
+    Ratio,
+    /// The decision state ([`super::decisions::STATE_PALETTE`]): the classes of
+    /// [`ColourBy::Ratio`], coloured by state.
+    State,
 }
 
 /// Colour of each panel, sRGB, repeated from the start past the eighth panel.

@@ -28,17 +28,32 @@ const LEVEL_NAMES: [&str; 8] = [
 const ANGLE_NAMES: [&str; 4] = ["dark slate", "violet", "orange", "yellow"];
 
 /// `#RRGGBB`.
-fn hex([r, g, b]: [u8; 3]) -> String {
+pub(super) fn hex([r, g, b]: [u8; 3]) -> String {
     format!("#{r:02X}{g:02X}{b:02X}")
+}
+
+/// What the legend names for the cloth's colours.
+#[derive(Debug, Clone, Copy)]
+pub(super) enum ClothLegend<'a> {
+    /// The refinement levels.
+    Levels,
+    /// The garment's panels, by name.
+    Panels(&'a [String]),
+    /// The criterion's ratio bands.
+    Ratio,
+    /// The decision states.
+    State,
 }
 
 /// The legend shown beside the event log (markdown): the cloth's colours (refinement levels,
 /// or with `panels` each panel's name and colour), the angle scale, the seam colours (when
 /// `seams`: a garment) and the event point colours.
-pub(super) fn legend_markdown(panels: Option<&[String]>, seams: bool) -> String {
+pub(super) fn legend_markdown(cloth: ClothLegend, seams: bool) -> String {
     let mut s = String::new();
-    match panels {
-        Some(names) => {
+    match cloth {
+        ClothLegend::Ratio => s.push_str(&super::decisions::legend(false)),
+        ClothLegend::State => s.push_str(&super::decisions::legend(true)),
+        ClothLegend::Panels(names) => {
             s.push_str("**cloth: panel**\n\n");
             for (p, name) in names.iter().enumerate() {
                 let k = p % PANEL_PALETTE.len();
@@ -50,7 +65,7 @@ pub(super) fn legend_markdown(panels: Option<&[String]>, seams: bool) -> String 
                 );
             }
         }
-        None => {
+        ClothLegend::Levels => {
             s.push_str("**cloth: refinement level**\n\n");
             let last = LEVEL_PALETTE.len() - 1;
             for (l, (c, name)) in LEVEL_PALETTE.iter().zip(LEVEL_NAMES).enumerate() {
@@ -74,7 +89,7 @@ pub(super) fn legend_markdown(panels: Option<&[String]>, seams: bool) -> String 
     }
     s.push_str(
         "\n**events**: split orange, closure split yellow, bounce purple, merge or collapse \
-         blue, flip grey, rollback red, weld green\n",
+         blue, refused merge light blue, flip grey, rollback red, weld green\n",
     );
     s
 }

@@ -44,12 +44,14 @@
 
 mod blueprint;
 mod convert;
+pub mod decisions;
 pub mod decode;
 pub mod edges;
 mod error;
 mod events;
 mod frame;
 pub mod garment;
+pub mod history;
 pub mod inspect;
 mod layout;
 pub mod mesh;
@@ -58,10 +60,13 @@ mod obstacles;
 mod recorder;
 mod report;
 mod sink;
+mod track;
 
+pub use decisions::DecisionData;
 pub use edges::EdgeDisplay;
+pub use events::EVENT_CORNERS_COMPONENT;
 pub use error::{BoxError, RecordError};
-pub use frame::{EventMark, FrameView, GarmentView, SeamSegment, WeldMark};
+pub use frame::{DecisionView, EventMark, FrameView, GarmentView, SeamSegment, WeldMark};
 pub use garment::ColourBy;
 pub use mesh::{DUPLICATE_COMPONENT, LEVEL_COMPONENT};
 pub use recorder::Recorder;

@@ -7,6 +7,7 @@ use std::path::Path;
 use rerun::{AsComponents, EntityPath, RecordingStream, RecordingStreamBuilder};
 
 use super::garment::{self, ColourBy, SINGLE_PANEL_NAME};
+use super::decisions;
 use super::{
     APPLICATION_ID, BoxError, ENTITY_EDGES, ENTITY_EVENT_LOG, ENTITY_EVENT_POINTS, ENTITY_LEGEND,
     ENTITY_MESH, ENTITY_PINS, ENTITY_PLOTS, ENTITY_SEAMS, EdgeDisplay, FrameView, RecordError,
@@ -171,12 +172,19 @@ impl Recorder {
         let context = match self.colour_by {
             ColourBy::Level => convert::level_annotations(),
             ColourBy::Panel => garment::panel_annotations(panels),
+            ColourBy::Ratio => decisions::decision_annotations(false),
+            ColourBy::State => decisions::decision_annotations(true),
         };
         self.stream
             .log_static("cloth", &context)
             .map_err(|e| self.log_err("cloth", e))?;
-        let legend_panels = (self.colour_by == ColourBy::Panel).then_some(panels);
-        let legend = layout::legend_markdown(legend_panels, frame.garment.is_some());
+        let cloth = match self.colour_by {
+            ColourBy::Level => layout::ClothLegend::Levels,
+            ColourBy::Panel => layout::ClothLegend::Panels(panels),
+            ColourBy::Ratio => layout::ClothLegend::Ratio,
+            ColourBy::State => layout::ClothLegend::State,
+        };
+        let legend = layout::legend_markdown(cloth, frame.garment.is_some());
         self.stream
             .log_static(ENTITY_LEGEND, &rerun::TextDocument::from_markdown(legend))
             .map_err(|e| self.log_err(ENTITY_LEGEND, e))?;
@@ -221,17 +229,11 @@ impl Recorder {
         self.log_scalars(frame)
     }
 
-    /// `cloth/mesh`: positions and normals, with the topology when it changed.
+    /// `cloth/mesh`: positions, normals and the decisions (when given), with the topology
+    /// when it changed.
     fn log_mesh(&mut self, frame: &FrameView) -> Result<(), RecordError> {
         let (positions, normals) = (frame.positions, frame.vertex_normals);
-        self.classes.clear();
-        match (self.colour_by, &frame.garment) {
-            (ColourBy::Level, _) => self
-                .classes
-                .extend(frame.triangle_levels.iter().map(|&l| u16::from(l))),
-            (ColourBy::Panel, Some(g)) => self.classes.extend_from_slice(g.triangle_panels),
-            (ColourBy::Panel, None) => self.classes.resize(frame.triangles.len(), 0),
-        }
+        self.mesh_classes(frame)?;
         let changed = self.cloth_mesh.update(
             positions.len(),
             frame.triangles,
@@ -239,21 +241,56 @@ impl Recorder {
             &self.classes,
         );
         let geometry = self.cloth_mesh.geometry(positions, normals);
-        let logged = if changed {
-            let (topology, data) = match self.colour_by {
+        let decided = frame
+            .decisions
+            .map(|d| decisions::decision_row(d.ratio, d.term, d.state));
+        let mut row: Vec<&dyn AsComponents> = vec![&geometry];
+        if let Some(d) = &decided {
+            row.push(d);
+        }
+        let topology;
+        if changed {
+            topology = match self.colour_by {
                 ColourBy::Level => self
                     .cloth_mesh
                     .topology(|c| convert::level_rgb(u8::try_from(c).unwrap_or(u8::MAX))),
                 ColourBy::Panel => self.cloth_mesh.topology(garment::panel_rgb),
+                ColourBy::Ratio => self
+                    .cloth_mesh
+                    .topology(|c| decisions::class_rgb(c, false)),
+                ColourBy::State => self.cloth_mesh.topology(|c| decisions::class_rgb(c, true)),
             };
-            self.stream.log(
-                self.mesh_path.clone(),
-                &[&geometry as &dyn AsComponents, &topology, &data],
-            )
-        } else {
-            self.stream.log(self.mesh_path.clone(), &geometry)
-        };
-        logged.map_err(|e| self.log_err(ENTITY_MESH, e))
+            row.push(&topology.0);
+            row.push(&topology.1);
+        }
+        self.stream
+            .log(self.mesh_path.clone(), &row)
+            .map_err(|e| self.log_err(ENTITY_MESH, e))
+    }
+
+    /// The class of each triangle for [`Recorder::colour_by`] into `self.classes`; fails
+    /// when the frame lacks the decisions that colour by ratio or state needs.
+    fn mesh_classes(&mut self, frame: &FrameView) -> Result<(), RecordError> {
+        self.classes.clear();
+        match (self.colour_by, &frame.garment, &frame.decisions) {
+            (ColourBy::Level, _, _) => self
+                .classes
+                .extend(frame.triangle_levels.iter().map(|&l| u16::from(l))),
+            (ColourBy::Panel, Some(g), _) => self.classes.extend_from_slice(g.triangle_panels),
+            (ColourBy::Panel, None, _) => self.classes.resize(frame.triangles.len(), 0),
+            (ColourBy::Ratio | ColourBy::State, _, Some(d)) => self.classes.extend(
+                (0..d.ratio.len()).map(|t| decisions::decision_class(d.ratio[t], d.term[t], d.state[t])),
+            ),
+            (ColourBy::Ratio | ColourBy::State, _, None) => {
+                return Err(RecordError::InvalidFrame {
+                    frame: frame.frame,
+                    reason: "colouring by ratio or state needs the refinement decisions \
+                             (an adaptive scene, with decisions recorded)"
+                        .into(),
+                });
+            }
+        }
+        Ok(())
     }
 
     /// `cloth/edges`, unless [`EdgeDisplay::Off`] (or no edge is selected).
@@ -315,8 +352,9 @@ impl Recorder {
             )
             .map_err(|e| self.log_err(ENTITY_EVENT_POINTS, e))?;
         for e in frame.events {
+            let (line, corners) = events::event_row(e);
             self.stream
-                .log(ENTITY_EVENT_LOG, &events::event_line(e))
+                .log(ENTITY_EVENT_LOG, &[&line as &dyn AsComponents, &corners])
                 .map_err(|err| self.log_err(ENTITY_EVENT_LOG, err))?;
         }
         Ok(())

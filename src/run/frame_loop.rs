@@ -10,7 +10,7 @@ use super::{FrameState, Progress, RunError, RunOptions};
 use crate::adapt::Adapter;
 use crate::math::{Scalar, Vector};
 use crate::physics::Energy;
-use crate::record::{RecordError, RecordTarget, Recorder, obj::write_mesh_obj};
+use crate::record::{DecisionData, RecordError, RecordTarget, Recorder, obj::write_mesh_obj};
 use crate::scene::Scene;
 use crate::sim::{
     FrameFailed, FrameFailure, MAX_STEP_HALVINGS, Pipeline, Setup, SimParts, SimState, StepFailure,
@@ -34,6 +34,8 @@ pub struct FrameLoop<'a> {
     record_path: Option<PathBuf>,
     obj_dir: Option<PathBuf>,
     record_every: u64,
+    /// Whether the recording holds the refinement decisions.
+    decisions: DecisionData,
     /// Frames after the initial one.
     frames: u64,
     frame_interval: Scalar,
@@ -100,6 +102,7 @@ impl<'a> FrameLoop<'a> {
             record_path: opts.record.clone(),
             obj_dir: opts.obj_dir.clone(),
             record_every: opts.record_every.max(1),
+            decisions: opts.decisions,
             frames,
             frame_interval: scene.simulation.frame_interval(),
             frame: 0,
@@ -232,6 +235,7 @@ impl<'a> FrameLoop<'a> {
             energy,
             timing: self.timing,
             frame_interval: self.frame_interval,
+            decisions: self.decisions,
         };
         let (state, pipeline) = (&mut self.state, &mut self.pipeline);
         recording::record_state(rec, &self.setup, state, pipeline, &snap, &mut self.normals)?;

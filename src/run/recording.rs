@@ -9,7 +9,9 @@ use crate::collide::Drawn;
 use crate::math::{Scalar, Vector};
 use crate::mesh::Mesh;
 use crate::physics::Energy;
-use crate::record::{EventMark, FrameView, GarmentView, Recorder, SeamSegment, WeldMark};
+use crate::record::{
+    DecisionData, DecisionView, EventMark, FrameView, GarmentView, Recorder, SeamSegment, WeldMark,
+};
 use crate::sim::{Pipeline, Setup, SimState, WeldEvent};
 use crate::world::World;
 
@@ -36,6 +38,8 @@ pub(super) struct Snapshot {
     pub timing: FrameTiming,
     /// Simulated seconds between frames.
     pub frame_interval: Scalar,
+    /// Whether to record the refinement decisions.
+    pub decisions: DecisionData,
 }
 
 /// Records the world's current state as frame `snap.frame`, with the events and welds since
@@ -103,6 +107,8 @@ pub(super) fn record_state(
         scalars.push(("collision/contacts", c.last_contacts as f64));
         scalars.push(("penetration/max_mm", c.last_penetration * 1e3));
     }
+    let decided = decisions(setup, state, snap.decisions);
+    let world = &state.world;
     rec.record_frame(&FrameView {
         frame: snap.frame,
         sim_time: world.time,
@@ -116,8 +122,39 @@ pub(super) fn record_state(
         scalars: &scalars,
         events: &marks,
         garment,
+        decisions: decided.as_ref().map(|d| DecisionView {
+            ratio: &d.0,
+            term: &d.1,
+            state: &d.2,
+        }),
     })?;
     record_obstacles(rec, setup, world, snap.frame)
+}
+
+/// Each triangle's refinement decision (ratio, term code, state code), when the run adapts
+/// and `data` asks for them: read on the state as it is, as the next pass would (with the
+/// obstacles' nearest planes when the sizing criterion has an obstacle term).
+fn decisions(
+    setup: &Setup,
+    state: &SimState,
+    data: DecisionData,
+) -> Option<(Vec<f32>, Vec<u8>, Vec<u8>)> {
+    let (Some(ad), Some(config), DecisionData::Recorded) =
+        (&state.adapter, &setup.settings.adapt, data)
+    else {
+        return None;
+    };
+    let world = &state.world;
+    let mut planes = Vec::new();
+    if config.refine_obstacle.is_some() {
+        setup.obstacles.nearest_planes(&world.x, world.time, &mut planes);
+    }
+    let all = ad.decisions(config, world, &planes);
+    Some((
+        all.iter().map(|d| d.reading.ratio as f32).collect(),
+        all.iter().map(|d| d.reading.term.code()).collect(),
+        all.iter().map(|d| d.state.code()).collect(),
+    ))
 }
 
 /// Records the obstacles at `frame`: their meshes with frame 0, and every recorded frame the
@@ -169,6 +206,7 @@ fn event_mark(e: &AdaptEvent) -> EventMark {
         EventKind::ClosureSplit => "closure_split",
         EventKind::Bounce => "bounce",
         EventKind::Merge => "merge",
+        EventKind::MergeRefused => "merge_refused",
         EventKind::Rollback => "rollback",
         EventKind::Flip => "flip",
         EventKind::Collapse => "collapse",
@@ -180,6 +218,8 @@ fn event_mark(e: &AdaptEvent) -> EventMark {
         angle: e.angle,
         step: e.step,
         weld: None,
+        reason: e.reason.to_string(),
+        corners: e.corners,
     }
 }
 
@@ -195,6 +235,8 @@ fn weld_mark(w: &WeldEvent) -> EventMark {
             seam: w.seam.clone(),
             gap: w.gap,
         }),
+        reason: String::new(),
+        corners: None,
     }
 }
 

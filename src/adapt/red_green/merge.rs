@@ -51,6 +51,15 @@ impl RedGreen {
     /// than one of its edge midpoints would stay in use by neighbours that are
     /// not merging too (closure would split it again at once); the rest merge.
     pub fn merge_batch(&mut self, candidates: &[u32], out: &mut Vec<Applied>) {
+        for n in self.select_merges(candidates).0 {
+            self.merge(n, out);
+        }
+    }
+
+    /// The nodes [`RedGreen::merge_batch`] would merge out of `candidates`
+    /// (sorted), and those it would drop while their children may merge, each
+    /// with the number of its edge midpoints that neighbours keep in use.
+    pub fn select_merges(&self, candidates: &[u32]) -> (Vec<u32>, Vec<(u32, usize)>) {
         let mut set: Vec<u32> = candidates
             .iter()
             .copied()
@@ -58,20 +67,21 @@ impl RedGreen {
             .collect();
         set.sort_unstable();
         set.dedup();
+        let mut dropped = Vec::new();
         loop {
-            let keep: Vec<u32> = set
-                .iter()
-                .copied()
-                .filter(|&n| self.persisting_uses(n, &set) <= 1)
-                .collect();
+            let mut keep = Vec::with_capacity(set.len());
+            for &n in &set {
+                match self.persisting_uses(n, &set) {
+                    0 | 1 => keep.push(n),
+                    uses => dropped.push((n, uses)),
+                }
+            }
             if keep.len() == set.len() {
                 break;
             }
             set = keep;
         }
-        for n in set {
-            self.merge(n, out);
-        }
+        (set, dropped)
     }
 
     pub(super) fn merge(&mut self, n: u32, out: &mut Vec<Applied>) {
@@ -100,6 +110,7 @@ impl RedGreen {
             vertices: self.vertices(n),
             level,
             forced: false,
+            neighbour: None,
             children,
             midpoints,
             nodes_before: self.nodes.len() as u32,
@@ -110,13 +121,25 @@ impl RedGreen {
     /// Nodes whose four children are leaves and could merge (alone or together
     /// with neighbours), in leaf order.
     pub fn mergeable_parents(&self) -> Vec<u32> {
-        let mut seen = Vec::new();
+        self.leaf_parents()
+            .into_iter()
+            .filter_map(|(p, mergeable)| mergeable.then_some(p))
+            .collect()
+    }
+
+    /// Nodes whose four children are leaves, in leaf order, each with whether
+    /// they could merge (false: a neighbour is two splits finer along its
+    /// edges).
+    pub fn leaf_parents(&self) -> Vec<(u32, bool)> {
+        let mut seen: Vec<(u32, bool)> = Vec::new();
         for t in self.leaves() {
             if let Some(p) = self.parent(t)
-                && seen.last() != Some(&p)
-                && self.children_mergeable(p)
+                && seen.last().map(|s| s.0) != Some(p)
+                && self
+                    .children(p)
+                    .is_some_and(|ch| ch.iter().all(|&c| self.is_leaf(c)))
             {
-                seen.push(p);
+                seen.push((p, self.children_mergeable(p)));
             }
         }
         seen

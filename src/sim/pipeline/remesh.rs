@@ -87,7 +87,9 @@ impl Pipeline {
         if !ad.needs_refinement(config, &state.world, &self.angles) {
             return Ok(false);
         }
-        let marks = ad.refinement_marks(config, &state.world, &self.angles);
+        let readings = ad.rollback_marks(config, &state.world, &self.angles);
+        let marks: Vec<(u32, crate::math::Scalar)> =
+            readings.iter().map(|&(l, r)| (l, r.angle)).collect();
         self.angles_fresh = false;
         let s = &mut self.step_start;
         std::mem::swap(&mut state.world.x, &mut s.x);
@@ -97,7 +99,7 @@ impl Pipeline {
         if let Some(ledger) = s.ledger {
             state.ledger = ledger;
         }
-        ad.note_rollback(&state.world, state.ledger.steps_done);
+        ad.note_rollback(&state.world, &readings, state.ledger.steps_done);
         // The contacts the rejected step started from fit the restored start;
         // they go through the refinement like the vertices (`remesh` below).
         let start_contacts = std::mem::take(&mut self.stepper.contacts);
