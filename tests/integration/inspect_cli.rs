@@ -33,6 +33,8 @@ fn mark(kind: &'static str, level: u8, step: u64) -> EventMark {
         angle: Some(20.0),
         step,
         weld: None,
+        reason: String::new(),
+        corners: None,
     }
 }
 
@@ -70,6 +72,7 @@ fn known_recording(path: &Path) {
             scalars: &vertices,
             events: ev,
             garment: None,
+            decisions: None,
         })
         .expect("frame");
     }
@@ -168,6 +171,7 @@ fn inspect_frames_prints_a_line_per_frame_and_the_stepping_total() {
             scalars: &scalars,
             events: &[],
             garment: None,
+            decisions: None,
         })
         .expect("frame");
     }

@@ -14,6 +14,7 @@ mod bench;
 mod bench_convergence;
 mod canonical;
 mod cli;
+mod decisions;
 mod collide;
 mod common;
 mod docs_commands;

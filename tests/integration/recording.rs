@@ -79,6 +79,7 @@ fn record_mesh(
             scalars: &scalars,
             events: &[],
             garment: None,
+            decisions: None,
         })?;
         spent += start.elapsed();
         std::thread::sleep(pause);
@@ -308,6 +309,7 @@ fn dropped_recorder_leaves_valid_file() {
             scalars: &[],
             events: &[],
             garment: None,
+            decisions: None,
         })?;
         // A later frame is invalid: `?` returns early and drops the recorder.
         rec.record_frame(&FrameView {
@@ -323,6 +325,7 @@ fn dropped_recorder_leaves_valid_file() {
             scalars: &[],
             events: &[],
             garment: None,
+            decisions: None,
         })?;
         Ok(())
     })();
@@ -423,6 +426,7 @@ fn decoded_frame_rebuilds_the_triangle_list_with_levels() {
                 scalars: &[],
                 events: &[],
                 garment: None,
+                decisions: None,
             })
             .expect("frame");
             recorded.push(positions);
