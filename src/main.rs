@@ -254,7 +254,9 @@ fn cmd_check(args: SceneArgs) -> Result<ExitCode> {
 fn point(s: &str) -> Result<[f64; 3], String> {
     let parts: Vec<&str> = s.split(',').map(str::trim).collect();
     let [x, y, z] = parts[..] else {
-        return Err(format!("{s} is not a point X,Y,Z (three numbers separated by commas)"));
+        return Err(format!(
+            "{s} is not a point X,Y,Z (three numbers separated by commas)"
+        ));
     };
     let number = |v: &str| match v.parse::<f64>() {
         Ok(n) if n.is_finite() => Ok(n),

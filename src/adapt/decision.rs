@@ -73,12 +73,13 @@ impl Reading {
     /// The reading of the largest of several terms (each a ratio to its
     /// threshold), the first on a tie; `angle` is the node's largest angle.
     pub fn largest(terms: &[(Term, Scalar)], angle: Scalar) -> Reading {
-        let (term, ratio) = terms
-            .iter()
-            .copied()
-            .fold((Term::Angle, Scalar::NEG_INFINITY), |best, t| {
-                if t.1 > best.1 { t } else { best }
-            });
+        let (term, ratio) =
+            terms
+                .iter()
+                .copied()
+                .fold((Term::Angle, Scalar::NEG_INFINITY), |best, t| {
+                    if t.1 > best.1 { t } else { best }
+                });
         Reading {
             ratio: ratio.max(0.0),
             term,

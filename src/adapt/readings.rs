@@ -43,7 +43,11 @@ fn angle_decisions(c: &AdaptConfig, world: &World, angles: &[Scalar]) -> Vec<Tri
     let m = &world.mesh;
     let mut largest = vec![0.0 as Scalar; m.triangles.len()];
     for (e, edge) in m.edges.iter().enumerate() {
-        for &t in edge.triangles.iter().filter(|&&t| t != crate::mesh::NO_TRIANGLE) {
+        for &t in edge
+            .triangles
+            .iter()
+            .filter(|&&t| t != crate::mesh::NO_TRIANGLE)
+        {
             let a = &mut largest[t as usize];
             *a = a.max(angles[e]);
         }

@@ -3,7 +3,7 @@
 //! conforming mesh built from it, and an event with its reason for each
 //! operation.
 
-use super::decision::Reason;
+use super::decision::{Reading, Reason};
 use super::red_green::{Applied, RedGreenOp};
 use super::red_green_pass::{RedGreenState, vertex_position};
 use super::{AdaptConfig, AdaptEvent, Adapter, EventKind, Measured, MethodState, edge_angles};
@@ -49,6 +49,39 @@ impl Adapter {
         rg.merged_last_pass.sort_unstable();
         self.stats.note_levels(world, c.max_level);
         changed
+    }
+
+    /// Records a rollback of step `step`, triggered by the leaves `marks` (from
+    /// [`Adapter::rollback_marks`]): the event sits at the leaf with the largest
+    /// reading (at the cloth's centre when there is none).
+    pub fn note_rollback(&mut self, world: &World, marks: &[(u32, Reading)], step: u64) {
+        self.stats.rollbacks += 1;
+        let worst = marks
+            .iter()
+            .max_by(|a, b| a.1.ratio.total_cmp(&b.1.ratio).then(b.0.cmp(&a.0)));
+        let corners = match (&self.method, worst) {
+            (MethodState::RedGreen(rg), Some(&(leaf, _))) => {
+                Some(rg.hierarchy.vertices(leaf).map(|v| world.x[v as usize]))
+            }
+            _ => None,
+        };
+        let position = match corners {
+            Some(c) => (c[0] + c[1] + c[2]) / 3.0,
+            None => world.x.iter().copied().sum::<Vector>() / world.x.len().max(1) as Scalar,
+        };
+        let reading = worst.map(|m| m.1).unwrap_or_default();
+        self.events.push(AdaptEvent {
+            kind: EventKind::Rollback,
+            position,
+            level: 0,
+            angle: worst.map(|m| m.1.angle),
+            step,
+            reason: Reason::Rollback {
+                reading,
+                marked: marks.len(),
+            },
+            corners,
+        });
     }
 
     /// The red-green state. Panics on an adapter of another method.
@@ -156,9 +189,7 @@ fn red_green_event(
     asked: Option<Reason>,
     step: u64,
 ) -> AdaptEvent {
-    let corners = a
-        .vertices
-        .map(|v| vertex_position(world, &rg.hierarchy, v));
+    let corners = a.vertices.map(|v| vertex_position(world, &rg.hierarchy, v));
     let centre = |c: [Vector; 3]| (c[0] + c[1] + c[2]) / 3.0;
     let kind = match a.op {
         RedGreenOp::Merge(_) => EventKind::Merge,

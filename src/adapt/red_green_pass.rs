@@ -73,7 +73,13 @@ impl RedGreenState {
 
     /// The merges and the splits the criterion asks for, each with its reason,
     /// and the merges it asks for that a finer neighbour keeps.
-    pub(super) fn marks(&self, c: &AdaptConfig, world: &World, angles: &[Scalar], known: Measured) -> PassMarks {
+    pub(super) fn marks(
+        &self,
+        c: &AdaptConfig,
+        world: &World,
+        angles: &[Scalar],
+        known: Measured,
+    ) -> PassMarks {
         let parents = self.hierarchy.leaf_parents();
         let all: Vec<u32> = parents.iter().map(|p| p.0).collect();
         let (merge_ok, splits) = match c.criterion {
@@ -88,12 +94,22 @@ impl RedGreenState {
             }
         };
         // `merge_ok` follows `parents`' order.
-        let mut mergeable = parents.iter().filter(|p| merge_ok.iter().any(|m| m.0 == p.0));
+        let mut mergeable = parents
+            .iter()
+            .filter(|p| merge_ok.iter().any(|m| m.0 == p.0));
         let mut marks = PassMarks {
             merges: Vec::new(),
             splits: splits
                 .into_iter()
-                .map(|(l, reading)| (l, Reason::Criterion { reading, limit: 1.0 }))
+                .map(|(l, reading)| {
+                    (
+                        l,
+                        Reason::Criterion {
+                            reading,
+                            limit: 1.0,
+                        },
+                    )
+                })
                 .collect(),
             kept: Vec::new(),
         };
@@ -111,7 +127,12 @@ impl RedGreenState {
     /// not refuse in the previous one (the criterion's merges a finer
     /// neighbour keeps, and those [`RedGreen::select_merges`] drops), at the
     /// world's positions before the pass.
-    pub(super) fn refusal_events(&mut self, world: &World, marks: &PassMarks, step: u64) -> Vec<AdaptEvent> {
+    pub(super) fn refusal_events(
+        &mut self,
+        world: &World,
+        marks: &PassMarks,
+        step: u64,
+    ) -> Vec<AdaptEvent> {
         let candidates: Vec<u32> = marks.merges.iter().map(|m| m.0).collect();
         let (_, dropped) = self.hierarchy.select_merges(&candidates);
         let reading_of = |p: u32| match marks.merges.iter().find(|m| m.0 == p) {
@@ -241,7 +262,10 @@ pub(super) fn vertex_position(world: &World, h: &RedGreen, v: u32) -> Vector {
         return x;
     }
     let (first_new, created) = h.created();
-    match v.checked_sub(first_new).and_then(|k| created.get(k as usize)) {
+    match v
+        .checked_sub(first_new)
+        .and_then(|k| created.get(k as usize))
+    {
         Some(&(a, b)) => 0.5 * (vertex_position(world, h, a) + vertex_position(world, h, b)),
         // Every vertex of the hierarchy is the world's or made by the pass.
         None => unreachable!("vertex {v} is neither the world's nor made by the pass"),

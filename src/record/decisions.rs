@@ -177,7 +177,10 @@ pub(super) fn legend(by_state: bool) -> String {
 /// The decision components of one frame's `cloth/mesh` row.
 pub(super) fn decision_row(ratio: &[f32], term: &[u8], state: &[u8]) -> rerun::AnyValues {
     rerun::AnyValues::default()
-        .with_component_from_data(RATIO_COMPONENT, Arc::new(Float32Array::from(ratio.to_vec())))
+        .with_component_from_data(
+            RATIO_COMPONENT,
+            Arc::new(Float32Array::from(ratio.to_vec())),
+        )
         .with_component_from_data(TERM_COMPONENT, Arc::new(UInt8Array::from(term.to_vec())))
         .with_component_from_data(STATE_COMPONENT, Arc::new(UInt8Array::from(state.to_vec())))
 }

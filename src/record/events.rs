@@ -51,17 +51,23 @@ pub(super) fn mean_edge_length(
     (mean.is_finite() && mean > 0.0).then_some(mean as f32)
 }
 
-/// The frame's events as labelled points (empty when there are none, so the 3D view shows only
-/// the current frame's events), each sized to the edges at its level: `base_edge` is the
+/// The frame's events but refused merges as labelled points (empty when there are none, so the
+/// 3D view shows only the current frame's events), each sized to the edges at its level: `base_edge` is the
 /// unrefined mesh's mean edge length, halved every two levels (a red 1-4 split, or two edge
 /// bisections). Without it the points have a fixed size on screen.
 pub(super) fn event_points(events: &[EventMark], base_edge: Option<f32>) -> rerun::Points3D {
+    // Refused merges change nothing on the cloth: they are in the log only, so that the
+    // points mark where the mesh changed.
+    let events: Vec<&EventMark> = events
+        .iter()
+        .filter(|e| e.kind != "merge_refused")
+        .collect();
     let points = rerun::Points3D::new(events.iter().map(|e| convert::position(e.position)))
         .with_colors(events.iter().map(|e| {
             let [r, g, b] = event_rgb(e.kind);
             rerun::Rgba32::from_rgb(r, g, b)
         }))
-        .with_labels(events.iter().map(point_label));
+        .with_labels(events.iter().map(|e| point_label(e)));
     match base_edge {
         Some(h) => points.with_radii(events.iter().map(|e| {
             let edge = h * 0.5f32.powf(f32::from(e.level) / 2.0);

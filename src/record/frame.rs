@@ -209,10 +209,20 @@ fn validate_decisions(d: &DecisionView, triangles: usize) -> Result<(), String> 
         }
     }
     if let Some(t) = d.term.iter().find(|&&t| usize::from(t) >= TERM_NAMES.len()) {
-        return Err(format!("decision term {t} is past the {} terms", TERM_NAMES.len()));
+        return Err(format!(
+            "decision term {t} is past the {} terms",
+            TERM_NAMES.len()
+        ));
     }
-    if let Some(s) = d.state.iter().find(|&&s| usize::from(s) >= STATE_NAMES.len()) {
-        return Err(format!("decision state {s} is past the {} states", STATE_NAMES.len()));
+    if let Some(s) = d
+        .state
+        .iter()
+        .find(|&&s| usize::from(s) >= STATE_NAMES.len())
+    {
+        return Err(format!(
+            "decision state {s} is past the {} states",
+            STATE_NAMES.len()
+        ));
     }
     Ok(())
 }

@@ -7,6 +7,7 @@
 
 use std::collections::BTreeMap;
 use std::path::Path;
+use std::rc::Rc;
 
 use rerun::external::arrow::array::{
     Array, ArrayRef, AsArray, StringArray,
@@ -34,6 +35,12 @@ const COMPONENTS: [&str; 7] = [
     STATE_COMPONENT,
 ];
 
+/// The topology last logged: its frame, triangles and levels.
+type Topology = (i64, Rc<Vec<[u32; 3]>>, Rc<Vec<u8>>);
+
+/// What a history line shows of a frame: the level, and the ratio band, term and state.
+type LineKey = (u8, Option<(usize, u8, u8)>);
+
 /// What one frame logged: its `cloth/mesh` cells and its events.
 #[derive(Default)]
 struct Cells {
@@ -51,9 +58,9 @@ pub struct MeshAt {
     /// Positions of the simulated vertices, m.
     pub positions: Vec<[f64; 3]>,
     /// Triangles of the simulated mesh.
-    pub triangles: std::rc::Rc<Vec<[u32; 3]>>,
+    pub triangles: Rc<Vec<[u32; 3]>>,
     /// Level per triangle.
-    pub levels: std::rc::Rc<Vec<u8>>,
+    pub levels: Rc<Vec<u8>>,
     /// The frame whose row logged the topology.
     pub topology_frame: i64,
     /// Per triangle: ratio, term and state code (empty without decisions).
@@ -96,11 +103,25 @@ pub fn history_at(path: &Path, at: [f64; 3], frame: Option<i64>) -> Result<Histo
     let meshes = resolve(path, cells)?;
     let (first, last) = match (meshes.keys().next(), meshes.keys().next_back()) {
         (Some(&f), Some(&l)) => (f, l),
-        _ => return Err(InspectError::NoFrame { frame: frame.unwrap_or(0), first: 0, last: 0 }),
+        _ => {
+            return Err(InspectError::NoFrame {
+                frame: frame.unwrap_or(0),
+                first: 0,
+                last: 0,
+            });
+        }
     };
     let start = frame.unwrap_or(last);
-    let mesh = meshes.get(&start).ok_or(InspectError::NoFrame { frame: start, first, last })?;
-    let (place, distance) = nearest(mesh, at).ok_or(InspectError::NoFrame { frame: start, first, last })?;
+    let mesh = meshes.get(&start).ok_or(InspectError::NoFrame {
+        frame: start,
+        first,
+        last,
+    })?;
+    let (place, distance) = nearest(mesh, at).ok_or(InspectError::NoFrame {
+        frame: start,
+        first,
+        last,
+    })?;
     Ok(History {
         point: at,
         frame: start,
@@ -162,7 +183,10 @@ fn add_chunk(cells: &mut BTreeMap<i64, Cells>, chunk: &Chunk) {
             continue;
         };
         let tri = cell(corners, row)
-            .and_then(|c| c.as_primitive_opt::<Float32Type>().map(|c| c.values().to_vec()))
+            .and_then(|c| {
+                c.as_primitive_opt::<Float32Type>()
+                    .map(|c| c.values().to_vec())
+            })
             .filter(|c| c.len() == 9)
             .map(|c| [0, 1, 2].map(|k| [0, 1, 2].map(|i| f64::from(c[3 * k + i]))));
         let c = cells.entry(f).or_default();
@@ -173,14 +197,17 @@ fn add_chunk(cells: &mut BTreeMap<i64, Cells>, chunk: &Chunk) {
 
 /// Every frame's mesh from the cells, each component carried from the last frame that
 /// logged it.
-fn resolve(path: &Path, cells: BTreeMap<i64, Cells>) -> Result<BTreeMap<i64, MeshAt>, InspectError> {
+fn resolve(
+    path: &Path,
+    cells: BTreeMap<i64, Cells>,
+) -> Result<BTreeMap<i64, MeshAt>, InspectError> {
     let bad = |frame: i64, reason: &str| InspectError::Decode {
         path: path.to_path_buf(),
         index: 0,
         reason: format!("cloth/mesh at frame {frame}: {reason}"),
     };
     let mut latest: [Option<ArrayRef>; 7] = Default::default();
-    let mut topology: Option<(i64, std::rc::Rc<Vec<[u32; 3]>>, std::rc::Rc<Vec<u8>>)> = None;
+    let mut topology: Option<Topology> = None;
     let mut out = BTreeMap::new();
     for (frame, c) in cells {
         let logged_topology = c.mesh[1].is_some() || c.mesh[3].is_some();
@@ -193,10 +220,14 @@ fn resolve(path: &Path, cells: BTreeMap<i64, Cells>) -> Result<BTreeMap<i64, Mes
         let Some(positions) = positions else {
             continue;
         };
-        let positions = triples::<Float32Type, f32>(positions).ok_or_else(|| bad(frame, "positions"))?;
+        let positions =
+            triples::<Float32Type, f32>(positions).ok_or_else(|| bad(frame, "positions"))?;
         let copies: Vec<u32> = copies
             .as_ref()
-            .and_then(|c| c.as_primitive_opt::<UInt32Type>().map(|c| c.values().to_vec()))
+            .and_then(|c| {
+                c.as_primitive_opt::<UInt32Type>()
+                    .map(|c| c.values().to_vec())
+            })
             .unwrap_or_default();
         let vertices = positions
             .len()
@@ -206,7 +237,8 @@ fn resolve(path: &Path, cells: BTreeMap<i64, Cells>) -> Result<BTreeMap<i64, Mes
             let (Some(indices), Some(levels)) = (indices, levels) else {
                 return Err(bad(frame, "no topology logged at or before it"));
             };
-            let indices = triples::<UInt32Type, u32>(indices).ok_or_else(|| bad(frame, "indices"))?;
+            let indices =
+                triples::<UInt32Type, u32>(indices).ok_or_else(|| bad(frame, "indices"))?;
             let triangles = simulated_triangles(vertices, &indices, &copies)
                 .filter(|t| t.iter().flatten().all(|&i| (i as usize) < vertices))
                 .ok_or_else(|| bad(frame, "an index past the vertices"))?;
@@ -248,9 +280,21 @@ fn decisions(
     term: &Option<ArrayRef>,
     state: &Option<ArrayRef>,
 ) -> Option<Vec<(f32, u8, u8)>> {
-    let ratio = ratio.as_ref()?.as_primitive_opt::<Float32Type>()?.values().to_vec();
-    let term = term.as_ref()?.as_primitive_opt::<UInt8Type>()?.values().to_vec();
-    let state = state.as_ref()?.as_primitive_opt::<UInt8Type>()?.values().to_vec();
+    let ratio = ratio
+        .as_ref()?
+        .as_primitive_opt::<Float32Type>()?
+        .values()
+        .to_vec();
+    let term = term
+        .as_ref()?
+        .as_primitive_opt::<UInt8Type>()?
+        .values()
+        .to_vec();
+    let state = state
+        .as_ref()?
+        .as_primitive_opt::<UInt8Type>()?
+        .values()
+        .to_vec();
     (ratio.len() == term.len() && term.len() == state.len()).then(|| {
         ratio
             .into_iter()
@@ -303,7 +347,7 @@ impl History {
         );
         let _ = writeln!(s, "frame  time s  level  ratio  term       state");
         let last_frame = self.frames.keys().next_back().copied();
-        let mut previous: Option<(u8, Option<(usize, u8, u8)>)> = None;
+        let mut previous: Option<LineKey> = None;
         let mut before: Option<[f64; 3]> = None;
         for (&f, (place, mesh)) in &self.frames {
             let level = mesh.levels.get(place.triangle).copied().unwrap_or(0);

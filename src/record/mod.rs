@@ -64,8 +64,8 @@ mod track;
 
 pub use decisions::DecisionData;
 pub use edges::EdgeDisplay;
-pub use events::EVENT_CORNERS_COMPONENT;
 pub use error::{BoxError, RecordError};
+pub use events::EVENT_CORNERS_COMPONENT;
 pub use frame::{DecisionView, EventMark, FrameView, GarmentView, SeamSegment, WeldMark};
 pub use garment::ColourBy;
 pub use mesh::{DUPLICATE_COMPONENT, LEVEL_COMPONENT};

@@ -6,8 +6,8 @@ use std::path::Path;
 
 use rerun::{AsComponents, EntityPath, RecordingStream, RecordingStreamBuilder};
 
-use super::garment::{self, ColourBy, SINGLE_PANEL_NAME};
 use super::decisions;
+use super::garment::{self, ColourBy, SINGLE_PANEL_NAME};
 use super::{
     APPLICATION_ID, BoxError, ENTITY_EDGES, ENTITY_EVENT_LOG, ENTITY_EVENT_POINTS, ENTITY_LEGEND,
     ENTITY_MESH, ENTITY_PINS, ENTITY_PLOTS, ENTITY_SEAMS, EdgeDisplay, FrameView, RecordError,
@@ -255,9 +255,7 @@ impl Recorder {
                     .cloth_mesh
                     .topology(|c| convert::level_rgb(u8::try_from(c).unwrap_or(u8::MAX))),
                 ColourBy::Panel => self.cloth_mesh.topology(garment::panel_rgb),
-                ColourBy::Ratio => self
-                    .cloth_mesh
-                    .topology(|c| decisions::class_rgb(c, false)),
+                ColourBy::Ratio => self.cloth_mesh.topology(|c| decisions::class_rgb(c, false)),
                 ColourBy::State => self.cloth_mesh.topology(|c| decisions::class_rgb(c, true)),
             };
             row.push(&topology.0);
@@ -279,7 +277,8 @@ impl Recorder {
             (ColourBy::Panel, Some(g), _) => self.classes.extend_from_slice(g.triangle_panels),
             (ColourBy::Panel, None, _) => self.classes.resize(frame.triangles.len(), 0),
             (ColourBy::Ratio | ColourBy::State, _, Some(d)) => self.classes.extend(
-                (0..d.ratio.len()).map(|t| decisions::decision_class(d.ratio[t], d.term[t], d.state[t])),
+                (0..d.ratio.len())
+                    .map(|t| decisions::decision_class(d.ratio[t], d.term[t], d.state[t])),
             ),
             (ColourBy::Ratio | ColourBy::State, _, None) => {
                 return Err(RecordError::InvalidFrame {

@@ -147,7 +147,9 @@ fn decisions(
     let world = &state.world;
     let mut planes = Vec::new();
     if config.refine_obstacle.is_some() {
-        setup.obstacles.nearest_planes(&world.x, world.time, &mut planes);
+        setup
+            .obstacles
+            .nearest_planes(&world.x, world.time, &mut planes);
     }
     let all = ad.decisions(config, world, &planes);
     Some((

@@ -72,7 +72,11 @@ fn decision_lengths(path: &Path) -> BTreeMap<i64, [usize; 3]> {
             assert!(r.values().iter().all(|v| v.is_finite() && *v >= 0.0));
             let s = state.value(row);
             let s = s.as_primitive::<UInt8Type>();
-            assert!(s.values().iter().all(|&v| usize::from(v) < STATE_NAMES.len()));
+            assert!(
+                s.values()
+                    .iter()
+                    .all(|&v| usize::from(v) < STATE_NAMES.len())
+            );
             out.insert(f, [r.len(), term.value(row).len(), s.len()]);
         }
     }
@@ -84,14 +88,23 @@ fn every_frame_holds_each_triangles_ratio_term_and_state() {
     let path = temp("every-frame.rrd");
     let summary = record_default(&path, DecisionData::Recorded);
     let lengths = decision_lengths(&path);
-    assert_eq!(lengths.len() as u64, summary.frames, "one decision row per frame");
+    assert_eq!(
+        lengths.len() as u64,
+        summary.frames,
+        "one decision row per frame"
+    );
     for (&f, lens) in &lengths {
         let mesh = drape::record::decode::cloth_mesh_at(&path, f).expect("the frame's mesh");
         assert_eq!(*lens, [mesh.triangles.len(); 3], "frame {f}");
     }
     // `drape inspect --at` reads the same components back.
     let history = history_at(&path, [0.0, 0.5, 0.8], None).expect("history");
-    assert!(history.frames.values().all(|(_, m)| !m.decisions.is_empty()));
+    assert!(
+        history
+            .frames
+            .values()
+            .all(|(_, m)| !m.decisions.is_empty())
+    );
     std::fs::remove_file(&path).ok();
 }
 
@@ -129,7 +142,9 @@ fn inspect_at_lists_the_split_forced_split_and_bounce_of_the_triangle_under_a_po
         let (frame, at, line) = find_event(&path, kind, reason);
         // The event's triangle is gone after it: the point is on one of its children, whose
         // history lists the event at its frame.
-        let report = history_at(&path, at, Some(frame)).expect("history").report();
+        let report = history_at(&path, at, Some(frame))
+            .expect("history")
+            .report();
         assert!(
             report.lines().any(|l| l.trim() == line),
             "{kind} at frame {frame} missing from\n{report}"
@@ -158,7 +173,10 @@ fn recording_the_decisions_leaves_the_simulation_as_it_is() {
     );
     assert_eq!(ma.positions, mb.positions);
     assert_eq!(ma.triangles, mb.triangles);
-    assert_eq!((a.splits, a.merges, a.energy.r#final), (b.splits, b.merges, b.energy.r#final));
+    assert_eq!(
+        (a.splits, a.merges, a.energy.r#final),
+        (b.splits, b.merges, b.energy.r#final)
+    );
     assert!(
         std::fs::metadata(&with).expect("file").len()
             > std::fs::metadata(&without).expect("file").len()
@@ -192,7 +210,10 @@ fn a_fold_at_max_level_is_held_there() {
         assert_eq!(decisions.len(), world.mesh.triangles.len());
         let creased: Vec<_> = decisions.iter().filter(|d| d.reading.ratio > 1.0).collect();
         assert!(!creased.is_empty(), "the crease is past the threshold");
-        assert!(creased.iter().all(|d| d.state == want), "max_level {max_level}");
+        assert!(
+            creased.iter().all(|d| d.state == want),
+            "max_level {max_level}"
+        );
         // 90 degrees over 15.
         assert!(creased.iter().all(|d| (d.reading.ratio - 6.0).abs() < 1e-9));
     }
