@@ -93,10 +93,8 @@ impl RedGreenState {
                 (merges, self.sizing_refinement_marks(c, &curv))
             }
         };
-        // `merge_ok` follows `parents`' order.
-        let mut mergeable = parents
-            .iter()
-            .filter(|p| merge_ok.iter().any(|m| m.0 == p.0));
+        // Whether each parent may merge alone; `merge_ok` follows `parents`' order.
+        let alone: HashMap<u32, bool> = parents.iter().copied().collect();
         let mut marks = PassMarks {
             merges: Vec::new(),
             splits: splits
@@ -114,8 +112,7 @@ impl RedGreenState {
             kept: Vec::new(),
         };
         for &(p, reading, limit) in &merge_ok {
-            let alone = mergeable.find(|q| q.0 == p).is_some_and(|q| q.1);
-            match alone {
+            match alone.get(&p).copied().unwrap_or(false) {
                 true => marks.merges.push((p, Reason::Criterion { reading, limit })),
                 false => marks.kept.push((p, reading)),
             }
