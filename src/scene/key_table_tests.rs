@@ -58,6 +58,7 @@ fn tables() -> Vec<(&'static str, String, &'static str)> {
             appended("[self_collision]\nzzz = 1"),
             "## `[self_collision]`",
         ),
+        ("camera", appended("[camera]\nzzz = 1"), "## `[camera]`"),
     ]
 }
 

@@ -46,6 +46,9 @@ pub(crate) fn validate(scene: &Scene, doc: &Table) -> Result<(), Issue> {
     if let Some(s) = &scene.self_collision {
         super::validate_collide::self_collision(s)?;
     }
+    if let Some(c) = &scene.camera {
+        super::camera::validate(c)?;
+    }
     // `method = "none"` is the same as leaving `[adapt]` out: its other keys
     // are not used, so a `--set adapt.method=none` on an adaptive scene is
     // never refused for them.
