@@ -40,8 +40,9 @@ pub(crate) fn validate(scene: &Scene, doc: &Table) -> Result<(), Issue> {
         super::validate_body::parts(i, o, written)?;
     }
     super::validate_attach::obstacle_names(&scene.obstacle)?;
+    let obstacles = super::validate_attach::resolved(&scene.obstacle)?;
     for (i, pin) in scene.pin.iter().enumerate() {
-        super::validate_attach::pin_target(i, pin, &scene.obstacle)?;
+        super::validate_attach::pin_target(i, pin, &obstacles)?;
     }
     if let Some(s) = &scene.self_collision {
         super::validate_collide::self_collision(s)?;
