@@ -20,6 +20,16 @@ use drape::summary::Summary;
 /// stopped on a numerical failure (its summary is still printed and written), 130
 /// interrupted by Ctrl-C.
 pub fn cmd_run(args: RunArgs) -> Result<ExitCode> {
+    if args.no_decisions && matches!(args.colour_by, ColourChoice::Ratio | ColourChoice::State) {
+        anyhow::bail!(
+            "--colour-by {} colours the triangles by their refinement decisions, which \
+             --no-decisions leaves out of the recording; drop one of the two",
+            match args.colour_by {
+                ColourChoice::Ratio => "ratio",
+                _ => "state",
+            }
+        );
+    }
     let scene = load(&args.scene)?;
     let opts = run_options(&args, &scene);
     // Build the cloth and the obstacles once before any output is opened: a bad

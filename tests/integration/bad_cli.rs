@@ -134,3 +134,27 @@ fn bench_plan_into_a_closed_pipe_does_not_panic() {
     assert!(!stderr.contains("panicked"), "stderr: {stderr}");
     std::fs::remove_dir_all(&out_dir).ok();
 }
+
+#[test]
+fn colouring_by_decisions_without_them_is_refused_before_the_run() {
+    let dir = temp_dir("colour-no-decisions");
+    for colour in ["ratio", "state"] {
+        refused(
+            &drape(
+                &dir,
+                &[
+                    "run",
+                    "--no-decisions",
+                    "--colour-by",
+                    colour,
+                    "-o",
+                    "x.rrd",
+                ],
+            ),
+            1,
+            &[&format!("--colour-by {colour}"), "--no-decisions"],
+        );
+        assert!(!dir.join("x.rrd").exists(), "no recording is started");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
