@@ -69,6 +69,9 @@ pub struct PanelTable {
     pub rotation: Option<[f64; 3]>,
     /// Wraps the pattern around the garment's vertical axis instead.
     pub wrap: Option<WrapTable>,
+    /// The curved sides (the others are straight).
+    #[serde(default)]
+    pub curves: Vec<crate::spec::SideCurve>,
 }
 
 /// `wrap = { radius, angle }` of a panel: around a cylinder about z.
@@ -92,6 +95,12 @@ pub struct SeamTable {
     pub a: crate::spec::SeamSide,
     /// The second side, sewn end to start against the first.
     pub b: crate::spec::SeamSide,
+    /// Which way the second side runs against the first.
+    #[serde(default)]
+    pub direction: crate::spec::SeamDirection,
+    /// The sides may differ in length: the longer one is gathered.
+    #[serde(default)]
+    pub gather: bool,
 }
 
 /// `[cloth.sewing]`: how seams are sewn and welded.

@@ -8,7 +8,7 @@ use crate::adapt::AdaptConfig;
 use crate::collide::{CollideError, Obstacles, cusick::CusickSummary};
 use crate::math::Vector;
 use crate::physics::{ExternalForces, MaterialParams, Model, SolverSettings, WindForce};
-use crate::spec::{ClothMesh, ClothSpec, Garment, PanelSpec, Placement, SeamSpec, Sewing};
+use crate::spec::{ClothMesh, ClothSpec, Garment, Gather, PanelSpec, Placement, SeamSpec, Sewing};
 use crate::world::{BuildError, World};
 
 use super::model::{PanelTable, SeamTable};
@@ -86,6 +86,8 @@ pub fn cloth_spec(
                     name: s.name.clone(),
                     a: s.a.clone(),
                     b: s.b.clone(),
+                    direction: s.direction,
+                    gather: if s.gather { Gather::Any } else { Gather::None },
                 })
                 .collect(),
             max_edge: need(c.max_edge, "max_edge")?,
@@ -124,6 +126,7 @@ fn panel_spec(p: &PanelTable) -> PanelSpec {
     PanelSpec {
         name: p.name.clone(),
         outline: p.outline.clone(),
+        curves: p.curves.clone(),
         placement,
     }
 }

@@ -24,6 +24,7 @@ mod energy;
 mod fast_contact;
 mod fuzz;
 mod garment_bench;
+mod garment_curves;
 mod garment_recording;
 mod garment_remesh;
 mod garments;
