@@ -123,7 +123,7 @@ pub fn build(garment: &Garment) -> Result<BuiltGarment, GarmentError> {
                 side_index(garment, s, false)?,
             );
             let (chain_a, chain_b) = (&chains[a.0][a.1], &chains[b.0][b.1]);
-            let pairs: Vec<[u32; 2]> = match s.direction {
+            let mut pairs: Vec<[u32; 2]> = match s.direction {
                 SeamDirection::Opposite => chain_a
                     .iter()
                     .zip(chain_b.iter().rev())
@@ -135,6 +135,9 @@ pub fn build(garment: &Garment) -> Result<BuiltGarment, GarmentError> {
                     .map(|(&u, &w)| [u, w])
                     .collect(),
             };
+            // Two adjacent sides of one panel (a dart) share their corner,
+            // which is joined already.
+            pairs.retain(|p| p[0] != p[1]);
             Ok(Seam {
                 name: s.name.clone(),
                 pairs,

@@ -186,8 +186,7 @@ fn unequal_sides_without_gather_are_refused_with_their_lengths() {
 fn a_curve_on_a_missing_side_names_the_panel_key() {
     let text = GATHERED.replace("side = 3, kind", "side = 7, kind");
     let err = load_scene_str(&text, "garment.toml", &[])
-        .err()
-        .expect("refused")
+        .expect_err("refused")
         .to_string();
     assert!(
         err.contains("panel") && err.contains("sides 1 to 4, not 7"),

@@ -27,6 +27,7 @@ mod garment_bench;
 mod garment_curves;
 mod garment_recording;
 mod garment_remesh;
+mod garmentcode;
 mod garments;
 mod gradient;
 mod inspect_cli;
