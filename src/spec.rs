@@ -16,10 +16,12 @@ use crate::math::Scalar;
 mod curve;
 mod part;
 mod pin;
+mod rest;
 mod sequence;
 pub use curve::{Curve, SideCurve};
 pub use part::Part;
 pub use pin::{Pin, PinMotion};
+pub use rest::Rest;
 pub use sequence::{BodySurface, SequenceFiles};
 
 /// The cloth's rest mesh and its placement in the world, resolved from `[cloth]`.

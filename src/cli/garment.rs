@@ -18,9 +18,12 @@ use drape::spec::Sewing;
 /// The draping settings the written scene starts from (`docs/garmentcode.md`).
 const DRAPING: Draping = Draping {
     max_edge: 0.02,
-    duration: 6.0,
+    duration: 10.0,
     sewing_stiffness: 1000.0,
-    weld_gap: 0.005,
+    weld_gap: 0.02,
+    weightless: 1.0,
+    rest_speed: 0.05,
+    rest_window: 0.5,
 };
 
 #[derive(Args)]

@@ -43,6 +43,12 @@ pub struct Draping {
     pub sewing_stiffness: f64,
     /// The gap below which a seam is welded, m.
     pub weld_gap: f64,
+    /// Gravity is off while a seam is open, for at most this long, s.
+    pub weightless: f64,
+    /// The run ends at rest: no vertex faster than this, m/s ...
+    pub rest_speed: f64,
+    /// ... at any frame end of this long, s.
+    pub rest_window: f64,
 }
 
 /// The scene of `pattern` (from the file `source`) on `body`, named `name`.
@@ -86,6 +92,7 @@ frame_rate = 30
 integrator = "implicit"
 dt = "auto"
 gravity = [0.0, 0.0, -9.81]
+rest = {{ speed = {rest_speed:?}, window = {rest_window:?} }}  # ends at rest: m/s, s
 
 [cloth]
 shape = "panels"
@@ -95,6 +102,7 @@ rotation = [90.0, 0.0, 0.0]         # GarmentCode's y up -> drape's z up
 [cloth.sewing]
 stiffness = {stiffness:?}             # N/m per m of seam
 weld_gap = {weld_gap:?}              # m
+weightless = {weightless:?}            # gravity off while a seam is open, at most this long, s
 
 [material]
 preset = "gray-interlock"           # a t-shirt knit (docs/fabrics.md)
@@ -106,6 +114,9 @@ damping = 0.001
         max_edge = d.max_edge,
         stiffness = d.sewing_stiffness,
         weld_gap = d.weld_gap,
+        weightless = d.weightless,
+        rest_speed = d.rest_speed,
+        rest_window = d.rest_window,
     );
 }
 

@@ -117,6 +117,10 @@ pub struct SewingTable {
     /// absent: no cap.
     #[serde(default)]
     pub max_force: Option<f64>,
+    /// Gravity is off while a seam is open, for at most this long from the
+    /// start, s (> 0); absent: gravity acts from the start.
+    #[serde(default)]
+    pub weightless: Option<f64>,
 }
 
 impl Default for SewingTable {
@@ -125,6 +129,7 @@ impl Default for SewingTable {
             stiffness: default_sewing_stiffness(),
             weld_gap: default_weld_gap(),
             max_force: None,
+            weightless: None,
         }
     }
 }
@@ -188,6 +193,9 @@ pub struct Simulation {
     /// (used when `newton_iterations` > 1).
     #[serde(default = "default_newton_tolerance")]
     pub newton_tolerance: f64,
+    /// When the run ends at rest (absent: it runs for `duration`).
+    #[serde(default)]
+    pub rest: Option<crate::spec::Rest>,
 }
 
 impl Simulation {

@@ -64,6 +64,9 @@ pub(super) fn sewing(s: &SewingTable) -> Result<(), Issue> {
     let at = |key: &str| keys(&["cloth", "sewing", key]);
     positive(at("stiffness"), s.stiffness)?;
     positive(at("weld_gap"), s.weld_gap)?;
+    if let Some(t) = s.weightless {
+        positive(at("weightless"), t)?;
+    }
     match s.max_force {
         Some(f) => positive(at("max_force"), f),
         None => Ok(()),

@@ -19,7 +19,7 @@ const EXAMPLES: [&str; 4] = ["dress_pencil", "hoody_mean", "js_mean_all", "shirt
 
 fn example(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/data/garmentcode")
+        .join("scenes/garmentcode")
         .join(format!("{name}_specification.json"))
 }
 

@@ -25,6 +25,7 @@ mod fast_contact;
 mod fuzz;
 mod garment_bench;
 mod garment_curves;
+mod garment_phases;
 mod garment_recording;
 mod garment_remesh;
 mod garmentcode;
