@@ -14,11 +14,15 @@ use serde::Deserialize;
 use crate::math::Scalar;
 
 mod curve;
+mod obstacle_spec;
 mod part;
 mod pin;
 mod rest;
 mod sequence;
 pub use curve::{Curve, SideCurve};
+pub use obstacle_spec::{
+    Geometry, ObstacleMotion, ObstacleSpec, ObstacleSpecError, PartSpec, Primitive,
+};
 pub use part::Part;
 pub use pin::{Pin, PinMotion};
 pub use rest::Rest;
