@@ -34,6 +34,7 @@ pub mod world;
 pub mod bench;
 pub mod cantilever;
 pub mod check;
+pub mod garmentcode;
 pub mod record;
 pub mod run;
 pub mod scene;

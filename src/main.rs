@@ -9,6 +9,7 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 
 use cli::bench::{BenchArgs, cmd_bench};
 use cli::body_frames::{BodyFramesArgs, cmd_body_frames};
+use cli::garment::{GarmentArgs, cmd_garment};
 use cli::run::cmd_run;
 use drape::record::history::history_at;
 use drape::record::inspect::inspect;
@@ -18,6 +19,7 @@ use drape::scene::{Scene, default_scene, load_scene_file};
 mod cli {
     pub mod bench;
     pub mod body_frames;
+    pub mod garment;
     pub mod run;
 }
 
@@ -33,6 +35,10 @@ pub(crate) struct Cli {
 enum Command {
     /// Simulate a scene and record every frame to a .rrd file.
     Run(RunArgs),
+    /// Drape a GarmentCode sewing pattern (`*_specification.json`) on a body
+    /// (`--body BODY.obj`): the pattern and the body become a scene
+    /// (`--write-scene` saves it), run as `drape run` runs one.
+    Garment(GarmentArgs),
     /// Validate a scene and print the resolved model without simulating.
     Check(SceneArgs),
     /// Decode a .rrd recording and print what it holds.
@@ -92,7 +98,7 @@ struct InspectArgs {
 }
 
 #[derive(Args)]
-struct SceneArgs {
+pub(crate) struct SceneArgs {
     /// Scene file (TOML). Without one, the embedded default scene is used.
     scene: Option<PathBuf>,
     /// Override a scene value by its dotted path, e.g. `--set cloth.resolution=64` (repeatable).
@@ -101,7 +107,7 @@ struct SceneArgs {
 }
 
 #[derive(Args)]
-struct RunArgs {
+pub(crate) struct RunArgs {
     #[command(flatten)]
     scene: SceneArgs,
     /// Output recording (default: the scene's name + `.rrd` in the current directory).
@@ -172,6 +178,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Run(args) => cmd_run(args),
+        Command::Garment(args) => cmd_garment(args),
         Command::Check(args) => cmd_check(args),
         Command::Inspect(args) => cmd_inspect(args),
         Command::Bench(args) => cmd_bench(args),

@@ -13,15 +13,19 @@ use serde::Deserialize;
 
 use crate::math::Scalar;
 
+mod curve;
 mod obstacle_spec;
 mod part;
 mod pin;
+mod rest;
 mod sequence;
+pub use curve::{Curve, SideCurve};
 pub use obstacle_spec::{
     Geometry, ObstacleMotion, ObstacleSpec, ObstacleSpecError, PartSpec, Primitive,
 };
 pub use part::Part;
 pub use pin::{Pin, PinMotion};
+pub use rest::Rest;
 pub use sequence::{BodySurface, SequenceFiles};
 
 /// The cloth's rest mesh and its placement in the world, resolved from `[cloth]`.
@@ -92,6 +96,9 @@ pub struct PanelSpec {
     /// The outline's corners in pattern coordinates, m; side k runs from corner
     /// k to corner k + 1 (1-based), the last side back to the first corner.
     pub outline: Vec<[f64; 2]>,
+    /// The sides that are curved (every other side is straight), at most one
+    /// entry per side.
+    pub curves: Vec<SideCurve>,
     /// How the flat pattern is placed in the garment's frame.
     pub placement: Placement,
 }
@@ -120,9 +127,11 @@ pub enum Placement {
     },
 }
 
-/// A seam: two panel sides sewn together, the first side's start to the
-/// second side's end (two counter-clockwise outlines run a shared seam in
-/// opposite directions).
+/// A seam: two panel sides sewn together, by default the first side's start
+/// to the second side's end (two counter-clockwise outlines run a shared seam
+/// in opposite directions). Both sides are divided into the same number of
+/// segments, each side's points equally spaced along its own length, so a
+/// longer side gathers into a shorter one.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SeamSpec {
     /// The seam's name.
@@ -131,6 +140,32 @@ pub struct SeamSpec {
     pub a: SeamSide,
     /// The second side.
     pub b: SeamSide,
+    /// Which way the second side runs against the first.
+    pub direction: SeamDirection,
+    /// How much longer one side may be than the other.
+    pub gather: Gather,
+}
+
+/// Which way a seam's second side runs against its first.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SeamDirection {
+    /// The first side's start meets the second side's end.
+    #[default]
+    Opposite,
+    /// The first side's start meets the second side's start.
+    Same,
+}
+
+/// How much the lengths of a seam's two sides may differ.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum Gather {
+    /// Within [`crate::garment::SEAM_LENGTH_TOLERANCE`] of each other: the
+    /// sides are sewn point to point.
+    #[default]
+    None,
+    /// Any lengths: the longer side is gathered into the shorter one.
+    Any,
 }
 
 /// One side of a seam: a panel and one of its outline's sides.

@@ -170,6 +170,10 @@ pub struct Summary {
     /// wide); absent from the JSON for a cloth without seams.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub seams: Vec<SeamSummary>,
+    /// Whether the run ended at rest (`simulation.rest`), and when; absent
+    /// from the JSON for a scene without a rest criterion.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rest: Option<RestSummary>,
     /// True when Ctrl-C ended the run early.
     pub interrupted: bool,
     /// The recording, if one was written.
@@ -182,6 +186,38 @@ fn seams_sentence(seams: &[SeamSummary]) -> String {
     }
     let parts: Vec<String> = seams.iter().map(SeamSummary::describe).collect();
     format!(" Seams: {}.", parts.join(", "))
+}
+
+/// The rest criterion at the end of a run.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RestSummary {
+    /// True when the run ended at rest.
+    pub at_rest: bool,
+    /// When it came to rest, s (`None`: it did not).
+    pub time: Option<Scalar>,
+    /// The largest vertex speed at the end, m/s.
+    pub speed: Scalar,
+    /// The rest speed, m/s (`simulation.rest.speed`).
+    pub threshold: Scalar,
+    /// The rest window, s (`simulation.rest.window`).
+    pub window: Scalar,
+}
+
+impl RestSummary {
+    /// The rest criterion in words.
+    fn sentence(&self) -> String {
+        match self.time {
+            Some(t) => format!(
+                " At rest at t = {t:.3} s (every vertex under {} m/s for {} s).",
+                self.threshold, self.window
+            ),
+            None => format!(
+                " Not at rest: the fastest vertex moves at {:.4} m/s at the end (rest: under {} \
+                 m/s for {} s with every seam welded).",
+                self.speed, self.threshold, self.window
+            ),
+        }
+    }
 }
 
 /// One seam of a garment at the end of a run.
@@ -345,7 +381,11 @@ impl Summary {
                 .iter()
                 .map(|m| format!(" Pin region differs from the scene: {}.", m.describe()))
                 .collect::<String>()
-                + &seams_sentence(&self.seams),
+                + &seams_sentence(&self.seams)
+                + &self
+                    .rest
+                    .as_ref()
+                    .map_or(String::new(), RestSummary::sentence),
             end,
             rec
         )

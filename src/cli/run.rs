@@ -31,7 +31,13 @@ pub fn cmd_run(args: RunArgs) -> Result<ExitCode> {
         );
     }
     let scene = load(&args.scene)?;
-    let opts = run_options(&args, &scene);
+    run_scene(scene, &args)
+}
+
+/// Runs a loaded scene with `drape run`'s options (its scene arguments
+/// already applied), with `drape run`'s exit codes.
+pub fn run_scene(scene: Scene, args: &RunArgs) -> Result<ExitCode> {
+    let opts = run_options(args, &scene);
     // Build the cloth and the obstacles once before any output is opened: a bad
     // OBJ or a pin that selects nothing fails here and leaves no empty recording
     // behind (nor truncates an existing one).

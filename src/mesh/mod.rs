@@ -5,6 +5,7 @@
 //! same physical sheet. Topology is index-based: triangles reference vertices,
 //! edges reference their two triangles (the hinge).
 
+mod curve;
 mod generate;
 mod obj;
 mod outline;
@@ -13,6 +14,7 @@ mod panels;
 mod rest_space;
 mod topology;
 
+pub use curve::{CURVE_STEPS, side_length, side_points};
 pub use generate::{
     GridCuts, cell_counts, disk, fitted_lines, rectangle, rectangle_cells, rectangle_on_lines,
 };

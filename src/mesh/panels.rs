@@ -252,6 +252,15 @@ impl Mesh {
             }
             if k == s {
                 other.state = SeamState::Welded { time };
+            } else if other.is_open() {
+                // A pair this weld joined (the corner where this seam and
+                // another meet) is closed already; a seam whose every pair
+                // is joined is welded.
+                if other.pairs.iter().all(|p| p[0] == p[1]) {
+                    other.state = SeamState::Welded { time };
+                } else {
+                    other.pairs.retain(|p| p[0] != p[1]);
+                }
             }
         }
         let triangles = self

@@ -4,6 +4,7 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
+use super::phases::Phases;
 use super::recording::{self, FrameTiming, Snapshot};
 use super::tally::{Tally, TallyEnd};
 use super::{FrameState, Progress, RunError, RunOptions};
@@ -53,6 +54,8 @@ pub struct FrameLoop<'a> {
     interrupted: bool,
     /// The frame whose steps all failed, and how.
     failure: Option<(u64, FrameFailure)>,
+    /// Sewing weightless, draping, and the rest criterion.
+    phases: Phases,
 }
 
 impl<'a> FrameLoop<'a> {
@@ -97,6 +100,7 @@ impl<'a> FrameLoop<'a> {
             pipeline,
         } = sim;
         let tally = Tally::new(&setup.model, &state.world, pipeline.stepper(), &scene.pin);
+        let phases = Phases::new(scene, &setup.model, &state.world);
         Ok(FrameLoop {
             scene,
             setup,
@@ -121,6 +125,7 @@ impl<'a> FrameLoop<'a> {
             energy_now: None,
             interrupted: false,
             failure: None,
+            phases,
         })
     }
 
@@ -148,7 +153,14 @@ impl<'a> FrameLoop<'a> {
     /// reports the failure.
     pub fn advance(&mut self) -> Result<bool, RunError> {
         let t0 = Instant::now();
-        let start_energy = self.energy_now.take();
+        let mut start_energy = self.energy_now.take();
+        if self
+            .phases
+            .before_frame(&mut self.setup.model, &self.state.world)
+        {
+            // The energy measured under the other gravity is not this frame's.
+            start_energy = None;
+        }
         match self.pipeline.advance_frame_from(
             &self.setup,
             &mut self.state,
@@ -163,6 +175,10 @@ impl<'a> FrameLoop<'a> {
             Err(FrameFailed::Remesh(e)) => return Err(RunError::Remesh(e)),
         }
         self.frame += 1;
+        if self.phases.after_frame(&self.state.world) {
+            // At rest: this frame is the last, recorded and exported.
+            self.frames = self.frame;
+        }
         self.timing.sim_s = t0.elapsed().as_secs_f64();
         self.sim_seconds += self.timing.sim_s;
         Ok(true)
@@ -321,6 +337,7 @@ impl<'a> FrameLoop<'a> {
             mass_final: stepper.elements.total_mass(),
             cusick,
             cantilever,
+            rest: self.phases.summary(),
         })
     }
 }

@@ -41,6 +41,8 @@ pub(super) struct TallyEnd<'a> {
     pub(super) mass_final: Scalar,
     pub(super) cusick: Option<crate::collide::cusick::CusickSummary>,
     pub(super) cantilever: Option<crate::cantilever::CantileverSummary>,
+    /// The rest criterion's outcome, when the scene has one.
+    pub(super) rest: Option<crate::summary::RestSummary>,
 }
 
 impl Tally {
@@ -128,6 +130,7 @@ impl Tally {
             collision_wall_s: collision.collision_wall_s,
             self_collision_wall_s: collision.self_collision_wall_s,
             cusick: end.cusick,
+            rest: end.rest,
             cantilever: end.cantilever,
             pin_mismatches: self.pin_mismatches.clone(),
             seams: crate::summary::SeamSummary::of(&end.state.world.mesh, &end.state.world.x),

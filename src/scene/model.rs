@@ -71,6 +71,9 @@ pub struct PanelTable {
     pub rotation: Option<[f64; 3]>,
     /// Wraps the pattern around the garment's vertical axis instead.
     pub wrap: Option<WrapTable>,
+    /// The curved sides (the others are straight).
+    #[serde(default)]
+    pub curves: Vec<crate::spec::SideCurve>,
 }
 
 /// `wrap = { radius, angle }` of a panel: around a cylinder about z.
@@ -94,6 +97,12 @@ pub struct SeamTable {
     pub a: crate::spec::SeamSide,
     /// The second side, sewn end to start against the first.
     pub b: crate::spec::SeamSide,
+    /// Which way the second side runs against the first.
+    #[serde(default)]
+    pub direction: crate::spec::SeamDirection,
+    /// The sides may differ in length: the longer one is gathered.
+    #[serde(default)]
+    pub gather: bool,
 }
 
 /// `[cloth.sewing]`: how seams are sewn and welded.
@@ -110,6 +119,10 @@ pub struct SewingTable {
     /// absent: no cap.
     #[serde(default)]
     pub max_force: Option<f64>,
+    /// Gravity is off while a seam is open, for at most this long from the
+    /// start, s (> 0); absent: gravity acts from the start.
+    #[serde(default)]
+    pub weightless: Option<f64>,
 }
 
 impl Default for SewingTable {
@@ -118,6 +131,7 @@ impl Default for SewingTable {
             stiffness: default_sewing_stiffness(),
             weld_gap: default_weld_gap(),
             max_force: None,
+            weightless: None,
         }
     }
 }
@@ -181,6 +195,9 @@ pub struct Simulation {
     /// (used when `newton_iterations` > 1).
     #[serde(default = "default_newton_tolerance")]
     pub newton_tolerance: f64,
+    /// When the run ends at rest (absent: it runs for `duration`).
+    #[serde(default)]
+    pub rest: Option<crate::spec::Rest>,
 }
 
 impl Simulation {

@@ -9,8 +9,8 @@ use crate::collide::{CollideError, Obstacles, cusick::CusickSummary};
 use crate::math::Vector;
 use crate::physics::{ExternalForces, MaterialParams, Model, SolverSettings, WindForce};
 use crate::spec::{
-    ClothMesh, ClothSpec, Garment, ObstacleSpec, ObstacleSpecError, PanelSpec, Placement, SeamSpec,
-    Sewing,
+    ClothMesh, ClothSpec, Garment, Gather, ObstacleSpec, ObstacleSpecError, PanelSpec, Placement,
+    SeamSpec, Sewing,
 };
 use crate::world::{BuildError, World};
 
@@ -91,6 +91,8 @@ pub fn cloth_spec(
                     name: s.name.clone(),
                     a: s.a.clone(),
                     b: s.b.clone(),
+                    direction: s.direction,
+                    gather: if s.gather { Gather::Any } else { Gather::None },
                 })
                 .collect(),
             max_edge: need(c.max_edge, "max_edge")?,
@@ -129,6 +131,7 @@ fn panel_spec(p: &PanelTable) -> PanelSpec {
     PanelSpec {
         name: p.name.clone(),
         outline: p.outline.clone(),
+        curves: p.curves.clone(),
         placement,
     }
 }

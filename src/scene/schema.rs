@@ -51,6 +51,10 @@ pub(crate) fn allowed(path: &str) -> Option<&'static str> {
         "panel.wrap" => "a table { radius, angle } (m, degrees), radius > 0",
         "panel.wrap.radius" => "a finite number > 0 (m)",
         "panel.wrap.angle" => "a finite number (degrees)",
+        "panel.curves" => {
+            "an array of { side, kind, controls } (kind \"quadratic\" or \"cubic\") or \
+             { side, kind = \"arc\", radius, large_arc, counter_clockwise }, one per side"
+        }
         "seam" => "an array of tables [[seam]] (with cloth.shape = \"panels\")",
         "seam.name" => "a non-empty string, unique among the seams",
         "seam.a" | "seam.b" => {
@@ -58,10 +62,16 @@ pub(crate) fn allowed(path: &str) -> Option<&'static str> {
         }
         "seam.a.panel" | "seam.b.panel" => "the name of a [[panel]]",
         "seam.a.side" | "seam.b.side" => "an integer from 1 to the panel's corner count",
+        "seam.direction" => "\"opposite\" or \"same\"",
+        "seam.gather" => "true or false",
         "cloth.sewing" => "a table [cloth.sewing] (shape = \"panels\" or \"obj\" only)",
         "cloth.sewing.stiffness" => "a finite number > 0 (N/m per m of seam)",
         "cloth.sewing.weld_gap" => "a finite number > 0 (m)",
         "cloth.sewing.max_force" => "a finite number > 0 (N per m of seam); absent: no cap",
+        "cloth.sewing.weightless" => "a finite number > 0 (s); absent: gravity from the start",
+        "simulation.rest" => "a table { speed, window } (m/s, s), both > 0",
+        "simulation.rest.speed" => "a finite number > 0 (m/s)",
+        "simulation.rest.window" => "a finite number > 0 (s)",
         "material" => "a table [material]",
         "material.preset" => super::presets::ALLOWED,
         "material.density" => "a finite number > 0 (kg/m^2)",

@@ -211,6 +211,11 @@ fn simulation(s: &Simulation) -> Result<(), Issue> {
             ),
         ));
     }
+    if let Some(rest) = s.rest {
+        let key = |k: &str| keys(&["simulation", "rest", k]);
+        positive(key("speed"), rest.speed)?;
+        positive(key("window"), rest.window)?;
+    }
     Ok(())
 }
 

@@ -9,7 +9,7 @@ use super::model::{PanelTable, SeamTable, SewingTable};
 use super::validate::{all_finite, positive};
 use super::{ClothShape, Scene};
 use crate::garment::SEAM_LENGTH_TOLERANCE;
-use crate::spec::AdaptMethod;
+use crate::spec::{AdaptMethod, Curve};
 
 fn at(table: &str, i: usize, key: &str) -> KeyPath {
     vec![Seg::Key(table.into()), Seg::Index(i), Seg::Key(key.into())]
@@ -64,6 +64,9 @@ pub(super) fn sewing(s: &SewingTable) -> Result<(), Issue> {
     let at = |key: &str| keys(&["cloth", "sewing", key]);
     positive(at("stiffness"), s.stiffness)?;
     positive(at("weld_gap"), s.weld_gap)?;
+    if let Some(t) = s.weightless {
+        positive(at("weightless"), t)?;
+    }
     match s.max_force {
         Some(f) => positive(at("max_force"), f),
         None => Ok(()),
@@ -109,6 +112,7 @@ fn panel(i: usize, p: &PanelTable, earlier: &[PanelTable]) -> Result<(), Issue> 
     let flat: Vec<f64> = p.outline.iter().flatten().copied().collect();
     all_finite(at("panel", i, "outline"), &flat)?;
     all_finite(at("panel", i, "position"), &p.position)?;
+    curves(i, p)?;
     match (&p.wrap, &p.rotation) {
         (Some(_), Some(_)) => Err(Issue::new(
             at("panel", i, "rotation"),
@@ -127,6 +131,36 @@ fn panel(i: usize, p: &PanelTable, earlier: &[PanelTable]) -> Result<(), Issue> 
         (None, Some(r)) => all_finite(at("panel", i, "rotation"), r),
         (None, None) => Ok(()),
     }
+}
+
+/// Each curve names an existing side, one curve per side, with finite
+/// control points and a positive arc radius.
+fn curves(i: usize, p: &PanelTable) -> Result<(), Issue> {
+    let n = p.outline.len();
+    for (k, c) in p.curves.iter().enumerate() {
+        let mut path = at("panel", i, "curves");
+        path.push(Seg::Index(k));
+        let bad = |what: String| Err(Issue::new(path.clone(), Kind::BadValue, what));
+        if c.side == 0 || c.side > n {
+            return Err(Issue::new(
+                path,
+                Kind::OutOfRange,
+                format!("the panel has sides 1 to {n}, not {}", c.side),
+            )
+            .allowed(format!(
+                "1 to {n}: side k runs from outline corner k to corner k + 1"
+            )));
+        }
+        if p.curves[..k].iter().any(|e| e.side == c.side) {
+            return bad(format!("side {} has two curves", c.side));
+        }
+        match c.curve {
+            Curve::Quadratic { control } => all_finite(path, &control)?,
+            Curve::Cubic { controls } => all_finite(path, controls.as_flattened())?,
+            Curve::Arc { radius, .. } => positive(path, radius)?,
+        }
+    }
+    Ok(())
 }
 
 fn seam(
@@ -189,6 +223,16 @@ fn seam(
             }
         }
     }
+    let curved = [&s.a, &s.b].iter().any(|side| {
+        panels
+            .iter()
+            .find(|p| p.name == side.panel)
+            .is_some_and(|p| p.curves.iter().any(|c| c.side == side.side))
+    });
+    if s.gather || curved {
+        // A curved side's length is checked where the garment is built.
+        return Ok(());
+    }
     let (la, lb) = (length[0], length[1]);
     if (la - lb).abs() > SEAM_LENGTH_TOLERANCE * la.max(lb) {
         return Err(Issue::new(
@@ -200,7 +244,8 @@ fn seam(
             ),
         )
         .allowed(format!(
-            "sides within {:.0} % of each other's length (they are sewn point to point)",
+            "sides within {:.0} % of each other's length (they are sewn point to point), \
+             or `gather = true`",
             100.0 * SEAM_LENGTH_TOLERANCE
         )));
     }

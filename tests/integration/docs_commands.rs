@@ -105,7 +105,7 @@ fn brief(args: &[String], dir: &Path) -> Vec<String> {
     let s = |v: &[&str]| v.iter().map(|x| (*x).to_owned()).collect::<Vec<_>>();
     let mut a = args.to_vec();
     match a.first().map(String::as_str) {
-        Some("run") => {
+        Some("run" | "garment") => {
             a = without(&without(&a, "--out"), "-o");
             a.extend(s(&[
                 "--no-record",

@@ -18,7 +18,7 @@ use drape::mesh::{DEFAULT_SEWING_STIFFNESS, DEFAULT_WELD_GAP, Mesh, SeamState};
 use drape::physics::{Elements, MaterialParams, Membrane};
 use drape::scene::{AdaptMethod, BendingModel, StiffnessRule, load_scene_str};
 use drape::spec::Sewing;
-use drape::spec::{Garment, PanelSpec, Placement, SeamSide, SeamSpec};
+use drape::spec::{Garment, Gather, PanelSpec, Placement, SeamDirection, SeamSide, SeamSpec};
 use drape::world::World;
 use proptest::prelude::*;
 
@@ -49,6 +49,7 @@ fn welded_halves(width: Scalar, placements: [Placement; 2]) -> (World, Scalar) {
     let half = |name: &str, placement: Placement| PanelSpec {
         name: name.into(),
         outline: vec![[0.0, 0.0], [width, 0.0], [width, HEIGHT], [0.0, HEIGHT]],
+        curves: Vec::new(),
         placement,
     };
     let side = |panel: &str, side: usize| SeamSide {
@@ -60,11 +61,15 @@ fn welded_halves(width: Scalar, placements: [Placement; 2]) -> (World, Scalar) {
             name: "left".into(),
             a: side("front", 2),
             b: side("back", 4),
+            direction: SeamDirection::Opposite,
+            gather: Gather::None,
         },
         SeamSpec {
             name: "right".into(),
             a: side("back", 2),
             b: side("front", 4),
+            direction: SeamDirection::Opposite,
+            gather: Gather::None,
         },
     ];
     let BuiltGarment { mesh, positions } = garment::build(&Garment {

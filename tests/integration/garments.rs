@@ -14,7 +14,7 @@ use drape::physics::{Elements, ExternalForces, MaterialParams, Membrane};
 use drape::scene::{BendingModel, StiffnessRule, load_scene_str};
 use drape::sim::build;
 use drape::spec::Sewing;
-use drape::spec::{Garment, PanelSpec, Placement, SeamSide, SeamSpec};
+use drape::spec::{Garment, Gather, PanelSpec, Placement, SeamDirection, SeamSide, SeamSpec};
 use drape::world::World;
 
 use crate::common::Sim;
@@ -38,6 +38,8 @@ fn seam(name: &str, a: (&str, usize), b: (&str, usize)) -> SeamSpec {
             panel: b.0.into(),
             side: b.1,
         },
+        direction: SeamDirection::Opposite,
+        gather: Gather::None,
     }
 }
 
@@ -45,6 +47,7 @@ fn rectangle(name: &str, w: Scalar, h: Scalar, placement: Placement) -> PanelSpe
     PanelSpec {
         name: name.into(),
         outline: vec![[0.0, 0.0], [w, 0.0], [w, h], [0.0, h]],
+        curves: Vec::new(),
         placement,
     }
 }

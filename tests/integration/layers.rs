@@ -29,6 +29,7 @@ const LAYERS: [&[&str]; 3] = [
         "record",
         "run",
         "check",
+        "garmentcode",
         "bench",
         "stability",
         "cli",

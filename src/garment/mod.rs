@@ -1,18 +1,16 @@
 //! Building a garment from its panels and seams: each outline is meshed (both
-//! sides of a seam divided into the same number of segments, so their points
-//! pair up), the panels are gathered into one mesh with per-corner pattern
+//! sides of a seam divided into the same number of segments, each side's
+//! points equally spaced along its own length, curved or straight, so their
+//! points pair up and a longer side gathers into a shorter one), the panels are gathered into one mesh with per-corner pattern
 //! coordinates ([`crate::mesh::Panels`]), and each panel is placed in the
 //! garment's frame, flat or wrapped around a cylinder.
 
-use crate::math::{Scalar, Vector, Vector2, rotation_from_euler_deg};
-use crate::mesh::{
-    Mesh, MeshError, OutlineError, Panels, Seam, SeamState, mesh_outline, segments_for,
-};
-use crate::spec::{Garment, Placement, SeamSpec};
+mod sides;
 
-/// The relative difference in length the two sides of a seam may have: sewn
-/// point to point, longer differences would gather the cloth.
-pub const SEAM_LENGTH_TOLERANCE: Scalar = 0.05;
+use crate::math::{Vector, Vector2, rotation_from_euler_deg};
+use crate::mesh::{Mesh, MeshError, OutlineError, Panels, Seam, SeamState, mesh_outline};
+use crate::spec::{Garment, Placement, SeamDirection, SeamSpec};
+pub use sides::SEAM_LENGTH_TOLERANCE;
 
 /// Why a garment could not be built.
 #[derive(Debug, thiserror::Error)]
@@ -24,6 +22,14 @@ pub enum GarmentError {
         panel: String,
         /// Why (its sides numbered from 0; the message numbers them from 1).
         why: OutlineError,
+    },
+    /// A panel's curves name sides that do not exist, or are malformed.
+    #[error("panel `{panel}`: {reason}")]
+    Curve {
+        /// The panel.
+        panel: String,
+        /// What is wrong.
+        reason: String,
     },
     /// A seam names a panel or side that does not exist, or sides that cannot be sewn.
     #[error("seam `{seam}`: {reason}")]
@@ -72,26 +78,24 @@ pub struct BuiltGarment {
 
 /// Meshes, gathers and places the panels of `garment`.
 pub fn build(garment: &Garment) -> Result<BuiltGarment, GarmentError> {
-    let segments = side_segments(garment)?;
+    for panel in &garment.panels {
+        sides::check_curves(panel)?;
+    }
+    let segments = sides::side_segments(garment)?;
     let mut material = Vec::new();
     let mut positions = Vec::new();
     let mut triangles = Vec::new();
     let mut corners = Vec::new();
     let mut of_triangle = Vec::new();
     let mut of_vertex = Vec::new();
-    let mut sides: Vec<Vec<Vec<u32>>> = Vec::new();
+    let mut chains: Vec<Vec<Vec<u32>>> = Vec::new();
     for (p, panel) in garment.panels.iter().enumerate() {
-        let outline: Vec<Vector2> = panel
-            .outline
-            .iter()
-            .map(|c| Vector2::from_array(*c))
-            .collect();
-        let meshed = mesh_outline(&outline, &segments[p], garment.max_edge).map_err(|why| {
-            GarmentError::Outline {
+        let expanded = sides::expand(panel, &segments[p]);
+        let meshed = mesh_outline(&expanded.outline, &expanded.segments, garment.max_edge)
+            .map_err(|why| GarmentError::Outline {
                 panel: panel.name.clone(),
-                why,
-            }
-        })?;
+                why: expanded.renumber(why),
+            })?;
         let base = material.len() as u32;
         positions.extend(meshed.points.iter().map(|q| place(&panel.placement, *q)));
         material.extend_from_slice(&meshed.points);
@@ -101,11 +105,12 @@ pub fn build(garment: &Garment) -> Result<BuiltGarment, GarmentError> {
             corners.push(t.map(|v| meshed.points[v as usize]));
             of_triangle.push(p as u16);
         }
-        sides.push(
-            meshed
-                .sides
-                .iter()
-                .map(|s| s.iter().map(|v| v + base).collect())
+        chains.push(
+            (0..panel.outline.len())
+                .map(|k| {
+                    let chain = expanded.chain(&meshed.sides, k);
+                    chain.iter().map(|v| v + base).collect()
+                })
                 .collect(),
         );
     }
@@ -117,14 +122,25 @@ pub fn build(garment: &Garment) -> Result<BuiltGarment, GarmentError> {
                 side_index(garment, s, true)?,
                 side_index(garment, s, false)?,
             );
-            let (chain_a, chain_b) = (&sides[a.0][a.1], &sides[b.0][b.1]);
-            Ok(Seam {
-                name: s.name.clone(),
-                pairs: chain_a
+            let (chain_a, chain_b) = (&chains[a.0][a.1], &chains[b.0][b.1]);
+            let mut pairs: Vec<[u32; 2]> = match s.direction {
+                SeamDirection::Opposite => chain_a
                     .iter()
                     .zip(chain_b.iter().rev())
                     .map(|(&u, &w)| [u, w])
                     .collect(),
+                SeamDirection::Same => chain_a
+                    .iter()
+                    .zip(chain_b.iter())
+                    .map(|(&u, &w)| [u, w])
+                    .collect(),
+            };
+            // Two adjacent sides of one panel (a dart) share their corner,
+            // which is joined already.
+            pairs.retain(|p| p[0] != p[1]);
+            Ok(Seam {
+                name: s.name.clone(),
+                pairs,
                 state: SeamState::Open,
                 sewing: garment.sewing,
             })
@@ -140,62 +156,6 @@ pub fn build(garment: &Garment) -> Result<BuiltGarment, GarmentError> {
     let mesh = Mesh::from_panels(material, triangles, panels)?;
     check_weldable(&mesh)?;
     Ok(BuiltGarment { mesh, positions })
-}
-
-/// Segments per side of every panel: each side gets `max_edge`'s share of its
-/// length; both sides of a seam get the larger of their two counts.
-fn side_segments(garment: &Garment) -> Result<Vec<Vec<usize>>, GarmentError> {
-    let mut segments: Vec<Vec<usize>> = garment
-        .panels
-        .iter()
-        .map(|p| {
-            (0..p.outline.len())
-                .map(|k| segments_for(side_length(&p.outline, k), garment.max_edge))
-                .collect()
-        })
-        .collect();
-    let mut used_sides: Vec<(usize, usize)> = Vec::new();
-    for s in &garment.seams {
-        let (a, b) = (
-            side_index(garment, s, true)?,
-            side_index(garment, s, false)?,
-        );
-        if a == b {
-            return Err(seam_error(s, "both sides are the same panel side".into()));
-        }
-        for side in [a, b] {
-            if let Some(k) = used_sides.iter().position(|&u| u == side) {
-                // Two sides per seam, in seam order.
-                let name = &garment.seams[k / 2].name;
-                return Err(seam_error(
-                    s,
-                    format!(
-                        "side {} of panel `{}` is already sewn by seam `{name}`",
-                        side.1 + 1,
-                        garment.panels[side.0].name
-                    ),
-                ));
-            }
-            used_sides.push(side);
-        }
-        let len = |(p, k): (usize, usize)| side_length(&garment.panels[p].outline, k);
-        let (la, lb) = (len(a), len(b));
-        if (la - lb).abs() > SEAM_LENGTH_TOLERANCE * la.max(lb) {
-            return Err(seam_error(
-                s,
-                format!(
-                    "its sides are {la:.4} m and {lb:.4} m long, {:.1} % apart; allowed: at most \
-                     {:.0} % (the sides are sewn point to point)",
-                    100.0 * (la - lb).abs() / la.max(lb),
-                    100.0 * SEAM_LENGTH_TOLERANCE
-                ),
-            ));
-        }
-        let n = segments[a.0][a.1].max(segments[b.0][b.1]);
-        segments[a.0][a.1] = n;
-        segments[b.0][b.1] = n;
-    }
-    Ok(segments)
 }
 
 /// The (panel, 0-based side) of a seam's first (`first`) or second side.
@@ -228,13 +188,6 @@ fn seam_error(s: &SeamSpec, reason: String) -> GarmentError {
         seam: s.name.clone(),
         reason,
     }
-}
-
-/// The length of side `k` (0-based) of an outline, m.
-fn side_length(outline: &[[f64; 2]], k: usize) -> Scalar {
-    let a = Vector2::from_array(outline[k]);
-    let b = Vector2::from_array(outline[(k + 1) % outline.len()]);
-    a.distance(b)
 }
 
 /// A pattern point placed in the garment's frame.

@@ -1,0 +1,188 @@
+//! `drape garment`: a GarmentCode pattern draped on a body. The pattern and
+//! the body become a scene (`drape::garmentcode::scene_text`), which
+//! `--write-scene` saves and which runs as `drape run` runs a scene file.
+
+use std::path::{Component, Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::{Context, Result};
+use clap::{Args, ValueEnum};
+
+use crate::cli::run::run_scene;
+use crate::{ColourChoice, EdgeChoice, RunArgs, SceneArgs};
+use drape::garmentcode::body::check_body;
+use drape::garmentcode::scene_text::{Body, BodyUp, Draping, scene};
+use drape::scene::load_scene_str_in;
+use drape::spec::Sewing;
+
+/// The draping settings the written scene starts from (`docs/garmentcode.md`).
+const DRAPING: Draping = Draping {
+    max_edge: 0.02,
+    duration: 10.0,
+    sewing_stiffness: 1000.0,
+    weld_gap: 0.02,
+    weightless: 1.0,
+    rest_speed: 0.05,
+    rest_window: 0.5,
+};
+
+#[derive(Args)]
+pub struct GarmentArgs {
+    /// The GarmentCode specification (`*_specification.json`).
+    spec: PathBuf,
+    /// The body to drape on: an OBJ file (GarmentCode's `assets/bodies/*.obj`).
+    #[arg(long, value_name = "BODY.obj")]
+    body: PathBuf,
+    /// Which axis of the body file points up: `y` (GarmentCode's bodies, turned
+    /// by (x, y, z) -> (x, -z, y)) or `z`.
+    #[arg(long, value_enum, value_name = "AXIS", default_value_t = Up::Y)]
+    body_up: Up,
+    /// Metres per unit of the body file: 1 for metres, 0.01 for centimetres.
+    #[arg(long, value_name = "SCALE", default_value_t = 1.0)]
+    body_scale: f64,
+    /// Also write the scene that runs to this file (the body's path relative to it).
+    #[arg(long, value_name = "FILE.toml")]
+    write_scene: Option<PathBuf>,
+    /// Override a value of the scene, e.g. `--set cloth.max_edge=0.03` (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    overrides: Vec<String>,
+    /// Output recording (default: the pattern's name + `.rrd`).
+    #[arg(long, short, value_name = "FILE.rrd", conflicts_with = "no_record")]
+    out: Option<PathBuf>,
+    /// Do not write a recording file.
+    #[arg(long)]
+    no_record: bool,
+    /// Write a machine-readable summary (JSON) here.
+    #[arg(long, value_name = "FILE.json")]
+    summary: Option<PathBuf>,
+    /// Write every recorded frame as an OBJ file into this directory.
+    #[arg(long, value_name = "DIR")]
+    obj_dir: Option<PathBuf>,
+    /// Worker threads, 1 to 256 (default: one per core). Results are identical at any count.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=256))]
+    threads: Option<u32>,
+    /// No progress bar.
+    #[arg(long, short)]
+    quiet: bool,
+}
+
+/// The values of `--body-up`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum Up {
+    /// y up.
+    Y,
+    /// z up.
+    Z,
+}
+
+/// Runs `drape garment`, with `drape run`'s exit codes.
+pub fn cmd_garment(args: GarmentArgs) -> Result<ExitCode> {
+    let pattern = drape::garmentcode::load(&args.spec)?;
+    let sewing = Sewing {
+        stiffness: DRAPING.sewing_stiffness,
+        weld_gap: DRAPING.weld_gap,
+        max_force: None,
+    };
+    drape::garmentcode::check(&pattern, DRAPING.max_edge, sewing).map_err(|why| {
+        drape::garmentcode::GarmentCodeError {
+            file: args.spec.display().to_string(),
+            why,
+        }
+    })?;
+    if !(args.body_scale.is_finite() && args.body_scale > 0.0) {
+        anyhow::bail!("--body-scale must be a number > 0, got {}", args.body_scale);
+    }
+    check_body(&args.body, args.body_scale)?;
+    let name = args
+        .spec
+        .file_stem()
+        .map(|s| {
+            s.to_string_lossy()
+                .trim_end_matches("_specification")
+                .to_owned()
+        })
+        .filter(|s| !s.is_empty())
+        .unwrap_or_else(|| "garment".into());
+    let cwd = std::env::current_dir().context("cannot read the current directory")?;
+    let scene_dir = match &args.write_scene {
+        Some(file) => absolute(&cwd, file.parent().unwrap_or(Path::new(""))),
+        None => cwd.clone(),
+    };
+    let body = Body {
+        path: relative(&absolute(&cwd, &args.body), &scene_dir),
+        up: match args.body_up {
+            Up::Y => BodyUp::Y,
+            Up::Z => BodyUp::Z,
+        },
+        scale: args.body_scale,
+    };
+    let text = scene(
+        &name,
+        &args.spec.display().to_string(),
+        &pattern,
+        &body,
+        &DRAPING,
+    );
+    let origin = match &args.write_scene {
+        Some(file) => {
+            std::fs::write(file, &text)
+                .with_context(|| format!("cannot write the scene {}", file.display()))?;
+            file.display().to_string()
+        }
+        None => format!("the scene of {}", args.spec.display()),
+    };
+    let loaded = load_scene_str_in(&text, &origin, &scene_dir, &args.overrides)?;
+    let run = RunArgs {
+        scene: SceneArgs {
+            scene: None,
+            overrides: args.overrides.clone(),
+        },
+        out: args.out,
+        no_record: args.no_record,
+        summary: args.summary,
+        obj_dir: args.obj_dir,
+        record_every: 1,
+        edges: EdgeChoice::Review,
+        no_edges: false,
+        edge_threshold: None,
+        colour_by: ColourChoice::Panel,
+        spawn: false,
+        connect: None,
+        threads: args.threads,
+        quiet: args.quiet,
+        sample_at: None,
+        samples_out: None,
+    };
+    run_scene(loaded, &run)
+}
+
+/// `path` made absolute against `cwd`, `.` and `..` resolved by name.
+fn absolute(cwd: &Path, path: &Path) -> PathBuf {
+    let mut out = PathBuf::new();
+    for c in cwd.join(path).components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir => {
+                out.pop();
+            }
+            other => out.push(other),
+        }
+    }
+    out
+}
+
+/// `target` relative to the folder `base` (both absolute), as a string with `/`.
+fn relative(target: &Path, base: &Path) -> String {
+    let (t, b): (Vec<_>, Vec<_>) = (target.components().collect(), base.components().collect());
+    let common = t.iter().zip(&b).take_while(|(x, y)| x == y).count();
+    if common == 0 {
+        return target.display().to_string();
+    }
+    let mut parts: Vec<String> = vec!["..".into(); b.len() - common];
+    parts.extend(
+        t[common..]
+            .iter()
+            .map(|c| c.as_os_str().to_string_lossy().into_owned()),
+    );
+    parts.join("/")
+}

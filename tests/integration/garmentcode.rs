@@ -1,0 +1,277 @@
+//! GarmentCode patterns: GarmentCode's four example specifications load and
+//! build into garments; a panel lands where GarmentCode places it and faces
+//! the way its outline winds; `drape garment` writes a scene that `drape run`
+//! reads; and bad input is one line naming the file and the panel, edge,
+//! stitch or body file.
+
+use std::path::{Path, PathBuf};
+
+use serde_json::Value;
+
+use drape::garment;
+use drape::garmentcode::{self, Pattern};
+use drape::math::{Vector, Vector2, rotation_from_euler_deg};
+use drape::spec::{Garment, Sewing};
+
+use crate::bad_input::{drape, refused, temp_dir};
+
+const EXAMPLES: [&str; 4] = ["dress_pencil", "hoody_mean", "js_mean_all", "shirt_mean"];
+
+fn example(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes/garmentcode")
+        .join(format!("{name}_specification.json"))
+}
+
+fn json(name: &str) -> Value {
+    serde_json::from_str(&std::fs::read_to_string(example(name)).expect("read")).expect("json")
+}
+
+fn built(pattern: &Pattern) -> garment::BuiltGarment {
+    garment::build(&Garment {
+        panels: pattern.panels.clone(),
+        seams: pattern.seams.clone(),
+        max_edge: 0.03,
+        sewing: Sewing {
+            stiffness: 1000.0,
+            weld_gap: 0.005,
+            max_force: None,
+        },
+    })
+    .expect("the garment builds")
+}
+
+#[test]
+fn the_four_garmentcode_examples_load_and_build_with_every_stitch_a_seam() {
+    for name in EXAMPLES {
+        let pattern = garmentcode::load(&example(name)).expect("loads");
+        let spec = json(name);
+        let stitches = spec["pattern"]["stitches"]
+            .as_array()
+            .expect("stitches")
+            .len();
+        let panels = spec["pattern"]["panels"].as_object().expect("panels").len();
+        assert_eq!(pattern.panels.len(), panels, "{name}");
+        assert_eq!(pattern.seams.len(), stitches, "{name}");
+        let g = built(&pattern);
+        let seams = g.mesh.panels().expect("panels").seams.len();
+        println!(
+            "{name}: {panels} panels, {stitches} stitches, {} gathered, {} vertices",
+            pattern
+                .seams
+                .iter()
+                .filter(|s| s.gather == drape::spec::Gather::Any)
+                .count(),
+            g.mesh.vertex_count()
+        );
+        assert_eq!(seams, stitches, "{name}");
+    }
+}
+
+/// Where GarmentCode puts corner `c` of panel `name`: R p + t, in metres.
+fn garmentcode_corner(spec: &Value, name: &str, c: usize) -> Vector {
+    let p = &spec["pattern"]["panels"][name];
+    let f = |v: &Value| v.as_f64().expect("number");
+    let corner = &p["vertices"][c];
+    let local = Vector::new(f(&corner[0]), f(&corner[1]), 0.0);
+    let t = &p["translation"];
+    let r = &p["rotation"];
+    let rotation = rotation_from_euler_deg([f(&r[0]), f(&r[1]), f(&r[2])]);
+    (rotation * local + Vector::new(f(&t[0]), f(&t[1]), f(&t[2]))) / 100.0
+}
+
+#[test]
+fn every_panel_corner_starts_where_garmentcode_places_it_and_faces_as_its_outline_winds() {
+    let spec = json("shirt_mean");
+    let pattern = garmentcode::load(&example("shirt_mean")).expect("loads");
+    let g = built(&pattern);
+    let panels = g.mesh.panels().expect("panels");
+    for (p, panel) in pattern.panels.iter().enumerate() {
+        let count = panel.outline.len();
+        for c in 0..count {
+            let want = garmentcode_corner(&spec, &panel.name, c);
+            let corner = Vector2::from_array(panel.outline[c]);
+            let v = (0..g.mesh.vertex_count())
+                .find(|&v| {
+                    panels.of_vertex[v] as usize == p && g.mesh.material[v].distance(corner) < 1e-12
+                })
+                .expect("a vertex at the corner");
+            let got = g.positions[v];
+            assert!(
+                got.distance(want) < 1e-9,
+                "{} corner {c}: {got} != {want}",
+                panel.name
+            );
+        }
+        // The panel's triangles face the way GarmentCode's outline winds:
+        // along +z for the front panels (counter-clockwise), -z for the back.
+        let t = panels
+            .of_triangle
+            .iter()
+            .position(|&q| q as usize == p)
+            .expect("a triangle");
+        let [a, b, c] = g.mesh.triangles[t].map(|v| g.positions[v as usize]);
+        let normal = (b - a).cross(c - a);
+        let json_corners: Vec<[f64; 2]> = (0..count)
+            .map(|k| {
+                let q = &spec["pattern"]["panels"][&panel.name]["vertices"][k];
+                [q[0].as_f64().expect("x"), q[1].as_f64().expect("y")]
+            })
+            .collect();
+        let winding: f64 = (0..count)
+            .map(|k| {
+                let (u, w) = (json_corners[k], json_corners[(k + 1) % count]);
+                u[0] * w[1] - w[0] * u[1]
+            })
+            .sum();
+        let r = &spec["pattern"]["panels"][&panel.name]["rotation"];
+        let f = |v: &Value| v.as_f64().expect("number");
+        let facing = rotation_from_euler_deg([f(&r[0]), f(&r[1]), f(&r[2])]) * Vector::Z;
+        assert!(
+            normal.dot(facing) * winding > 0.0,
+            "{} faces against its outline's winding",
+            panel.name
+        );
+    }
+}
+
+/// A temp dir with a small y-up box body (`body.obj`, 0.4 x 1.7 x 0.3 m) and
+/// the shirt's specification edited by `edit`.
+fn case(name: &str, edit: impl Fn(&mut Value)) -> PathBuf {
+    let dir = temp_dir(name);
+    let mut spec = json("shirt_mean");
+    edit(&mut spec);
+    std::fs::write(dir.join("shirt.json"), spec.to_string()).expect("write");
+    // A closed 0.5 m cube (y up) 2 m below the garment.
+    let mut body = String::new();
+    for k in 0..8 {
+        let (x, y, z) = (k & 1, (k >> 1) & 1, (k >> 2) & 1);
+        body.push_str(&format!(
+            "v {} {} {}\n",
+            0.5 * x as f64,
+            0.5 * y as f64 - 3.0,
+            0.5 * z as f64
+        ));
+    }
+    for f in [
+        [1, 3, 4, 2],
+        [5, 6, 8, 7],
+        [1, 2, 6, 5],
+        [3, 7, 8, 4],
+        [1, 5, 7, 3],
+        [2, 4, 8, 6],
+    ] {
+        body.push_str(&format!("f {} {} {} {}\n", f[0], f[1], f[2], f[3]));
+    }
+    std::fs::write(dir.join("body.obj"), body).expect("write body");
+    dir
+}
+
+#[test]
+fn bad_patterns_are_one_line_naming_the_file_and_the_panel_edge_or_stitch() {
+    type Edit = Box<dyn Fn(&mut Value)>;
+    let cases: Vec<(&str, Edit, Vec<&str>)> = vec![
+        (
+            "curvature",
+            Box::new(|s| {
+                s["pattern"]["panels"]["left_btorso"]["edges"][1]["curvature"]["type"] =
+                    "spline".into()
+            }),
+            vec![
+                "panel `left_btorso`, edge 1",
+                "unknown curvature type \"spline\"",
+            ],
+        ),
+        (
+            "stitch-panel",
+            Box::new(|s| s["pattern"]["stitches"][3][0]["panel"] = "collar".into()),
+            vec!["stitch 3", "there is no panel `collar`"],
+        ),
+        (
+            "stitch-edge",
+            Box::new(|s| s["pattern"]["stitches"][4][1]["edge"] = 9.into()),
+            vec!["stitch 4", "edges 0 to 6, not 9"],
+        ),
+        (
+            "zero-length",
+            Box::new(|s| {
+                let v = s["pattern"]["panels"]["left_ftorso"]["vertices"][1].clone();
+                s["pattern"]["panels"]["left_ftorso"]["vertices"][2] = v;
+            }),
+            vec!["panel `left_ftorso`, edge 1", "zero length"],
+        ),
+        (
+            "crossing",
+            Box::new(|s| {
+                let v = &mut s["pattern"]["panels"]["left_ftorso"]["vertices"];
+                v.as_array_mut().expect("corners").swap(1, 4);
+            }),
+            vec!["panel `left_ftorso`", "crosses itself", "edges 0 and 4"],
+        ),
+    ];
+    for (name, edit, needles) in cases {
+        let dir = case(name, edit);
+        let out = drape(
+            &dir,
+            &["garment", "shirt.json", "--body", "body.obj", "--no-record"],
+        );
+        let mut all = vec!["shirt.json"];
+        all.extend(needles);
+        refused(&out, 1, &all);
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}
+
+#[test]
+fn bad_bodies_are_one_line_naming_the_body_file() {
+    let dir = case("bodies", |_| {});
+    std::fs::write(dir.join("empty.obj"), "").expect("write");
+    std::fs::write(dir.join("points.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\n").expect("write");
+    for (body, scale, needle) in [
+        ("missing.obj", "1", "body missing.obj: cannot read it"),
+        ("empty.obj", "1", "body empty.obj: the file has no faces"),
+        ("points.obj", "1", "body points.obj: the file has no faces"),
+        ("body.obj", "0.01", "its largest extent is 0.005 m"),
+        ("body.obj", "100", "its largest extent is 50.000 m"),
+    ] {
+        let args = [
+            "garment",
+            "shirt.json",
+            "--body",
+            body,
+            "--body-scale",
+            scale,
+            "--no-record",
+        ];
+        refused(&drape(&dir, &args), 1, &[needle]);
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn the_written_scene_loads_as_a_scene_with_every_panel_curve_and_seam() {
+    let dir = case("write-scene", |_| {});
+    let args = [
+        "garment",
+        "shirt.json",
+        "--body",
+        "body.obj",
+        "--write-scene",
+        "shirt.toml",
+        "--no-record",
+        "-q",
+        "--set",
+        "simulation.duration=0.02",
+    ];
+    let out = drape(&dir, &args);
+    assert_eq!(out.status.code(), Some(0));
+    let scene = drape::scene::load_scene_file(&dir.join("shirt.toml"), &[]).expect("scene");
+    let pattern = garmentcode::load(&dir.join("shirt.json")).expect("pattern");
+    assert_eq!(scene.panel.len(), pattern.panels.len());
+    assert_eq!(scene.seam.len(), pattern.seams.len());
+    for (table, panel) in scene.panel.iter().zip(&pattern.panels) {
+        assert_eq!(table.curves, panel.curves, "{}", panel.name);
+        assert_eq!(table.outline, panel.outline, "{}", panel.name);
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
