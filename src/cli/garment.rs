@@ -146,6 +146,7 @@ pub fn cmd_garment(args: GarmentArgs) -> Result<ExitCode> {
         no_edges: false,
         edge_threshold: None,
         colour_by: ColourChoice::Panel,
+        no_decisions: false,
         spawn: false,
         connect: None,
         threads: args.threads,
