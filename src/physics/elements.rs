@@ -286,7 +286,9 @@ impl Elements {
             computed: scratch.shapes.len() - kept,
         };
         std::mem::swap(&mut self.shape_triangles, &mut scratch.shapes);
-        self.fold_splits = FoldSplits::new(&self.shape_triangles, splits)
+        self.fold_splits = self
+            .fold_splits
+            .renew(&self.shape_triangles, splits)
             .expect("the plate matrices of a valid mesh are positive definite");
         self.fold_edges = FoldEdges::build(&self.shape_triangles, n);
         edge_bending(mesh, mat, area, &mut self.springs, &mut self.hinges);
