@@ -113,9 +113,11 @@ pub struct StepStats {
     /// Solves with a Cholesky factor (one per preconditioned iteration, plus one per
     /// solve to start it).
     pub factor_solves: u64,
-    /// Wall time spent assembling the system matrix and right-hand side, s.
+    /// Wall time spent assembling the system matrix and right-hand side, s
+    /// (a new mesh's block pattern counts in `rebuild_s`).
     pub assembly_s: f64,
-    /// Wall time spent in symbolic analyses and numerical factorizations, s.
+    /// Wall time spent in symbolic analyses and numerical factorizations, s
+    /// (a new mesh's ordering and first factorization count in `rebuild_s`).
     pub factorization_s: f64,
     /// Wall time spent in the iterations of the linear solves, s.
     pub solve_s: f64,
@@ -123,9 +125,10 @@ pub struct StepStats {
     /// transfer of the state onto the new mesh, rollbacks' refinements
     /// included), s.
     pub remesh_s: f64,
-    /// Wall time rebuilding the force elements, the fold splits' factor and
-    /// the solver's tables after the mesh changed, s (the new matrix's
-    /// ordering and factorization count in `factorization_s`).
+    /// Wall time rebuilding after the mesh changed (a remesh, a rollback, a
+    /// seam weld or a restored start), s: the force elements, the fold splits'
+    /// factor, and with the direct solver the new block pattern, its ordering
+    /// and the new mesh's first factorization.
     pub rebuild_s: f64,
 }
 

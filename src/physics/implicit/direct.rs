@@ -94,6 +94,14 @@ const TIPS_CONSIDER: u32 = 10;
 pub(super) struct DirectScratch {
     /// Block pattern of the current mesh (`None`: not built yet).
     pattern: Option<Arc<BlockPattern>>,
+    /// True from a change of mesh until the new mesh's first factorization:
+    /// its pattern, ordering and first factor are counted as rebuilding
+    /// ([`StepStats::rebuild_s`]).
+    new_mesh: bool,
+    /// Wall time of building the pattern after a change of mesh, s, not yet
+    /// moved from the linearisation's assembly time to the rebuild's
+    /// ([`DirectScratch::take_pattern_time`]).
+    pattern_s: f64,
     /// Factor the hinge tip-tip blocks too (block module docs): set for the rest of
     /// the run once a fresh factor without them needed more iterations than
     /// `tips_break_even` (module docs, "Which factor").
@@ -133,9 +141,15 @@ impl DirectScratch {
     /// Forgets the pattern and the factorization (the mesh changed).
     pub(super) fn mesh_changed(&mut self) {
         self.pattern = None;
+        self.new_mesh = true;
         self.tips_break_even = None;
         self.factorization.reset();
         self.laplacian.reset();
+    }
+
+    /// The wall time spent building a new mesh's pattern since the last call, s.
+    pub(super) fn take_pattern_time(&mut self) -> f64 {
+        std::mem::take(&mut self.pattern_s)
     }
 
     /// Makes `preconditioner` the one factored from now on (a change forgets
