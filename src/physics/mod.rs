@@ -233,17 +233,31 @@ impl Stepper {
 
     /// Rebuilds the force elements of `model` after the world's mesh changed
     /// (incrementally: [`Elements::rebuild`]).
+    ///
+    /// With the direct solver, the new mesh's block pattern and its ordering
+    /// are made here too, on one thread while the fold splits' system is
+    /// factored on another (both only read the rebuilt elements, so the
+    /// results do not depend on the thread count).
     pub fn rebuild(&mut self, model: &Model, world: &World) {
-        self.elements.rebuild(
-            &world.mesh,
-            &model.material,
-            &world.pins.clamped(world.mesh.vertex_count()),
-        );
+        let clamped = world.pins.clamped(world.mesh.vertex_count());
+        let splits = (self.elements).rebuild_but_splits(&world.mesh, &model.material, &clamped);
         self.held.resize(world.mesh.vertex_count(), false);
         self.contacts.clear();
         self.contact_push.clear();
         self.implicit.mesh_changed();
         self.levels = None;
+        let direct =
+            model.integrator == Integrator::Implicit && model.solver.solver == Solver::Direct;
+        let (elements, implicit) = (&self.elements, &mut self.implicit);
+        let (fold_splits, ()) = rayon::join(
+            || elements.renewed_fold_splits(splits),
+            || {
+                if direct {
+                    implicit.prepare_direct(elements, model.solver.preconditioner);
+                }
+            },
+        );
+        self.elements.fold_splits = fold_splits;
     }
 
     /// Advances `world` by `dt` seconds with `model`'s integrator. `warm_start`: the

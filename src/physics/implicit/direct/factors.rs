@@ -112,6 +112,8 @@ pub(super) fn refactor(
         if !a.factorization.is_analysed() {
             a.factorization.analyse(pattern).map_err(map)?;
             stats.symbolic_analyses += 1;
+        } else if std::mem::take(&mut a.analysis_uncounted) {
+            stats.symbolic_analyses += 1;
         }
         a.factorization
             .factor(pattern, &a.system, &a.compensation)
