@@ -222,3 +222,53 @@ fn lower_columns(
     let values = entries.iter().map(|&(_, v)| v).collect();
     (col_ptr, row_idx, values)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::FoldSplits;
+    use crate::math::Scalar;
+    use crate::mesh::{Mesh, rectangle};
+    use crate::physics::Model;
+    use crate::physics::elements::{Elements, MaterialParams};
+    use crate::scene::{DiagonalPattern, default_scene};
+
+    /// The splits of `s` for `el`'s shape triangles at made-up folds, as bits.
+    fn solved(s: &FoldSplits, el: &Elements) -> Vec<u64> {
+        let folds: Vec<[Scalar; 3]> = (0..el.shape_triangles.len())
+            .map(|t| [0, 1, 2].map(|a| ((7 * t + 3 * a) % 11) as Scalar * 0.01 - 0.05))
+            .collect();
+        let mut out = Vec::new();
+        s.solve(&el.shape_triangles, &folds, &mut out);
+        out.iter().map(|v| v.to_bits()).collect()
+    }
+
+    fn grid(resolution: u32) -> Mesh {
+        rectangle(1.0, 1.0, resolution, DiagonalPattern::Alternating).expect("a grid")
+    }
+
+    /// A system renewed from another, whether the matrices are equal, share
+    /// their structure only (another rigidity) or differ in size (another
+    /// mesh), is the one made new and solves bit for bit as it does.
+    #[test]
+    fn a_renewed_system_solves_as_a_new_one() {
+        let scene = default_scene(&[]).expect("the default scene");
+        let fabric = Model::from_scene(&scene).material;
+        let stiffer = MaterialParams {
+            bending: 3.0 * fabric.bending,
+            ..fabric
+        };
+        let (coarse, fine) = (grid(6), grid(9));
+        let base = Elements::build(&coarse, &fabric);
+        for (mesh, mat) in [(&coarse, &fabric), (&coarse, &stiffer), (&fine, &fabric)] {
+            let el = Elements::build(mesh, mat);
+            let count = el.fold_splits.count();
+            assert!(count > 0, "the grid has split unknowns");
+            let new = FoldSplits::new(&el.shape_triangles, count).expect("factored");
+            let renewed = (base.fold_splits)
+                .renew(&el.shape_triangles, count)
+                .expect("factored");
+            assert!(renewed == new, "the renewed system's matrix differs");
+            assert_eq!(solved(&renewed, &el), solved(&new, &el));
+        }
+    }
+}
