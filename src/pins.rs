@@ -10,7 +10,7 @@ use crate::kinematics::carrier::{AttachError, Carrier};
 use crate::kinematics::motion::Track;
 use crate::math::{Matrix3, Scalar, Vector, Vector2};
 use crate::mesh::{GridCuts, Mesh};
-use crate::spec::{Obstacle, Pin, PinMotion};
+use crate::spec::{ObstacleSpec, Pin, PinMotion};
 
 /// The edges of the `box` regions of `pins`: the lines a generated grid needs
 /// so that each box holds exactly the cloth inside it. Other regions (and
@@ -114,7 +114,7 @@ pub struct PinScript {
 
 impl PinScript {
     /// The script of `pin`, whose `attach` (if any) names one of `obstacles`.
-    fn new(p: usize, pin: &Pin, obstacles: &[Obstacle]) -> Result<PinScript, PinError> {
+    fn new(p: usize, pin: &Pin, obstacles: &[ObstacleSpec]) -> Result<PinScript, PinError> {
         let v = Vector::from_array;
         let path = match (&pin.attach, pin.motion) {
             (Some(attach), _) => PinPath::Attached(
@@ -218,7 +218,7 @@ impl Pins {
     /// a pin's `attach` names one of `obstacles`.
     pub fn select_among(
         pins: &[Pin],
-        obstacles: &[Obstacle],
+        obstacles: &[ObstacleSpec],
         mesh: &Mesh,
         x: &[Vector],
     ) -> Result<Pins, PinError> {

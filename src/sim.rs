@@ -49,7 +49,7 @@ use crate::adapt::Adapter;
 use crate::collide::{CollideError, Obstacles};
 use crate::math::Scalar;
 use crate::physics::Model;
-use crate::spec::{ClothSpec, Obstacle, Pin};
+use crate::spec::{ClothSpec, ObstacleSpec, Pin};
 use crate::world::{BuildError, World};
 
 /// Everything a simulation is built from: a scene resolved into the engine's
@@ -63,7 +63,7 @@ pub struct SimSpec {
     /// Material, external forces, integrator and solver settings.
     pub model: Model,
     /// The rigid obstacles.
-    pub obstacles: Vec<Obstacle>,
+    pub obstacles: Vec<ObstacleSpec>,
     /// Step size, multirate stepping, self-collision and adaptivity.
     pub settings: Settings,
     /// Area density, kg/m^2 (the remesher's mass transfer).

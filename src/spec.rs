@@ -13,9 +13,13 @@ use serde::Deserialize;
 
 use crate::math::Scalar;
 
+mod obstacle_spec;
 mod part;
 mod pin;
 mod sequence;
+pub use obstacle_spec::{
+    Geometry, ObstacleMotion, ObstacleSpec, ObstacleSpecError, PartSpec, Primitive,
+};
 pub use part::Part;
 pub use pin::{Pin, PinMotion};
 pub use sequence::{BodySurface, SequenceFiles};

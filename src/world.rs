@@ -9,7 +9,7 @@ use std::path::Path;
 use crate::math::{Scalar, Vector, rotation_from_euler_deg};
 use crate::mesh::{self, Mesh, MeshError, ObjError};
 use crate::pins::{PinError, Pins};
-use crate::spec::{ClothMesh, ClothSpec, Obstacle, Pin};
+use crate::spec::{ClothMesh, ClothSpec, ObstacleSpec, Pin};
 
 /// Why a world could not be built from a scene.
 #[derive(Debug, thiserror::Error)]
@@ -29,6 +29,15 @@ pub enum BuildError {
     /// A key the shape needs is missing (validation normally catches this first).
     #[error("cloth: `{0}` is required for this shape")]
     Missing(&'static str),
+    /// An obstacle's table lacks a key its shape needs (validation normally catches
+    /// this first).
+    #[error("obstacle {index}: {why}")]
+    Obstacle {
+        /// Obstacle index.
+        index: usize,
+        /// What is missing.
+        why: crate::spec::ObstacleSpecError,
+    },
 }
 
 /// Simulation state of one cloth.
@@ -65,7 +74,7 @@ impl World {
     pub fn from_spec(
         cloth: &ClothSpec,
         pins: &[Pin],
-        obstacles: &[Obstacle],
+        obstacles: &[ObstacleSpec],
     ) -> Result<World, BuildError> {
         let (mesh, local): (Mesh, Vec<Vector>) = match &cloth.mesh {
             &ClothMesh::Rectangle {

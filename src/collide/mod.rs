@@ -53,7 +53,7 @@ use serde::Serialize;
 
 use crate::math::{Scalar, Vector};
 use crate::physics::Contact;
-use crate::spec::{Obstacle, SelfCollision};
+use crate::spec::{ObstacleSpec, SelfCollision};
 use crate::world::World;
 use deform::At;
 use obstacle::Body;
@@ -92,22 +92,21 @@ pub enum CollideError {
         /// What is wrong.
         reason: String,
     },
-    /// An articulated obstacle's hierarchy is unusable (validation normally
-    /// catches this first).
-    #[error("obstacle {index}: {reason}")]
-    Hierarchy {
+    /// A mesh sequence's `files` pattern reached the engine unexpanded (the scene loader
+    /// expands it into the list of files).
+    #[error("obstacle {index}: the `files` pattern was not expanded into a list of files")]
+    Unexpanded {
         /// Obstacle index.
         index: usize,
-        /// What is wrong.
-        reason: String,
     },
-    /// A key the shape needs is missing (validation normally catches this first).
-    #[error("obstacle {index}: `{key}` is required for this shape")]
-    Missing {
+    /// An obstacle's table lacks a key its shape needs (validation normally catches
+    /// this first).
+    #[error("obstacle {index}: {why}")]
+    Spec {
         /// Obstacle index.
         index: usize,
-        /// The key.
-        key: &'static str,
+        /// What is missing.
+        why: crate::spec::ObstacleSpecError,
     },
 }
 
@@ -185,7 +184,7 @@ pub struct Obstacles {
 impl Obstacles {
     /// The obstacles of a scene's `[[obstacle]]` tables (none: an empty set).
     /// `crate::scene` builds them from a scene (`Obstacles::from_scene`).
-    pub fn new(obstacles: &[Obstacle]) -> Result<Obstacles, CollideError> {
+    pub fn new(obstacles: &[ObstacleSpec]) -> Result<Obstacles, CollideError> {
         let bodies = obstacles
             .iter()
             .enumerate()

@@ -18,7 +18,7 @@ use crate::kinematics::motion::{Motion, obstacle_motion};
 use crate::kinematics::skeleton::Skeleton;
 use crate::kinematics::skin::Skin;
 use crate::math::{Scalar, Vector, rotation_from_euler_deg};
-use crate::spec::{BodySurface, Obstacle, ObstacleShape, Part, SequenceFiles};
+use crate::spec::{BodySurface, Geometry, ObstacleShape, ObstacleSpec, PartSpec, SequenceFiles};
 
 /// A rigid obstacle the cloth collides with.
 pub struct Body {
@@ -64,69 +64,77 @@ pub struct Probe {
 impl Body {
     /// Builds obstacle `index` of a scene (OBJ paths are already resolved by
     /// the loader): one body, or one per part of an articulated obstacle.
-    pub fn from_spec(index: usize, o: &Obstacle) -> Result<Vec<Body>, CollideError> {
-        let axis = Vector::from_array(o.axis).normalize_or_zero();
-        if o.shape == ObstacleShape::Articulated {
-            let skeleton = Arc::new(Skeleton::new(index, o, obstacle_motion(o, axis))?);
-            if o.surface == BodySurface::SkinnedMesh {
-                return Ok(vec![Body::skinned(index, o, skeleton)?]);
-            }
-            return o
-                .part
-                .iter()
-                .enumerate()
-                .map(|(i, p)| Body::part(index, o, &skeleton, i, p))
-                .collect();
-        }
-        if o.shape == ObstacleShape::MeshSequence {
-            return Ok(vec![Body::mesh_sequence(index, o)?]);
-        }
+    pub fn from_spec(index: usize, o: &ObstacleSpec) -> Result<Vec<Body>, CollideError> {
         // parry's cylinder is along local y; ours stand along local z.
         let y_to_z = glam::DQuat::from_rotation_x(std::f64::consts::FRAC_PI_2);
         let mut fix = glam::DQuat::IDENTITY;
-        let shape: Box<dyn Shape> = match o.shape {
-            ObstacleShape::Plane => Box::new(HalfSpace::new(
-                Vector::from_array(o.normal).normalize_or(Vector::Z),
+        let shape: Box<dyn Shape> = match &o.geometry {
+            Geometry::Articulated { parts, surface } => {
+                let skeleton = Arc::new(Skeleton::new(index, o, obstacle_motion(&o.motion))?);
+                if *surface == BodySurface::SkinnedMesh {
+                    return Ok(vec![Body::skinned(index, o, parts, skeleton)]);
+                }
+                return Ok(parts
+                    .iter()
+                    .enumerate()
+                    .map(|(i, p)| Body::part(index, o, &skeleton, i, p))
+                    .collect());
+            }
+            Geometry::MeshSequence {
+                files,
+                frame_rate,
+                scale,
+                after_last,
+            } => {
+                let rot = rotation_from_euler_deg(o.rotation);
+                let origin = Vector::from_array(o.position);
+                let SequenceFiles::List(files) = files else {
+                    return Err(CollideError::Unexpanded { index });
+                };
+                let (triangles, frames) = load_frames(index, files, *scale, &|p| origin + rot * p)?;
+                let animation =
+                    Animation::Sequence(Sequence::new(frames, *frame_rate, *after_last));
+                let name = format!("obstacle {index} (mesh sequence)");
+                let deform = Deforming::new(triangles, animation);
+                return Ok(vec![Body::with_deform(name, o, deform)]);
+            }
+            Geometry::Plane { normal } => Box::new(HalfSpace::new(
+                Vector::from_array(*normal).normalize_or(Vector::Z),
             )),
-            ObstacleShape::Cylinder => {
+            Geometry::Cylinder {
+                radius,
+                half_height,
+            } => {
                 fix = y_to_z;
-                let need = |v: Option<Scalar>, key| v.ok_or(CollideError::Missing { index, key });
-                Box::new(Cylinder::new(
-                    need(o.half_height, "half_height")?,
-                    need(o.radius, "radius")?,
-                ))
+                Box::new(Cylinder::new(*half_height, *radius))
             }
-            ObstacleShape::Mesh => {
-                let path = o
-                    .path
-                    .as_deref()
-                    .ok_or(CollideError::Missing { index, key: "path" })?;
-                Box::new(load_mesh(index, Path::new(path), o.scale)?)
-            }
-            _ => primitive(index, o.shape, o.radius, o.half_height, o.half_extents)?,
+            Geometry::Mesh { path, scale } => Box::new(load_mesh(index, Path::new(path), *scale)?),
+            Geometry::Primitive(p) => primitive(p),
         };
         let rot = glam::DQuat::from_mat3(&rotation_from_euler_deg(o.rotation));
         let origin = Vector::from_array(o.position);
         let pose0 = Pose::from_parts(origin, rot * fix);
-        let name = format!("obstacle {index} ({})", o.shape.name());
+        let kind = o.geometry.kind();
+        let name = format!("obstacle {index} ({})", kind.name());
         Ok(vec![Body::rigid(
             name,
+            kind,
             o,
             shape,
             pose0,
-            obstacle_motion(o, axis),
+            obstacle_motion(&o.motion),
         )])
     }
 
     /// Part `i` (`p`) of articulated obstacle `index` (`o`), moved by `skeleton`.
     fn part(
         index: usize,
-        o: &Obstacle,
+        o: &ObstacleSpec,
         skeleton: &Arc<Skeleton>,
         i: usize,
-        p: &Part,
-    ) -> Result<Body, CollideError> {
-        let shape = primitive(index, p.shape, p.radius, p.half_height, p.half_extents)?;
+        p: &PartSpec,
+    ) -> Body {
+        let shape = primitive(&p.primitive);
         let rest = skeleton.rest(i);
         let centre = rest.position + rest.rotation * Vector::from_array(p.center);
         let pose0 = Pose::from_parts(centre, rest.rotation);
@@ -135,65 +143,32 @@ impl Body {
             part: i,
         };
         let name = format!("obstacle {index} part {}", p.name);
-        let mut body = Body::rigid(name, o, shape, pose0, motion);
+        let kind = ObstacleShape::Articulated;
+        let mut body = Body::rigid(name, kind, o, shape, pose0, motion);
         body.origin = rest.position;
-        Ok(body)
+        body
     }
 
-    /// Obstacle `index` (`o`), a `mesh_sequence`: its frames loaded, checked
-    /// and placed by `position` and `rotation`.
-    fn mesh_sequence(index: usize, o: &Obstacle) -> Result<Body, CollideError> {
-        let files = match &o.files {
-            Some(SequenceFiles::List(files)) => files.as_slice(),
-            _ => {
-                return Err(CollideError::Missing {
-                    index,
-                    key: "files",
-                });
-            }
-        };
-        let rate = o.frame_rate.ok_or(CollideError::Missing {
-            index,
-            key: "frame_rate",
-        })?;
-        let rot = rotation_from_euler_deg(o.rotation);
-        let origin = Vector::from_array(o.position);
-        let (triangles, frames) = load_frames(index, files, o.scale, &|p| origin + rot * p)?;
-        let animation = Animation::Sequence(Sequence::new(frames, rate, o.after_last));
-        let name = format!("obstacle {index} (mesh sequence)");
-        Ok(Body::with_deform(
-            name,
-            o,
-            Deforming::new(triangles, animation),
-        ))
-    }
-
-    /// Articulated obstacle `index` (`o`) as one mesh skinned to its parts.
-    fn skinned(index: usize, o: &Obstacle, skeleton: Arc<Skeleton>) -> Result<Body, CollideError> {
-        let shapes = o
-            .part
-            .iter()
-            .map(|p| primitive(index, p.shape, p.radius, p.half_height, p.half_extents))
-            .collect::<Result<Vec<_>, _>>()?;
-        let centres: Vec<Vector> = o
-            .part
-            .iter()
-            .map(|p| Vector::from_array(p.center))
-            .collect();
+    /// Articulated obstacle `index` (`o`, with `parts`) as one mesh skinned to its parts.
+    fn skinned(
+        index: usize,
+        o: &ObstacleSpec,
+        parts: &[PartSpec],
+        skeleton: Arc<Skeleton>,
+    ) -> Body {
+        let shapes: Vec<Box<dyn Shape>> = parts.iter().map(|p| primitive(&p.primitive)).collect();
+        let centres: Vec<Vector> = parts.iter().map(|p| Vector::from_array(p.center)).collect();
         let (skin, triangles) = Skin::new(skeleton, &shapes, &centres);
         let name = format!("obstacle {index} (skinned mesh)");
-        Ok(Body::with_deform(
-            name,
-            o,
-            Deforming::new(triangles, Animation::Skinned(skin)),
-        ))
+        Body::with_deform(name, o, Deforming::new(triangles, Animation::Skinned(skin)))
     }
 
     /// A deforming mesh body with `o`'s friction and thickness.
-    fn with_deform(name: String, o: &Obstacle, deform: Deforming) -> Body {
+    fn with_deform(name: String, o: &ObstacleSpec, deform: Deforming) -> Body {
         let rest = deform.at(0.0);
         let shape = Box::new(rest.mesh().clone());
-        let mut body = Body::rigid(name, o, shape, Pose::IDENTITY, Motion::Fixed);
+        let kind = o.geometry.kind();
+        let mut body = Body::rigid(name, kind, o, shape, Pose::IDENTITY, Motion::Fixed);
         body.origin = Vector::ZERO;
         body.deform = Some(deform);
         body
@@ -203,7 +178,8 @@ impl Body {
     /// translation), with `o`'s friction and thickness.
     fn rigid(
         name: String,
-        o: &Obstacle,
+        kind: ObstacleShape,
+        o: &ObstacleSpec,
         shape: Box<dyn Shape>,
         pose0: Pose,
         motion: Motion,
@@ -213,13 +189,13 @@ impl Body {
         let local_box = Aabb::new(local.mins - Vector::splat(t), local.maxs + Vector::splat(t));
         Body {
             name,
-            kind: o.shape,
+            kind,
             shape,
             origin: pose0.translation,
             pose0,
             motion,
             mu_static: o.friction_static,
-            mu_kinetic: o.friction_kinetic.unwrap_or(o.friction_static),
+            mu_kinetic: o.friction_kinetic,
             thickness: t,
             local_box,
             deform: None,

@@ -96,9 +96,12 @@ pub fn load_frames(
         reason,
     };
     let Some(first_path) = files.first() else {
-        return Err(CollideError::Missing {
+        return Err(CollideError::Spec {
             index,
-            key: "files",
+            why: crate::spec::ObstacleSpecError::Missing {
+                shape: "mesh sequence",
+                key: "files",
+            },
         });
     };
     let (first, triangles) = read_frame(index, first_path, scale)?;

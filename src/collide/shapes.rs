@@ -7,41 +7,18 @@ use parry3d_f64::shape::{Ball, Capsule, Cuboid, Shape, TriMesh, TriMeshFlags};
 
 use super::CollideError;
 use crate::math::{Scalar, Vector};
-use crate::spec::ObstacleShape;
+use crate::spec::Primitive;
 
-/// A sphere, box or capsule of the given sizes (the shapes an articulated
-/// body's parts may have); any other shape is refused.
-pub(super) fn primitive(
-    index: usize,
-    shape: ObstacleShape,
-    radius: Option<Scalar>,
-    half_height: Option<Scalar>,
-    half_extents: Option<[Scalar; 3]>,
-) -> Result<Box<dyn Shape>, CollideError> {
-    let need = |v: Option<Scalar>, key: &'static str| v.ok_or(CollideError::Missing { index, key });
-    Ok(match shape {
-        ObstacleShape::Sphere => Box::new(Ball::new(need(radius, "radius")?)),
-        ObstacleShape::Box => {
-            let h = half_extents.ok_or(CollideError::Missing {
-                index,
-                key: "half_extents",
-            })?;
-            Box::new(Cuboid::new(Vector::from_array(h)))
-        }
-        ObstacleShape::Capsule => Box::new(Capsule::new_z(
-            need(half_height, "half_height")?,
-            need(radius, "radius")?,
-        )),
-        other => {
-            return Err(CollideError::Hierarchy {
-                index,
-                reason: format!(
-                    "a part cannot be a {}: parts are spheres, capsules or boxes",
-                    other.name()
-                ),
-            });
-        }
-    })
+/// The parry shape of a sphere, box or capsule (capsules along local z).
+pub(super) fn primitive(p: &Primitive) -> Box<dyn Shape> {
+    match *p {
+        Primitive::Sphere { radius } => Box::new(Ball::new(radius)),
+        Primitive::Box { half_extents } => Box::new(Cuboid::new(Vector::from_array(half_extents))),
+        Primitive::Capsule {
+            radius,
+            half_height,
+        } => Box::new(Capsule::new_z(half_height, radius)),
+    }
 }
 
 /// Loads an obstacle mesh from OBJ (every object of the file, triangulated), scaled.

@@ -26,7 +26,7 @@ use std::sync::Arc;
 use super::motion::{Motion, RigidState, obstacle_motion};
 use super::skeleton::Skeleton;
 use crate::math::{Scalar, Vector};
-use crate::spec::{Obstacle, ObstacleShape};
+use crate::spec::{Geometry, ObstacleSpec};
 
 /// Why an `attach` value names nothing that can carry pins.
 #[derive(Debug, Clone, thiserror::Error, PartialEq)]
@@ -95,7 +95,7 @@ pub struct AttachTarget {
 }
 
 /// Finds what `attach` (`"NAME"` or `"NAME/PART"`) names among `obstacles`.
-pub fn locate(obstacles: &[Obstacle], attach: &str) -> Result<AttachTarget, AttachError> {
+pub fn locate(obstacles: &[ObstacleSpec], attach: &str) -> Result<AttachTarget, AttachError> {
     let (name, part) = match attach.split_once('/') {
         Some((n, p)) => (n, Some(p)),
         None => (attach, None),
@@ -110,7 +110,7 @@ pub fn locate(obstacles: &[Obstacle], attach: &str) -> Result<AttachTarget, Atta
         .position(|o| o.name.as_deref() == Some(name))
         .ok_or_else(|| AttachError::UnknownObstacle { name: name.into() })?;
     let o = &obstacles[index];
-    if o.shape == ObstacleShape::MeshSequence {
+    if matches!(o.geometry, Geometry::MeshSequence { .. }) {
         return Err(AttachError::NoRigidFrame {
             obstacle: name.into(),
         });
@@ -121,13 +121,13 @@ pub fn locate(obstacles: &[Obstacle], attach: &str) -> Result<AttachTarget, Atta
             part: None,
         });
     };
-    if o.shape != ObstacleShape::Articulated {
+    let Geometry::Articulated { parts, .. } = &o.geometry else {
         return Err(AttachError::NoParts {
             obstacle: name.into(),
-            shape: o.shape.name(),
+            shape: o.geometry.kind().name(),
         });
-    }
-    let found = o.part.iter().position(|p| p.name == part);
+    };
+    let found = parts.iter().position(|p| p.name == part);
     found
         .map(|p| AttachTarget {
             obstacle: index,
@@ -141,15 +141,18 @@ pub fn locate(obstacles: &[Obstacle], attach: &str) -> Result<AttachTarget, Atta
 
 /// Every value `attach` may take with `obstacles`, quoted, for messages:
 /// each named obstacle with a rigid frame, and each part of the articulated ones.
-pub fn targets(obstacles: &[Obstacle]) -> Vec<String> {
+pub fn targets(obstacles: &[ObstacleSpec]) -> Vec<String> {
     let mut out = Vec::new();
     for o in obstacles {
         let Some(name) = &o.name else { continue };
-        if o.shape == ObstacleShape::MeshSequence {
-            continue;
+        match &o.geometry {
+            Geometry::MeshSequence { .. } => continue,
+            Geometry::Articulated { parts, .. } => {
+                out.push(format!("\"{name}\""));
+                out.extend(parts.iter().map(|p| format!("\"{name}/{}\"", p.name)));
+            }
+            _ => out.push(format!("\"{name}\"")),
         }
-        out.push(format!("\"{name}\""));
-        out.extend(o.part.iter().map(|p| format!("\"{name}/{}\"", p.name)));
     }
     out
 }
@@ -169,10 +172,10 @@ pub struct Carrier {
 
 impl Carrier {
     /// The body `attach` names among `obstacles` (see [`locate`]).
-    pub fn new(obstacles: &[Obstacle], attach: &str) -> Result<Carrier, AttachError> {
+    pub fn new(obstacles: &[ObstacleSpec], attach: &str) -> Result<Carrier, AttachError> {
         let target = locate(obstacles, attach)?;
         let o = &obstacles[target.obstacle];
-        let root = obstacle_motion(o, Vector::from_array(o.axis).normalize_or_zero());
+        let root = obstacle_motion(&o.motion);
         let (origin, motion) = match target.part {
             None => (Vector::from_array(o.position), root),
             Some(part) => {

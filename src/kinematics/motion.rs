@@ -40,7 +40,7 @@ use glam::DQuat;
 use super::skeleton::Skeleton;
 
 use crate::math::{Scalar, Vector, rotation_from_euler_deg};
-use crate::spec::{Keyframe, KeyframeAfter, KeyframeEasing, Obstacle};
+use crate::spec::{Keyframe, KeyframeAfter, KeyframeEasing, ObstacleMotion};
 
 /// The obstacle's motion relative to its placement at rest.
 #[derive(Debug, Clone, PartialEq)]
@@ -228,16 +228,27 @@ impl Motion {
 }
 
 /// The motion an obstacle's keys ask for: keyframes, else a constant velocity
-/// and spin about `axis` (normalised), else none.
-pub fn obstacle_motion(o: &Obstacle, axis: Vector) -> Motion {
-    if !o.keyframes.is_empty() {
-        return Motion::Keyframed(Track::new(&o.keyframes, o.easing, o.after_last));
-    }
-    let velocity = Vector::from_array(o.velocity);
-    let omega = axis * o.angular_velocity;
-    if velocity == Vector::ZERO && omega == Vector::ZERO {
-        Motion::Fixed
-    } else {
-        Motion::Constant { velocity, omega }
+/// and spin about its axis (normalised; a zero axis spins nothing), else none.
+pub fn obstacle_motion(motion: &ObstacleMotion) -> Motion {
+    match motion {
+        ObstacleMotion::Still => Motion::Fixed,
+        ObstacleMotion::Keyframed {
+            keyframes,
+            easing,
+            after_last,
+        } => Motion::Keyframed(Track::new(keyframes, *easing, *after_last)),
+        ObstacleMotion::Constant {
+            velocity,
+            angular_velocity,
+            axis,
+        } => {
+            let velocity = Vector::from_array(*velocity);
+            let omega = Vector::from_array(*axis).normalize_or_zero() * *angular_velocity;
+            if velocity == Vector::ZERO && omega == Vector::ZERO {
+                Motion::Fixed
+            } else {
+                Motion::Constant { velocity, omega }
+            }
+        }
     }
 }

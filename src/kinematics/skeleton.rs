@@ -29,7 +29,7 @@ use glam::DQuat;
 use super::KinematicsError;
 use super::motion::{Motion, RigidState, Track};
 use crate::math::{Scalar, Vector, rotation_from_euler_deg};
-use crate::spec::{Obstacle, Part};
+use crate::spec::{Geometry, ObstacleSpec, PartSpec};
 
 /// A part's frame in the world at one time.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -76,12 +76,17 @@ pub struct Skeleton {
 
 impl Skeleton {
     /// The hierarchy of `o`'s parts (obstacle `index`), whose root moves as
-    /// `root` says. Fails on a parent that names no part or a cycle
-    /// (validation normally catches both first).
-    pub fn new(index: usize, o: &Obstacle, root: Motion) -> Result<Skeleton, KinematicsError> {
-        let names: Vec<String> = o.part.iter().map(|p| p.name.clone()).collect();
-        let joints = o
-            .part
+    /// `root` says. Fails on an obstacle that is not articulated, a parent that
+    /// names no part or a cycle (validation normally catches the last two first).
+    pub fn new(index: usize, o: &ObstacleSpec, root: Motion) -> Result<Skeleton, KinematicsError> {
+        let Geometry::Articulated { parts, .. } = &o.geometry else {
+            return Err(KinematicsError::Hierarchy {
+                index,
+                reason: format!("a {} has no parts", o.geometry.kind().name()),
+            });
+        };
+        let names: Vec<String> = parts.iter().map(|p| p.name.clone()).collect();
+        let joints = parts
             .iter()
             .map(|p| joint(index, p, &names))
             .collect::<Result<Vec<_>, _>>()?;
@@ -220,7 +225,7 @@ impl Skeleton {
 }
 
 /// Part `p`'s joint, its parent looked up among `names`.
-fn joint(index: usize, p: &Part, names: &[String]) -> Result<Joint, KinematicsError> {
+fn joint(index: usize, p: &PartSpec, names: &[String]) -> Result<Joint, KinematicsError> {
     let parent = match &p.parent {
         None => None,
         Some(name) => Some(names.iter().position(|n| n == name).ok_or_else(|| {

@@ -7,10 +7,15 @@
 //! layout gives the same blueprint store.
 
 use rerun::external::re_log_types::{BlueprintActivationCommand, LogMsg};
+use rerun::external::re_sdk_types::Visualizer;
+use rerun::external::re_sdk_types::blueprint::archetypes::{
+    ActiveVisualizers, VisualizerInstruction,
+};
 use rerun::external::re_sdk_types::blueprint::archetypes::{
     ContainerBlueprint, EyeControls3D, PanelBlueprint, TimePanelBlueprint, ViewBlueprint,
     ViewContents, ViewportBlueprint,
 };
+use rerun::external::re_sdk_types::blueprint::components::VisualizerInstructionId;
 use rerun::external::re_sdk_types::blueprint::components::{
     AutoViews, ColumnShare, ContainerKind, IncludedContent, PanelState, QueryExpression,
     RootContainer, RowShare, ViewClass,
@@ -29,8 +34,26 @@ pub(super) struct ViewSpec {
     pub origin: String,
     /// Query expressions (`+ /path/**`, `- /path`); empty: everything under the origin.
     pub contents: Vec<String>,
-    /// The entity the 3D eye follows while the recording plays (3D views only).
-    pub tracking: Option<String>,
+    /// Where the 3D eye starts (3D views only).
+    pub eye: Eye,
+    /// Per-entity visualizer overrides in this view: the entity path and the visualizer
+    /// carrying the overriding components (e.g. the cloth drawn in one faint colour).
+    pub overrides: Vec<(String, Visualizer)>,
+}
+
+/// Where a 3D view's eye starts and what it follows.
+pub(super) enum Eye {
+    /// Rerun's default eye, for views that are not 3D.
+    Default,
+    /// Rerun's default placement, following the entity at this path as it moves.
+    Tracking(String),
+    /// At `position`, looking at `look_target` (both in metres, world frame).
+    Fixed {
+        /// The eye's position.
+        position: [f32; 3],
+        /// The point it looks at and orbits around.
+        look_target: [f32; 3],
+    },
 }
 
 /// One node of the layout tree: a container of nodes or a view.
@@ -70,10 +93,16 @@ fn numbered_id(n: u64) -> (Uuid, String) {
 }
 
 impl Writer {
+    /// The next numbered id.
+    fn next(&mut self) -> (Uuid, String) {
+        let id = numbered_id(self.next_id);
+        self.next_id += 1;
+        id
+    }
+
     /// Logs `node` and its children; returns its blueprint path and id.
     fn log(&mut self, node: &Node) -> RecordingStreamResult<(String, Uuid)> {
-        let (uuid, text) = numbered_id(self.next_id);
-        self.next_id += 1;
+        let (uuid, text) = self.next();
         match node {
             Node::View(view) => {
                 let path = format!("view/{text}");
@@ -105,8 +134,8 @@ impl Writer {
         }
     }
 
-    /// Logs one view: its contents, its blueprint and its eye.
-    fn log_view(&self, path: &str, view: &ViewSpec) -> RecordingStreamResult<()> {
+    /// Logs one view: its contents, its blueprint, its eye and its overrides.
+    fn log_view(&mut self, path: &str, view: &ViewSpec) -> RecordingStreamResult<()> {
         let contents = if view.contents.is_empty() {
             vec!["+ $origin/**".to_owned()]
         } else {
@@ -120,12 +149,57 @@ impl Writer {
             .with_display_name(view.name.as_str())
             .with_space_origin(view.origin.as_str());
         self.stream.log(path, &arch)?;
-        if let Some(entity) = &view.tracking {
-            self.stream.log(
-                format!("{path}/EyeControls3D"),
-                &EyeControls3D::new().with_tracking_entity(entity.as_str()),
-            )?;
+        let eye = match &view.eye {
+            Eye::Default => None,
+            Eye::Tracking(entity) => {
+                Some(EyeControls3D::new().with_tracking_entity(entity.as_str()))
+            }
+            Eye::Fixed {
+                position,
+                look_target,
+            } => Some(
+                EyeControls3D::new()
+                    .with_position(*position)
+                    .with_look_target(*look_target),
+            ),
+        };
+        if let Some(eye) = eye {
+            self.stream.log(format!("{path}/EyeControls3D"), &eye)?;
         }
+        for (entity, visualizer) in &view.overrides {
+            self.log_override(path, entity, visualizer)?;
+        }
+        Ok(())
+    }
+
+    /// Logs one entity's visualizer override in the view at `path`, where rerun's own
+    /// blueprint builder puts it (`<view>/ViewContents/overrides/<entity>/visualizers/<id>`),
+    /// with a numbered instead of a random instruction id.
+    fn log_override(
+        &mut self,
+        path: &str,
+        entity: &str,
+        visualizer: &Visualizer,
+    ) -> RecordingStreamResult<()> {
+        let base = format!(
+            "{path}/ViewContents/overrides/{}/visualizers",
+            entity.trim_start_matches('/')
+        );
+        let (uuid, text) = self.next();
+        let instruction_path = format!("{base}/{text}");
+        self.stream.log(
+            instruction_path.as_str(),
+            &VisualizerInstruction::new(visualizer.visualizer_type.clone()),
+        )?;
+        self.stream.log_serialized_batches(
+            instruction_path.as_str(),
+            false,
+            visualizer.overrides.iter().cloned(),
+        )?;
+        self.stream.log(
+            base.as_str(),
+            &ActiveVisualizers::new([VisualizerInstructionId(uuid)]),
+        )?;
         Ok(())
     }
 }

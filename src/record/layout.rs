@@ -5,7 +5,12 @@ use std::fmt::Write as _;
 
 use rerun::{RecordingStream, RecordingStreamError};
 
-use super::blueprint::{self, Node, ViewSpec};
+use rerun::external::re_sdk_types::VisualizableArchetype as _;
+
+use crate::math::Vector;
+
+use super::blueprint::{self, Eye, Node, ViewSpec};
+use super::camera::{self, Camera};
 use super::edges::ANGLE_STOPS;
 use super::garment::{PANEL_COLOUR_NAMES, PANEL_PALETTE, SEAM_OPEN_RGB, SEAM_WELDED_RGB};
 use super::{
@@ -26,6 +31,11 @@ const LEVEL_NAMES: [&str; 8] = [
 ];
 /// Names of the angle scale's colours, in [`ANGLE_STOPS`] order.
 const ANGLE_NAMES: [&str; 4] = ["dark slate", "violet", "orange", "yellow"];
+
+/// The colour the cloth is drawn in under the edges of the `angles` view: a pale grey that
+/// every colour of the angle scale stands out on, so the segments read as folds of a surface
+/// and the cloth hides the edges behind it.
+pub(super) const ANGLES_CLOTH_RGB: [u8; 3] = [0xE4, 0xE4, 0xE4];
 
 /// `#RRGGBB`.
 fn hex([r, g, b]: [u8; 3]) -> String {
@@ -59,7 +69,12 @@ pub(super) fn legend_markdown(panels: Option<&[String]>, seams: bool) -> String 
             }
         }
     }
-    s.push_str("\n**angles: dihedral angle per edge** (linear between stops)\n\n");
+    let _ = writeln!(
+        s,
+        "\n**angles: dihedral angle per edge** (linear between stops), on the cloth in pale \
+         grey `{}`\n",
+        hex(ANGLES_CLOTH_RGB)
+    );
     for ((a, c), name) in ANGLE_STOPS.iter().zip(ANGLE_NAMES) {
         let _ = writeln!(s, "- {a} deg: {name} `{}`", hex(*c));
     }
@@ -89,29 +104,34 @@ pub(super) fn legend_markdown(panels: Option<&[String]>, seams: bool) -> String 
 /// - right: one time-series view per top-level plot group (the first segment of the scalar
 ///   names, alphabetically).
 ///
-/// The eyes of both 3D views follow the cloth (`cloth/mesh` and `cloth/edges`), so the cloth
-/// stays framed while a body carries it or a pin drags it away.
+/// With [`Camera::Follow`] (the default) the eyes of both 3D views follow the cloth
+/// (`cloth/mesh`: the whole cloth, also where the angles view draws only some edges), so the cloth stays framed while a body carries it or a
+/// pin drags it away; another camera places both eyes where it says, framing the cloth's
+/// `first_positions` (`camera.rs`). The `angles` view draws `cloth/mesh` in one pale colour
+/// ([`ANGLES_CLOTH_RGB`], a visualizer override) under the edges.
 ///
 /// The blueprint and selection panels start collapsed and the time panel collapsed to its
 /// play controls, so the views get the window; all can be reopened in the viewer.
 pub(super) fn send_blueprint(
     stream: &RecordingStream,
     scalar_names: &[&str],
+    camera: Camera,
+    first_positions: &[Vector],
 ) -> Result<(), RecordingStreamError> {
+    let eye_on = |entity: &str| camera::eye(camera, first_positions, &format!("/{entity}"));
     let mut groups: Vec<&str> = scalar_names
         .iter()
         .filter_map(|name| name.split('/').find(|s| !s.is_empty()))
         .collect();
     groups.sort_unstable();
     groups.dedup();
-    let view = |class, name: &str, origin: &str, contents: Vec<String>, tracking: Option<&str>| {
-        Node::View(ViewSpec {
-            class,
-            name: name.to_owned(),
-            origin: origin.to_owned(),
-            contents,
-            tracking: tracking.map(|t| format!("/{t}")),
-        })
+    let view = |class, name: &str, origin: &str, contents: Vec<String>, eye: Eye| ViewSpec {
+        class,
+        name: name.to_owned(),
+        origin: origin.to_owned(),
+        contents,
+        eye,
+        overrides: Vec::new(),
     };
     let cloth = view(
         "3D",
@@ -122,22 +142,42 @@ pub(super) fn send_blueprint(
             format!("- /{ENTITY_EDGES}"),
             format!("- /{ENTITY_LEGEND}"),
         ],
-        Some(ENTITY_MESH),
+        eye_on(ENTITY_MESH),
     );
-    let angles = view(
+    let mut angles = view(
         "3D",
         "angles",
         "/",
         vec![
             format!("+ /{ENTITY_EDGES}"),
+            format!("+ /{ENTITY_MESH}"),
             format!("+ /{ENTITY_SEAMS}"),
             "+ /events/points".to_owned(),
             "+ /obstacles/**".to_owned(),
         ],
-        Some(ENTITY_EDGES),
+        eye_on(ENTITY_MESH),
     );
-    let log = view("TextLog", "events", ENTITY_EVENT_LOG, Vec::new(), None);
-    let legend = view("TextDocument", "legend", ENTITY_LEGEND, Vec::new(), None);
+    angles.overrides.push((
+        format!("/{ENTITY_MESH}"),
+        rerun::Mesh3D::update_fields()
+            .with_vertex_colors([ANGLES_CLOTH_RGB])
+            .visualizer(),
+    ));
+    let (cloth, angles) = (Node::View(cloth), Node::View(angles));
+    let log = Node::View(view(
+        "TextLog",
+        "events",
+        ENTITY_EVENT_LOG,
+        Vec::new(),
+        Eye::Default,
+    ));
+    let legend = Node::View(view(
+        "TextDocument",
+        "legend",
+        ENTITY_LEGEND,
+        Vec::new(),
+        Eye::Default,
+    ));
     let bottom = Node::Horizontal(vec![log, legend], vec![3.0, 1.0]);
     let scenes = Node::Vertical(
         vec![
@@ -149,13 +189,13 @@ pub(super) fn send_blueprint(
     let plots = groups
         .iter()
         .map(|g| {
-            view(
+            Node::View(view(
                 "TimeSeries",
                 g,
                 &format!("{ENTITY_PLOTS}/{g}"),
                 Vec::new(),
-                None,
-            )
+                Eye::Default,
+            ))
         })
         .collect::<Vec<_>>();
     let shares = vec![1.0; plots.len()];

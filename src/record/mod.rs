@@ -34,7 +34,8 @@
 //! - `legend` (static, with the first frame): a markdown text document naming the colours;
 //! - `plots/<name>` every frame for each scalar of [`FrameView::scalars`];
 //! - `obstacles/<name>`: obstacle meshes, static or per frame;
-//! - a default blueprint, sent with the first frame once the plot names are known (`layout.rs`).
+//! - a default blueprint, sent with the first frame once the plot names are known (`layout.rs`),
+//!   its 3D eyes placed by the scene's [`Camera`] (`camera.rs`).
 //!
 //! The recording is forced on: `RERUN=off` in the environment does not disable it (the builder
 //! uses `enabled(true)`, which rerun documents as ignoring the `RERUN` variable), and so is
@@ -43,6 +44,7 @@
 //! path; do not set it.
 
 mod blueprint;
+mod camera;
 mod convert;
 pub mod decode;
 pub mod edges;
@@ -59,6 +61,7 @@ mod recorder;
 mod report;
 mod sink;
 
+pub use camera::{Camera, CameraSide};
 pub use edges::EdgeDisplay;
 pub use error::{BoxError, RecordError};
 pub use frame::{EventMark, FrameView, GarmentView, SeamSegment, WeldMark};

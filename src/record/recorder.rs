@@ -8,10 +8,10 @@ use rerun::{AsComponents, EntityPath, RecordingStream, RecordingStreamBuilder};
 
 use super::garment::{self, ColourBy, SINGLE_PANEL_NAME};
 use super::{
-    APPLICATION_ID, BoxError, ENTITY_EDGES, ENTITY_EVENT_LOG, ENTITY_EVENT_POINTS, ENTITY_LEGEND,
-    ENTITY_MESH, ENTITY_PINS, ENTITY_PLOTS, ENTITY_SEAMS, EdgeDisplay, FrameView, RecordError,
-    RecordTarget, TIMELINE_FRAME, TIMELINE_SIM_TIME, convert, edges, events, frame, layout, mesh,
-    recording_id, sink,
+    APPLICATION_ID, BoxError, Camera, ENTITY_EDGES, ENTITY_EVENT_LOG, ENTITY_EVENT_POINTS,
+    ENTITY_LEGEND, ENTITY_MESH, ENTITY_PINS, ENTITY_PLOTS, ENTITY_SEAMS, EdgeDisplay, FrameView,
+    RecordError, RecordTarget, TIMELINE_FRAME, TIMELINE_SIM_TIME, convert, edges, events, frame,
+    layout, mesh, recording_id, sink,
 };
 
 /// Colour of the pin markers (white, visible on every level colour).
@@ -47,6 +47,8 @@ pub struct Recorder {
     /// The first recorded frame's mean edge length, m: the unrefined mesh's, which sizes the
     /// event points.
     base_edge: Option<f32>,
+    /// Where the blueprint's 3D views look from.
+    camera: Camera,
 }
 
 impl std::fmt::Debug for Recorder {
@@ -141,6 +143,7 @@ impl Recorder {
             scalar_paths: HashMap::new(),
             blueprint_sent: false,
             base_edge: None,
+            camera: Camera::Follow,
         };
         recorder.log_static_data()?;
         Ok(recorder)
@@ -181,7 +184,14 @@ impl Recorder {
             .log_static(ENTITY_LEGEND, &rerun::TextDocument::from_markdown(legend))
             .map_err(|e| self.log_err(ENTITY_LEGEND, e))?;
         let names: Vec<&str> = frame.scalars.iter().map(|(n, _)| *n).collect();
-        layout::send_blueprint(&self.stream, &names).map_err(|e| self.log_err("blueprint", e))
+        layout::send_blueprint(&self.stream, &names, self.camera, frame.positions)
+            .map_err(|e| self.log_err("blueprint", e))
+    }
+
+    /// Sets where the blueprint's 3D views look from ([`Camera::Follow`] unless set). The
+    /// blueprint goes out with the first frame, so a camera set after it has no effect.
+    pub fn set_camera(&mut self, camera: Camera) {
+        self.camera = camera;
     }
 
     /// Where the recording goes.

@@ -70,12 +70,16 @@ impl<'a> FrameLoop<'a> {
                     live: live.clone(),
                 };
                 let refine = scene.adapt.as_ref().map(|a| a.refine_angle);
-                Some(Recorder::open_coloured(
+                let mut recorder = Recorder::open_coloured(
                     &target,
                     &scene.name,
                     opts.edges.resolve(refine),
                     opts.colour_by,
-                )?)
+                )?;
+                if let Some(camera) = &scene.camera {
+                    recorder.set_camera(camera.camera());
+                }
+                Some(recorder)
             }
         };
         if let Some(dir) = &opts.obj_dir {

@@ -1,5 +1,6 @@
 //! One key table: every key the parser accepts has its wording in
-//! `schema::allowed` (the error messages) and a row in `docs/scenes.md`.
+//! `schema::allowed` (the error messages) and a row in `docs/scenes.md`, and
+//! every key row of `docs/scenes.md` is a key the parser accepts there.
 //! The parser's own list of a table's keys is what it answers to an unknown
 //! key there.
 
@@ -58,6 +59,7 @@ fn tables() -> Vec<(&'static str, String, &'static str)> {
             appended("[self_collision]\nzzz = 1"),
             "## `[self_collision]`",
         ),
+        ("camera", appended("[camera]\nzzz = 1"), "## `[camera]`"),
     ]
 }
 
@@ -126,4 +128,53 @@ fn every_accepted_key_has_its_wording_and_its_row_in_the_docs() {
         }
     }
     assert!(missing.is_empty(), "{}", missing.join("\n"));
+}
+
+/// The first cells of the rows of the key tables (those whose header starts with
+/// `| key |`) in `part`.
+fn documented_keys(part: &str) -> Vec<String> {
+    let mut keys = Vec::new();
+    let mut in_key_table = false;
+    for line in part.lines() {
+        if !line.starts_with('|') {
+            in_key_table = false;
+            continue;
+        }
+        if line.starts_with("| key |") {
+            in_key_table = true;
+            continue;
+        }
+        if in_key_table && !line.starts_with("|---") && !line.starts_with("| ---") {
+            let first = line.split('|').nth(1).unwrap_or("").trim();
+            keys.push(first.trim_matches('`').to_owned());
+        }
+    }
+    keys
+}
+
+#[test]
+fn every_documented_key_is_one_the_parser_accepts() {
+    let docs = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/scenes.md"),
+    )
+    .expect("docs/scenes.md");
+    let tables = tables();
+    let mut stale = Vec::new();
+    for (table, _, heading) in &tables {
+        let part = section(&docs, heading);
+        // The keys of this table and of the tables documented inside its part.
+        let known: Vec<String> = tables
+            .iter()
+            .filter(|(_, _, h)| h == heading || part.contains(h))
+            .flat_map(|(_, text, _)| accepted(text))
+            .collect();
+        for key in documented_keys(part) {
+            if !known.contains(&key) {
+                stale.push(format!(
+                    "`{key}` has a row under \"{heading}\" in docs/scenes.md, but [{table}] does not accept it"
+                ));
+            }
+        }
+    }
+    assert!(stale.is_empty(), "{}", stale.join("\n"));
 }

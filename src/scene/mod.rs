@@ -7,6 +7,7 @@
 //! Every error names the file, the line (or the `--set`) and the key; see
 //! [`SceneError`] and `docs/scenes.md`.
 
+pub mod camera;
 mod error;
 #[cfg(test)]
 mod key_table_tests;
@@ -34,6 +35,7 @@ mod validate_step;
 
 use std::path::Path;
 
+pub use camera::CameraTable;
 pub use error::{SceneError, SceneErrorKind};
 pub use limits::{MAX_COUNT, MAX_RESOLUTION};
 pub use model::*;

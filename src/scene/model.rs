@@ -51,6 +51,8 @@ pub struct Scene {
     /// Garment seams (`[[seam]]`, with `shape = "panels"`).
     #[serde(default)]
     pub seam: Vec<SeamTable>,
+    /// Where the recording's 3D views look from; absent: they follow the cloth.
+    pub camera: Option<super::CameraTable>,
 }
 
 /// `[[panel]]`: one garment panel.

@@ -8,7 +8,10 @@ use crate::adapt::AdaptConfig;
 use crate::collide::{CollideError, Obstacles, cusick::CusickSummary};
 use crate::math::Vector;
 use crate::physics::{ExternalForces, MaterialParams, Model, SolverSettings, WindForce};
-use crate::spec::{ClothMesh, ClothSpec, Garment, PanelSpec, Placement, SeamSpec, Sewing};
+use crate::spec::{
+    ClothMesh, ClothSpec, Garment, ObstacleSpec, ObstacleSpecError, PanelSpec, Placement, SeamSpec,
+    Sewing,
+};
 use crate::world::{BuildError, World};
 
 use super::model::{PanelTable, SeamTable};
@@ -23,7 +26,9 @@ impl Scene {
             cloth: cloth_spec(&self.cloth, &self.panel, &self.seam)?,
             pins: self.pin.clone(),
             model: Model::from_scene(self),
-            obstacles: self.obstacle.clone(),
+            obstacles: self
+                .obstacle_specs()
+                .map_err(|(index, why)| BuildError::Obstacle { index, why })?,
             settings: Settings {
                 step: match self.simulation.dt {
                     TimeStep::Fixed(dt) => StepSize::Fixed(dt),
@@ -128,13 +133,28 @@ fn panel_spec(p: &PanelTable) -> PanelSpec {
     }
 }
 
+impl Scene {
+    /// The `[[obstacle]]` tables resolved for the engine; on a key a shape needs and
+    /// lacks (validation reports it first), the obstacle's index and the key.
+    pub fn obstacle_specs(&self) -> Result<Vec<ObstacleSpec>, (usize, ObstacleSpecError)> {
+        self.obstacle
+            .iter()
+            .enumerate()
+            .map(|(i, o)| o.resolve().map_err(|e| (i, e)))
+            .collect()
+    }
+}
+
 impl World {
     /// Builds the cloth of `scene` and resolves its pins.
     pub fn from_scene(scene: &Scene) -> Result<World, BuildError> {
+        let obstacles = scene
+            .obstacle_specs()
+            .map_err(|(index, why)| BuildError::Obstacle { index, why })?;
         World::from_spec(
             &cloth_spec(&scene.cloth, &scene.panel, &scene.seam)?,
             &scene.pin,
-            &scene.obstacle,
+            &obstacles,
         )
     }
 }
@@ -142,7 +162,10 @@ impl World {
 impl Obstacles {
     /// The obstacles `scene` declares (none: an empty set).
     pub fn from_scene(scene: &Scene) -> Result<Obstacles, CollideError> {
-        Obstacles::new(&scene.obstacle)
+        let specs = scene
+            .obstacle_specs()
+            .map_err(|(index, why)| CollideError::Spec { index, why })?;
+        Obstacles::new(&specs)
     }
 
     /// The Cusick drape measurements, when the scene is a disk specimen lying on a

@@ -40,11 +40,15 @@ pub(crate) fn validate(scene: &Scene, doc: &Table) -> Result<(), Issue> {
         super::validate_body::parts(i, o, written)?;
     }
     super::validate_attach::obstacle_names(&scene.obstacle)?;
+    let obstacles = super::validate_attach::resolved(&scene.obstacle)?;
     for (i, pin) in scene.pin.iter().enumerate() {
-        super::validate_attach::pin_target(i, pin, &scene.obstacle)?;
+        super::validate_attach::pin_target(i, pin, &obstacles)?;
     }
     if let Some(s) = &scene.self_collision {
         super::validate_collide::self_collision(s)?;
+    }
+    if let Some(c) = &scene.camera {
+        super::camera::validate(c)?;
     }
     // `method = "none"` is the same as leaving `[adapt]` out: its other keys
     // are not used, so a `--set adapt.method=none` on an adaptive scene is

@@ -7,6 +7,7 @@ use super::error::{Issue, KeyPath, SceneErrorKind as Kind, Seg};
 use super::validate::{allowed_for, non_negative};
 use super::{Obstacle, Pin};
 use crate::kinematics::carrier::{locate, targets};
+use crate::spec::ObstacleSpec;
 
 /// The keys of a pin's own motion, which an attached pin does not have.
 const MOTION_KEYS: [&str; 9] = [
@@ -76,8 +77,23 @@ pub(super) fn pin_keys(
     }
 }
 
+/// The obstacles resolved for the engine (after their own checks, which report a missing
+/// key first with its line; a key missing here is reported at the obstacle).
+pub(super) fn resolved(obstacles: &[Obstacle]) -> Result<Vec<ObstacleSpec>, Issue> {
+    obstacles
+        .iter()
+        .enumerate()
+        .map(|(i, o)| {
+            o.resolve().map_err(|e| {
+                let path = vec![Seg::Key("obstacle".into()), Seg::Index(i)];
+                Issue::new(path, Kind::MissingKey, e)
+            })
+        })
+        .collect()
+}
+
 /// Pin `i`'s `attach` names an obstacle of `obstacles` that can carry it.
-pub(super) fn pin_target(i: usize, p: &Pin, obstacles: &[Obstacle]) -> Result<(), Issue> {
+pub(super) fn pin_target(i: usize, p: &Pin, obstacles: &[ObstacleSpec]) -> Result<(), Issue> {
     let Some(attach) = &p.attach else {
         return Ok(());
     };

@@ -58,7 +58,7 @@ fn arm(sets: &[&str]) -> Scene {
 }
 
 fn bodies(scene: &Scene) -> Vec<Body> {
-    Body::from_spec(0, &scene.obstacle[0]).expect("bodies")
+    Body::from_spec(0, &scene.obstacle[0].resolve().expect("resolved")).expect("bodies")
 }
 
 /// Where local point `q` of `b`'s shape is at `t`.

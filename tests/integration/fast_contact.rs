@@ -229,7 +229,7 @@ fn sweeps_keep_the_sheet_ahead(what: &str, limb: &str, duration: Scalar) {
     ];
     for (integrator, h) in runs {
         let scene = stretched_sheet_with(limb, integrator);
-        let body = Body::from_spec(0, &scene.obstacle[0])
+        let body = Body::from_spec(0, &scene.obstacle[0].resolve().expect("resolved"))
             .expect("body")
             .remove(0);
         let what = format!("{what}, {integrator}");

@@ -12,6 +12,7 @@ mod bad_input;
 mod bad_obj;
 mod bench;
 mod bench_convergence;
+mod camera;
 mod canonical;
 mod cli;
 mod collide;

@@ -73,7 +73,8 @@ fn a_sequence_interpolates_positions_and_per_vertex_velocities() {
             "shape = \"mesh_sequence\"\nfiles = [\"f0.obj\", \"f1.obj\", \"f2.obj\"]\nframe_rate = 2.0\nscale = 2.0\nposition = [1.0, 0.0, 0.0]\nafter_last = \"{after}\"\n"
         );
         let scene = scene_in(&dir, "", &obstacle, &[]).expect("scene");
-        let body = &Body::from_spec(0, &scene.obstacle[0]).expect("body")[0];
+        let body =
+            &Body::from_spec(0, &scene.obstacle[0].resolve().expect("resolved")).expect("body")[0];
         let (x, tris) = body.world_triangles(t, (Vector::ZERO, 1.0));
         assert_eq!(tris, vec![[0, 1, 2]]);
         let at = body.at(t);
@@ -118,7 +119,7 @@ fn sequence_errors_name_the_file_and_what_is_wrong() {
     let build = |files: &str| -> String {
         let obstacle = format!("shape = \"mesh_sequence\"\nfiles = {files}\nframe_rate = 24.0\n");
         let scene = scene_in(&dir, "", &obstacle, &[]).expect("scene");
-        Obstacles::new(&scene.obstacle)
+        Obstacles::from_scene(&scene)
             .expect_err("refused")
             .to_string()
     };

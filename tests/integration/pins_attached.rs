@@ -76,7 +76,7 @@ fn arm(sets: &[&str]) -> Scene {
 /// (m), the largest difference from the link's point velocity (m/s) and the
 /// largest relative difference from the finite difference of its positions.
 fn follow(scene: &Scene, h: Scalar, steps: usize) -> (Scalar, Scalar, Scalar) {
-    let lower = Body::from_spec(0, &scene.obstacle[0])
+    let lower = Body::from_spec(0, &scene.obstacle[0].resolve().expect("resolved"))
         .expect("bodies")
         .remove(1);
     let mut sim = Sim::new(scene);
@@ -136,7 +136,7 @@ fn attached_pins_follow_a_turning_part_exactly() {
 #[test]
 fn attached_pins_let_go_at_their_release_time() {
     let scene = arm(&["pin.0.release_time=0.5"]);
-    let lower = Body::from_spec(0, &scene.obstacle[0])
+    let lower = Body::from_spec(0, &scene.obstacle[0].resolve().expect("resolved"))
         .expect("bodies")
         .remove(1);
     let mut sim = Sim::new(&scene);

@@ -133,7 +133,13 @@ pub(crate) struct Decoded {
     blueprint_msgs: usize,
     /// The entity paths the blueprint's 3D eyes track (the arrow text of each
     /// `EyeControls3D:tracking_entity` column).
-    tracked: Vec<String>,
+    pub(crate) tracked: Vec<String>,
+    /// The blueprint's fixed 3D eye positions (the arrow text of each
+    /// `EyeControls3D:position` column).
+    pub(crate) eye_positions: Vec<String>,
+    /// The blueprint entities holding a `Mesh3D:vertex_colors` override, with the arrow
+    /// text of the colours.
+    pub(crate) colour_overrides: Vec<(String, String)>,
 }
 
 /// Decodes a `.rrd` file (panics if it does not decode); also used by the CLI tests.
@@ -151,6 +157,15 @@ pub(crate) fn decode(path: &std::path::Path) -> Decoded {
                 let id = "EyeControls3D:tracking_entity".into();
                 if let Some(array) = chunk.raw_component_array(id) {
                     out.tracked.push(format!("{array:?}"));
+                }
+                let id = "EyeControls3D:position".into();
+                if let Some(array) = chunk.raw_component_array(id) {
+                    out.eye_positions.push(format!("{array:?}"));
+                }
+                let id = "Mesh3D:vertex_colors".into();
+                if let Some(array) = chunk.raw_component_array(id) {
+                    let entity = chunk.entity_path().to_string();
+                    out.colour_overrides.push((entity, format!("{array:?}")));
                 }
             }
             continue;
@@ -210,8 +225,11 @@ fn three_frames_decode_to_three_mesh_rows() {
     let mut tracked = d.tracked.clone();
     tracked.sort();
     assert_eq!(tracked.len(), 2, "tracked {tracked:?}");
-    assert!(tracked[0].contains("\"/cloth/edges\""), "{tracked:?}");
-    assert!(tracked[1].contains("\"/cloth/mesh\""), "{tracked:?}");
+    assert!(
+        tracked.iter().all(|t| t.contains("\"/cloth/mesh\"")),
+        "{tracked:?}"
+    );
+    assert!(d.eye_positions.is_empty(), "{:?}", d.eye_positions);
     std::fs::remove_file(&path).ok();
 }
 
