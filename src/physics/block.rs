@@ -80,6 +80,7 @@ mod tests;
 pub use terms::{ElementBlocks, ElementTerms};
 
 use super::elements::Elements;
+use super::shape::SHAPE_SLOTS;
 use crate::math::{Matrix3, Vector};
 pub(crate) use buckets::group_by_key;
 use buckets::sorted_unique_rows;
@@ -167,7 +168,13 @@ impl BlockPattern {
     pub fn build(vertices: usize, elements: &Elements, factor_tips: bool) -> BlockPattern {
         let n = vertices;
         // Every coupled pair, both ways, and the diagonal.
-        let mut pairs: Vec<(u32, u32)> = (0..n as u32).map(|i| (i, i)).collect();
+        let mut pairs: Vec<(u32, u32)> = Vec::with_capacity(
+            n + 2 * elements.springs.len()
+                + 12 * elements.hinges.len()
+                + 6 * elements.membrane_triangles.len()
+                + SHAPE_SLOTS * (SHAPE_SLOTS - 1) * elements.shape_triangles.len(),
+        );
+        pairs.extend((0..n as u32).map(|i| (i, i)));
         for sp in &elements.springs {
             let [a, b] = sp.v;
             pairs.extend([(a, b), (b, a)]);

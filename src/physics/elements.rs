@@ -240,6 +240,20 @@ impl Elements {
     /// mesh these elements were built for keeps its matrix instead of computing
     /// it again (module [`reuse`]). [`Elements::last_rebuild`] says how many did.
     pub fn rebuild(&mut self, mesh: &Mesh, mat: &MaterialParams, clamped: &[u32]) {
+        let splits = self.rebuild_but_splits(mesh, mat, clamped);
+        self.fold_splits = self.renewed_fold_splits(splits);
+    }
+
+    /// [`Elements::rebuild`] but for the fold splits' system, which is left
+    /// that of the mesh before: [`Elements::renewed_fold_splits`] makes it,
+    /// given the number of split unknowns this returns, and may run beside
+    /// other work that reads the rebuilt elements.
+    pub fn rebuild_but_splits(
+        &mut self,
+        mesh: &Mesh,
+        mat: &MaterialParams,
+        clamped: &[u32],
+    ) -> usize {
         let n = mesh.vertex_count();
         let scratch = &mut self.scratch;
         scratch.area.clear();
@@ -286,14 +300,22 @@ impl Elements {
             computed: scratch.shapes.len() - kept,
         };
         std::mem::swap(&mut self.shape_triangles, &mut scratch.shapes);
-        self.fold_splits = FoldSplits::new(&self.shape_triangles, splits)
-            .expect("the plate matrices of a valid mesh are positive definite");
         self.fold_edges = FoldEdges::build(&self.shape_triangles, n);
         edge_bending(mesh, mat, area, &mut self.springs, &mut self.hinges);
         sewing_springs(mesh, mat, &mut self.springs, &mut self.sewing_caps);
         self.fill_tables(n, mesh);
         self.previous
             .record(mesh, mat, clamped, &self.shape_triangles);
+        splits
+    }
+
+    /// The fold splits' system of the current shape triangles, whose split
+    /// indices run over `0..splits` (reusing what it shares with the present
+    /// one: [`FoldSplits::renew`]).
+    pub fn renewed_fold_splits(&self, splits: usize) -> FoldSplits {
+        self.fold_splits
+            .renew(&self.shape_triangles, splits)
+            .expect("the plate matrices of a valid mesh are positive definite")
     }
 
     /// How the last [`Elements::rebuild`] made its shape triangles.

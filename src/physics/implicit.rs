@@ -81,10 +81,11 @@ use linearise::linearise;
 
 use rayon::prelude::*;
 
+use super::elements::Elements;
 use super::forces::PAR_MIN;
 use super::membrane::ColumnBlocks;
 use super::shape::{EdgeFold, ShapeJacobian};
-use super::{Contact, Model, Stepper};
+use super::{Contact, Model, Preconditioner, Stepper};
 use crate::math::{Matrix3, Scalar, Vector, deterministic_sum};
 use crate::spec::Solver;
 use crate::world::World;
@@ -189,6 +190,13 @@ impl ImplicitScratch {
     /// start is simulation state, not scratch: its owner clears it.
     pub fn mesh_changed(&mut self) {
         self.direct.mesh_changed();
+    }
+
+    /// After [`ImplicitScratch::mesh_changed`], with the direct solver: the new
+    /// mesh's block pattern and ordering made ahead of the first solve
+    /// (the direct solver's `prepare`).
+    pub fn prepare_direct(&mut self, elements: &Elements, preconditioner: Preconditioner) {
+        self.direct.prepare(elements, preconditioner);
     }
 }
 

@@ -113,9 +113,11 @@ pub struct StepStats {
     /// Solves with a Cholesky factor (one per preconditioned iteration, plus one per
     /// solve to start it).
     pub factor_solves: u64,
-    /// Wall time spent assembling the system matrix and right-hand side, s.
+    /// Wall time spent assembling the system matrix and right-hand side, s
+    /// (a new mesh's block pattern counts in `rebuild_s`).
     pub assembly_s: f64,
-    /// Wall time spent in symbolic analyses and numerical factorizations, s.
+    /// Wall time spent in symbolic analyses and numerical factorizations, s
+    /// (a new mesh's ordering and first factorization count in `rebuild_s`).
     pub factorization_s: f64,
     /// Wall time spent in the iterations of the linear solves, s.
     pub solve_s: f64,
@@ -123,9 +125,10 @@ pub struct StepStats {
     /// transfer of the state onto the new mesh, rollbacks' refinements
     /// included), s.
     pub remesh_s: f64,
-    /// Wall time rebuilding the force elements, the fold splits' factor and
-    /// the solver's tables after the mesh changed, s (the new matrix's
-    /// ordering and factorization count in `factorization_s`).
+    /// Wall time rebuilding after the mesh changed (a remesh, a rollback, a
+    /// seam weld or a restored start), s: the force elements, the fold splits'
+    /// factor, and with the direct solver the new block pattern, its ordering
+    /// and the new mesh's first factorization.
     pub rebuild_s: f64,
 }
 
@@ -230,17 +233,31 @@ impl Stepper {
 
     /// Rebuilds the force elements of `model` after the world's mesh changed
     /// (incrementally: [`Elements::rebuild`]).
+    ///
+    /// With the direct solver, the new mesh's block pattern and its ordering
+    /// are made here too, on one thread while the fold splits' system is
+    /// factored on another (both only read the rebuilt elements, so the
+    /// results do not depend on the thread count).
     pub fn rebuild(&mut self, model: &Model, world: &World) {
-        self.elements.rebuild(
-            &world.mesh,
-            &model.material,
-            &world.pins.clamped(world.mesh.vertex_count()),
-        );
+        let clamped = world.pins.clamped(world.mesh.vertex_count());
+        let splits = (self.elements).rebuild_but_splits(&world.mesh, &model.material, &clamped);
         self.held.resize(world.mesh.vertex_count(), false);
         self.contacts.clear();
         self.contact_push.clear();
         self.implicit.mesh_changed();
         self.levels = None;
+        let direct =
+            model.integrator == Integrator::Implicit && model.solver.solver == Solver::Direct;
+        let (elements, implicit) = (&self.elements, &mut self.implicit);
+        let (fold_splits, ()) = rayon::join(
+            || elements.renewed_fold_splits(splits),
+            || {
+                if direct {
+                    implicit.prepare_direct(elements, model.solver.preconditioner);
+                }
+            },
+        );
+        self.elements.fold_splits = fold_splits;
     }
 
     /// Advances `world` by `dt` seconds with `model`'s integrator. `warm_start`: the

@@ -499,13 +499,16 @@ impl Pipeline {
     }
 
     /// After the state's mesh changed (remeshing, or a restored start): rebuilds
-    /// `setup`'s force elements and forgets the step size, the air power, and the
-    /// state's (now stale) contacts and warm start. The pipeline calls it after its
+    /// `setup`'s force elements (timed as the state's `rebuild_s`) and forgets the
+    /// step size, the air power, and the state's (now stale) contacts and warm
+    /// start. The pipeline calls it after its
     /// own remeshing and restores; call it after changing a state's mesh outside the
     /// pipeline (for a state saved elsewhere, whose contacts and warm start still
     /// fit its mesh, [`Pipeline::attach`] keeps them).
     pub fn mesh_changed(&mut self, setup: &Setup, state: &mut SimState) {
+        let started = std::time::Instant::now();
         self.attach(setup, state);
+        state.effort.solver.rebuild_s += started.elapsed().as_secs_f64();
         state.contacts.clear();
         state.warm_start.clear();
     }

@@ -76,6 +76,7 @@ use super::refactor::RefactorPolicy;
 use crate::math::{Matrix3, Scalar, Vector};
 use crate::physics::block::{BlockPattern, ElementTerms};
 use crate::physics::cholesky::Factorization;
+use crate::physics::elements::Elements;
 use crate::physics::forces::PAR_MIN;
 use crate::physics::laplacian::LaplacianFactor;
 use crate::physics::{Model, Preconditioner, Refactor, StepStats, Stepper};
@@ -94,6 +95,17 @@ const TIPS_CONSIDER: u32 = 10;
 pub(super) struct DirectScratch {
     /// Block pattern of the current mesh (`None`: not built yet).
     pattern: Option<Arc<BlockPattern>>,
+    /// True from a change of mesh until the new mesh's first factorization:
+    /// its pattern, ordering and first factor are counted as rebuilding
+    /// ([`StepStats::rebuild_s`]).
+    new_mesh: bool,
+    /// True when the block factor's ordering was made ahead of the new mesh's
+    /// first factorization ([`DirectScratch::prepare`]), which counts it.
+    analysis_uncounted: bool,
+    /// Wall time of building the pattern after a change of mesh, s, not yet
+    /// moved from the linearisation's assembly time to the rebuild's
+    /// ([`DirectScratch::take_pattern_time`]).
+    pattern_s: f64,
     /// Factor the hinge tip-tip blocks too (block module docs): set for the rest of
     /// the run once a fresh factor without them needed more iterations than
     /// `tips_break_even` (module docs, "Which factor").
@@ -133,9 +145,31 @@ impl DirectScratch {
     /// Forgets the pattern and the factorization (the mesh changed).
     pub(super) fn mesh_changed(&mut self) {
         self.pattern = None;
+        self.new_mesh = true;
+        self.analysis_uncounted = false;
         self.tips_break_even = None;
         self.factorization.reset();
         self.laplacian.reset();
+    }
+
+    /// After a change of mesh ([`DirectScratch::mesh_changed`]): builds the new
+    /// mesh's block pattern from its `elements` and, for a block factor, its
+    /// ordering, ahead of the first solve (so that the rebuild can run them
+    /// beside the fold splits' factorization). The first factorization counts
+    /// the ordering as a symbolic analysis, as if it had made it.
+    pub(super) fn prepare(&mut self, elements: &Elements, preconditioner: Preconditioner) {
+        self.choose(preconditioner);
+        let n = elements.mass.len();
+        let pattern = Arc::new(BlockPattern::build(n, elements, self.factor_tips));
+        // A failed analysis is left to the first factorization, which reports it.
+        self.analysis_uncounted = preconditioner != Preconditioner::Laplacian
+            && self.factorization.analyse(&pattern).is_ok();
+        self.pattern = Some(pattern);
+    }
+
+    /// The wall time spent building a new mesh's pattern since the last call, s.
+    pub(super) fn take_pattern_time(&mut self) -> f64 {
+        std::mem::take(&mut self.pattern_s)
     }
 
     /// Makes `preconditioner` the one factored from now on (a change forgets

@@ -87,7 +87,10 @@ pub(super) fn linearise(st: &mut Stepper, model: &Model, w: &World, h: Scalar, n
     }
     // The diagonal of `A` is the Jacobi preconditioner of `solver = "cg"` only.
     gather(s, el, ext, v, h, newton, !direct);
-    st.stats.assembly_s += started.elapsed().as_secs_f64();
+    // A new mesh's pattern is part of rebuilding after the change of mesh.
+    let pattern_s = s.direct.take_pattern_time();
+    st.stats.assembly_s += started.elapsed().as_secs_f64() - pattern_s;
+    st.stats.rebuild_s += pattern_s;
 }
 
 /// Mass plus `h` times the drag coefficient of vertex `i`, kg: the diagonal of

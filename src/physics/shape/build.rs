@@ -20,6 +20,9 @@ pub(crate) struct ShapeScratch {
     across: Vec<[usize; 3]>,
     /// Per triangle: twice its part of each edge's fold.
     share: Vec<[Scalar; 3]>,
+    /// Per triangle: no corner thinner than [`SPLIT_MIN_ANGLE_DEG`], so its
+    /// edges may take split unknowns.
+    wide: Vec<bool>,
 }
 
 /// Into `out` (cleared first): one shape triangle per mesh triangle not held by
@@ -47,6 +50,7 @@ pub(crate) fn build_shape_triangles_into(
         stencil,
         across,
         share,
+        wide,
     } = scratch;
     stencil.clear();
     stencil.extend(mesh.triangles.iter().map(|tri| ShapeTriangle {
@@ -81,27 +85,29 @@ pub(crate) fn build_shape_triangles_into(
             };
         }
     }
+    wide.clear();
+    wide.extend((0..n).map(|t| min_angle(mesh, t) >= SPLIT_MIN_ANGLE_DEG));
     let mut splits = 0u32;
     for e in &mesh.edges {
-        let free: Vec<(usize, Scalar)> = e
-            .triangles
-            .iter()
-            .zip([1.0, -1.0])
-            .filter(|(t, _)| **t != crate::mesh::NO_TRIANGLE && !held(**t as usize))
-            .map(|(t, sign)| (*t as usize, sign))
-            .collect();
+        // The edge's triangles not held by a clamp, with the sign of their part.
+        let mut free = [(0usize, 0.0); 2];
+        let mut count = 0;
+        for (&t, sign) in e.triangles.iter().zip([1.0, -1.0]) {
+            if t != crate::mesh::NO_TRIANGLE && !held(t as usize) {
+                free[count] = (t as usize, sign);
+                count += 1;
+            }
+        }
+        let free = &free[..count];
         // Both sides free, or a free edge of the cloth (its one triangle's part is
         // a free unknown: module docs, "Free edges"), and no triangle thin
         // (module docs, "Thin triangles").
         let free_edge = free.len() == 1 && e.triangles.contains(&crate::mesh::NO_TRIANGLE);
-        let split = (free.len() == 2 || free_edge)
-            && free
-                .iter()
-                .all(|&(t, _)| min_angle(mesh, t) >= SPLIT_MIN_ANGLE_DEG);
+        let split = (free.len() == 2 || free_edge) && free.iter().all(|&(t, _)| wide[t]);
         if !split {
             continue;
         }
-        for (t, sign) in free {
+        for &(t, sign) in free {
             let tri = mesh.triangles[t];
             let a = (0..3)
                 .find(|&a| !e.vertices.contains(&tri[a]))

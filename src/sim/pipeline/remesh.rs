@@ -196,9 +196,7 @@ impl Pipeline {
             carried.is_some() || !had_contacts,
             "resting contacts that do not fit the mesh they were carried from"
         );
-        let started = Instant::now();
         self.mesh_changed(setup, state);
-        state.effort.solver.rebuild_s += started.elapsed().as_secs_f64();
         if let Some(contacts) = carried {
             state.contacts = contacts;
         }

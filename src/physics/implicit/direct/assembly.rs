@@ -49,10 +49,15 @@ pub(in crate::physics::implicit) fn gather(
         a.factorization.reset();
         a.tips_break_even = None;
     }
+    let started = Instant::now();
+    let built = a.pattern.is_none();
     let pattern = a
         .pattern
         .get_or_insert_with(|| Arc::new(BlockPattern::build(n, el, a.factor_tips)))
         .clone();
+    if built && a.new_mesh {
+        a.pattern_s += started.elapsed().as_secs_f64();
+    }
     let terms = element_blocks!(s, el);
     pattern.gather(&terms, &mut s.direct.element, &mut s.direct.lower);
     pattern

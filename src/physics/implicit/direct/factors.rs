@@ -112,6 +112,8 @@ pub(super) fn refactor(
         if !a.factorization.is_analysed() {
             a.factorization.analyse(pattern).map_err(map)?;
             stats.symbolic_analyses += 1;
+        } else if std::mem::take(&mut a.analysis_uncounted) {
+            stats.symbolic_analyses += 1;
         }
         a.factorization
             .factor(pattern, &a.system, &a.compensation)
@@ -121,6 +123,13 @@ pub(super) fn refactor(
     if a.factor_tips {
         stats.full_factorizations += 1;
     }
-    stats.factorization_s += started.elapsed().as_secs_f64();
+    // A new mesh's ordering and first factor are part of rebuilding after the
+    // change of mesh.
+    let elapsed = started.elapsed().as_secs_f64();
+    if std::mem::take(&mut a.new_mesh) {
+        stats.rebuild_s += elapsed;
+    } else {
+        stats.factorization_s += elapsed;
+    }
     result
 }
