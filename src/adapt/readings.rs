@@ -20,7 +20,9 @@ impl Adapter {
     /// per vertex, when `refine_obstacle` is set) and gives it to the leaf's
     /// triangles. The edge and tensor methods, and a garment waiting for its
     /// welds, read the angle criterion at each triangle, its state `AtMaxLevel`
-    /// when it would refine at `max_level` and `Free` otherwise.
+    /// when it would refine at `max_level`, for the edge method `AtMinEdge` when
+    /// it would refine but halving its longest edge (the split the method
+    /// makes) would go below `min_edge_length`, and `Free` otherwise.
     pub fn decisions(
         &self,
         config: &AdaptConfig,
@@ -30,16 +32,26 @@ impl Adapter {
         let angles = edge_angles(world);
         match &self.method {
             MethodState::RedGreen(rg) => rg.decisions(config, world, &angles, obstacle_planes),
-            MethodState::Edge(_) | MethodState::Tensor(_) | MethodState::AwaitingWelds => {
-                angle_decisions(config, world, &angles)
+            MethodState::Edge(limits) => {
+                angle_decisions(config, world, &angles, Some(limits.min_edge))
+            }
+            MethodState::Tensor(_) | MethodState::AwaitingWelds => {
+                angle_decisions(config, world, &angles, None)
             }
         }
     }
 }
 
 /// The angle criterion at each world triangle: its largest edge angle over
-/// `refine_angle`, at `max_level` when it would refine there.
-fn angle_decisions(c: &AdaptConfig, world: &World, angles: &[Scalar]) -> Vec<TriangleDecision> {
+/// `refine_angle`, at `max_level` when it would refine there, and (with
+/// `min_edge`, the edge method's limit) at the smallest edge when half its
+/// longest material edge is below `min_edge`.
+fn angle_decisions(
+    c: &AdaptConfig,
+    world: &World,
+    angles: &[Scalar],
+    min_edge: Option<Scalar>,
+) -> Vec<TriangleDecision> {
     let m = &world.mesh;
     let mut largest = vec![0.0 as Scalar; m.triangles.len()];
     for (e, edge) in m.edges.iter().enumerate() {
@@ -52,14 +64,28 @@ fn angle_decisions(c: &AdaptConfig, world: &World, angles: &[Scalar]) -> Vec<Tri
             *a = a.max(angles[e]);
         }
     }
+    let too_short = |t: usize| {
+        min_edge.is_some_and(|min| {
+            let p = m.corners(t);
+            let longest = (0..3)
+                .map(|k| p[k].distance(p[(k + 1) % 3]))
+                .fold(0.0, Scalar::max);
+            0.5 * longest < min
+        })
+    };
     largest
         .iter()
         .zip(&m.levels)
-        .map(|(&angle, &level)| {
+        .enumerate()
+        .map(|(t, (&angle, &level))| {
             let reading = Reading::of_angle(angle, c.refine_angle);
-            let state = match angle > c.refine_angle && level >= c.max_level {
-                true => TriangleState::AtMaxLevel,
-                false => TriangleState::Free,
+            let wants = angle > c.refine_angle;
+            let state = if wants && level >= c.max_level {
+                TriangleState::AtMaxLevel
+            } else if wants && too_short(t) {
+                TriangleState::AtMinEdge
+            } else {
+                TriangleState::Free
             };
             TriangleDecision { reading, state }
         })

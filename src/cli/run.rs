@@ -31,6 +31,17 @@ pub fn cmd_run(args: RunArgs) -> Result<ExitCode> {
         );
     }
     let scene = load(&args.scene)?;
+    let adapts = scene
+        .adapt
+        .as_ref()
+        .is_some_and(|a| a.method != drape::scene::AdaptMethod::None);
+    if !adapts && matches!(args.colour_by, ColourChoice::Ratio | ColourChoice::State) {
+        anyhow::bail!(
+            "--colour-by ratio and --colour-by state colour the triangles by their refinement \
+             decisions, and scene `{}` does not adapt its mesh (no [adapt], or method = \"none\")",
+            scene.name
+        );
+    }
     run_scene(scene, &args)
 }
 

@@ -158,3 +158,24 @@ fn colouring_by_decisions_without_them_is_refused_before_the_run() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn colouring_by_decisions_on_a_scene_that_does_not_adapt_is_refused_before_the_run() {
+    let dir = temp_dir("colour-no-adapt");
+    let args = [
+        "run",
+        "--set",
+        "adapt.method=none",
+        "--colour-by",
+        "state",
+        "-o",
+        "x.rrd",
+    ];
+    refused(
+        &drape(&dir, &args),
+        1,
+        &["--colour-by ratio and --colour-by state", "does not adapt"],
+    );
+    assert!(!dir.join("x.rrd").exists(), "no recording is started");
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -185,8 +185,8 @@ fn recording_the_decisions_leaves_the_simulation_as_it_is() {
     std::fs::remove_file(&without).ok();
 }
 
-#[test]
-fn a_fold_at_max_level_is_held_there() {
+/// A 1 m sheet of 4 x 4 squares folded 90 degrees about the grid line through its middle.
+fn folded_sheet() -> World {
     let m = drape::mesh::rectangle(1.0, 1.0, 4, DiagonalPattern::Regular).expect("a grid");
     // Folded 90 degrees about the grid line through the middle of the sheet: the edges on
     // the crease bend far past 15 degrees.
@@ -199,7 +199,12 @@ fn a_fold_at_max_level_is_held_there() {
             false => p.extend(0.0),
         })
         .collect();
-    let world = World::new(m, x);
+    World::new(m, x)
+}
+
+#[test]
+fn a_fold_at_max_level_is_held_there() {
+    let world = folded_sheet();
     for (max_level, want) in [(0, TriangleState::AtMaxLevel), (4, TriangleState::Free)] {
         let config = drape::adapt::AdaptConfig {
             max_level,
@@ -216,5 +221,27 @@ fn a_fold_at_max_level_is_held_there() {
         );
         // 90 degrees over 15.
         assert!(creased.iter().all(|d| (d.reading.ratio - 6.0).abs() < 1e-9));
+    }
+}
+
+#[test]
+fn an_edge_method_fold_whose_split_would_be_too_short_is_at_the_smallest_edge() {
+    let world = folded_sheet();
+    // The squares' diagonals are 0.354 m: bisected, 0.177 m.
+    for (min_edge, want) in [(0.2, TriangleState::AtMinEdge), (0.1, TriangleState::Free)] {
+        let config = drape::adapt::AdaptConfig {
+            max_level: 4,
+            min_edge_length: min_edge,
+            ..crate::common::angle_config(AdaptMethod::Edge)
+        };
+        let ad = Adapter::new(&config, &world, 0.15).expect("the adapter");
+        let decisions = ad.decisions(&config, &world, &[]);
+        let creased: Vec<_> = decisions.iter().filter(|d| d.reading.ratio > 1.0).collect();
+        assert!(!creased.is_empty(), "the crease is past the threshold");
+        assert!(
+            creased.iter().all(|d| d.state == want),
+            "min_edge_length {min_edge}: {:?}",
+            creased.iter().map(|d| d.state).collect::<Vec<_>>()
+        );
     }
 }
