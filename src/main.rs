@@ -10,6 +10,9 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 use cli::bench::{BenchArgs, cmd_bench};
 use cli::body_frames::{BodyFramesArgs, cmd_body_frames};
 use cli::garment::{GarmentArgs, cmd_garment};
+use cli::garment_batch::{
+    GarmentCollectArgs, GarmentPlanArgs, cmd_garment_collect, cmd_garment_plan,
+};
 use cli::run::cmd_run;
 use drape::record::history::history_at;
 use drape::record::inspect::inspect;
@@ -20,6 +23,7 @@ mod cli {
     pub mod bench;
     pub mod body_frames;
     pub mod garment;
+    pub mod garment_batch;
     pub mod run;
 }
 
@@ -39,6 +43,11 @@ enum Command {
     /// (`--body BODY.obj`): the pattern and the body become a scene
     /// (`--write-scene` saves it), run as `drape run` runs one.
     Garment(GarmentArgs),
+    /// Write a folder of GarmentCode patterns as a job list (DIR/jobs.txt, one
+    /// `drape garment` per pattern, for GNU parallel or a Slurm array).
+    GarmentPlan(GarmentPlanArgs),
+    /// Gather the summaries of the jobs `garment-plan` wrote into DIR/garments.csv.
+    GarmentCollect(GarmentCollectArgs),
     /// Validate a scene and print the resolved model without simulating.
     Check(SceneArgs),
     /// Decode a .rrd recording and print what it holds.
@@ -179,6 +188,8 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Run(args) => cmd_run(args),
         Command::Garment(args) => cmd_garment(args),
+        Command::GarmentPlan(args) => cmd_garment_plan(args),
+        Command::GarmentCollect(args) => cmd_garment_collect(args),
         Command::Check(args) => cmd_check(args),
         Command::Inspect(args) => cmd_inspect(args),
         Command::Bench(args) => cmd_bench(args),

@@ -68,7 +68,7 @@ pub struct GarmentArgs {
 
 /// The values of `--body-up`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-enum Up {
+pub enum Up {
     /// y up.
     Y,
     /// z up.

@@ -25,6 +25,7 @@ mod elements;
 mod energy;
 mod fast_contact;
 mod fuzz;
+mod garment_batch;
 mod garment_bench;
 mod garment_curves;
 mod garment_phases;
