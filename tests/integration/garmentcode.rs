@@ -275,3 +275,21 @@ fn the_written_scene_loads_as_a_scene_with_every_panel_curve_and_seam() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn the_shipped_garmentcode_scenes_load_and_build() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/garmentcode");
+    let mut built_scenes = 0;
+    for entry in std::fs::read_dir(&dir).expect("scenes/garmentcode") {
+        let path = entry.expect("entry").path();
+        if path.extension().is_none_or(|x| x != "toml") {
+            continue;
+        }
+        let scene = drape::scene::load_scene_file(&path, &[])
+            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let spec = scene.resolve().expect("resolved");
+        drape::sim::build(&spec).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        built_scenes += 1;
+    }
+    assert_eq!(built_scenes, 4, "shirt, hoody, dress and jumpsuit");
+}
