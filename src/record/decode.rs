@@ -92,12 +92,7 @@ impl MeshRows {
         {
             return;
         }
-        let Some(times) = chunk
-            .timelines()
-            .iter()
-            .find(|(n, _)| n.as_str() == TIMELINE_FRAME)
-            .map(|(_, col)| col.times_raw().to_vec())
-        else {
+        let Some(times) = timeline_times(chunk, TIMELINE_FRAME) else {
             return;
         };
         for &t in &times {
@@ -193,6 +188,16 @@ impl MeshRows {
             topology_frame: *topology_frame,
         })
     }
+}
+
+/// The raw times of `chunk`'s rows on the timeline `name` (frame numbers, or
+/// nanoseconds of `sim_time`); `None` when the chunk is not on it.
+pub(super) fn timeline_times(chunk: &Chunk, name: &str) -> Option<Vec<i64>> {
+    chunk
+        .timelines()
+        .iter()
+        .find(|(n, _)| n.as_str() == name)
+        .map(|(_, col)| col.times_raw().to_vec())
 }
 
 /// A list cell of fixed-size-3 lists as triples, or `None` when it is not one.

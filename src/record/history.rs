@@ -137,13 +137,7 @@ fn add_chunk(cells: &mut BTreeMap<i64, Cells>, chunk: &Chunk) {
     if chunk.is_static() || (entity != ENTITY_MESH && entity != ENTITY_EVENT_LOG) {
         return;
     }
-    let timeline = |name: &str| {
-        chunk
-            .timelines()
-            .iter()
-            .find(|(n, _)| n.as_str() == name)
-            .map(|(_, col)| col.times_raw().to_vec())
-    };
+    let timeline = |name: &str| super::decode::timeline_times(chunk, name);
     let Some(frames) = timeline(TIMELINE_FRAME) else {
         return;
     };

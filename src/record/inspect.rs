@@ -293,13 +293,7 @@ fn gather(out: &mut Inspection, chunk: &Chunk) {
         return;
     }
     rows.temporal += chunk.num_rows();
-    let timeline = |name: &str| {
-        chunk
-            .timelines()
-            .iter()
-            .find(|(n, _)| n.as_str() == name)
-            .map(|(_, col)| col.times_raw().to_vec())
-    };
+    let timeline = |name: &str| super::decode::timeline_times(chunk, name);
     let Some(frames) = timeline(TIMELINE_FRAME) else {
         return;
     };

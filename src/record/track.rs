@@ -10,6 +10,8 @@
 use std::collections::BTreeMap;
 
 use super::history::MeshAt;
+use crate::collide::geometry::closest_on_triangle;
+use crate::math::Vector;
 
 /// Where the point is on one frame's mesh.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -37,43 +39,11 @@ fn at(t: [P; 3], w: [f64; 3]) -> P {
     [0, 1, 2].map(|i| w[0] * t[0][i] + w[1] * t[1][i] + w[2] * t[2][i])
 }
 
-/// The barycentric coordinates of the point of triangle `t` nearest to `p` (Ericson,
-/// "Real-Time Collision Detection", 5.1.5).
+/// The barycentric coordinates of the point of triangle `t` nearest to `p`
+/// ([`closest_on_triangle`], the collision code's).
 pub(super) fn closest_bary(t: [P; 3], p: P) -> [f64; 3] {
-    let [a, b, c] = t;
-    let (ab, ac, ap) = (sub(b, a), sub(c, a), sub(p, a));
-    let (d1, d2) = (dot(ab, ap), dot(ac, ap));
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return [1.0, 0.0, 0.0];
-    }
-    let bp = sub(p, b);
-    let (d3, d4) = (dot(ab, bp), dot(ac, bp));
-    if d3 >= 0.0 && d4 <= d3 {
-        return [0.0, 1.0, 0.0];
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        let v = d1 / (d1 - d3);
-        return [1.0 - v, v, 0.0];
-    }
-    let cp = sub(p, c);
-    let (d5, d6) = (dot(ab, cp), dot(ac, cp));
-    if d6 >= 0.0 && d5 <= d6 {
-        return [0.0, 0.0, 1.0];
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        let w = d2 / (d2 - d6);
-        return [1.0 - w, 0.0, w];
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        return [0.0, 1.0 - w, w];
-    }
-    let denom = 1.0 / (va + vb + vc);
-    let (v, w) = (vb * denom, vc * denom);
-    [1.0 - v - w, v, w]
+    let [a, b, c] = t.map(Vector::from_array);
+    closest_on_triangle(Vector::from_array(p), a, b, c)
 }
 
 /// The distance from `p` to triangle `t`, m.
