@@ -30,16 +30,8 @@ const DRAPING: Draping = Draping {
 pub struct GarmentArgs {
     /// The GarmentCode specification (`*_specification.json`).
     spec: PathBuf,
-    /// The body to drape on: an OBJ file (GarmentCode's `assets/bodies/*.obj`).
-    #[arg(long, value_name = "BODY.obj")]
-    body: PathBuf,
-    /// Which axis of the body file points up: `y` (GarmentCode's bodies, turned
-    /// by (x, y, z) -> (x, -z, y)) or `z`.
-    #[arg(long, value_enum, value_name = "AXIS", default_value_t = Up::Y)]
-    body_up: Up,
-    /// Metres per unit of the body file: 1 for metres, 0.01 for centimetres.
-    #[arg(long, value_name = "SCALE", default_value_t = 1.0)]
-    body_scale: f64,
+    #[command(flatten)]
+    body: BodyArgs,
     /// Also write the scene that runs to this file (the body's path relative to it).
     #[arg(long, value_name = "FILE.toml")]
     write_scene: Option<PathBuf>,
@@ -66,6 +58,32 @@ pub struct GarmentArgs {
     quiet: bool,
 }
 
+/// The body options `drape garment` and `drape garment-plan` share.
+#[derive(Args)]
+pub struct BodyArgs {
+    /// The body to drape on: an OBJ file (GarmentCode's `assets/bodies/*.obj`).
+    #[arg(long, value_name = "BODY.obj")]
+    pub body: PathBuf,
+    /// Which axis of the body file points up: `y` (GarmentCode's bodies, turned
+    /// by (x, y, z) -> (x, -z, y)) or `z`.
+    #[arg(long, value_enum, value_name = "AXIS", default_value_t = Up::Y)]
+    pub body_up: Up,
+    /// Metres per unit of the body file: 1 for metres, 0.01 for centimetres.
+    #[arg(long, value_name = "SCALE", default_value_t = 1.0)]
+    pub body_scale: f64,
+}
+
+impl BodyArgs {
+    /// Checks the scale and the body file (readable, with faces, of a human size).
+    pub fn check(&self) -> Result<()> {
+        if !(self.body_scale.is_finite() && self.body_scale > 0.0) {
+            anyhow::bail!("--body-scale must be a number > 0, got {}", self.body_scale);
+        }
+        check_body(&self.body, self.body_scale)?;
+        Ok(())
+    }
+}
+
 /// The values of `--body-up`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum Up {
@@ -89,10 +107,7 @@ pub fn cmd_garment(args: GarmentArgs) -> Result<ExitCode> {
             why,
         }
     })?;
-    if !(args.body_scale.is_finite() && args.body_scale > 0.0) {
-        anyhow::bail!("--body-scale must be a number > 0, got {}", args.body_scale);
-    }
-    check_body(&args.body, args.body_scale)?;
+    args.body.check()?;
     let name = args
         .spec
         .file_stem()
@@ -109,12 +124,12 @@ pub fn cmd_garment(args: GarmentArgs) -> Result<ExitCode> {
         None => cwd.clone(),
     };
     let body = Body {
-        path: relative(&absolute(&cwd, &args.body), &scene_dir),
-        up: match args.body_up {
+        path: relative(&absolute(&cwd, &args.body.body), &scene_dir),
+        up: match args.body.body_up {
             Up::Y => BodyUp::Y,
             Up::Z => BodyUp::Z,
         },
-        scale: args.body_scale,
+        scale: args.body.body_scale,
     };
     let text = scene(
         &name,

@@ -18,7 +18,7 @@ use anyhow::{Context, Result};
 use clap::Args;
 use serde_json::Value;
 
-use crate::cli::garment::Up;
+use crate::cli::garment::{BodyArgs, Up};
 use drape::bench::plan::shell_words;
 
 /// The job list, one command line per pattern.
@@ -34,15 +34,8 @@ const SPEC_SUFFIX: &str = "_specification.json";
 pub struct GarmentPlanArgs {
     /// The folder of GarmentCode patterns: every `*_specification.json` in it.
     patterns: PathBuf,
-    /// The body to drape on (as for `drape garment`).
-    #[arg(long, value_name = "BODY.obj")]
-    body: PathBuf,
-    /// Which axis of the body file points up (as for `drape garment`).
-    #[arg(long, value_enum, value_name = "AXIS", default_value_t = Up::Y)]
-    body_up: Up,
-    /// Metres per unit of the body file (as for `drape garment`).
-    #[arg(long, value_name = "SCALE", default_value_t = 1.0)]
-    body_scale: f64,
+    #[command(flatten)]
+    body: BodyArgs,
     /// Override a value of every pattern's scene (repeatable).
     #[arg(long = "set", value_name = "KEY=VALUE")]
     overrides: Vec<String>,
@@ -87,10 +80,9 @@ pub fn cmd_garment_plan(args: GarmentPlanArgs) -> Result<ExitCode> {
             folder.display()
         );
     }
-    let body = cwd.join(&args.body);
-    if !body.is_file() {
-        anyhow::bail!("--body {}: no such file", args.body.display());
-    }
+    // A bad body fails here, once, rather than in every job.
+    args.body.check()?;
+    let body = cwd.join(&args.body.body);
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
     let (mut jobs, mut names) = (String::new(), String::new());
@@ -98,12 +90,12 @@ pub fn cmd_garment_plan(args: GarmentPlanArgs) -> Result<ExitCode> {
         let name = job_name(spec);
         let mut argv: Vec<String> = vec!["garment".into(), spec.display().to_string()];
         argv.extend(["--body".into(), body.display().to_string()]);
-        let up = match args.body_up {
+        let up = match args.body.body_up {
             Up::Y => "y",
             Up::Z => "z",
         };
         argv.extend(["--body-up".into(), up.into()]);
-        argv.extend(["--body-scale".into(), args.body_scale.to_string()]);
+        argv.extend(["--body-scale".into(), args.body.body_scale.to_string()]);
         argv.extend(["--no-record".into(), "--quiet".into()]);
         argv.extend(["--summary".into(), format!("{name}.json")]);
         if args.obj {
