@@ -93,6 +93,45 @@ struct Scratch {
     count: Vec<u32>,
 }
 
+impl Scratch {
+    /// Sums the corrections of `fixes` per vertex into `dx`, `dv` and `count`
+    /// (over `n` vertices); the number of pairs that acted.
+    fn sum_fixes(&mut self, n: usize) -> u64 {
+        for buf in [&mut self.dx, &mut self.dv] {
+            buf.clear();
+            buf.resize(n, Vector::ZERO);
+        }
+        self.count.clear();
+        self.count.resize(n, 0);
+        let mut acted = 0u64;
+        for f in &self.fixes {
+            acted += 1;
+            for k in 0..4 {
+                let i = f.vertex[k] as usize;
+                if f.dx[k] != Vector::ZERO || f.dv[k] != Vector::ZERO {
+                    self.dx[i] += f.dx[k];
+                    self.dv[i] += f.dv[k];
+                    self.count[i] += 1;
+                }
+            }
+        }
+        acted
+    }
+
+    /// Moves every corrected vertex by the mean of its corrections, and notes
+    /// which moved.
+    fn apply_fixes(&mut self, x: &mut [Vector], v: &mut [Vector]) {
+        for i in 0..x.len() {
+            self.moved[i] = self.count[i] > 0;
+            if self.count[i] > 0 {
+                let c = self.count[i] as Scalar;
+                x[i] += self.dx[i] / c;
+                v[i] += self.dv[i] / c;
+            }
+        }
+    }
+}
+
 impl SelfCollider {
     /// From the scene's `[self_collision]`.
     pub fn new(s: &SelfCollision) -> SelfCollider {
@@ -160,57 +199,38 @@ impl SelfCollider {
         s.moved.clear();
         s.moved.resize(x.len(), true);
         for _ in 0..self.iterations {
-            // A pair none of whose vertices the last pass moved gives what it
-            // gave then: nothing (a pair that acted moved its vertices).
-            let moved = &s.moved;
-            // Only the pairs that act are kept, in pair order (few of them: a
-            // list of every pair's outcome would be most of the step's traffic).
-            s.fixes.clear();
-            s.fixes
-                .par_extend(
-                    s.prims
-                        .par_iter()
-                        .zip(s.start.par_iter())
-                        .filter_map(|(p, start)| {
-                            // No start normal: the pair gives nothing.
-                            let start = start.as_ref()?;
-                            let touched = start.ids.iter().any(|&i| moved[i as usize]);
-                            touched.then(|| self.fix(tris, *p, start, x, v, &s.inv_mass))?
-                        }),
-                );
-            for buf in [&mut s.dx, &mut s.dv] {
-                buf.clear();
-                buf.resize(x.len(), Vector::ZERO);
-            }
-            s.count.clear();
-            s.count.resize(x.len(), 0);
-            let mut acted = 0u64;
-            for f in &s.fixes {
-                acted += 1;
-                for k in 0..4 {
-                    let i = f.vertex[k] as usize;
-                    if f.dx[k] != Vector::ZERO || f.dv[k] != Vector::ZERO {
-                        s.dx[i] += f.dx[k];
-                        s.dv[i] += f.dv[k];
-                        s.count[i] += 1;
-                    }
-                }
-            }
+            self.collect_fixes(tris, x, v, &mut s);
+            let acted = s.sum_fixes(x.len());
             stats.resolved += acted;
             if acted == 0 {
                 break;
             }
-            for i in 0..x.len() {
-                s.moved[i] = s.count[i] > 0;
-                if s.count[i] > 0 {
-                    let c = s.count[i] as Scalar;
-                    x[i] += s.dx[i] / c;
-                    v[i] += s.dv[i] / c;
-                }
-            }
+            s.apply_fixes(x, v);
         }
         self.scratch = s;
         stats
+    }
+
+    /// One pass's corrections into `s.fixes`: those of the pairs with a start
+    /// normal and a vertex the last pass moved, in pair order.
+    fn collect_fixes(&self, tris: &[[u32; 3]], x: &[Vector], v: &[Vector], s: &mut Scratch) {
+        // A pair none of whose vertices the last pass moved gives what it
+        // gave then: nothing (a pair that acted moved its vertices).
+        let moved = &s.moved;
+        // Only the pairs that act are kept, in pair order (few of them: a
+        // list of every pair's outcome would be most of the step's traffic).
+        s.fixes.clear();
+        s.fixes.par_extend(
+            s.prims
+                .par_iter()
+                .zip(s.start.par_iter())
+                .filter_map(|(p, start)| {
+                    // No start normal: the pair gives nothing.
+                    let start = start.as_ref()?;
+                    let touched = start.ids.iter().any(|&i| moved[i as usize]);
+                    touched.then(|| self.fix(tris, *p, start, x, v, &s.inv_mass))?
+                }),
+        );
     }
 
     /// Primitive pairs of the box-overlapping, non-adjacent triangle pairs, into
