@@ -136,7 +136,7 @@ impl Tally {
             },
             checks: SceneChecks {
                 pin_mismatches: self.pin_mismatches.clone(),
-                seams: crate::summary::SeamSummary::of(&world.mesh, &world.x),
+                seams: crate::summary::SeamSummary::of(&world.mesh, &end.state.seams, &world.x),
                 rest: end.rest,
             },
             interrupted: end.interrupted,
