@@ -317,11 +317,7 @@ impl SeamSummary {
         states: &[crate::sim::SeamState],
         x: &[crate::math::Vector],
     ) -> Vec<SeamSummary> {
-        let Some(panels) = mesh.panels() else {
-            return Vec::new();
-        };
-        panels
-            .seams
+        mesh.seams()
             .iter()
             .zip(states)
             .map(|(s, state)| SeamSummary {
