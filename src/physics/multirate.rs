@@ -226,19 +226,7 @@ pub fn symplectic_multirate(st: &mut Stepper, model: &Model, w: &mut World, big:
     let levels = take_levels(st, model, w);
     let mut rk = std::mem::take(&mut st.rk4_multirate);
     let scratch = &mut st.forces;
-    let n_springs = st.elements.springs.len();
-    scratch.spring.resize(n_springs, Vector::ZERO);
-    scratch
-        .hinge
-        .resize(4 * st.elements.hinges.len(), Vector::ZERO);
-    scratch.shape.resize(
-        SHAPE_SLOTS * st.elements.shape_triangles.len(),
-        Vector::ZERO,
-    );
-    scratch.membrane.resize(
-        MEMBRANE_SLOTS * st.elements.membrane_triangles.len(),
-        Vector::ZERO,
-    );
+    scratch.kinds.size(&st.elements);
     if model.external.wind.is_some() {
         scratch
             .triangle
@@ -321,11 +309,11 @@ fn level_forces(
         })
         .collect_into_vec(&mut level.springs);
     for (&s, &f) in g.springs.iter().zip(&level.springs) {
-        scratch.spring[s as usize] = f;
+        scratch.kinds.springs[s as usize] = f;
     }
     for &c in &g.caps {
         let cap = &el.sewing_caps[c as usize];
-        scratch.spring[cap.spring as usize] = cap_force(el, cap, x, v);
+        scratch.kinds.springs[cap.spring as usize] = cap_force(el, cap, x, v);
     }
     g.hinges
         .par_iter()
@@ -337,13 +325,18 @@ fn level_forces(
         })
         .collect_into_vec(&mut level.hinges);
     for (&h, f) in g.hinges.iter().zip(&level.hinges) {
-        scratch.hinge[4 * h as usize..4 * h as usize + 4].copy_from_slice(f);
+        scratch.kinds.hinges[4 * h as usize..4 * h as usize + 4].copy_from_slice(f);
     }
     if !g.shape.is_empty() {
         // The splits couple every fold: they are solved over the whole mesh.
-        solve_splits(el, x, &mut scratch.folds, &mut scratch.splits);
+        solve_splits(
+            el,
+            x,
+            &mut scratch.kinds.shapes.folds,
+            &mut scratch.kinds.shapes.splits,
+        );
     }
-    let splits = &scratch.splits;
+    let splits = &scratch.kinds.shapes.splits;
     g.shape
         .par_iter()
         .with_min_len(128)
@@ -354,7 +347,8 @@ fn level_forces(
         })
         .collect_into_vec(&mut level.shape);
     for (&p, f) in g.shape.iter().zip(&level.shape) {
-        scratch.shape[SHAPE_SLOTS * p as usize..SHAPE_SLOTS * (p as usize + 1)].copy_from_slice(f);
+        scratch.kinds.shapes.slots[SHAPE_SLOTS * p as usize..SHAPE_SLOTS * (p as usize + 1)]
+            .copy_from_slice(f);
     }
     // Membrane triangle t is mesh triangle t: the group's triangles are its own.
     if !el.membrane_triangles.is_empty() {
@@ -369,7 +363,7 @@ fn level_forces(
             .collect_into_vec(&mut level.membrane);
         for (&t, f) in g.triangles.iter().zip(&level.membrane) {
             let at = MEMBRANE_SLOTS * t as usize;
-            scratch.membrane[at..at + MEMBRANE_SLOTS].copy_from_slice(f);
+            scratch.kinds.membrane[at..at + MEMBRANE_SLOTS].copy_from_slice(f);
         }
     }
     if let Some(wind) = &ext.wind {
