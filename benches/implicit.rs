@@ -171,6 +171,7 @@ fn shape_operator_fabric() -> MaterialParams {
         damping: 0.001,
         bending_model: BendingModel::ShapeOperator,
         stiffness_rule: StiffnessRule::Consistent,
+        sewing: Default::default(),
     }
 }
 

@@ -60,6 +60,7 @@ fn setup(resolution: u32, membrane: Membrane) -> (World, Model) {
             damping: 0.0,
             bending_model: BendingModel::ShapeOperator,
             stiffness_rule: StiffnessRule::Consistent,
+            sewing: Default::default(),
         },
         external: ExternalForces {
             gravity: Some(Vector::new(0.0, 0.0, -9.81)),

@@ -47,6 +47,7 @@ fn setup(resolution: u32, bending_model: BendingModel) -> Setup {
             damping: 0.001,
             bending_model,
             stiffness_rule: StiffnessRule::Consistent,
+            sewing: Default::default(),
         },
         external: ExternalForces {
             gravity: Some(Vector::new(0.0, 0.0, -9.81)),

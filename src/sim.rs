@@ -40,7 +40,7 @@ pub use pipeline::{
     Pipeline, StepError, StepOutcome, WeldEvent,
 };
 pub use setup::{Settings, Setup, StepSize};
-pub use state::{Effort, Ledger, RefusedSteps, SimState};
+pub use state::{Effort, Ledger, RefusedSteps, SeamState, SimState};
 pub use step_control::{
     AdaptiveStep, DEFAULT_MIN_STEP, DEFAULT_STEP_PENETRATION, DEFAULT_STEP_TOLERANCE, StepControl,
 };

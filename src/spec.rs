@@ -68,8 +68,6 @@ pub enum ClothMesh {
         path: String,
         /// Metres per texture-coordinate unit (the `vt` become material coordinates).
         uv_scale: f64,
-        /// How seams read from the file's `l` elements are sewn.
-        sewing: Sewing,
     },
     /// A garment: panels cut from outlines and sewn at seams.
     Panels(Garment),
@@ -84,8 +82,6 @@ pub struct Garment {
     pub seams: Vec<SeamSpec>,
     /// The target edge length of the panels' triangles, m.
     pub max_edge: f64,
-    /// How every seam is sewn and welded.
-    pub sewing: Sewing,
 }
 
 /// One panel: its outline in pattern coordinates and where it starts.
@@ -178,8 +174,18 @@ pub struct SeamSide {
     pub side: usize,
 }
 
-/// How a seam is sewn: the pull of its springs, its cap, and the gap at which
-/// it is welded.
+/// The sewing stiffness a seam gets unless told otherwise, N/m per m of seam:
+/// a 1 m seam's springs together pull with 50 N per metre of gap.
+pub const DEFAULT_SEWING_STIFFNESS: Scalar = 50.0;
+
+/// The weld gap a seam gets unless told otherwise, m: it is welded once every
+/// pair is closer than 5 mm.
+pub const DEFAULT_WELD_GAP: Scalar = 0.005;
+
+/// How the seams are sewn: the pull of their springs, its cap, and the gap at
+/// which a seam is welded. Part of the physics model
+/// (`physics::MaterialParams`), not of the mesh: the mesh only says which
+/// vertices each seam pairs.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Sewing {
     /// Sewing stiffness per metre of seam, N/m per m: each pair's zero-length
@@ -192,6 +198,18 @@ pub struct Sewing {
     /// and beyond the gap where it reaches that force its energy grows
     /// linearly (`physics::sewing`).
     pub max_force: Option<Scalar>,
+}
+
+impl Default for Sewing {
+    /// The scene's defaults: [`DEFAULT_SEWING_STIFFNESS`], [`DEFAULT_WELD_GAP`],
+    /// no cap.
+    fn default() -> Sewing {
+        Sewing {
+            stiffness: DEFAULT_SEWING_STIFFNESS,
+            weld_gap: DEFAULT_WELD_GAP,
+            max_force: None,
+        }
+    }
 }
 
 /// The linear solver of the implicit integrator.

@@ -232,20 +232,23 @@ pub struct SeamSummary {
 }
 
 impl SeamSummary {
-    /// The seams of `mesh` at positions `x`.
-    pub fn of(mesh: &crate::mesh::Mesh, x: &[crate::math::Vector]) -> Vec<SeamSummary> {
+    /// The seams of `mesh` in the states `states` (one per seam), at
+    /// positions `x`.
+    pub fn of(
+        mesh: &crate::mesh::Mesh,
+        states: &[crate::sim::SeamState],
+        x: &[crate::math::Vector],
+    ) -> Vec<SeamSummary> {
         let Some(panels) = mesh.panels() else {
             return Vec::new();
         };
         panels
             .seams
             .iter()
-            .map(|s| SeamSummary {
+            .zip(states)
+            .map(|(s, state)| SeamSummary {
                 name: s.name.clone(),
-                welded_at: match s.state {
-                    crate::mesh::SeamState::Open => None,
-                    crate::mesh::SeamState::Welded { time } => Some(time),
-                },
+                welded_at: state.welded_at(),
                 gap: s.gap(x),
             })
             .collect()

@@ -96,12 +96,8 @@ impl World {
                 let local = m.material.iter().map(|p| p.extend(0.0)).collect();
                 (m, local)
             }
-            ClothMesh::Obj {
-                path,
-                uv_scale,
-                sewing,
-            } => {
-                let obj = mesh::load_obj(Path::new(path), *uv_scale, *sewing)?;
+            ClothMesh::Obj { path, uv_scale } => {
+                let obj = mesh::load_obj(Path::new(path), *uv_scale)?;
                 (obj.mesh, obj.positions)
             }
             ClothMesh::Panels(garment) => {
@@ -118,13 +114,12 @@ impl World {
         Ok(world)
     }
 
-    /// Welds seam `s` of the garment (see [`Mesh::weld`]) at the current time:
-    /// each pair becomes one vertex at the pair's centre of mass, moving with
+    /// Welds seam `s` of the garment (see [`Mesh::weld`]): each pair becomes one vertex at the pair's centre of mass, moving with
     /// its mean momentum (`mass`: the vertex masses before the weld), so mass
     /// and momentum are conserved. Pins follow their vertices. Returns the
     /// number of vertices merged away.
     pub fn weld_seam(&mut self, s: usize, mass: &[Scalar]) -> Result<usize, MeshError> {
-        let weld = self.mesh.weld(s, self.time)?;
+        let weld = self.mesh.weld(s)?;
         let n = weld.mesh.vertex_count();
         let mut m = vec![0.0; n];
         let mut p = vec![Vector::ZERO; n];

@@ -59,6 +59,7 @@ pub fn setup(
             damping: 0.001,
             bending_model: bending,
             stiffness_rule: StiffnessRule::Consistent,
+            sewing: Default::default(),
         },
         external: ExternalForces {
             gravity: Some(Vector::new(0.0, 0.0, -9.81)),

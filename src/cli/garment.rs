@@ -13,7 +13,6 @@ use crate::{ColourChoice, EdgeChoice, RunArgs, SceneArgs};
 use drape::garmentcode::body::check_body;
 use drape::garmentcode::scene_text::{Body, BodyUp, Draping, scene};
 use drape::scene::load_scene_str_in;
-use drape::spec::Sewing;
 
 /// The draping settings the written scene starts from (`docs/garmentcode.md`).
 const DRAPING: Draping = Draping {
@@ -96,12 +95,7 @@ pub enum Up {
 /// Runs `drape garment`, with `drape run`'s exit codes.
 pub fn cmd_garment(args: GarmentArgs) -> Result<ExitCode> {
     let pattern = drape::garmentcode::load(&args.spec)?;
-    let sewing = Sewing {
-        stiffness: DRAPING.sewing_stiffness,
-        weld_gap: DRAPING.weld_gap,
-        max_force: None,
-    };
-    drape::garmentcode::check(&pattern, DRAPING.max_edge, sewing).map_err(|why| {
+    drape::garmentcode::check(&pattern, DRAPING.max_edge).map_err(|why| {
         drape::garmentcode::GarmentCodeError {
             file: args.spec.display().to_string(),
             why,

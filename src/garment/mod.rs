@@ -8,7 +8,7 @@
 mod sides;
 
 use crate::math::{Vector, Vector2, rotation_from_euler_deg};
-use crate::mesh::{Mesh, MeshError, OutlineError, Panels, Seam, SeamState, mesh_outline};
+use crate::mesh::{Mesh, MeshError, OutlineError, Panels, Seam, mesh_outline};
 use crate::spec::{Garment, Placement, SeamDirection, SeamSpec};
 pub use sides::SEAM_LENGTH_TOLERANCE;
 
@@ -141,8 +141,6 @@ pub fn build(garment: &Garment) -> Result<BuiltGarment, GarmentError> {
             Ok(Seam {
                 name: s.name.clone(),
                 pairs,
-                state: SeamState::Open,
-                sewing: garment.sewing,
             })
         })
         .collect::<Result<Vec<Seam>, GarmentError>>()?;
@@ -214,7 +212,7 @@ fn check_weldable(mesh: &Mesh) -> Result<(), GarmentError> {
     let mut welded = mesh.clone();
     for s in 0..count {
         welded = welded
-            .weld(s, 0.0)
+            .weld(s)
             .map_err(|e| match e {
                 MeshError::SeamTwisted { .. } | MeshError::NonManifoldEdge { .. } => {
                     GarmentError::Seam {

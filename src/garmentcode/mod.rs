@@ -23,7 +23,7 @@ use std::path::Path;
 
 use crate::garment::{GarmentError, build};
 use crate::mesh::OutlineError;
-use crate::spec::{Garment, PanelSpec, SeamSpec, Sewing};
+use crate::spec::{Garment, PanelSpec, SeamSpec};
 use json::SpecFile;
 
 /// A GarmentCode pattern in drape's terms (metres, GarmentCode's y-up frame).
@@ -198,12 +198,11 @@ pub fn parse(text: &str) -> Result<Pattern, Why> {
 
 /// Builds the pattern's garment with triangles about `max_edge` (m) across,
 /// to find what cannot be meshed or sewn before a scene is made of it.
-pub fn check(pattern: &Pattern, max_edge: f64, sewing: Sewing) -> Result<(), Why> {
+pub fn check(pattern: &Pattern, max_edge: f64) -> Result<(), Why> {
     let garment = Garment {
         panels: pattern.panels.clone(),
         seams: pattern.seams.clone(),
         max_edge,
-        sewing,
     };
     match build(&garment) {
         Ok(_) => Ok(()),

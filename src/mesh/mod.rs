@@ -24,9 +24,7 @@ pub use outline::{
     segments_for,
 };
 pub use pairmap::{PairHasher, PairMap, PairSet};
-pub use panels::{
-    DEFAULT_SEWING_STIFFNESS, DEFAULT_WELD_GAP, Panels, Pattern, Seam, SeamState, Weld,
-};
+pub use panels::{Panels, Pattern, Seam, Weld};
 pub use topology::{Edge, NO_TRIANGLE};
 
 use crate::math::{Scalar, Vector2};

@@ -17,15 +17,6 @@
 
 use super::{Mesh, MeshError, topology};
 use crate::math::{Scalar, Vector, Vector2};
-use crate::spec::Sewing;
-
-/// The sewing stiffness a seam gets unless told otherwise, N/m per m of seam:
-/// a 1 m seam's springs together pull with 50 N per metre of gap.
-pub const DEFAULT_SEWING_STIFFNESS: Scalar = 50.0;
-
-/// The weld gap a seam gets unless told otherwise, m: it is welded once every
-/// pair is closer than 5 mm.
-pub const DEFAULT_WELD_GAP: Scalar = 0.005;
 
 /// Where each triangle's corners lie in material space.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -54,36 +45,25 @@ pub struct Panels {
     pub seams: Vec<Seam>,
 }
 
-/// A seam: vertex pairs on two panel boundaries, sewn together.
+/// A seam: vertex pairs on two panel boundaries, sewn together. The mesh holds
+/// only which vertices a seam pairs; how it is sewn is the physics model's
+/// (`spec::Sewing` in `physics::MaterialParams`) and when it was welded the
+/// simulation state's (`sim::SeamState`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Seam {
     /// The seam's name (from the scene, or `l1`, `l2`, ... from an OBJ).
     pub name: String,
     /// The sewn pairs: a vertex of the first side and its partner on the second.
-    /// Both entries name the same vertex once the seam is welded.
+    /// While the seam is open every pair names two vertices; once it is welded
+    /// both entries of every pair name the same vertex.
     pub pairs: Vec<[u32; 2]>,
-    /// Whether the seam is still being sewn.
-    pub state: SeamState,
-    /// How the seam is sewn and when it is welded.
-    pub sewing: Sewing,
-}
-
-/// Whether a seam is open (sewing springs pull it) or welded into one surface.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum SeamState {
-    /// The sides are separate vertices, pulled together by sewing springs.
-    Open,
-    /// The sides are one surface since the given simulated time, s.
-    Welded {
-        /// When the seam was welded, s (0 for a garment sewn in a modeller).
-        time: Scalar,
-    },
 }
 
 impl Seam {
-    /// True while the seam is open.
+    /// True while the seam is open: its pairs are distinct vertices, which
+    /// sewing springs pull together. A welded seam's pairs are single vertices.
     pub fn is_open(&self) -> bool {
-        self.state == SeamState::Open
+        self.pairs.iter().any(|p| p[0] != p[1])
     }
 
     /// Each pair's share of the seam's rest length, m: half of each seam segment
@@ -202,9 +182,10 @@ impl Mesh {
     }
 
     /// Welds seam `s`: merges each pair into the first side's vertex (placed and
-    /// moving as the caller decides, see [`crate::world::World::weld_seam`]),
-    /// marks the seam welded at `time` and renumbers the vertices densely.
-    pub fn weld(&self, s: usize, time: Scalar) -> Result<Weld, MeshError> {
+    /// moving as the caller decides, see [`crate::world::World::weld_seam`]) and
+    /// renumbers the vertices densely. Another open seam whose every pair this
+    /// joins is welded with it.
+    pub fn weld(&self, s: usize) -> Result<Weld, MeshError> {
         let Pattern::Panels(panels) = &self.pattern else {
             return Err(MeshError::NoSuchSeam { seam: s });
         };
@@ -246,21 +227,16 @@ impl Mesh {
             .filter(|&v| keep(v))
             .map(|v| panels.of_vertex[v])
             .collect();
-        for (k, other) in next.seams.iter_mut().enumerate() {
+        for other in &mut next.seams {
+            let open = other.is_open();
             for pair in &mut other.pairs {
                 *pair = pair.map(|v| new_index[v as usize]);
             }
-            if k == s {
-                other.state = SeamState::Welded { time };
-            } else if other.is_open() {
-                // A pair this weld joined (the corner where this seam and
-                // another meet) is closed already; a seam whose every pair
-                // is joined is welded.
-                if other.pairs.iter().all(|p| p[0] == p[1]) {
-                    other.state = SeamState::Welded { time };
-                } else {
-                    other.pairs.retain(|p| p[0] != p[1]);
-                }
+            // A pair this weld joined (the corner where this seam and another
+            // meet) is closed already; a seam whose every pair is joined is
+            // welded, and one with pairs left open keeps only those.
+            if open && other.is_open() {
+                other.pairs.retain(|p| p[0] != p[1]);
             }
         }
         let triangles = self

@@ -65,7 +65,7 @@ use super::shape::{
 };
 use crate::math::{Scalar, Vector2};
 use crate::mesh::Mesh;
-use crate::spec::{BendingModel, StiffnessRule};
+use crate::spec::{BendingModel, Sewing, StiffnessRule};
 use reuse::{Previous, Reuse};
 
 /// Material parameters the elements are built from (per area, mesh independent).
@@ -86,6 +86,9 @@ pub struct MaterialParams {
     pub bending_model: BendingModel,
     /// How spring constants are derived.
     pub stiffness_rule: StiffnessRule,
+    /// How a garment's open seams are sewn (their springs' stiffness and cap;
+    /// the weld gap is read by the pipeline's sewing phase).
+    pub sewing: Sewing,
 }
 
 /// A linear spring with damping along its axis.

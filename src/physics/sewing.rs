@@ -61,8 +61,8 @@ pub(super) fn sewing_springs(
     };
     for seam in panels.seams.iter().filter(|s| s.is_open()) {
         for (pair, share) in seam.pairs.iter().zip(seam.pair_lengths(mesh)) {
-            let k = seam.sewing.stiffness * share;
-            if let Some(max_force) = seam.sewing.max_force {
+            let k = mat.sewing.stiffness * share;
+            if let Some(max_force) = mat.sewing.max_force {
                 caps.push(SpringCap {
                     spring: springs.len() as u32,
                     max_force: max_force * share,

@@ -133,7 +133,11 @@ impl Tally {
             rest: end.rest,
             cantilever: end.cantilever,
             pin_mismatches: self.pin_mismatches.clone(),
-            seams: crate::summary::SeamSummary::of(&end.state.world.mesh, &end.state.world.x),
+            seams: crate::summary::SeamSummary::of(
+                &end.state.world.mesh,
+                &end.state.seams,
+                &end.state.world.x,
+            ),
             recording: end.recording.map(|(path, bytes, frames)| RecordingSummary {
                 path,
                 bytes,

@@ -137,11 +137,11 @@ impl Default for SewingTable {
 }
 
 fn default_sewing_stiffness() -> f64 {
-    crate::mesh::DEFAULT_SEWING_STIFFNESS
+    crate::spec::DEFAULT_SEWING_STIFFNESS
 }
 
 fn default_weld_gap() -> f64 {
-    crate::mesh::DEFAULT_WELD_GAP
+    crate::spec::DEFAULT_WELD_GAP
 }
 
 /// `[simulation]`: time span, integrator and global forces.

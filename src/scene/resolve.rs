@@ -81,7 +81,6 @@ pub fn cloth_spec(
         ClothShape::Obj => ClothMesh::Obj {
             path: c.path.clone().ok_or(BuildError::Missing("path"))?,
             uv_scale: c.uv_scale,
-            sewing: sewing(c),
         },
         ClothShape::Panels => ClothMesh::Panels(Garment {
             panels: panels.iter().map(panel_spec).collect(),
@@ -96,7 +95,6 @@ pub fn cloth_spec(
                 })
                 .collect(),
             max_edge: need(c.max_edge, "max_edge")?,
-            sewing: sewing(c),
         }),
     };
     Ok(ClothSpec {
@@ -209,6 +207,7 @@ impl Model {
                 damping: m.damping,
                 bending_model: m.bending_model,
                 stiffness_rule: m.stiffness_rule,
+                sewing: sewing(&scene.cloth),
             },
             external,
             integrator: scene.simulation.integrator,

@@ -34,11 +34,62 @@ pub struct SimState {
     pub ledger: Ledger,
     /// What the computer did, retried work included.
     pub effort: Effort,
+    /// Each seam of a garment, open or welded (empty without panels).
+    pub seams: Vec<SeamState>,
     /// Seams welded since the recording last took them.
     pub welds: Vec<WeldEvent>,
     /// The adaptive step's proposal for the next step (read with
     /// `dt = "adaptive"` only).
     pub step_control: StepControl,
+}
+
+/// Whether a seam is open (sewing springs pull it) or welded into one surface.
+/// The mesh says which vertices a seam pairs (one vertex per pair once
+/// welded, [`crate::mesh::Seam::is_open`]); the state adds when it was welded.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SeamState {
+    /// The sides are separate vertices, pulled together by sewing springs.
+    Open,
+    /// The sides are one surface since the given simulated time, s.
+    Welded {
+        /// When the seam was welded, s (0 for a seam welded when the run
+        /// starts).
+        time: Scalar,
+    },
+}
+
+impl SeamState {
+    /// The state of each seam of `world`'s mesh at the start of a run: open
+    /// where its pairs are apart, welded at time 0 where they are one vertex.
+    pub fn at_start(world: &World) -> Vec<SeamState> {
+        let Some(panels) = world.mesh.panels() else {
+            return Vec::new();
+        };
+        panels
+            .seams
+            .iter()
+            .map(|s| {
+                if s.is_open() {
+                    SeamState::Open
+                } else {
+                    SeamState::Welded { time: 0.0 }
+                }
+            })
+            .collect()
+    }
+
+    /// True while the seam is open.
+    pub fn is_open(self) -> bool {
+        self == SeamState::Open
+    }
+
+    /// When the seam was welded, s (`None` while it is open).
+    pub fn welded_at(self) -> Option<Scalar> {
+        match self {
+            SeamState::Open => None,
+            SeamState::Welded { time } => Some(time),
+        }
+    }
 }
 
 /// The energy accounting of a run: the work done on the cloth from outside, the
@@ -126,6 +177,7 @@ impl SimState {
         pipeline: &Pipeline,
     ) -> SimState {
         let bound = EnergyBound::new(&world, pipeline.stepper(), &setup.model);
+        let seams = SeamState::at_start(&world);
         SimState {
             world,
             adapter,
@@ -139,6 +191,7 @@ impl SimState {
                 excess_max: 0.0,
             },
             effort: Effort::default(),
+            seams,
             welds: Vec::new(),
             step_control: StepControl::default(),
         }
@@ -162,6 +215,7 @@ impl Clone for SimState {
             warm_start: self.warm_start.clone(),
             ledger: self.ledger,
             effort: self.effort,
+            seams: self.seams.clone(),
             welds: self.welds.clone(),
             step_control: self.step_control,
         }
@@ -178,6 +232,7 @@ impl Clone for SimState {
             warm_start,
             ledger,
             effort,
+            seams,
             welds,
             step_control,
         } = source;
@@ -198,6 +253,7 @@ impl Clone for SimState {
         self.warm_start.clone_from(warm_start);
         self.ledger = *ledger;
         self.effort = *effort;
+        self.seams.clone_from(seams);
         self.welds.clone_from(welds);
         self.step_control = *step_control;
     }

@@ -57,6 +57,7 @@ fn swinging_stepper(
         damping,
         bending_model: BendingModel::Dihedral,
         stiffness_rule: StiffnessRule::Consistent,
+        sewing: Default::default(),
     };
     let external = ExternalForces {
         gravity: Some(Vector::new(0.0, 0.0, -9.81)),

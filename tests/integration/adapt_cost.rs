@@ -57,6 +57,7 @@ fn cost(method: AdaptMethod) {
         damping: 0.001,
         bending_model: BendingModel::ShapeOperator,
         stiffness_rule: StiffnessRule::Consistent,
+        sewing: Default::default(),
     };
     let mut ad = Adapter::new(&config, &w, 0.15).unwrap();
     let (mut pass_s, mut rebuild_s, mut times) = (0.0, 0.0, Vec::new());

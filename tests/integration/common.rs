@@ -2,12 +2,10 @@
 
 use drape::adapt::AdaptConfig;
 use drape::math::{Scalar, Vector};
-use drape::mesh::{DEFAULT_SEWING_STIFFNESS, DEFAULT_WELD_GAP};
 use drape::physics::{Energy, Model, SolveFailure, Stepper};
 use drape::scene::Scene;
 use drape::scene::{AdaptCriterion, AdaptMethod, Pin, PinMotion};
 use drape::sim::{Pipeline, Setup, SimParts, SimState, build};
-use drape::spec::Sewing;
 use drape::world::World;
 
 /// Overrides of `scenes/hanging_sheet_rest.toml` that made the sizing
@@ -22,13 +20,6 @@ pub const BOUNCING_SHEET: [&str; 6] = [
     "adapt.refine_strain=0.02",
     "adapt.rollback=false",
 ];
-
-/// The default sewing, for OBJ files loaded in tests.
-pub const SEWING: Sewing = Sewing {
-    stiffness: DEFAULT_SEWING_STIFFNESS,
-    weld_gap: DEFAULT_WELD_GAP,
-    max_force: None,
-};
 
 /// A fixed pin on `region` with every other key at its default.
 pub fn pin(region: &str) -> Pin {

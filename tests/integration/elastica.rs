@@ -80,6 +80,7 @@ pub fn strip_material(bending: Scalar, model: BendingModel, rule: StiffnessRule)
         damping: 0.0,
         bending_model: model,
         stiffness_rule: rule,
+        sewing: Default::default(),
     }
 }
 

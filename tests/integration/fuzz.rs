@@ -11,8 +11,6 @@ use drape::scene::{Scene, load_scene_str};
 use drape::world::World;
 use proptest::prelude::*;
 
-use crate::common::SEWING;
-
 /// Cases per fuzz test: 2000 (about a second each in release), or `PROPTEST_CASES`.
 fn cases() -> u32 {
     std::env::var("PROPTEST_CASES")
@@ -302,7 +300,7 @@ fn obj_samples() -> Vec<String> {
 fn load_bytes(bytes: &[u8], uv_scale: f64, name: &str) -> Result<(), TestCaseError> {
     let path = std::env::temp_dir().join(format!("drape-fuzz-{}-{name}.obj", std::process::id()));
     std::fs::write(&path, bytes).expect("write temp OBJ");
-    let loaded = load_obj(&path, uv_scale, SEWING);
+    let loaded = load_obj(&path, uv_scale);
     // The same file as an obstacle mesh (a different loader, in `collide`).
     let sets = [
         "obstacle.0.shape=mesh".to_owned(),

@@ -4,8 +4,8 @@
 //! decides which ends meet.
 
 use drape::math::Scalar;
-use drape::mesh::SeamState;
 use drape::scene::load_scene_str;
+use drape::sim::SeamState;
 
 use crate::garments::{garment_sim, seam_state};
 

@@ -14,10 +14,10 @@ use drape::adapt::transfer::mesh_lumped_masses;
 use drape::adapt::{AdaptConfig, Adapter};
 use drape::garment::{self, BuiltGarment};
 use drape::math::{Scalar, Vector, Vector2};
-use drape::mesh::{DEFAULT_SEWING_STIFFNESS, DEFAULT_WELD_GAP, Mesh, SeamState};
+use drape::mesh::Mesh;
 use drape::physics::{Elements, MaterialParams, Membrane};
 use drape::scene::{AdaptMethod, BendingModel, StiffnessRule, load_scene_str};
-use drape::spec::Sewing;
+use drape::sim::SeamState;
 use drape::spec::{Garment, Gather, PanelSpec, Placement, SeamDirection, SeamSide, SeamSpec};
 use drape::world::World;
 use proptest::prelude::*;
@@ -76,11 +76,6 @@ fn welded_halves(width: Scalar, placements: [Placement; 2]) -> (World, Scalar) {
         panels: vec![half("front", pf), half("back", pb)],
         seams,
         max_edge: 0.06,
-        sewing: Sewing {
-            stiffness: DEFAULT_SEWING_STIFFNESS,
-            weld_gap: DEFAULT_WELD_GAP,
-            max_force: None,
-        },
     })
     .expect("garment");
     let mat = MaterialParams {
@@ -91,6 +86,7 @@ fn welded_halves(width: Scalar, placements: [Placement; 2]) -> (World, Scalar) {
         damping: 0.0,
         bending_model: BendingModel::ShapeOperator,
         stiffness_rule: StiffnessRule::Consistent,
+        sewing: Default::default(),
     };
     let mut world = World::new(mesh, positions);
     for s in 0..2 {
@@ -408,18 +404,10 @@ fn a_garment_scene_remeshes_once_its_seams_are_welded() {
     }
     let stats = sim.state.adapter.as_ref().expect("adapter").stats;
     assert!(!stats.awaiting_welds);
-    let welded_at = sim
-        .state
-        .world
-        .mesh
-        .panels()
-        .expect("panels")
-        .seams
-        .iter()
-        .map(|s| match s.state {
-            SeamState::Welded { time } => time,
-            SeamState::Open => Scalar::INFINITY,
-        });
+    let welded_at = sim.state.seams.iter().map(|s| match *s {
+        SeamState::Welded { time } => time,
+        SeamState::Open => Scalar::INFINITY,
+    });
     let last_weld = welded_at.fold(0.0, Scalar::max);
     println!(
         "last weld at {last_weld:.3} s, remeshing from {:.3} s",

@@ -11,7 +11,7 @@ use serde_json::Value;
 use drape::garment;
 use drape::garmentcode::{self, Pattern};
 use drape::math::{Vector, Vector2, rotation_from_euler_deg};
-use drape::spec::{Garment, Sewing};
+use drape::spec::Garment;
 
 use crate::bad_input::{drape, refused, temp_dir};
 
@@ -32,11 +32,6 @@ fn built(pattern: &Pattern) -> garment::BuiltGarment {
         panels: pattern.panels.clone(),
         seams: pattern.seams.clone(),
         max_edge: 0.03,
-        sewing: Sewing {
-            stiffness: 1000.0,
-            weld_gap: 0.005,
-            max_force: None,
-        },
     })
     .expect("the garment builds")
 }

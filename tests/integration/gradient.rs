@@ -74,6 +74,7 @@ fn total_force_is_minus_the_energy_gradient() {
                 damping: 0.0,
                 bending_model: model,
                 stiffness_rule: StiffnessRule::Consistent,
+                sewing: Default::default(),
             };
             let el = Elements::build(m, &mat);
             let ext = ExternalForces {

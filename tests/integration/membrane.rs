@@ -147,6 +147,7 @@ pub(crate) fn membrane_material(membrane: Membrane) -> MaterialParams {
         damping: 0.0,
         bending_model: BendingModel::ShapeOperator,
         stiffness_rule: StiffnessRule::Consistent,
+        sewing: Default::default(),
     }
 }
 

@@ -11,8 +11,6 @@ use drape::math::{Vector, Vector2};
 use drape::mesh::{self, Mesh, MeshError, ObjError};
 use drape::scene::DiagonalPattern;
 
-use crate::common::SEWING;
-
 /// A fixture in `tests/data/`.
 fn data(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -33,7 +31,7 @@ fn temp_dir(name: &str) -> PathBuf {
 
 /// Loads a fixture that must be refused; returns the error.
 fn refused(name: &str) -> ObjError {
-    let err = mesh::load_obj(&data(name), 1.0, SEWING).expect_err(name);
+    let err = mesh::load_obj(&data(name), 1.0).expect_err(name);
     assert!(
         err.to_string().contains(name),
         "the message names the file: {err}"
@@ -63,7 +61,7 @@ fn area3(p: &[Vector], tri: &[u32; 3]) -> f64 {
 
 #[test]
 fn obj_texcoords_times_uv_scale_become_material_and_positions_are_kept() {
-    let cloth = mesh::load_obj(&data("quad_2x2_uv.obj"), 4.0, SEWING).expect("load");
+    let cloth = mesh::load_obj(&data("quad_2x2_uv.obj"), 4.0).expect("load");
     let m = &cloth.mesh;
     assert_eq!(m.vertex_count(), 9);
     assert_eq!(m.triangles.len(), 8, "four quads, triangulated");
@@ -82,13 +80,13 @@ fn obj_texcoords_times_uv_scale_become_material_and_positions_are_kept() {
     assert!(area_3d > 4.0 + 1e-3, "3D area {area_3d}");
 
     // uv_scale scales areas by its square.
-    let half = mesh::load_obj(&data("quad_2x2_uv.obj"), 2.0, SEWING).expect("load");
+    let half = mesh::load_obj(&data("quad_2x2_uv.obj"), 2.0).expect("load");
     assert!((half.mesh.total_rest_area() - 1.0).abs() < 1e-12);
 }
 
 #[test]
 fn flat_obj_without_texcoords_rests_in_its_own_plane() {
-    let cloth = mesh::load_obj(&data("quad_2x2_tilted.obj"), 1.0, SEWING).expect("load");
+    let cloth = mesh::load_obj(&data("quad_2x2_tilted.obj"), 1.0).expect("load");
     let m = &cloth.mesh;
     assert_eq!((m.vertex_count(), m.triangles.len()), (9, 8));
     let area_3d: f64 = m.triangles.iter().map(|t| area3(&cloth.positions, t)).sum();
@@ -121,7 +119,7 @@ fn non_planar_obj_without_texcoords_is_not_planar() {
 /// panels (formerly refused as a UV seam).
 #[test]
 fn one_position_with_two_texcoords_is_welded_across_two_panels() {
-    let cloth = mesh::load_obj(&data("seam.obj"), 1.0, SEWING).expect("seam.obj loads");
+    let cloth = mesh::load_obj(&data("seam.obj"), 1.0).expect("seam.obj loads");
     let m = &cloth.mesh;
     let panels = m.panels().expect("a garment");
     assert_eq!(panels.names, ["piece1", "piece2"]);
@@ -186,14 +184,14 @@ fn flat_obj_with_a_reversed_face_still_gets_its_planar_rest_shape() {
         "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 4 3\n",
     )
     .unwrap();
-    let cloth = drape::mesh::load_obj(&path, 1.0, SEWING).expect("a flat square loads");
+    let cloth = drape::mesh::load_obj(&path, 1.0).expect("a flat square loads");
     assert!((cloth.mesh.total_rest_area() - 1.0).abs() < 1e-12);
     std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]
 fn missing_garbage_and_empty_obj_files_are_read_errors_naming_the_file() {
-    let missing = mesh::load_obj(&data("no_such_file.obj"), 1.0, SEWING).expect_err("missing");
+    let missing = mesh::load_obj(&data("no_such_file.obj"), 1.0).expect_err("missing");
     assert!(matches!(missing, ObjError::Read { .. }), "{missing:?}");
     assert!(
         missing.to_string().contains("no_such_file.obj"),
@@ -204,7 +202,7 @@ fn missing_garbage_and_empty_obj_files_are_read_errors_naming_the_file() {
     let dir = temp_dir("empty");
     let empty = dir.join("empty.obj");
     std::fs::write(&empty, "# nothing here\n").unwrap();
-    let err = mesh::load_obj(&empty, 1.0, SEWING).expect_err("an empty OBJ has no cloth");
+    let err = mesh::load_obj(&empty, 1.0).expect_err("an empty OBJ has no cloth");
     assert!(err.to_string().contains("empty.obj"), "{err}");
     std::fs::remove_dir_all(&dir).ok();
 }
@@ -230,7 +228,7 @@ fn obj_bow_tie_is_a_non_manifold_vertex() {
 /// Two separate pieces are two panels (formerly refused as disconnected).
 #[test]
 fn obj_in_two_pieces_is_two_panels() {
-    let cloth = mesh::load_obj(&data("two_pieces.obj"), 1.0, SEWING).expect("loads");
+    let cloth = mesh::load_obj(&data("two_pieces.obj"), 1.0).expect("loads");
     let panels = cloth.mesh.panels().expect("a garment");
     assert_eq!(panels.names, ["piece1", "piece2"]);
     assert_eq!(panels.of_triangle, [0, 1]);

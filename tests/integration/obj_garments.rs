@@ -8,10 +8,7 @@
 use std::path::PathBuf;
 
 use drape::math::Vector2;
-use drape::mesh::{self, ObjCloth, ObjError, Panels, Pattern, SeamState};
-use drape::spec::Sewing;
-
-use crate::common::SEWING;
+use drape::mesh::{self, ObjCloth, ObjError, Panels, Pattern};
 
 /// A fresh empty directory in the temp dir, unique per process, test and call.
 pub(crate) fn temp_dir(name: &str) -> PathBuf {
@@ -27,11 +24,11 @@ pub(crate) fn temp_dir(name: &str) -> PathBuf {
 }
 
 /// Writes `text` to `NAME.obj` in a fresh directory and loads it.
-pub(crate) fn load(name: &str, text: &str, sewing: Sewing) -> Result<ObjCloth, ObjError> {
+pub(crate) fn load(name: &str, text: &str) -> Result<ObjCloth, ObjError> {
     let dir = temp_dir(name);
     let path = dir.join(format!("{name}.obj"));
     std::fs::write(&path, text).expect("write fixture");
-    let loaded = mesh::load_obj(&path, 1.0, sewing);
+    let loaded = mesh::load_obj(&path, 1.0);
     std::fs::remove_dir_all(&dir).ok();
     loaded
 }
@@ -97,7 +94,7 @@ const TWO_PANEL_PAIRS: [[u32; 2]; 3] = [[1, 6], [2, 9], [4, 11]];
 
 /// Checks the two-panel garment: panels `front` and `back`, one seam of three
 /// pairs from the front's right edge to the back's left edge.
-fn check_two_panels(cloth: &ObjCloth, first_l: usize, sewing: Sewing) {
+fn check_two_panels(cloth: &ObjCloth, first_l: usize) {
     let p = panels(cloth);
     assert_eq!(p.names, ["front", "back"]);
     assert_eq!(p.of_triangle, [0, 0, 0, 0, 1, 1, 1, 1]);
@@ -105,8 +102,7 @@ fn check_two_panels(cloth: &ObjCloth, first_l: usize, sewing: Sewing) {
     assert_eq!(p.seams.len(), 1, "{:?}", p.seams);
     let seam = &p.seams[0];
     assert_eq!(seam.name, format!("l{first_l}"));
-    assert_eq!(seam.state, SeamState::Open);
-    assert_eq!(seam.sewing, sewing);
+    assert!(seam.is_open());
     assert_eq!(seam.pairs, TWO_PANEL_PAIRS);
     for &[a, b] in &seam.pairs {
         let (pa, pb) = (cloth.positions[a as usize], cloth.positions[b as usize]);
@@ -122,13 +118,8 @@ fn check_two_panels(cloth: &ObjCloth, first_l: usize, sewing: Sewing) {
 
 #[test]
 fn two_panels_with_l_sewing_edges_read_as_two_panels_and_one_seam() {
-    let sewing = Sewing {
-        stiffness: 80.0,
-        weld_gap: 0.002,
-        max_force: Some(30.0),
-    };
-    let cloth = load("two_panels", TWO_PANELS, sewing).expect("a two-panel garment loads");
-    check_two_panels(&cloth, line_of(TWO_PANELS, "l "), sewing);
+    let cloth = load("two_panels", TWO_PANELS).expect("a two-panel garment loads");
+    check_two_panels(&cloth, line_of(TWO_PANELS, "l "));
 }
 
 /// The same garment with the `v` lines in another order than the faces use
@@ -172,8 +163,8 @@ l 9/2 1/1
 l -1 3
 l 6 -2
 ";
-    let cloth = load("mapping", text, SEWING).expect("the garment loads");
-    check_two_panels(&cloth, line_of(text, "l "), SEWING);
+    let cloth = load("mapping", text).expect("the garment loads");
+    check_two_panels(&cloth, line_of(text, "l "));
     assert_eq!(
         cloth.positions.len(),
         12,
@@ -219,7 +210,7 @@ fn cylinder_obj(segments: usize, rows: usize) -> (String, f64, f64) {
 fn cylinder_welded_at_its_seam_reads_as_one_welded_panel_with_per_corner_coordinates() {
     let (segments, rows) = (16, 3);
     let (text, width, height) = cylinder_obj(segments, rows);
-    let cloth = load("cylinder", &text, SEWING).expect("the cylinder loads");
+    let cloth = load("cylinder", &text).expect("the cylinder loads");
     let m = &cloth.mesh;
     let p = panels(&cloth);
     assert_eq!(p.names, ["sleeve"]);
@@ -292,7 +283,7 @@ fn panel_with(l: &str) -> String {
 /// with a reason containing `says`.
 fn refused_l(l: &str, says: &str) {
     let text = panel_with(l);
-    let err = load("bad_l", &text, SEWING).expect_err(l);
+    let err = load("bad_l", &text).expect_err(l);
     let line = line_of(&text, "l ");
     assert!(
         matches!(err, ObjError::BadLine { line: n, .. } if n == line),
@@ -307,7 +298,7 @@ fn refused_l(l: &str, says: &str) {
 #[test]
 fn l_endpoint_inside_a_panel_is_refused_naming_file_and_line() {
     // Sanity: the same file sewing two boundary vertices loads.
-    let ok = load("good_l", &panel_with("l 3 10"), SEWING).expect("boundary to boundary");
+    let ok = load("good_l", &panel_with("l 3 10")).expect("boundary to boundary");
     assert_eq!(panels(&ok).seams.len(), 1);
     refused_l("l 5 10", "`l` vertex 5 is not a boundary vertex");
 }
@@ -351,12 +342,12 @@ f 1/1 2/2 3/3
 o right
 f 1/1 3/3 4/4
 ";
-    let cloth = load("two_objects", text, SEWING).expect("loads");
+    let cloth = load("two_objects", text).expect("loads");
     assert_eq!(cloth.mesh.pattern, Pattern::PerVertex);
     assert_eq!(cloth.mesh.total_rest_area(), 1.0);
     let fixture = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data");
     for name in ["quad_2x2_uv.obj", "quad_2x2_tilted.obj"] {
-        let cloth = mesh::load_obj(&fixture.join(name), 1.0, SEWING).expect(name);
+        let cloth = mesh::load_obj(&fixture.join(name), 1.0).expect(name);
         assert_eq!(cloth.mesh.pattern, Pattern::PerVertex, "{name}");
         let rebuilt = mesh::Mesh::new(cloth.mesh.material.clone(), cloth.mesh.triangles.clone())
             .expect("valid");
@@ -368,7 +359,7 @@ f 1/1 3/3 4/4
 #[test]
 fn flat_pieces_without_texcoords_are_panels_named_by_number() {
     let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 3 0 0\nv 4 0 0\nv 3 1 0\nf 1 2 3\nf 4 5 6\n";
-    let cloth = load("flat_pieces", text, SEWING).expect("two flat pieces load");
+    let cloth = load("flat_pieces", text).expect("two flat pieces load");
     let p = panels(&cloth);
     assert_eq!(p.names, ["piece1", "piece2"]);
     assert_eq!(p.of_triangle, [0, 1]);

@@ -28,6 +28,7 @@ pub(crate) fn material(
         damping: 0.001,
         bending_model,
         stiffness_rule,
+        sewing: Default::default(),
     }
 }
 

@@ -5,7 +5,7 @@
 //! apply the cap.
 
 use drape::math::{Scalar, Vector};
-use drape::mesh::SeamState;
+use drape::sim::SeamState;
 
 use crate::common::Sim;
 use crate::garments::seam_state;

@@ -28,6 +28,7 @@ fn fabric(stretch: Scalar) -> MaterialParams {
         damping: 0.001,
         bending_model: BendingModel::Dihedral,
         stiffness_rule: StiffnessRule::Consistent,
+        sewing: Default::default(),
     }
 }
 

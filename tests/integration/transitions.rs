@@ -130,6 +130,7 @@ fn green_closures_stretch_unlike_the_grid() {
         damping: 0.0,
         bending_model: BendingModel::ShapeOperator,
         stiffness_rule: StiffnessRule::Consistent,
+        sewing: Default::default(),
     };
     let e = 0.01;
     let cases: [(&str, [[Scalar; 2]; 2]); 4] = [

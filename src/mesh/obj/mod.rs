@@ -29,8 +29,8 @@
 //!   edges from one side of a seam to the other): each pairs its consecutive
 //!   vertices, which must be boundary vertices of the mesh not joined by an
 //!   edge. The pairs are grouped into open seams along the boundary, each
-//!   named `lN` after the line of its first element ([`seams`] gives the rule)
-//!   and sewn with the `sewing` given to [`load_obj`].
+//!   named `lN` after the line of its first element ([`seams`] gives the rule);
+//!   how they are sewn is the physics model's (`[cloth.sewing]`).
 //!
 //! tobj reads the faces; the loader reads the text itself too ([`text`]),
 //! for what tobj lets through and for the `l` elements, which it hides from
@@ -45,7 +45,6 @@ use std::path::Path;
 
 use super::{Mesh, MeshError, topology};
 use crate::math::{Scalar, Vector, Vector2};
-use crate::spec::Sewing;
 use merge::{MergedObj, merge_models, planar_rest_shape};
 use pieces::{Pieces, find_pieces};
 use seams::{SeamMesh, read_seams};
@@ -117,10 +116,9 @@ pub struct ObjCloth {
     pub positions: Vec<Vector>,
 }
 
-/// Loads `path`; `uv_scale` is metres per texture-coordinate unit and
-/// `sewing` sews every seam read from `l` elements (see the module docs for
-/// how a file becomes a plain cloth or a garment).
-pub fn load_obj(path: &Path, uv_scale: Scalar, sewing: Sewing) -> Result<ObjCloth, ObjError> {
+/// Loads `path`; `uv_scale` is metres per texture-coordinate unit (see the
+/// module docs for how a file becomes a plain cloth or a garment).
+pub fn load_obj(path: &Path, uv_scale: Scalar) -> Result<ObjCloth, ObjError> {
     let name = path.display().to_string();
     let text = scan_text(path, &name)?;
     let models = read_models(&text, &name)?;
@@ -161,7 +159,7 @@ pub fn load_obj(path: &Path, uv_scale: Scalar, sewing: Sewing) -> Result<ObjClot
             positions: merged.positions,
         });
     }
-    garment(&text, &models, merged, corners, &pieces, sewing, name)
+    garment(&text, &models, merged, corners, &pieces, name)
 }
 
 /// Runs tobj over the file's text (without its `l` lines, and without
@@ -204,7 +202,6 @@ fn garment(
     merged: MergedObj,
     corners: Vec<[Vector2; 3]>,
     pieces: &Pieces,
-    sewing: Sewing,
     name: String,
 ) -> Result<ObjCloth, ObjError> {
     if pieces.count > usize::from(u16::MAX) + 1 {
@@ -233,7 +230,7 @@ fn garment(
             edges: &edges,
             of_vertex: &panels.of_vertex,
         };
-        panels.seams = read_seams(text, &merged, &seam_mesh, sewing, &name)?;
+        panels.seams = read_seams(text, &merged, &seam_mesh, &name)?;
     }
     let mesh = Mesh::from_panels(material, merged.triangles, panels).map_err(mesh_error)?;
     Ok(ObjCloth {

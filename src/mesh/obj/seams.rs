@@ -6,8 +6,7 @@ use std::collections::{HashMap, HashSet};
 use super::ObjError;
 use super::merge::{MergedObj, position_key};
 use super::text::{LineElement, ObjText};
-use crate::mesh::{Edge, Seam, SeamState};
-use crate::spec::Sewing;
+use crate::mesh::{Edge, Seam};
 
 /// A sewing pair read from the file.
 struct Pair {
@@ -32,13 +31,11 @@ pub(super) struct SeamMesh<'a> {
 /// first vertices are joined by a boundary edge and so are their second ones,
 /// or the first of each and the second of the other (then one is turned
 /// round). A seam is named `lN`, N the line of its first element (`lN_2`,
-/// `lN_3`, ... for further seams that start on that line), and sewn with
-/// `sewing`.
+/// `lN_3`, ... for further seams that start on that line).
 pub(super) fn read_seams(
     text: &ObjText,
     merged: &MergedObj,
     mesh: &SeamMesh,
-    sewing: Sewing,
     name: &str,
 ) -> Result<Vec<Seam>, ObjError> {
     let pairs = read_pairs(text, merged, mesh, name)?;
@@ -65,8 +62,6 @@ pub(super) fn read_seams(
             Seam {
                 name: seam_name,
                 pairs,
-                state: SeamState::Open,
-                sewing,
             }
         })
         .collect();

@@ -4,7 +4,7 @@
 use super::Pipeline;
 use crate::math::{Scalar, Vector};
 use crate::mesh::MeshError;
-use crate::sim::{Setup, SimState};
+use crate::sim::{SeamState, Setup, SimState};
 
 /// A seam welded during the run, for the recording's events.
 #[derive(Debug, Clone, PartialEq)]
@@ -33,9 +33,10 @@ impl Pipeline {
                 return Ok(welded);
             };
             let x = &state.world.x;
+            let weld_gap = setup.model.material.sewing.weld_gap;
             let closed = panels.seams.iter().enumerate().find_map(|(s, seam)| {
                 let gap = seam.gap(x);
-                (seam.is_open() && gap < seam.sewing.weld_gap).then_some((s, gap))
+                (seam.is_open() && gap < weld_gap).then_some((s, gap))
             });
             let Some((s, gap)) = closed else {
                 return Ok(welded);
@@ -51,6 +52,7 @@ impl Pipeline {
             let mass = self.stepper.elements.mass.clone();
             let before = self.stepper.energy(&setup.model, &state.world).total();
             state.world.weld_seam(s, &mass)?;
+            mark_welded(state);
             state.welds.push(WeldEvent {
                 seam: name,
                 position: centre,
@@ -64,6 +66,21 @@ impl Pipeline {
             let after = self.stepper.energy(&setup.model, &state.world).total();
             state.ledger.external_work += after - before;
             welded = true;
+        }
+    }
+}
+
+/// Marks welded, at the present time, every seam the state still has open
+/// whose pairs the mesh has joined (the seam just welded, and any other whose
+/// every pair that weld joined).
+fn mark_welded(state: &mut SimState) {
+    let Some(panels) = state.world.mesh.panels() else {
+        return;
+    };
+    let time = state.world.time;
+    for (seam, s) in panels.seams.iter().zip(&mut state.seams) {
+        if s.is_open() && !seam.is_open() {
+            *s = SeamState::Welded { time };
         }
     }
 }
