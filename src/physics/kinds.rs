@@ -47,9 +47,26 @@ pub trait ForceKind {
     type Forces: std::fmt::Debug + Default + Clone + Send + Sync;
     /// The linearised step's terms of this kind (blocks, slots, gradients).
     type Linear: std::fmt::Debug + Default + Clone + Send + Sync;
+    /// A multirate kick's scratch: the forces of a group's elements between
+    /// the parallel pass and their write into the slots.
+    type Kick: std::fmt::Debug + Default + Clone + Send + Sync;
     /// The place of this kind's energy in the elastic energy's sum.
     const ENERGY_RANK: usize;
 
+    /// The number of elements.
+    fn count(el: &Elements) -> usize;
+    /// Into `out` (cleared first): the vertices of element `e`, in slot order.
+    fn element_vertices(el: &Elements, e: usize, out: &mut Vec<u32>);
+    /// Writes the forces at `(x, v)` of the elements `ids` (ascending) into
+    /// their slots of `out` (a multirate kick); `kick` is scratch.
+    fn kick(
+        el: &Elements,
+        ids: &[u32],
+        x: &[Vector],
+        v: &[Vector],
+        out: &mut Self::Forces,
+        kick: &mut Self::Kick,
+    );
     /// Sizes `out` for the elements of `el` (no allocation once grown).
     fn size_forces(el: &Elements, out: &mut Self::Forces);
     /// Fills `out` with every element's forces at `(x, v)`, each into its own slots.
@@ -132,6 +149,49 @@ macro_rules! kind_list {
             }
         };
 
+        /// Each kind's place in the list.
+        #[allow(non_camel_case_types)]
+        #[derive(Debug, Clone, Copy)]
+        enum Place {
+            $($field,)+
+        }
+
+        /// Per kind, element indices (for example those that touch a
+        /// multirate group), in the list's order.
+        pub type KindIds = [Vec<u32>; KIND_COUNT];
+
+        /// Calls `f(kind, element, vertices)` for every element of every
+        /// kind, kind by kind, each kind in element order (`kind` its place
+        /// in the list).
+        pub fn for_each_element(el: &Elements, mut f: impl FnMut(usize, u32, &[u32])) {
+            let mut vertices = Vec::new();
+            $(
+                for e in 0..<$kind as ForceKind>::count(el) {
+                    <$kind as ForceKind>::element_vertices(el, e, &mut vertices);
+                    f(Place::$field as usize, e as u32, &vertices);
+                }
+            )+
+        }
+
+        /// Into `out` (cleared first): the vertices of element `e` of the kind
+        /// at place `kind` in the list.
+        pub fn element_vertices(el: &Elements, kind: usize, e: usize, out: &mut Vec<u32>) {
+            $(
+                if kind == Place::$field as usize {
+                    <$kind as ForceKind>::element_vertices(el, e, out);
+                }
+            )+
+        }
+
+        /// Every kind's multirate scratch.
+        #[derive(Debug, Default, Clone)]
+        pub struct KindKicks {
+            $(
+                #[doc = concat!("The kick scratch of [`", stringify!($kind), "`].")]
+                pub $field: <$kind as ForceKind>::Kick,
+            )+
+        }
+
         /// The element pass's scratch of every kind.
         #[derive(Debug, Default, Clone)]
         pub struct KindForces {
@@ -150,6 +210,25 @@ macro_rules! kind_list {
             /// Every kind's element pass at `(x, v)`.
             pub fn compute(&mut self, el: &Elements, x: &[Vector], v: &[Vector]) {
                 $(<$kind as ForceKind>::forces(el, x, v, &mut self.$field);)+
+            }
+
+            /// Every kind's [`ForceKind::kick`] of its elements in `ids`.
+            pub fn kick(
+                &mut self,
+                el: &Elements,
+                ids: &KindIds,
+                x: &[Vector],
+                v: &[Vector],
+                kicks: &mut KindKicks,
+            ) {
+                $(<$kind as ForceKind>::kick(
+                    el,
+                    &ids[Place::$field as usize],
+                    x,
+                    v,
+                    &mut self.$field,
+                    &mut kicks.$field,
+                );)+
             }
 
             /// Adds every kind's slots of vertex `i` to `f`, kind by kind.
@@ -251,3 +330,6 @@ kind_list! {
     shapes: ShapeTriangles,
     membrane: MembraneTriangles,
 }
+
+#[cfg(test)]
+mod tests;

@@ -29,7 +29,38 @@ pub struct HingeLinear {
 impl ForceKind for Hinges {
     type Forces = Vec<Vector>;
     type Linear = HingeLinear;
+    type Kick = Vec<[Vector; 4]>;
     const ENERGY_RANK: usize = 2;
+
+    fn count(el: &Elements) -> usize {
+        el.hinges.len()
+    }
+
+    fn element_vertices(el: &Elements, e: usize, out: &mut Vec<u32>) {
+        out.clear();
+        out.extend(el.hinges[e].v);
+    }
+
+    fn kick(
+        el: &Elements,
+        ids: &[u32],
+        x: &[Vector],
+        _v: &[Vector],
+        out: &mut Vec<Vector>,
+        kick: &mut Vec<[Vector; 4]>,
+    ) {
+        ids.par_iter()
+            .with_min_len(256)
+            .map(|&h| {
+                let hg = &el.hinges[h as usize];
+                let (theta, grad) = dihedral_angle_and_gradient(hg.v.map(|i| x[i as usize]));
+                grad.map(|gk| gk * (-hg.k * theta))
+            })
+            .collect_into_vec(kick);
+        for (&h, f) in ids.iter().zip(kick.iter()) {
+            out[4 * h as usize..4 * h as usize + 4].copy_from_slice(f);
+        }
+    }
 
     fn size_forces(el: &Elements, out: &mut Vec<Vector>) {
         out.resize(4 * el.hinges.len(), Vector::ZERO);

@@ -28,7 +28,39 @@ pub struct MembraneLinear {
 impl ForceKind for MembraneTriangles {
     type Forces = Vec<Vector>;
     type Linear = MembraneLinear;
+    type Kick = Vec<[Vector; MEMBRANE_SLOTS]>;
     const ENERGY_RANK: usize = 1;
+
+    fn count(el: &Elements) -> usize {
+        el.membrane_triangles.len()
+    }
+
+    fn element_vertices(el: &Elements, e: usize, out: &mut Vec<u32>) {
+        out.clear();
+        out.extend(el.membrane_triangles[e].v);
+    }
+
+    fn kick(
+        el: &Elements,
+        ids: &[u32],
+        x: &[Vector],
+        v: &[Vector],
+        out: &mut Vec<Vector>,
+        kick: &mut Vec<[Vector; MEMBRANE_SLOTS]>,
+    ) {
+        ids.par_iter()
+            .with_min_len(256)
+            .map(|&t| {
+                let mut f = [Vector::ZERO; MEMBRANE_SLOTS];
+                el.membrane_triangles[t as usize].forces(x, v, &mut f);
+                f
+            })
+            .collect_into_vec(kick);
+        for (&t, f) in ids.iter().zip(kick.iter()) {
+            let at = MEMBRANE_SLOTS * t as usize;
+            out[at..at + MEMBRANE_SLOTS].copy_from_slice(f);
+        }
+    }
 
     fn size_forces(el: &Elements, out: &mut Vec<Vector>) {
         out.resize(MEMBRANE_SLOTS * el.membrane_triangles.len(), Vector::ZERO);

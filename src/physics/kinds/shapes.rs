@@ -10,7 +10,9 @@ use super::ForceKind;
 use crate::math::{Scalar, Vector, deterministic_sum};
 use crate::mesh::Mesh;
 use crate::physics::elements::Elements;
-use crate::physics::forces::{PAR_MIN, edge_folds, fold_angles, fold_angles_and_splits, splits_at};
+use crate::physics::forces::{
+    PAR_MIN, edge_folds, fold_angles, fold_angles_and_splits, solve_splits, splits_at,
+};
 use crate::physics::shape::{EdgeFold, SHAPE_SLOTS, ShapeJacobian, rates, spread};
 
 /// The shape triangles of [`Elements::shape_triangles`].
@@ -64,7 +66,44 @@ impl ShapeTriangles {
 impl ForceKind for ShapeTriangles {
     type Forces = ShapeForces;
     type Linear = ShapeLinear;
+    type Kick = Vec<[Vector; SHAPE_SLOTS]>;
     const ENERGY_RANK: usize = 3;
+
+    fn count(el: &Elements) -> usize {
+        el.shape_triangles.len()
+    }
+
+    fn element_vertices(el: &Elements, e: usize, out: &mut Vec<u32>) {
+        out.clear();
+        out.extend(el.shape_triangles[e].slots().map(|(_, v)| v));
+    }
+
+    /// The splits couple every fold: they are solved over the whole mesh.
+    fn kick(
+        el: &Elements,
+        ids: &[u32],
+        x: &[Vector],
+        _v: &[Vector],
+        out: &mut ShapeForces,
+        kick: &mut Vec<[Vector; SHAPE_SLOTS]>,
+    ) {
+        if !ids.is_empty() {
+            solve_splits(el, x, &mut out.folds, &mut out.splits);
+        }
+        let splits = &out.splits;
+        ids.par_iter()
+            .with_min_len(128)
+            .map(|&p| {
+                let mut f = [Vector::ZERO; SHAPE_SLOTS];
+                el.shape_triangles[p as usize].forces(x, splits, &mut f);
+                f
+            })
+            .collect_into_vec(kick);
+        for (&p, f) in ids.iter().zip(kick.iter()) {
+            let at = SHAPE_SLOTS * p as usize;
+            out.slots[at..at + SHAPE_SLOTS].copy_from_slice(f);
+        }
+    }
 
     fn size_forces(el: &Elements, out: &mut ShapeForces) {
         out.slots

@@ -12,7 +12,7 @@ use crate::physics::block::outer;
 use crate::physics::elements::Elements;
 use crate::physics::forces::{PAR_MIN, spring_force};
 use crate::physics::sewing::{
-    cap_energy_change, cap_forces, capped_spring_force, capped_spring_stiffness,
+    cap_energy_change, cap_force, cap_forces, capped_spring_force, capped_spring_stiffness,
 };
 
 /// The springs of [`Elements::springs`] (with [`Elements::sewing_caps`]).
@@ -31,7 +31,44 @@ pub struct SpringLinear {
 impl ForceKind for Springs {
     type Forces = Vec<Vector>;
     type Linear = SpringLinear;
+    type Kick = Vec<Vector>;
     const ENERGY_RANK: usize = 0;
+
+    fn count(el: &Elements) -> usize {
+        el.springs.len()
+    }
+
+    fn element_vertices(el: &Elements, e: usize, out: &mut Vec<u32>) {
+        out.clear();
+        out.extend(el.springs[e].v);
+    }
+
+    /// The capped sewing springs among `ids` get their capped force
+    /// ([`Elements::sewing_caps`] is in spring order).
+    fn kick(
+        el: &Elements,
+        ids: &[u32],
+        x: &[Vector],
+        v: &[Vector],
+        out: &mut Vec<Vector>,
+        kick: &mut Vec<Vector>,
+    ) {
+        let caps = &el.sewing_caps;
+        ids.par_iter()
+            .with_min_len(512)
+            .map(|&s| match caps.binary_search_by_key(&s, |c| c.spring) {
+                Ok(c) => cap_force(el, &caps[c], x, v),
+                Err(_) => {
+                    let sp = &el.springs[s as usize];
+                    let [a, b] = [sp.v[0] as usize, sp.v[1] as usize];
+                    spring_force(x[a], x[b], v[a], v[b], sp.rest, sp.k, sp.c)
+                }
+            })
+            .collect_into_vec(kick);
+        for (&s, &f) in ids.iter().zip(kick.iter()) {
+            out[s as usize] = f;
+        }
+    }
 
     fn size_forces(el: &Elements, out: &mut Vec<Vector>) {
         out.resize(el.springs.len(), Vector::ZERO);
