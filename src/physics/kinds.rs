@@ -31,7 +31,10 @@ mod springs;
 
 pub use hinges::{HingeLinear, Hinges};
 pub use membrane::{MembraneLinear, MembraneTriangles};
-pub use shapes::{ShapeForces, ShapeLinear, ShapeTriangles};
+pub use shapes::{
+    ShapeForces, ShapeLinear, ShapeTriangles, edge_folds, fold_angles, fold_angles_and_splits,
+    solve_splits, splits_at,
+};
 pub use springs::{SpringLinear, Springs};
 
 use super::elements::Elements;

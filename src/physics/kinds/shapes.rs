@@ -10,9 +10,7 @@ use super::ForceKind;
 use crate::math::{Scalar, Vector, deterministic_sum};
 use crate::mesh::Mesh;
 use crate::physics::elements::Elements;
-use crate::physics::forces::{
-    PAR_MIN, edge_folds, fold_angles, fold_angles_and_splits, solve_splits, splits_at,
-};
+use crate::physics::forces::PAR_MIN;
 use crate::physics::shape::{EdgeFold, SHAPE_SLOTS, ShapeJacobian, rates, spread};
 
 /// The shape triangles of [`Elements::shape_triangles`].
@@ -47,6 +45,93 @@ pub struct ShapeLinear {
     pub folds: Vec<[Scalar; 3]>,
     /// The fold splits at the step's start.
     pub splits: Vec<Scalar>,
+}
+
+/// The fold splits that minimise the bending energy at `x` (see
+/// [`solve_splits`]); empty without shape triangles.
+pub fn splits_at(el: &Elements, x: &[Vector]) -> Vec<Scalar> {
+    let (mut folds, mut splits) = (Vec::new(), Vec::new());
+    if !el.shape_triangles.is_empty() {
+        solve_splits(el, x, &mut folds, &mut splits);
+    }
+    splits
+}
+
+/// Into `folds`, `gradients` and `splits`: each shape triangle's folds at
+/// `x` and their gradients by slot, then the splits that minimise the
+/// bending energy for them (`shape.rs`, "Splitting the folds"); `edges` is
+/// scratch ([`fold_angles`]).
+pub fn fold_angles_and_splits(
+    el: &Elements,
+    x: &[Vector],
+    edges: &mut Vec<EdgeFold>,
+    folds: &mut Vec<[Scalar; 3]>,
+    gradients: &mut Vec<ShapeJacobian>,
+    splits: &mut Vec<Scalar>,
+) {
+    fold_angles(el, x, edges, folds, gradients);
+    el.fold_splits.solve(&el.shape_triangles, folds, splits);
+}
+
+/// Into `folds` and `gradients`: each shape triangle's folds at `x` and their
+/// gradients by slot (the first half of [`fold_angles_and_splits`]), read
+/// from each interior edge's fold, computed once into `edges`.
+pub fn fold_angles(
+    el: &Elements,
+    x: &[Vector],
+    edges: &mut Vec<EdgeFold>,
+    folds: &mut Vec<[Scalar; 3]>,
+    gradients: &mut Vec<ShapeJacobian>,
+) {
+    let shapes = el.shape_triangles.len();
+    el.fold_edges.compute(x, edges);
+    let edges = &*edges;
+    folds.resize(shapes, [0.0; 3]);
+    gradients.resize(shapes, [[Vector::ZERO; SHAPE_SLOTS]; 3]);
+    folds
+        .par_iter_mut()
+        .zip(gradients.par_iter_mut())
+        .enumerate()
+        .with_min_len(PAR_MIN / SHAPE_SLOTS)
+        .for_each(|(t, (folds, jac))| (*folds, *jac) = el.fold_edges.angles(t, edges));
+}
+
+/// Into `edges` and `folds`: each interior edge's fold at `x` and each shape
+/// triangle's folds read from them ([`fold_angles`] without the gradients by
+/// slot, which a pass that needs them reads from `edges` with
+/// [`crate::physics::shape::FoldEdges::angles`]).
+pub fn edge_folds(
+    el: &Elements,
+    x: &[Vector],
+    edges: &mut Vec<EdgeFold>,
+    folds: &mut Vec<[Scalar; 3]>,
+) {
+    el.fold_edges.compute(x, edges);
+    let edges = &*edges;
+    folds.resize(el.shape_triangles.len(), [0.0; 3]);
+    folds
+        .par_iter_mut()
+        .enumerate()
+        .with_min_len(PAR_MIN)
+        .for_each(|(t, folds)| *folds = el.fold_edges.folds(t, edges));
+}
+
+/// Into `folds` and `splits`: each shape triangle's folds at `x` and the
+/// splits that minimise the bending energy for them (`shape.rs`, "Splitting
+/// the folds").
+pub fn solve_splits(
+    el: &Elements,
+    x: &[Vector],
+    folds: &mut Vec<[Scalar; 3]>,
+    splits: &mut Vec<Scalar>,
+) {
+    folds.resize(el.shape_triangles.len(), [0.0; 3]);
+    folds
+        .par_iter_mut()
+        .with_min_len(PAR_MIN)
+        .zip(el.shape_triangles.par_iter())
+        .for_each(|(f, t)| *f = t.folds(x));
+    el.fold_splits.solve(&el.shape_triangles, folds, splits);
 }
 
 impl ShapeTriangles {
