@@ -8,6 +8,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 mod frame_loop;
 mod measure;
+mod outputs;
 mod phases;
 mod recording;
 mod tally;

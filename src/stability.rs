@@ -203,7 +203,7 @@ impl Variant<'_> {
 /// g the gravity and D the diagonal of the cloth's material-space bounds.
 pub fn energy_scale(summary: &Summary, gravity: [Scalar; 3], diagonal: Scalar) -> Scalar {
     let g = gravity.iter().map(|x| x * x).sum::<Scalar>().sqrt();
-    summary.energy.initial.abs() + summary.mass_initial * g * diagonal
+    summary.conservation.energy.initial.abs() + summary.conservation.mass_initial * g * diagonal
 }
 
 /// FNV-1a over 64-bit words.
@@ -282,13 +282,14 @@ pub fn run_variant(
         case: variant.case.name.clone(),
         integrator: integrator_name(variant.integrator).to_string(),
         adaptive: variant.adaptive,
-        steps: summary.steps,
-        retries: summary.nan_recoveries,
+        steps: summary.extent.steps,
+        retries: summary.effort.nan_recoveries,
         energy_scale: s,
-        excess_ratio: summary.energy.excess_max / s,
-        max_penetration: thickness.map(|_| summary.max_penetration),
+        excess_ratio: summary.conservation.energy.excess_max / s,
+        max_penetration: thickness.map(|_| summary.collision.max_penetration),
         thickness,
-        mass_drift: (summary.mass_final - summary.mass_initial).abs() / summary.mass_initial,
+        mass_drift: (summary.conservation.mass_final - summary.conservation.mass_initial).abs()
+            / summary.conservation.mass_initial,
         wall_s,
         failure,
         hash,

@@ -8,6 +8,8 @@ use serde::Serialize;
 use crate::math::Scalar;
 use crate::physics::StepStats;
 
+mod paragraph;
+
 /// Minimum, mean and maximum of a quantity sampled once per recorded frame.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Range {
@@ -63,7 +65,7 @@ pub struct EnergySummary {
 /// What the adaptive step did (`dt = "adaptive"`).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct AdaptiveDtSummary {
-    /// The largest step taken, s (the smallest is [`Summary::dt`]).
+    /// The largest step taken, s (the smallest is [`Stepping::dt`]).
     pub max_dt: Scalar,
     /// Steps refused, by reason.
     pub refused: crate::sim::RefusedSteps,
@@ -82,9 +84,49 @@ pub struct RecordingSummary {
     pub frames: u64,
 }
 
-/// Everything `--summary` writes.
+/// Everything `--summary` writes, in parts that each say one thing. Every part
+/// is flattened into the JSON, whose keys keep the order of the fields here.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Summary {
+    /// What ran and how far.
+    #[serde(flatten)]
+    pub extent: Extent,
+    /// Where the wall time went.
+    #[serde(flatten)]
+    pub wall: WallTimes,
+    /// The sizes of the steps and their rate.
+    #[serde(flatten)]
+    pub stepping: Stepping,
+    /// The mesh's size over the recorded frames.
+    #[serde(flatten)]
+    pub mesh: MeshSize,
+    /// Mass and energy.
+    #[serde(flatten)]
+    pub conservation: Conservation,
+    /// Frame attempts retried and the implicit solver's work.
+    #[serde(flatten)]
+    pub effort: StepEffort,
+    /// What adaptive meshing did.
+    #[serde(flatten)]
+    pub adaptivity: Adaptivity,
+    /// Contacts with obstacles and self-collision, and their cost.
+    #[serde(flatten)]
+    pub collision: Collisions,
+    /// The standard tests' measurements at the end.
+    #[serde(flatten)]
+    pub measurements: Measurements,
+    /// What the scene asks of the cloth against what the run did.
+    #[serde(flatten)]
+    pub checks: SceneChecks,
+    /// True when Ctrl-C ended the run early.
+    pub interrupted: bool,
+    /// The recording, if one was written.
+    pub recording: Option<RecordingSummary>,
+}
+
+/// What ran and how far it went.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Extent {
     /// Scene name.
     pub scene: String,
     /// Recorded frames, including the initial one.
@@ -93,12 +135,22 @@ pub struct Summary {
     pub steps: u64,
     /// Simulated time reached, s.
     pub sim_time: Scalar,
+}
+
+/// Where the wall time went, s.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct WallTimes {
     /// Wall time of the whole run, s.
     pub wall_time_s: Scalar,
     /// Wall time spent stepping, s.
     pub simulation_wall_s: Scalar,
     /// Wall time spent recording (and exporting OBJ), s.
     pub recording_wall_s: Scalar,
+}
+
+/// The steps taken: their sizes, their count and their rate.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Stepping {
     /// The smallest time step taken, s (with `dt = "auto"` and adaptivity the
     /// step follows the finest triangles).
     pub dt: Scalar,
@@ -114,16 +166,32 @@ pub struct Summary {
     pub adaptive_dt: Option<AdaptiveDtSummary>,
     /// Steps times mean vertices per second of stepping wall time.
     pub vertex_steps_per_s: Scalar,
+}
+
+/// The mesh's size over the recorded frames.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct MeshSize {
     /// Vertex counts over the recorded frames.
     pub vertices: Range,
     /// Triangle counts over the recorded frames.
     pub triangles: Range,
+}
+
+/// Mass and energy at the start and the end.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Conservation {
     /// Total mass at the start, kg.
     pub mass_initial: Scalar,
     /// Total mass at the end, kg.
     pub mass_final: Scalar,
     /// Total energy.
     pub energy: EnergySummary,
+}
+
+/// What stepping took beyond one try per step: retried frame attempts and the
+/// implicit solver's work.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct StepEffort {
     /// Frame attempts retried with halved steps: after a non-finite state, an energy
     /// explosion, or an energy gain above the tolerance (the key keeps its first name).
     pub nan_recoveries: u64,
@@ -132,6 +200,11 @@ pub struct Summary {
     pub energy_retries: u64,
     /// CG iterations and capped solves of the implicit integrator.
     pub solver: StepStats,
+}
+
+/// What adaptive meshing did (zeros and `null` when the scene does not adapt).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Adaptivity {
     /// 1-4 splits made by adaptive meshing (including forced ones).
     pub splits: u64,
     /// Merges made by adaptive meshing.
@@ -142,6 +215,11 @@ pub struct Summary {
     pub max_level: u8,
     /// All adaptivity counters, when the scene adapts.
     pub adapt: Option<crate::adapt::AdaptStats>,
+}
+
+/// Contacts with obstacles and self-collision, and their wall time.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Collisions {
     /// Largest depth of a cloth vertex below an obstacle surface, measured after the
     /// collision response of every step, m (0 without obstacles).
     pub max_penetration: Scalar,
@@ -155,12 +233,24 @@ pub struct Summary {
     pub collision_wall_s: Scalar,
     /// Wall time in self-collision, s (part of `simulation_wall_s`).
     pub self_collision_wall_s: Scalar,
+}
+
+/// The standard tests' measurements at the end, for the scenes that set them up.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Measurements {
     /// Cusick drape measurements at the end, when the scene is a disk specimen on a
     /// vertical support cylinder (see `collide::cusick`).
     pub cusick: Option<crate::collide::cusick::CusickSummary>,
     /// Cantilever bending test measurements at the end, when the scene is a
     /// rectangle held by fixed pins over one end (see `cantilever`).
     pub cantilever: Option<crate::cantilever::CantileverSummary>,
+}
+
+/// What the scene asks of the cloth against what the run did: the pin regions
+/// hold the cloth they name, the seams close, the cloth comes to rest. Each
+/// part is absent from the JSON when there is nothing to report.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SceneChecks {
     /// Box pin regions whose held vertices are not the cloth inside the box
     /// (a mesh without lines on the box's edges: a disk, an OBJ); absent
     /// from the JSON when every pin holds what the scene names.
@@ -174,18 +264,6 @@ pub struct Summary {
     /// from the JSON for a scene without a rest criterion.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub rest: Option<RestSummary>,
-    /// True when Ctrl-C ended the run early.
-    pub interrupted: bool,
-    /// The recording, if one was written.
-    pub recording: Option<RecordingSummary>,
-}
-
-fn seams_sentence(seams: &[SeamSummary]) -> String {
-    if seams.is_empty() {
-        return String::new();
-    }
-    let parts: Vec<String> = seams.iter().map(SeamSummary::describe).collect();
-    format!(" Seams: {}.", parts.join(", "))
 }
 
 /// The rest criterion at the end of a run.
@@ -239,11 +317,7 @@ impl SeamSummary {
         states: &[crate::sim::SeamState],
         x: &[crate::math::Vector],
     ) -> Vec<SeamSummary> {
-        let Some(panels) = mesh.panels() else {
-            return Vec::new();
-        };
-        panels
-            .seams
+        mesh.seams()
             .iter()
             .zip(states)
             .map(|(s, state)| SeamSummary {
@@ -266,131 +340,6 @@ impl Summary {
     /// True when the steps taken differ in size (by more than rounding): by
     /// level, automatic step, retried frames or the adaptive step.
     pub fn step_varied(&self) -> bool {
-        self.dt_max - self.dt > 1e-9 * self.dt_max
-    }
-
-    /// The steps taken, in words: `N steps of DT s` for a steady step; for a
-    /// varying one the range and the mean step. The count is of the accepted
-    /// steps, so that it times the step (or the mean) is the simulated time;
-    /// steps retried or refused are counted besides, and the adaptive step's
-    /// refusals given.
-    fn steps_in_words(&self) -> String {
-        let redone = self.steps.saturating_sub(self.steps_accepted);
-        if !self.step_varied() {
-            return match redone {
-                0 => format!("{} steps of {:.3e} s", self.steps, self.dt),
-                n => format!(
-                    "{} steps of {:.3e} s ({n} more retried or refused)",
-                    self.steps_accepted, self.dt
-                ),
-            };
-        }
-        let besides = match redone {
-            0 => String::new(),
-            n => format!("; {n} more retried or refused"),
-        };
-        let adaptive = match &self.adaptive_dt {
-            None => String::new(),
-            Some(a) => format!(
-                "; adaptive: {} refused, {} for the error, {} for penetration, {} failed; largest accepted error estimate {:.3e} m",
-                a.refused.total(),
-                a.refused.error,
-                a.refused.penetration,
-                a.refused.failed,
-                a.largest_error
-            ),
-        };
-        format!(
-            "{} steps of {:.3e} to {:.3e} s (mean {:.3e} s{besides}{adaptive})",
-            self.steps_accepted, self.dt, self.dt_max, self.dt_mean
-        )
-    }
-
-    /// The one-paragraph summary printed at the end of a run.
-    pub fn paragraph(&self) -> String {
-        let rec = match &self.recording {
-            Some(r) => format!(
-                "Recording: {} ({:.1} MB).",
-                r.path.display(),
-                r.bytes as f64 / 1e6
-            ),
-            None => "No recording.".to_string(),
-        };
-        let end = if self.interrupted {
-            " Interrupted by Ctrl-C."
-        } else {
-            ""
-        };
-        format!(
-            "{}: {} frames, {} to t = {:.3} s in {:.2} s wall ({:.2} s stepping, {:.2} s recording); \
-             {:.0} vertices, {:.0} triangles; {:.3e} vertex-steps/s. Mass {:.6} -> {:.6} kg; \
-             energy {:.4e} -> {:.4e} J (max {:.4e}; external work {:.3e} J; largest excess over initial + work {:.3e} J); \
-             {} recoveries (frame attempts retried with halved steps, {} for energy gain); {}.{}{}{}{} {}",
-            self.scene,
-            self.frames,
-            self.steps_in_words(),
-            self.sim_time,
-            self.wall_time_s,
-            self.simulation_wall_s,
-            self.recording_wall_s,
-            self.vertices.mean,
-            self.triangles.mean,
-            self.vertex_steps_per_s,
-            self.mass_initial,
-            self.mass_final,
-            self.energy.initial,
-            self.energy.r#final,
-            self.energy.max,
-            self.energy.external_work,
-            self.energy.excess_max,
-            self.nan_recoveries,
-            self.energy_retries,
-            self.solver.describe(),
-            match &self.adapt {
-                Some(a) if a.awaiting_welds => {
-                    " Adaptive: not started, as remeshing waits until every seam is welded.".into()
-                }
-                Some(a) => format!(
-                    " Adaptive: {} splits ({} forced), {} merges ({} bounced), {} rollbacks, max level {}{}.",
-                    a.splits,
-                    a.closure_splits,
-                    a.merges,
-                    a.bounces,
-                    a.rollbacks,
-                    self.max_level,
-                    match a.started_at > 0.0 {
-                        true => format!(
-                            "; remeshing from t = {:.3} s, once every seam was welded",
-                            a.started_at
-                        ),
-                        false => String::new(),
-                    }
-                ),
-                None => String::new(),
-            },
-            match &self.cantilever {
-                Some(c) => format!(
-                    " Cantilever: overhang {:.4} m, chord angle {:.2} deg (elastica for the material: {:.2} deg), bending length {:.4} m (material {:.4} m; Peirce's formula {:.4} m).",
-                    c.overhang,
-                    c.chord_angle_deg,
-                    c.elastica_chord_angle_deg,
-                    c.bending_length,
-                    c.material_bending_length,
-                    c.bending_length_peirce
-                ),
-                None => String::new(),
-            },
-            self.pin_mismatches
-                .iter()
-                .map(|m| format!(" Pin region differs from the scene: {}.", m.describe()))
-                .collect::<String>()
-                + &seams_sentence(&self.seams)
-                + &self
-                    .rest
-                    .as_ref()
-                    .map_or(String::new(), RestSummary::sentence),
-            end,
-            rec
-        )
+        self.stepping.dt_max - self.stepping.dt > 1e-9 * self.stepping.dt_max
     }
 }

@@ -231,6 +231,23 @@ impl Soup {
     /// Flips interior edges at the given vertices while that improves the
     /// Delaunay criterion in material space (never below `min_angle`).
     pub fn flip_around(&mut self, seeds: &[u32], limits: &Limits, out: &mut Vec<EdgeOp>) {
+        let mut queue = self.edges_at(seeds);
+        let mut budget = 16 * queue.len() + 16;
+        while let Some((a, b)) = queue.pop() {
+            budget = budget.saturating_sub(1);
+            if budget == 0 {
+                break;
+            }
+            let Some([a, b, c, d]) = self.flip(a, b, limits) else {
+                continue;
+            };
+            queue.extend([sorted(a, c), sorted(c, b), sorted(b, d), sorted(d, a)]);
+            out.push(EdgeOp::Flip(a, b));
+        }
+    }
+
+    /// The edges of the triangles at the vertices `seeds`, sorted and without repeats.
+    fn edges_at(&self, seeds: &[u32]) -> Vec<(u32, u32)> {
         let mut queue: Vec<(u32, u32)> = Vec::new();
         for &v in seeds {
             for &t in &self.vert_tris[v as usize] {
@@ -241,79 +258,84 @@ impl Soup {
         }
         queue.sort_unstable();
         queue.dedup();
-        let mut budget = 16 * queue.len() + 16;
-        while let Some((a, b)) = queue.pop() {
-            budget = budget.saturating_sub(1);
-            if budget == 0 {
-                break;
-            }
-            let ts = match self.tris_at(a, b).to_pair() {
-                Some(pair) => pair,
-                None => continue,
-            };
-            let (Some(s0), Some(s1)) = (self.soup_tri(ts[0]), self.soup_tri(ts[1])) else {
-                continue;
-            };
-            let (t0, t1) = (s0.tri, s1.tri);
-            let opp = |t: [u32; 3]| t.into_iter().find(|&v| v != a && v != b).unwrap_or(a);
-            let (c, d) = (opp(t0), opp(t1));
-            if self.has_edge(c, d) {
-                continue; // flipping would duplicate an edge
-            }
-            // Orient: t0 runs a -> b, so the flipped pair is (c, a, d), (d, b, c).
-            let runs_ab = (0..3).any(|k| t0[k] == a && t0[(k + 1) % 3] == b);
-            let (a, b) = if runs_ab { (a, b) } else { (b, a) };
-            let at = |t: u32, v: u32| {
-                self.corner_at(t, v)
-                    .expect("a flip's four vertices are corners of its two triangles")
-            };
-            let (pa, pb, pc, pd) = (at(ts[0], a), at(ts[0], b), at(ts[0], c), at(ts[1], d));
-            // A garment's welded seam is not flipped: its two triangles lie in
-            // different patterns.
-            if s0.panel != s1.panel || at(ts[1], a) != pa || at(ts[1], b) != pb {
-                continue;
-            }
-            let new0 = [pc, pa, pd];
-            let new1 = [pd, pb, pc];
-            let area = |p: [Vector2; 3]| (p[1] - p[0]).perp_dot(p[2] - p[0]);
-            if area(new0) <= 0.0 || area(new1) <= 0.0 {
-                continue; // not a convex quadrilateral
-            }
-            let angle_at = |x: Vector2, p: Vector2, q: Vector2| {
-                (p - x).perp_dot(q - x).abs().atan2((p - x).dot(q - x))
-            };
-            if angle_at(pc, pa, pb) + angle_at(pd, pa, pb) <= std::f64::consts::PI + 1e-9 {
-                continue; // already Delaunay
-            }
-            let before = min_angle_deg([pa, pb, pc]).min(min_angle_deg([pb, pa, pd]));
-            let after = min_angle_deg(new0).min(min_angle_deg(new1));
-            if after < limits.min_angle || after <= before {
-                continue;
-            }
-            let level = s0.level.max(s1.level);
-            let base = self.tris.len() as u32;
-            let added = |slot: u32, tri: [u32; 3], uv: [Vector2; 3]| SoupTri {
-                slot,
-                tri,
-                level,
-                uv,
-                panel: s0.panel,
-            };
-            let op = SoupOp {
-                vertex: None,
-                removed: vec![s0, s1],
-                added: vec![
-                    added(base, [c, a, d], new0),
-                    added(base + 1, [d, b, c], new1),
-                ],
-                slots: (base, base + 2),
-                touched: self.touching(&[a, b, c, d]),
-            };
-            self.commit(op);
-            queue.extend([sorted(a, c), sorted(c, b), sorted(b, d), sorted(d, a)]);
-            out.push(EdgeOp::Flip(a, b));
-        }
+        queue
     }
+
+    /// Flips the interior edge `a`-`b` into `c`-`d` when that improves the
+    /// Delaunay criterion in material space (never below `min_angle`), and
+    /// returns `[a, b, c, d]` with `a -> b` the direction of the first
+    /// triangle; `None` when the edge stays.
+    fn flip(&mut self, a: u32, b: u32, limits: &Limits) -> Option<[u32; 4]> {
+        let ts = self.tris_at(a, b).to_pair()?;
+        let (s0, s1) = (self.soup_tri(ts[0])?, self.soup_tri(ts[1])?);
+        let (t0, t1) = (s0.tri, s1.tri);
+        let opp = |t: [u32; 3]| t.into_iter().find(|&v| v != a && v != b).unwrap_or(a);
+        let (c, d) = (opp(t0), opp(t1));
+        if self.has_edge(c, d) {
+            return None; // flipping would duplicate an edge
+        }
+        // Orient: t0 runs a -> b, so the flipped pair is (c, a, d), (d, b, c).
+        let runs_ab = (0..3).any(|k| t0[k] == a && t0[(k + 1) % 3] == b);
+        let (a, b) = if runs_ab { (a, b) } else { (b, a) };
+        let at = |t: u32, v: u32| {
+            self.corner_at(t, v)
+                .expect("a flip's four vertices are corners of its two triangles")
+        };
+        let (pa, pb, pc, pd) = (at(ts[0], a), at(ts[0], b), at(ts[0], c), at(ts[1], d));
+        // A garment's welded seam is not flipped: its two triangles lie in
+        // different patterns.
+        if s0.panel != s1.panel || at(ts[1], a) != pa || at(ts[1], b) != pb {
+            return None;
+        }
+        let [new0, new1] = flipped_if_better([pa, pb, pc, pd], limits)?;
+        let level = s0.level.max(s1.level);
+        let base = self.tris.len() as u32;
+        let added = |slot: u32, tri: [u32; 3], uv: [Vector2; 3]| SoupTri {
+            slot,
+            tri,
+            level,
+            uv,
+            panel: s0.panel,
+        };
+        let op = SoupOp {
+            vertex: None,
+            removed: vec![s0, s1],
+            added: vec![
+                added(base, [c, a, d], new0),
+                added(base + 1, [d, b, c], new1),
+            ],
+            slots: (base, base + 2),
+            touched: self.touching(&[a, b, c, d]),
+        };
+        self.commit(op);
+        Some([a, b, c, d])
+    }
+}
+
+/// The material-space triangles `(c, a, d)` and `(d, b, c)` of flipping the
+/// edge `a`-`b` of the triangles `(a, b, c)` and `(b, a, d)` (corners
+/// `[pa, pb, pc, pd]`), when the four make a convex quadrilateral that is not
+/// Delaunay and the flip raises the smallest angle to at least `min_angle`.
+fn flipped_if_better(corners: [Vector2; 4], limits: &Limits) -> Option<[[Vector2; 3]; 2]> {
+    let [pa, pb, pc, pd] = corners;
+    let new0 = [pc, pa, pd];
+    let new1 = [pd, pb, pc];
+    let area = |p: [Vector2; 3]| (p[1] - p[0]).perp_dot(p[2] - p[0]);
+    if area(new0) <= 0.0 || area(new1) <= 0.0 {
+        return None; // not a convex quadrilateral
+    }
+    let angle_at = |x: Vector2, p: Vector2, q: Vector2| {
+        (p - x).perp_dot(q - x).abs().atan2((p - x).dot(q - x))
+    };
+    if angle_at(pc, pa, pb) + angle_at(pd, pa, pb) <= std::f64::consts::PI + 1e-9 {
+        return None; // already Delaunay
+    }
+    let before = min_angle_deg([pa, pb, pc]).min(min_angle_deg([pb, pa, pd]));
+    let after = min_angle_deg(new0).min(min_angle_deg(new1));
+    if after < limits.min_angle || after <= before {
+        return None;
+    }
+    Some([new0, new1])
 }
 
 /// Limits of the edge method.

@@ -286,9 +286,7 @@ impl Adapter {
         density: Scalar,
     ) -> Result<Adapter, AdaptSetupError> {
         let m = &world.mesh;
-        let awaiting = m
-            .panels()
-            .is_some_and(|p| p.seams.iter().any(|s| s.is_open()));
+        let awaiting = m.has_open_seam();
         let method = match awaiting {
             // Checked now, so that a refusal comes before the run.
             true => Adapter::method_state(config, world).map(|_| MethodState::AwaitingWelds)?,
@@ -341,9 +339,7 @@ impl Adapter {
         world: &World,
     ) -> Result<bool, MeshError> {
         let m = &world.mesh;
-        if m.panels()
-            .is_some_and(|p| p.seams.iter().any(|s| s.is_open()))
-        {
+        if m.has_open_seam() {
             return Ok(false);
         }
         // `Adapter::new` built this method's state once already.

@@ -208,7 +208,7 @@ fn place(placement: &Placement, q: Vector2) -> Vector {
 /// Every seam can be welded: the panels it joins would face the same way.
 /// Checked on a copy at the start, so a twisted seam is refused before the run.
 fn check_weldable(mesh: &Mesh) -> Result<(), GarmentError> {
-    let count = mesh.panels().map_or(0, |p| p.seams.len());
+    let count = mesh.seams().len();
     let mut welded = mesh.clone();
     for s in 0..count {
         welded = welded
@@ -216,9 +216,7 @@ fn check_weldable(mesh: &Mesh) -> Result<(), GarmentError> {
             .map_err(|e| match e {
                 MeshError::SeamTwisted { .. } | MeshError::NonManifoldEdge { .. } => {
                     GarmentError::Seam {
-                        seam: mesh
-                            .panels()
-                            .map_or(String::new(), |p| p.seams[s].name.clone()),
+                        seam: mesh.seams()[s].name.clone(),
                         reason: format!("it cannot be welded: {e}"),
                     }
                 }

@@ -155,6 +155,16 @@ impl Mesh {
         }
     }
 
+    /// The garment's seams, open or welded (none for a cloth without panels).
+    pub fn seams(&self) -> &[Seam] {
+        self.panels().map_or(&[], |p| &p.seams)
+    }
+
+    /// True while a seam of the garment is open.
+    pub fn has_open_seam(&self) -> bool {
+        self.seams().iter().any(Seam::is_open)
+    }
+
     /// Material coordinates of triangle `t`'s corners, in its panel's pattern.
     #[inline]
     pub fn corners(&self, t: usize) -> [Vector2; 3] {

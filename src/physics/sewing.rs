@@ -56,10 +56,7 @@ pub(super) fn sewing_springs(
     caps: &mut Vec<SpringCap>,
 ) {
     caps.clear();
-    let Some(panels) = mesh.panels() else {
-        return;
-    };
-    for seam in panels.seams.iter().filter(|s| s.is_open()) {
+    for seam in mesh.seams().iter().filter(|s| s.is_open()) {
         for (pair, share) in seam.pairs.iter().zip(seam.pair_lengths(mesh)) {
             let k = mat.sewing.stiffness * share;
             if let Some(max_force) = mat.sewing.max_force {

@@ -134,20 +134,33 @@ pub(super) fn send_blueprint(
     first_positions: &[Vector],
 ) -> Result<(), RecordingStreamError> {
     let eye_on = |entity: &str| camera::eye(camera, first_positions, &format!("/{entity}"));
-    let mut groups: Vec<&str> = scalar_names
-        .iter()
-        .filter_map(|name| name.split('/').find(|s| !s.is_empty()))
-        .collect();
-    groups.sort_unstable();
-    groups.dedup();
-    let view = |class, name: &str, origin: &str, contents: Vec<String>, eye: Eye| ViewSpec {
+    let scenes = scene_views(eye_on(ENTITY_MESH), eye_on(ENTITY_MESH));
+    let root = Node::Horizontal(vec![scenes, plot_views(scalar_names)], vec![2.0, 1.0]);
+    blueprint::send(stream, &root)
+}
+
+/// A view of class `class` named `name`, rooted at `origin`, showing `contents`
+/// (all under `origin` when empty) from `eye`, without overrides.
+fn view(
+    class: &'static str,
+    name: &str,
+    origin: &str,
+    contents: Vec<String>,
+    eye: Eye,
+) -> ViewSpec {
+    ViewSpec {
         class,
         name: name.to_owned(),
         origin: origin.to_owned(),
         contents,
         eye,
         overrides: Vec::new(),
-    };
+    }
+}
+
+/// The blueprint's left part: the 3D views `cloth` (from `cloth_eye`) and `angles`
+/// (from `angles_eye`) side by side, over the text views `events` and `legend`.
+fn scene_views(cloth_eye: Eye, angles_eye: Eye) -> Node {
     let cloth = view(
         "3D",
         "cloth",
@@ -157,7 +170,7 @@ pub(super) fn send_blueprint(
             format!("- /{ENTITY_EDGES}"),
             format!("- /{ENTITY_LEGEND}"),
         ],
-        eye_on(ENTITY_MESH),
+        cloth_eye,
     );
     let mut angles = view(
         "3D",
@@ -170,7 +183,7 @@ pub(super) fn send_blueprint(
             "+ /events/points".to_owned(),
             "+ /obstacles/**".to_owned(),
         ],
-        eye_on(ENTITY_MESH),
+        angles_eye,
     );
     angles.overrides.push((
         format!("/{ENTITY_MESH}"),
@@ -194,13 +207,24 @@ pub(super) fn send_blueprint(
         Eye::Default,
     ));
     let bottom = Node::Horizontal(vec![log, legend], vec![3.0, 1.0]);
-    let scenes = Node::Vertical(
+    Node::Vertical(
         vec![
             Node::Horizontal(vec![cloth, angles], vec![1.0, 1.0]),
             bottom,
         ],
         vec![3.0, 1.0],
-    );
+    )
+}
+
+/// The blueprint's right part: one time-series view per top-level group of
+/// `scalar_names` (their first segment, alphabetically), stacked.
+fn plot_views(scalar_names: &[&str]) -> Node {
+    let mut groups: Vec<&str> = scalar_names
+        .iter()
+        .filter_map(|name| name.split('/').find(|s| !s.is_empty()))
+        .collect();
+    groups.sort_unstable();
+    groups.dedup();
     let plots = groups
         .iter()
         .map(|g| {
@@ -214,6 +238,5 @@ pub(super) fn send_blueprint(
         })
         .collect::<Vec<_>>();
     let shares = vec![1.0; plots.len()];
-    let root = Node::Horizontal(vec![scenes, Node::Vertical(plots, shares)], vec![2.0, 1.0]);
-    blueprint::send(stream, &root)
+    Node::Vertical(plots, shares)
 }

@@ -1,22 +1,18 @@
 //! [`FrameLoop`]: a run frame by frame — advance the simulation, observe and record
 //! the frame, and summarise at the end.
 
-use std::path::PathBuf;
 use std::time::Instant;
 
+use super::outputs::{Outputs, WrittenRecording};
 use super::phases::Phases;
-use super::recording::{self, FrameTiming, Snapshot};
+use super::recording::FrameTiming;
 use super::tally::{Tally, TallyEnd};
 use super::{FrameState, Progress, RunError, RunOptions};
 use crate::adapt::Adapter;
-use crate::math::{Scalar, Vector};
+use crate::math::Scalar;
 use crate::physics::Energy;
-use crate::record::{DecisionData, RecordError, RecordTarget, Recorder, obj::write_mesh_obj};
 use crate::scene::Scene;
-use crate::sim::{
-    FrameFailed, FrameFailure, MAX_STEP_HALVINGS, Pipeline, Setup, SimParts, SimState, StepFailure,
-    StepSize,
-};
+use crate::sim::{FrameFailed, FrameFailure, MAX_STEP_HALVINGS, SimParts, StepFailure, StepSize};
 use crate::summary::Summary;
 
 /// A run in progress: the simulation, its outputs and its running statistics.
@@ -25,37 +21,58 @@ use crate::summary::Summary;
 /// the summary.
 pub struct FrameLoop<'a> {
     scene: &'a Scene,
-    setup: Setup,
-    state: SimState,
-    pipeline: Pipeline,
+    /// The setup, the state and the pipeline that advances it.
+    sim: SimParts,
     /// The energy of the state as it is, once measured (or handed over by the
     /// pipeline) for the frame's statistics; cleared when the state advances.
     energy_now: Option<Energy>,
-    recorder: Option<Recorder>,
-    record_path: Option<PathBuf>,
-    obj_dir: Option<PathBuf>,
-    record_every: u64,
-    /// Whether the recording holds the refinement decisions.
-    decisions: DecisionData,
-    /// Frames after the initial one.
-    frames: u64,
-    frame_interval: Scalar,
-    /// The frame the state is at.
-    frame: u64,
+    /// The recording and the OBJ export.
+    outputs: Outputs,
+    /// Which frame the state is at, of how many.
+    clock: FrameClock,
+    /// Wall time spent stepping and recording.
+    wall: WallClock,
+    /// Running statistics for the summary.
     tally: Tally,
-    started: Instant,
-    sim_seconds: Scalar,
-    record_seconds: Scalar,
-    /// Wall time of the last frame's stepping and of the last recorded frame's recording.
-    timing: FrameTiming,
-    recorded_frames: u64,
-    last_recorded: Option<u64>,
-    normals: Vec<Vector>,
-    interrupted: bool,
-    /// The frame whose steps all failed, and how.
-    failure: Option<(u64, FrameFailure)>,
     /// Sewing weightless, draping, and the rest criterion.
     phases: Phases,
+    /// Why the run stopped before its last frame, if it did.
+    stop: Option<Stop>,
+}
+
+/// The frames of a run: the one the state is at, and how many.
+struct FrameClock {
+    /// The frame the state is at (0: the initial state).
+    frame: u64,
+    /// Frames after the initial one (fewer once the cloth is at rest).
+    frames: u64,
+    /// Simulated seconds between frames.
+    interval: Scalar,
+}
+
+/// Wall time spent stepping and recording, s.
+struct WallClock {
+    /// When the run started.
+    started: Instant,
+    /// Stepping, over the run.
+    sim_seconds: Scalar,
+    /// Recording and exporting, over the run.
+    record_seconds: Scalar,
+    /// The last frame's stepping and the last recorded frame's recording.
+    timing: FrameTiming,
+}
+
+/// Why a run stopped before its last frame.
+enum Stop {
+    /// Ctrl-C, before the next frame.
+    Interrupted,
+    /// Every step size tried for frame `frame` failed.
+    Failed {
+        /// The frame whose steps failed.
+        frame: u64,
+        /// How its last try failed.
+        failure: FrameFailure,
+    },
 }
 
 impl<'a> FrameLoop<'a> {
@@ -67,85 +84,50 @@ impl<'a> FrameLoop<'a> {
         opts: &RunOptions,
     ) -> Result<FrameLoop<'a>, RunError> {
         super::measure::check(scene, &sim.setup, &sim.state.world)?;
-        let recorder = match (&opts.record, &opts.live) {
-            (None, None) => None,
-            (file, live) => {
-                let target = RecordTarget {
-                    file: file.clone(),
-                    live: live.clone(),
-                };
-                let refine = scene.adapt.as_ref().map(|a| a.refine_angle);
-                let mut recorder = Recorder::open_coloured(
-                    &target,
-                    &scene.name,
-                    opts.edges.resolve(refine),
-                    opts.colour_by,
-                )?;
-                if let Some(camera) = &scene.camera {
-                    recorder.set_camera(camera.camera());
-                }
-                Some(recorder)
-            }
-        };
-        if let Some(dir) = &opts.obj_dir {
-            std::fs::create_dir_all(dir).map_err(|source| RecordError::Obj {
-                path: dir.clone(),
-                source,
-            })?;
-        }
-        let frames = scene.simulation.frame_count();
-        let SimParts {
-            setup,
-            state,
-            pipeline,
-        } = sim;
-        let tally = Tally::new(&setup.model, &state.world, pipeline.stepper(), &scene.pin);
-        let phases = Phases::new(scene, &setup.model, &state.world);
+        let outputs = Outputs::open(scene, opts)?;
+        let (model, world) = (&sim.setup.model, &sim.state.world);
+        let tally = Tally::new(model, world, sim.pipeline.stepper(), &scene.pin);
+        let phases = Phases::new(scene, model, world);
         Ok(FrameLoop {
             scene,
-            setup,
-            state,
-            pipeline,
-            recorder,
-            record_path: opts.record.clone(),
-            obj_dir: opts.obj_dir.clone(),
-            record_every: opts.record_every.max(1),
-            decisions: opts.decisions,
-            frames,
-            frame_interval: scene.simulation.frame_interval(),
-            frame: 0,
-            tally,
-            started: Instant::now(),
-            sim_seconds: 0.0,
-            record_seconds: 0.0,
-            timing: FrameTiming::default(),
-            recorded_frames: 0,
-            last_recorded: None,
-            normals: Vec::new(),
+            sim,
             energy_now: None,
-            interrupted: false,
-            failure: None,
+            outputs,
+            clock: FrameClock {
+                frame: 0,
+                frames: scene.simulation.frame_count(),
+                interval: scene.simulation.frame_interval(),
+            },
+            wall: WallClock {
+                started: Instant::now(),
+                sim_seconds: 0.0,
+                record_seconds: 0.0,
+                timing: FrameTiming::default(),
+            },
+            tally,
             phases,
+            stop: None,
         })
     }
 
     /// True when the state is at the last frame.
     pub fn at_end(&self) -> bool {
-        self.frame >= self.frames
+        self.clock.frame >= self.clock.frames
     }
 
     /// Progress after the frame the state is at.
     pub fn progress(&self) -> Progress {
         Progress {
-            frame: self.frame + 1,
-            frames: self.frames + 1,
-            sim_time: self.state.world.time,
+            frame: self.clock.frame + 1,
+            frames: self.clock.frames + 1,
+            sim_time: self.sim.state.world.time,
         }
     }
 
-    /// Notes that the run was interrupted (Ctrl-C) before the next frame.
+    /// Notes that the run was interrupted (Ctrl-C) before the next frame: the
+    /// run ends there.
     pub fn interrupt(&mut self) {
-        self.interrupted = true;
+        self.stop = Some(Stop::Interrupted);
     }
 
     /// Advances the simulation by one frame. False when every step size tried
@@ -154,33 +136,35 @@ impl<'a> FrameLoop<'a> {
     pub fn advance(&mut self) -> Result<bool, RunError> {
         let t0 = Instant::now();
         let mut start_energy = self.energy_now.take();
+        let sim = &mut self.sim;
         if self
             .phases
-            .before_frame(&mut self.setup.model, &self.state.world)
+            .before_frame(&mut sim.setup.model, &sim.state.world)
         {
             // The energy measured under the other gravity is not this frame's.
             start_energy = None;
         }
-        match self.pipeline.advance_frame_from(
-            &self.setup,
-            &mut self.state,
-            self.frame_interval,
+        match sim.pipeline.advance_frame_from(
+            &sim.setup,
+            &mut sim.state,
+            self.clock.interval,
             start_energy,
         ) {
             Ok(_) => {}
-            Err(FrameFailed::Steps(f)) => {
-                self.failure = Some((self.frame + 1, f));
+            Err(FrameFailed::Steps(failure)) => {
+                let frame = self.clock.frame + 1;
+                self.stop = Some(Stop::Failed { frame, failure });
                 return Ok(false);
             }
             Err(FrameFailed::Remesh(e)) => return Err(RunError::Remesh(e)),
         }
-        self.frame += 1;
-        if self.phases.after_frame(&self.state.world) {
+        self.clock.frame += 1;
+        if self.phases.after_frame(&self.sim.state.world) {
             // At rest: this frame is the last, recorded and exported.
-            self.frames = self.frame;
+            self.clock.frames = self.clock.frame;
         }
-        self.timing.sim_s = t0.elapsed().as_secs_f64();
-        self.sim_seconds += self.timing.sim_s;
+        self.wall.timing.sim_s = t0.elapsed().as_secs_f64();
+        self.wall.sim_seconds += self.wall.timing.sim_s;
         Ok(true)
     }
 
@@ -191,23 +175,24 @@ impl<'a> FrameLoop<'a> {
         observe: &mut (dyn FnMut(&FrameState) + Send),
     ) -> Result<(), RunError> {
         let energy = self.energy();
-        let world = &self.state.world;
+        let world = &self.sim.state.world;
         self.tally.observe(world, energy);
         observe(&FrameState {
-            frame: self.frame,
+            frame: self.clock.frame,
             sim_time: world.time,
             positions: &world.x,
             material: &world.mesh.material,
             triangles: &world.mesh.triangles,
             pattern: &world.mesh.pattern,
         });
-        if self.frame.is_multiple_of(self.record_every) || self.frame == self.frames {
+        if self.outputs.due(self.clock.frame, self.clock.frames) {
             self.record_now()?;
         }
-        if self.recorder.is_none() {
+        if !self.outputs.recording() {
             // Nobody takes the events: drop them rather than let them pile up.
-            self.state.adapter.as_mut().map(Adapter::take_events);
-            self.state.welds.clear();
+            let state = &mut self.sim.state;
+            state.adapter.as_mut().map(Adapter::take_events);
+            state.welds.clear();
         }
         Ok(())
     }
@@ -218,12 +203,13 @@ impl<'a> FrameLoop<'a> {
         if let Some(e) = self.energy_now {
             return e;
         }
-        let e = match self.pipeline.take_frame_end_energy() {
+        let sim = &mut self.sim;
+        let e = match sim.pipeline.take_frame_end_energy() {
             Some(e) => e,
-            None => self
+            None => sim
                 .pipeline
                 .stepper()
-                .energy(&self.setup.model, &self.state.world),
+                .energy(&sim.setup.model, &sim.state.world),
         };
         self.energy_now = Some(e);
         e
@@ -233,12 +219,10 @@ impl<'a> FrameLoop<'a> {
     fn record_now(&mut self) -> Result<(), RunError> {
         let t1 = Instant::now();
         self.log_frame()?;
-        if let Some(dir) = &self.obj_dir {
-            let w = &self.state.world;
-            write_mesh_obj(dir, self.frame, &w.x, &w.mesh)?;
-        }
-        self.timing.record_s = t1.elapsed().as_secs_f64();
-        self.record_seconds += self.timing.record_s;
+        self.outputs
+            .export_obj(self.clock.frame, &self.sim.state.world)?;
+        self.wall.timing.record_s = t1.elapsed().as_secs_f64();
+        self.wall.record_seconds += self.wall.timing.record_s;
         Ok(())
     }
 
@@ -247,91 +231,83 @@ impl<'a> FrameLoop<'a> {
         // `record` has measured this state already (after a failed frame,
         // `finish` comes here with the restored state and measures it once).
         let energy = self.energy();
-        let Some(rec) = self.recorder.as_mut() else {
-            return Ok(());
-        };
-        let snap = Snapshot {
-            frame: self.frame,
-            energy,
-            timing: self.timing,
-            frame_interval: self.frame_interval,
-            decisions: self.decisions,
-        };
-        let (state, pipeline) = (&mut self.state, &mut self.pipeline);
-        recording::record_state(rec, &self.setup, state, pipeline, &snap, &mut self.normals)?;
-        self.recorded_frames += 1;
-        self.last_recorded = Some(self.frame);
-        Ok(())
+        let (frame, timing) = (self.clock.frame, self.wall.timing);
+        self.outputs
+            .log(&mut self.sim, frame, energy, timing, self.clock.interval)
     }
 
     /// Ends the run: records the last good frame if `record_every` left it out
     /// (a run stopped early), closes the recording and returns the summary, or
     /// [`RunError::Numerical`] (with the summary) when a frame failed.
     pub fn finish(mut self) -> Result<Summary, RunError> {
-        if self.recorder.is_some() && self.last_recorded != Some(self.frame) {
+        if self.outputs.lacks(self.clock.frame) {
             let t1 = Instant::now();
             self.log_frame()?;
-            self.record_seconds += t1.elapsed().as_secs_f64();
+            self.wall.record_seconds += t1.elapsed().as_secs_f64();
         }
-        let recording = match self.recorder.take() {
-            Some(rec) => {
-                let bytes = rec.finish()?;
-                let frames = self.recorded_frames;
-                self.record_path.take().map(|path| (path, bytes, frames))
-            }
-            None => None,
-        };
+        let recording = self.outputs.finish()?;
         let summary = self.summary(recording);
-        match self.failure {
-            None => Ok(summary),
-            Some((frame, f)) => Err(RunError::Numerical {
-                step: f.step,
-                failure: f.failure,
-                frame,
-                time: self.state.world.time,
-                halvings: match self.setup.settings.step {
-                    StepSize::Adaptive(_) => 0,
-                    _ => MAX_STEP_HALVINGS,
-                },
-                dt: f.last_dt,
-                cause: match self.setup.settings.step {
-                    StepSize::Adaptive(_) => format!(
-                        "the tolerances are tighter than any step down to `simulation.adaptive_dt.min` = {:.3e} s meets (try a smaller `min`, or a larger `simulation.adaptive_dt.tolerance` or `penetration`{})",
-                        f.last_dt,
-                        solver_hint(&f.failure)
-                    ),
-                    _ => format!(
-                        "the time step is too large for the stiffness (step {:.3e} s with the {:?} integrator; try a smaller `simulation.dt`, `dt = \"auto\"`, or `integrator = \"implicit\"`{})",
-                        self.pipeline.step_size(&self.setup, &self.state.world),
-                        self.setup.model.integrator,
-                        solver_hint(&f.failure)
-                    ),
-                },
-                summary: Box::new(summary),
-            }),
+        match self.stop.take() {
+            None | Some(Stop::Interrupted) => Ok(summary),
+            Some(Stop::Failed { frame, failure }) => {
+                Err(self.numerical_error(frame, failure, summary))
+            }
         }
     }
 
-    fn summary(&mut self, recording: Option<(PathBuf, u64, u64)>) -> Summary {
-        let (state, pipe) = (&self.state, &mut self.pipeline);
+    /// The error for frame `frame`, whose steps all failed with `f`, with the
+    /// summary of the run up to it and a hint at the likely cause.
+    fn numerical_error(&mut self, frame: u64, f: FrameFailure, summary: Summary) -> RunError {
+        let sim = &mut self.sim;
+        let adaptive = matches!(sim.setup.settings.step, StepSize::Adaptive(_));
+        let cause = if adaptive {
+            format!(
+                "the tolerances are tighter than any step down to `simulation.adaptive_dt.min` = {:.3e} s meets (try a smaller `min`, or a larger `simulation.adaptive_dt.tolerance` or `penetration`{})",
+                f.last_dt,
+                solver_hint(&f.failure)
+            )
+        } else {
+            format!(
+                "the time step is too large for the stiffness (step {:.3e} s with the {:?} integrator; try a smaller `simulation.dt`, `dt = \"auto\"`, or `integrator = \"implicit\"`{})",
+                sim.pipeline.step_size(&sim.setup, &sim.state.world),
+                sim.setup.model.integrator,
+                solver_hint(&f.failure)
+            )
+        };
+        RunError::Numerical {
+            step: f.step,
+            failure: f.failure,
+            frame,
+            time: sim.state.world.time,
+            halvings: if adaptive { 0 } else { MAX_STEP_HALVINGS },
+            dt: f.last_dt,
+            cause,
+            summary: Box::new(summary),
+        }
+    }
+
+    /// The summary of the run so far, with the recording written.
+    fn summary(&mut self, recording: Option<WrittenRecording>) -> Summary {
+        let (state, pipe) = (&self.sim.state, &mut self.sim.pipeline);
+        let setup = &self.sim.setup;
         let dt = if state.effort.min_dt.is_finite() {
             state.effort.min_dt
         } else {
-            pipe.step_size(&self.setup, &state.world)
+            pipe.step_size(setup, &state.world)
         };
         let stepper = pipe.stepper();
-        let (cusick, cantilever) = super::measure::at_end(self.scene, &self.setup, &state.world);
+        let (cusick, cantilever) = super::measure::at_end(self.scene, setup, &state.world);
         self.tally.finish(TallyEnd {
             scene: self.scene.name.clone(),
-            frames: self.frame + 1,
+            frames: self.clock.frame + 1,
             sim_time: state.world.time,
-            wall_time_s: self.started.elapsed().as_secs_f64(),
-            sim_wall_s: self.sim_seconds,
-            record_wall_s: self.record_seconds,
+            wall_time_s: self.wall.started.elapsed().as_secs_f64(),
+            sim_wall_s: self.wall.sim_seconds,
+            record_wall_s: self.wall.record_seconds,
             dt,
             dt_max: state.effort.max_dt.max(dt),
-            adaptive_dt: matches!(self.setup.settings.step, StepSize::Adaptive(_)),
-            interrupted: self.interrupted,
+            adaptive_dt: matches!(setup.settings.step, StepSize::Adaptive(_)),
+            interrupted: matches!(self.stop, Some(Stop::Interrupted)),
             recording,
             state,
             mass_final: stepper.elements.total_mass(),

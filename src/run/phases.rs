@@ -100,8 +100,5 @@ impl Phases {
 
 /// True while a seam of the garment is open.
 fn any_open(world: &World) -> bool {
-    world
-        .mesh
-        .panels()
-        .is_some_and(|p| p.seams.iter().any(|s| s.is_open()))
+    world.mesh.has_open_seam()
 }

@@ -73,34 +73,9 @@ pub(super) fn record_state(
     world.vertex_normals(normals);
     let pinned: Vec<u32> = world.pins.anchors.iter().map(|a| a.vertex).collect();
     let dt_now = pipe.step_taken(setup, world, snap.frame_interval);
-    let e = snap.energy;
-    let mut scalars = vec![
-        ("mesh/vertices", world.x.len() as f64),
-        ("mesh/triangles", world.mesh.triangles.len() as f64),
-        ("energy/kinetic", e.kinetic),
-        ("energy/gravitational", e.gravitational),
-        ("energy/elastic", e.elastic),
-        ("energy/total", e.total()),
-        ("time/dt_ms", 1e3 * dt_now),
-        ("timing/sim_ms", 1e3 * snap.timing.sim_s),
-        ("timing/record_ms", 1e3 * snap.timing.record_s),
-        (
-            "angle/max_deg",
-            angles.iter().copied().fold(0.0, Scalar::max),
-        ),
-    ];
+    let mut scalars = frame_plots(world, snap, dt_now, &angles);
     if state.adapter.is_some() {
-        let count = |k: EventKind| events.iter().filter(|e| e.kind == k).count() as f64;
-        scalars.push((
-            "adapt/splits",
-            count(EventKind::Split) + count(EventKind::ClosureSplit) + count(EventKind::Bounce),
-        ));
-        scalars.push((
-            "adapt/merges",
-            count(EventKind::Merge) + count(EventKind::Collapse),
-        ));
-        scalars.push(("adapt/flips", count(EventKind::Flip)));
-        scalars.push(("adapt/rollbacks", count(EventKind::Rollback)));
+        scalars.extend(adapt_plots(&events));
     }
     if pipe.collider().is_some() {
         let c = &state.ledger.collision;
@@ -129,6 +104,49 @@ pub(super) fn record_state(
         }),
     })?;
     record_obstacles(rec, setup, world, snap.frame)
+}
+
+/// The plots of every frame: mesh size, energies, the step, the wall times
+/// and the largest dihedral angle of `angles`.
+fn frame_plots(
+    world: &World,
+    snap: &Snapshot,
+    dt_now: Scalar,
+    angles: &[Scalar],
+) -> Vec<(&'static str, f64)> {
+    let e = snap.energy;
+    vec![
+        ("mesh/vertices", world.x.len() as f64),
+        ("mesh/triangles", world.mesh.triangles.len() as f64),
+        ("energy/kinetic", e.kinetic),
+        ("energy/gravitational", e.gravitational),
+        ("energy/elastic", e.elastic),
+        ("energy/total", e.total()),
+        ("time/dt_ms", 1e3 * dt_now),
+        ("timing/sim_ms", 1e3 * snap.timing.sim_s),
+        ("timing/record_ms", 1e3 * snap.timing.record_s),
+        (
+            "angle/max_deg",
+            angles.iter().copied().fold(0.0, Scalar::max),
+        ),
+    ]
+}
+
+/// The remeshing plots of an adaptive run: `events` counted by kind.
+fn adapt_plots(events: &[AdaptEvent]) -> [(&'static str, f64); 4] {
+    let count = |k: EventKind| events.iter().filter(|e| e.kind == k).count() as f64;
+    [
+        (
+            "adapt/splits",
+            count(EventKind::Split) + count(EventKind::ClosureSplit) + count(EventKind::Bounce),
+        ),
+        (
+            "adapt/merges",
+            count(EventKind::Merge) + count(EventKind::Collapse),
+        ),
+        ("adapt/flips", count(EventKind::Flip)),
+        ("adapt/rollbacks", count(EventKind::Rollback)),
+    ]
 }
 
 /// Each triangle's refinement decision (ratio, term code, state code), when the run adapts

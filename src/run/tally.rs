@@ -6,7 +6,10 @@ use crate::math::Scalar;
 use crate::physics::{Energy, Model, Stepper};
 use crate::scene::Pin;
 use crate::sim::SimState;
-use crate::summary::{AdaptiveDtSummary, EnergySummary, Range, RecordingSummary, Summary};
+use crate::summary::{
+    AdaptiveDtSummary, Adaptivity, Collisions, Conservation, EnergySummary, Extent, Measurements,
+    MeshSize, Range, RecordingSummary, SceneChecks, StepEffort, Stepping, Summary, WallTimes,
+};
 use crate::world::World;
 
 /// Running statistics for the summary.
@@ -72,19 +75,84 @@ impl Tally {
         self.energy_max = self.energy_max.max(e.total());
     }
 
+    /// The summary of the run that ended with `end`.
     pub(super) fn finish(&self, end: TallyEnd) -> Summary {
         let (ledger, effort) = (&end.state.ledger, &end.state.effort);
         let adapt = end.state.adapter.as_ref().map(|a| a.stats);
         let collision = ledger.collision;
-        let vertex_steps = effort.solver.steps as Scalar * self.vertices.mean;
+        let world = &end.state.world;
+        let stepping = self.stepping(&end);
         Summary {
-            scene: end.scene,
-            frames: end.frames,
-            steps: effort.solver.steps,
-            sim_time: end.sim_time,
-            wall_time_s: end.wall_time_s,
-            simulation_wall_s: end.sim_wall_s,
-            recording_wall_s: end.record_wall_s,
+            extent: Extent {
+                scene: end.scene,
+                frames: end.frames,
+                steps: effort.solver.steps,
+                sim_time: end.sim_time,
+            },
+            wall: WallTimes {
+                wall_time_s: end.wall_time_s,
+                simulation_wall_s: end.sim_wall_s,
+                recording_wall_s: end.record_wall_s,
+            },
+            stepping,
+            mesh: MeshSize {
+                vertices: self.vertices,
+                triangles: self.triangles,
+            },
+            conservation: Conservation {
+                mass_initial: self.mass_initial,
+                mass_final: end.mass_final,
+                energy: EnergySummary {
+                    initial: self.energy_initial,
+                    r#final: self.energy_final,
+                    max: self.energy_max,
+                    external_work: ledger.work(),
+                    excess_max: ledger.excess_max,
+                },
+            },
+            effort: StepEffort {
+                nan_recoveries: effort.step_halvings,
+                energy_retries: effort.energy_retries,
+                solver: effort.solver,
+            },
+            adaptivity: Adaptivity {
+                splits: adapt.map_or(0, |a| a.splits),
+                merges: adapt.map_or(0, |a| a.merges),
+                rollbacks: adapt.map_or(0, |a| a.rollbacks),
+                max_level: self.max_level,
+                adapt,
+            },
+            collision: Collisions {
+                max_penetration: collision.max_penetration,
+                contacts: collision.mean_contacts(),
+                self_pairs_tested: collision.mean_self_pairs_tested(),
+                self_culled_fraction: collision.self_culled_fraction(),
+                collision_wall_s: collision.collision_wall_s,
+                self_collision_wall_s: collision.self_collision_wall_s,
+            },
+            measurements: Measurements {
+                cusick: end.cusick,
+                cantilever: end.cantilever,
+            },
+            checks: SceneChecks {
+                pin_mismatches: self.pin_mismatches.clone(),
+                seams: crate::summary::SeamSummary::of(&world.mesh, &end.state.seams, &world.x),
+                rest: end.rest,
+            },
+            interrupted: end.interrupted,
+            recording: end.recording.map(|(path, bytes, frames)| RecordingSummary {
+                path,
+                bytes,
+                frames,
+            }),
+        }
+    }
+
+    /// The steps' sizes and rate at the end `end`.
+    fn stepping(&self, end: &TallyEnd) -> Stepping {
+        let (ledger, effort) = (&end.state.ledger, &end.state.effort);
+        let vertex_steps = effort.solver.steps as Scalar * self.vertices.mean;
+        Stepping {
             dt: end.dt,
             dt_max: end.dt_max,
             steps_accepted: ledger.steps_done,
@@ -103,46 +171,6 @@ impl Tally {
             } else {
                 0.0
             },
-            vertices: self.vertices,
-            triangles: self.triangles,
-            mass_initial: self.mass_initial,
-            mass_final: end.mass_final,
-            energy: EnergySummary {
-                initial: self.energy_initial,
-                r#final: self.energy_final,
-                max: self.energy_max,
-                external_work: ledger.work(),
-                excess_max: ledger.excess_max,
-            },
-            nan_recoveries: effort.step_halvings,
-            energy_retries: effort.energy_retries,
-            solver: effort.solver,
-            interrupted: end.interrupted,
-            splits: adapt.map_or(0, |a| a.splits),
-            merges: adapt.map_or(0, |a| a.merges),
-            rollbacks: adapt.map_or(0, |a| a.rollbacks),
-            max_level: self.max_level,
-            adapt,
-            max_penetration: collision.max_penetration,
-            contacts: collision.mean_contacts(),
-            self_pairs_tested: collision.mean_self_pairs_tested(),
-            self_culled_fraction: collision.self_culled_fraction(),
-            collision_wall_s: collision.collision_wall_s,
-            self_collision_wall_s: collision.self_collision_wall_s,
-            cusick: end.cusick,
-            rest: end.rest,
-            cantilever: end.cantilever,
-            pin_mismatches: self.pin_mismatches.clone(),
-            seams: crate::summary::SeamSummary::of(
-                &end.state.world.mesh,
-                &end.state.seams,
-                &end.state.world.x,
-            ),
-            recording: end.recording.map(|(path, bytes, frames)| RecordingSummary {
-                path,
-                bytes,
-                frames,
-            }),
         }
     }
 }

@@ -9,7 +9,8 @@ use super::model::{PanelTable, SeamTable, SewingTable};
 use super::validate::{all_finite, positive};
 use super::{ClothShape, Scene};
 use crate::garment::SEAM_LENGTH_TOLERANCE;
-use crate::spec::{AdaptMethod, Curve};
+use crate::math::Scalar;
+use crate::spec::{AdaptMethod, Curve, SeamSide};
 
 fn at(table: &str, i: usize, key: &str) -> KeyPath {
     vec![Seg::Key(table.into()), Seg::Index(i), Seg::Key(key.into())]
@@ -163,6 +164,7 @@ fn curves(i: usize, p: &PanelTable) -> Result<(), Issue> {
     Ok(())
 }
 
+/// Checks `[[seam]]` number `i` (`s`) against the panels and the seams before it.
 fn seam(
     i: usize,
     s: &SeamTable,
@@ -174,31 +176,10 @@ fn seam(
         &s.name,
         earlier.iter().map(|e| e.name.clone()),
     )?;
-    let mut length = [0.0; 2];
-    for (k, (key, side)) in [("a", &s.a), ("b", &s.b)].into_iter().enumerate() {
-        let Some(p) = panels.iter().find(|p| p.name == side.panel) else {
-            let names: Vec<&str> = panels.iter().map(|p| p.name.as_str()).collect();
-            return Err(Issue::new(
-                at("seam", i, key),
-                Kind::BadValue,
-                format!("there is no panel `{}`", side.panel),
-            )
-            .allowed(format!("one of: {}", names.join(", "))));
-        };
-        let n = p.outline.len();
-        if side.side == 0 || side.side > n {
-            return Err(Issue::new(
-                at("seam", i, key),
-                Kind::OutOfRange,
-                format!("panel `{}` has sides 1 to {n}, not {}", p.name, side.side),
-            )
-            .allowed(format!(
-                "1 to {n}: side k runs from outline corner k to corner k + 1"
-            )));
-        }
-        let (u, w) = (p.outline[side.side - 1], p.outline[side.side % n]);
-        length[k] = (u[0] - w[0]).hypot(u[1] - w[1]);
-    }
+    let length = [
+        side_length(i, "a", &s.a, panels)?,
+        side_length(i, "b", &s.b, panels)?,
+    ];
     if s.a == s.b {
         return Err(Issue::new(
             at("seam", i, "b"),
@@ -206,6 +187,44 @@ fn seam(
             "both sides of the seam are the same panel side",
         ));
     }
+    not_sewn_before(i, s, earlier)?;
+    seam_lengths_match(i, s, panels, length)
+}
+
+/// The length of the panel side `side`, key `key` of `[[seam]]` number `i`,
+/// or the issue when there is no such panel or side.
+fn side_length(
+    i: usize,
+    key: &str,
+    side: &SeamSide,
+    panels: &[PanelTable],
+) -> Result<Scalar, Issue> {
+    let Some(p) = panels.iter().find(|p| p.name == side.panel) else {
+        let names: Vec<&str> = panels.iter().map(|p| p.name.as_str()).collect();
+        return Err(Issue::new(
+            at("seam", i, key),
+            Kind::BadValue,
+            format!("there is no panel `{}`", side.panel),
+        )
+        .allowed(format!("one of: {}", names.join(", "))));
+    };
+    let n = p.outline.len();
+    if side.side == 0 || side.side > n {
+        return Err(Issue::new(
+            at("seam", i, key),
+            Kind::OutOfRange,
+            format!("panel `{}` has sides 1 to {n}, not {}", p.name, side.side),
+        )
+        .allowed(format!(
+            "1 to {n}: side k runs from outline corner k to corner k + 1"
+        )));
+    }
+    let (u, w) = (p.outline[side.side - 1], p.outline[side.side % n]);
+    Ok((u[0] - w[0]).hypot(u[1] - w[1]))
+}
+
+/// The issue when a side of `[[seam]]` number `i` (`s`) is sewn by an earlier seam.
+fn not_sewn_before(i: usize, s: &SeamTable, earlier: &[SeamTable]) -> Result<(), Issue> {
     for (j, e) in earlier.iter().enumerate() {
         for (key, side) in [("a", &s.a), ("b", &s.b)] {
             if *side == e.a || *side == e.b {
@@ -223,6 +242,17 @@ fn seam(
             }
         }
     }
+    Ok(())
+}
+
+/// The issue when the straight sides of `[[seam]]` number `i` (`s`), `length`
+/// long, differ by more than [`SEAM_LENGTH_TOLERANCE`] without `gather`.
+fn seam_lengths_match(
+    i: usize,
+    s: &SeamTable,
+    panels: &[PanelTable],
+    length: [Scalar; 2],
+) -> Result<(), Issue> {
     let curved = [&s.a, &s.b].iter().any(|side| {
         panels
             .iter()

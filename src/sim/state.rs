@@ -62,11 +62,9 @@ impl SeamState {
     /// The state of each seam of `world`'s mesh at the start of a run: open
     /// where its pairs are apart, welded at time 0 where they are one vertex.
     pub fn at_start(world: &World) -> Vec<SeamState> {
-        let Some(panels) = world.mesh.panels() else {
-            return Vec::new();
-        };
-        panels
-            .seams
+        world
+            .mesh
+            .seams()
             .iter()
             .map(|s| {
                 if s.is_open() {

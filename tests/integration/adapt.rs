@@ -488,14 +488,17 @@ fn adaptation_runs_once_per_frame_or_every_n_steps() {
         let scene = drape::scene::load_scene_file(&path, &sets).unwrap();
         let opts = drape::run::RunOptions::default();
         let summary = drape::run::run(&scene, &opts, &AtomicBool::new(false), &mut |_| {}).unwrap();
-        let a = summary.adapt.expect("adaptive run");
+        let a = summary.adaptivity.adapt.expect("adaptive run");
         let expected = match every {
-            "4" => summary.steps / 4,
-            "1" => summary.steps,
-            _ => summary.frames - 1,
+            "4" => summary.extent.steps / 4,
+            "1" => summary.extent.steps,
+            _ => summary.extent.frames - 1,
         };
         assert_eq!(a.passes, expected, "every {every}: passes");
-        assert!(summary.splits > 0, "every {every}: the sheet is refined");
+        assert!(
+            summary.adaptivity.splits > 0,
+            "every {every}: the sheet is refined"
+        );
     }
 }
 
@@ -522,23 +525,30 @@ fn hanging_sheet_run_refines_rolls_back_and_reports_counts() {
     let scene = drape::scene::load_scene_file(&path, &sets).unwrap();
     let opts = drape::run::RunOptions::default();
     let summary = drape::run::run(&scene, &opts, &AtomicBool::new(false), &mut |_| {}).unwrap();
-    let a = summary.adapt.expect("adaptive run");
+    let a = summary.adaptivity.adapt.expect("adaptive run");
     assert!(
-        summary.splits > 0 && summary.max_level >= 2,
+        summary.adaptivity.splits > 0 && summary.adaptivity.max_level >= 2,
         "{} splits, max level {}",
-        summary.splits,
-        summary.max_level
+        summary.adaptivity.splits,
+        summary.adaptivity.max_level
     );
     assert!(
-        summary.rollbacks > 0,
+        summary.adaptivity.rollbacks > 0,
         "a falling sheet bends past 15 degrees within a step"
     );
     assert_eq!(
-        (summary.splits, summary.merges, summary.rollbacks),
+        (
+            summary.adaptivity.splits,
+            summary.adaptivity.merges,
+            summary.adaptivity.rollbacks
+        ),
         (a.splits, a.merges, a.rollbacks)
     );
-    assert!((summary.mass_final - summary.mass_initial).abs() < 1e-12 * summary.mass_initial);
-    assert!(summary.vertices.max > summary.vertices.min);
+    assert!(
+        (summary.conservation.mass_final - summary.conservation.mass_initial).abs()
+            < 1e-12 * summary.conservation.mass_initial
+    );
+    assert!(summary.mesh.vertices.max > summary.mesh.vertices.min);
 }
 
 fn edge_config() -> AdaptConfig {
@@ -786,14 +796,14 @@ fn recording_holds_one_event_log_line_per_engine_event() {
         .copied()
         .unwrap_or(0) as u64;
     std::fs::remove_file(&out).ok();
-    let a = summary.adapt.unwrap();
+    let a = summary.adaptivity.adapt.unwrap();
     let engine_events = a.splits + a.merges + a.flips + a.rollbacks;
     let logged = decoded.rows.get("/events/log").copied().unwrap_or(0) as u64;
     assert!(engine_events > 0, "{a:?}");
     assert_eq!(logged - refused, engine_events, "{a:?}");
     assert_eq!(
         decoded.rows.get("/events/points").copied(),
-        Some(summary.frames as usize)
+        Some(summary.extent.frames as usize)
     );
 }
 

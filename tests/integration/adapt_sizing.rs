@@ -357,7 +357,7 @@ fn a_sheet_at_rest_stops_remeshing() {
         },
     )
     .expect("run");
-    let a = summary.adapt.expect("adaptive");
+    let a = summary.adaptivity.adapt.expect("adaptive");
     assert!(a.bounces > 0, "the case bounces (else it tests nothing)");
     assert_eq!(
         late_changes, 0,
@@ -460,7 +460,7 @@ fn a_sheet_falling_onto_a_ball_is_refined_before_it_lands() {
             &mut |f| vertices = f.material.len(),
         )
         .expect("run");
-        (vertices, summary.contacts)
+        (vertices, summary.collision.contacts)
     };
     let (plain, plain_contacts) = run(None);
     let (refined, contacts) = run(Some("0.5"));

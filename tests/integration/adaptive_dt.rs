@@ -100,11 +100,11 @@ fn a_falling_sheet_stays_within_its_steps_times_the_tolerance_of_the_closed_form
         let x = final_positions(FALLING, &[&set]);
         let s = summary(FALLING, &[&set]);
         let worst = x.iter().map(|p| (p.z - exact).abs()).fold(0.0, Scalar::max);
-        let a = s.adaptive_dt.expect("adaptive figures");
+        let a = s.stepping.adaptive_dt.expect("adaptive figures");
         println!(
             "tolerance {tolerance} m: {} steps of {:.3e} to {:.3e} s, {} refused, largest error estimate {:.3e} m; z {:.6} m against {exact:.6} m, deviation {worst:.3e} m",
-            s.steps,
-            s.dt,
+            s.extent.steps,
+            s.stepping.dt,
             a.max_dt,
             a.refused.total(),
             a.largest_error,
@@ -113,9 +113,9 @@ fn a_falling_sheet_stays_within_its_steps_times_the_tolerance_of_the_closed_form
         let tol: Scalar = tolerance.parse().expect("number");
         assert!(a.largest_error <= tol, "accepted {:.3e} m", a.largest_error);
         assert!(
-            worst <= s.steps as Scalar * tol,
+            worst <= s.extent.steps as Scalar * tol,
             "deviation {worst:.3e} m above {} steps x {tol:e} m",
-            s.steps
+            s.extent.steps
         );
         worst
     };
@@ -132,16 +132,16 @@ fn a_falling_sheet_stays_within_its_steps_times_the_tolerance_of_the_closed_form
 #[test]
 fn a_cloth_at_rest_on_a_table_steps_a_frame_at_a_time() {
     let s = summary(RESTING, &[]);
-    let a = s.adaptive_dt.expect("adaptive figures");
+    let a = s.stepping.adaptive_dt.expect("adaptive figures");
     println!(
         "resting: {} steps for {} frames, {:.3e} to {:.3e} s, {} refused, largest error estimate {:.3e} m, penetration {:.3e} m",
-        s.steps,
-        s.frames - 1,
-        s.dt,
+        s.extent.steps,
+        s.extent.frames - 1,
+        s.stepping.dt,
         a.max_dt,
         a.refused.total(),
         a.largest_error,
-        s.max_penetration
+        s.collision.max_penetration
     );
     assert!(
         (a.max_dt - 1.0 / 30.0).abs() < 1e-12,
@@ -149,7 +149,11 @@ fn a_cloth_at_rest_on_a_table_steps_a_frame_at_a_time() {
         a.max_dt
     );
     // 10 ms, 20 ms (a frame of two), then a frame a step.
-    assert!(s.steps <= s.frames + 4, "{} steps", s.steps);
+    assert!(
+        s.extent.steps <= s.extent.frames + 4,
+        "{} steps",
+        s.extent.steps
+    );
 }
 
 /// The sheet dropped 10 cm onto the table: the landing shrinks the step, and
@@ -158,15 +162,24 @@ fn a_cloth_at_rest_on_a_table_steps_a_frame_at_a_time() {
 fn a_landing_shrinks_the_step_and_no_accepted_step_exceeds_a_tolerance() {
     let drop = ["cloth.position=[0.0, 0.0, 0.9]", "simulation.duration=0.6"];
     let s = summary(RESTING, &drop);
-    let a = s.adaptive_dt.expect("adaptive figures");
+    let a = s.stepping.adaptive_dt.expect("adaptive figures");
     println!(
         "landing: {} steps, {:.3e} to {:.3e} s, refused {:?}, largest error estimate {:.3e} m, penetration {:.3e} m",
-        s.steps, s.dt, a.max_dt, a.refused, a.largest_error, s.max_penetration
+        s.extent.steps,
+        s.stepping.dt,
+        a.max_dt,
+        a.refused,
+        a.largest_error,
+        s.collision.max_penetration
     );
-    assert!(s.dt < 2e-3, "smallest step {:.3e} s", s.dt);
+    assert!(
+        s.stepping.dt < 2e-3,
+        "smallest step {:.3e} s",
+        s.stepping.dt
+    );
     assert!(a.max_dt > 2e-2, "largest step {:.3e} s", a.max_dt);
     assert!(a.largest_error <= drape::sim::DEFAULT_STEP_TOLERANCE);
-    assert!(s.max_penetration <= drape::sim::DEFAULT_STEP_PENETRATION);
+    assert!(s.collision.max_penetration <= drape::sim::DEFAULT_STEP_PENETRATION);
 }
 
 #[test]

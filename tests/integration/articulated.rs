@@ -214,13 +214,13 @@ fn a_cloth_on_a_turning_part_moves_with_it() {
     println!(
         "tray turned 60 deg and moved 0.1 m: cloth centre {c0:.4?} -> {c1:.4?}, expected {want:.4?}, \
          off by {off:.4} m; max penetration {} m",
-        summary.max_penetration
+        summary.collision.max_penetration
     );
     assert!(
         off < 0.01,
         "the cloth follows the tray within 1 cm: {off} m"
     );
-    assert!(summary.max_penetration < 1e-3);
+    assert!(summary.collision.max_penetration < 1e-3);
 }
 
 /// ARM with the last occurrence of `from` replaced by `to`.
@@ -364,14 +364,14 @@ fn the_cape_scene_drapes_and_turns_with_the_mannequin() {
     println!(
         "cape at 2.75 s: centre {c:.3?}, turned {angle:.1} deg about the body's axis (body 45 deg), \
          lowest point {lowest:.2} m; max penetration {} m, mean contacts {:.0}",
-        summary.max_penetration, summary.contacts
+        summary.collision.max_penetration, summary.collision.contacts
     );
     assert!((25.0..60.0).contains(&angle), "turned {angle} deg");
     assert!(
         lowest < 1.0,
         "the cape hangs down the back: lowest {lowest} m"
     );
-    assert!(summary.max_penetration < 5e-3);
+    assert!(summary.collision.max_penetration < 5e-3);
 }
 
 #[test]
@@ -387,10 +387,10 @@ fn moving_parts_are_logged_once_and_placed_every_frame() {
     let ins = drape::record::inspect::inspect(&out).expect("decodes");
     for part in ["upper", "lower"] {
         let rows = &ins.entities[&format!("/obstacles/obstacle_0_part_{part}")];
-        println!("{part}: {rows:?} over {} frames", summary.frames);
+        println!("{part}: {rows:?} over {} frames", summary.extent.frames);
         // The mesh once (static), the transform at every recorded frame.
         assert_eq!(rows.static_rows, 1, "{part}");
-        assert_eq!(rows.temporal as u64, summary.frames, "{part}");
+        assert_eq!(rows.temporal as u64, summary.extent.frames, "{part}");
     }
     std::fs::remove_file(&out).ok();
 }

@@ -90,7 +90,7 @@ fn every_frame_holds_each_triangles_ratio_term_and_state() {
     let lengths = decision_lengths(&path);
     assert_eq!(
         lengths.len() as u64,
-        summary.frames,
+        summary.extent.frames,
         "one decision row per frame"
     );
     for (&f, lens) in &lengths {
@@ -166,7 +166,7 @@ fn recording_the_decisions_leaves_the_simulation_as_it_is() {
     let (with, without) = (temp("with.rrd"), temp("without.rrd"));
     let a = record_default(&with, DecisionData::Recorded);
     let b = record_default(&without, DecisionData::Off);
-    let last = (a.frames - 1) as i64;
+    let last = (a.extent.frames - 1) as i64;
     let (ma, mb) = (
         drape::record::decode::cloth_mesh_at(&with, last).expect("mesh"),
         drape::record::decode::cloth_mesh_at(&without, last).expect("mesh"),
@@ -174,8 +174,16 @@ fn recording_the_decisions_leaves_the_simulation_as_it_is() {
     assert_eq!(ma.positions, mb.positions);
     assert_eq!(ma.triangles, mb.triangles);
     assert_eq!(
-        (a.splits, a.merges, a.energy.r#final),
-        (b.splits, b.merges, b.energy.r#final)
+        (
+            a.adaptivity.splits,
+            a.adaptivity.merges,
+            a.conservation.energy.r#final
+        ),
+        (
+            b.adaptivity.splits,
+            b.adaptivity.merges,
+            b.conservation.energy.r#final
+        )
     );
     assert!(
         std::fs::metadata(&with).expect("file").len()

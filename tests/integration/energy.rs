@@ -35,21 +35,24 @@ fn an_impact_at_large_implicit_steps_does_not_gain_energy() {
     )
     .expect("scene");
     let s = simulate(&scene);
-    let scale = s.energy.initial.abs();
+    let scale = s.conservation.energy.initial.abs();
     assert!(
-        s.energy_retries > 0,
+        s.effort.energy_retries > 0,
         "the impact needed smaller steps: energy {} -> max {} J",
-        s.energy.initial,
-        s.energy.max
+        s.conservation.energy.initial,
+        s.conservation.energy.max
     );
     // An accepted frame may keep a gain below 1% of the energy scale, or above it when
     // halving stops helping; here none remains.
     assert!(
-        s.energy.excess_max <= 1e-3 * scale,
+        s.conservation.energy.excess_max <= 1e-3 * scale,
         "energy rose {} J above its bound",
-        s.energy.excess_max
+        s.conservation.energy.excess_max
     );
-    assert_eq!(s.energy.external_work, 0.0, "a static table does no work");
+    assert_eq!(
+        s.conservation.energy.external_work, 0.0,
+        "a static table does no work"
+    );
 }
 
 /// Regression: friction moved a vertex that reached an obstacle within a step
@@ -72,16 +75,16 @@ fn a_sheet_landing_on_a_ball_gains_no_energy_at_full_steps() {
     .expect("scene");
     let s = simulate(&scene);
     assert_eq!(
-        s.energy_retries, 0,
+        s.effort.energy_retries, 0,
         "the landing gained energy at full steps: {} -> max {} J, excess {:e} J",
-        s.energy.initial, s.energy.max, s.energy.excess_max
+        s.conservation.energy.initial, s.conservation.energy.max, s.conservation.energy.excess_max
     );
-    assert_eq!(s.steps, 72, "0.6 s at 1/120 s without halved steps");
+    assert_eq!(s.extent.steps, 72, "0.6 s at 1/120 s without halved steps");
     assert!(
-        s.energy.max <= s.energy.initial,
+        s.conservation.energy.max <= s.conservation.energy.initial,
         "energy rose above its start: {} -> max {} J",
-        s.energy.initial,
-        s.energy.max
+        s.conservation.energy.initial,
+        s.conservation.energy.max
     );
 }
 

@@ -422,7 +422,7 @@ fn the_tablecloth_pull_scene_pulls_the_cloth_off_the_table() {
     println!(
         "at 0.3 s: pulled edge {pulled0:.3?} -> {pulled1:.3?} (keys: {want:.3?}), far edge \
          {far0:.3?} -> {far1:.3?}; max penetration {} m, mean contacts {:.0}",
-        summary.max_penetration, summary.contacts
+        summary.collision.max_penetration, summary.collision.contacts
     );
     assert!((pulled1 - want).length() < 1e-6, "the pin follows its keys");
     assert!(
@@ -430,9 +430,9 @@ fn the_tablecloth_pull_scene_pulls_the_cloth_off_the_table() {
         "the far edge, at the table's right edge at the start, has passed its left edge: {far1:?}"
     );
     assert!(
-        summary.max_penetration < 1e-3,
+        summary.collision.max_penetration < 1e-3,
         "{} m",
-        summary.max_penetration
+        summary.collision.max_penetration
     );
 }
 

@@ -211,7 +211,7 @@ fn a_cloth_on_a_moving_turning_platform_moves_with_it() {
     println!(
         "platform moved 0.2 m and turned 90 deg: cloth centre moved {moved:?} (off by {off:.4} m), \
          its u axis turned {turned:.2} deg; max penetration {} m",
-        summary.max_penetration
+        summary.collision.max_penetration
     );
     assert!(
         off < 0.01,

@@ -64,10 +64,10 @@ fn obj_cloth_with_texture_coordinates_runs_with_both_membranes() {
         )
         .unwrap_or_else(|e| panic!("{membrane}: {e}"));
         assert!(
-            summary.frames > 0 && summary.energy.r#final.is_finite(),
+            summary.extent.frames > 0 && summary.conservation.energy.r#final.is_finite(),
             "{membrane}"
         );
-        masses.push(summary.mass_final);
+        masses.push(summary.conservation.mass_final);
         let world = World::from_scene(&scene).expect("the world");
         let model = Model::from_scene(&scene);
         let el = Elements::build(&world.mesh, &model.material);

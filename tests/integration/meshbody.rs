@@ -240,14 +240,14 @@ fn a_cloth_on_a_moving_mesh_moves_with_it() {
     let moved = c1 - c0;
     println!(
         "tray slid 0.1 m: cloth centre {c0:.4?} -> {c1:.4?}; max penetration {} m",
-        summary.max_penetration
+        summary.collision.max_penetration
     );
     assert!((moved.x - 0.1).abs() < 0.005, "moved {moved:?}");
     assert!(
         moved.y.abs() < 0.005 && moved.z.abs() < 0.005,
         "moved {moved:?}"
     );
-    assert!(summary.max_penetration < 1e-3);
+    assert!(summary.collision.max_penetration < 1e-3);
 }
 
 /// `scenes/cape_mesh_body.toml` with `sets`.
@@ -325,14 +325,14 @@ fn the_cape_turns_with_the_mesh_body() {
     println!(
         "cape on the mesh body at 2.75 s: centre {c:.3?}, turned {angle:.1} deg (body 45 deg), lowest {lowest:.2} m; \
          max penetration {} m, mean contacts {:.0}",
-        summary.max_penetration, summary.contacts
+        summary.collision.max_penetration, summary.collision.contacts
     );
     assert!((25.0..60.0).contains(&angle), "turned {angle} deg");
     assert!(
         lowest < 1.0,
         "the cape hangs down the back: lowest {lowest} m"
     );
-    assert!(summary.max_penetration < 5e-3);
+    assert!(summary.collision.max_penetration < 5e-3);
 }
 
 #[test]
@@ -347,9 +347,9 @@ fn the_mesh_body_is_logged_as_a_mesh_per_frame() {
         drape::run::run(&scene, &opts, &AtomicBool::new(false), &mut |_| {}).expect("run");
     let ins = drape::record::inspect::inspect(&out).expect("decodes");
     let rows = &ins.entities["/obstacles/obstacle_0__skinned_mesh_"];
-    println!("body: {rows:?} over {} frames", summary.frames);
+    println!("body: {rows:?} over {} frames", summary.extent.frames);
     // The triangles once (static), the vertex positions at every recorded frame.
     assert_eq!(rows.static_rows, 1);
-    assert_eq!(rows.temporal as u64, summary.frames);
+    assert_eq!(rows.temporal as u64, summary.extent.frames);
     std::fs::remove_file(&out).ok();
 }

@@ -80,7 +80,7 @@ fn a_clamp_box_between_grid_lines_clamps_at_its_edge_and_the_strip_follows_the_e
             &mut |_| {},
         )
         .expect("the run");
-        let c = summary.cantilever.expect("a cantilever");
+        let c = summary.measurements.cantilever.expect("a cantilever");
         let err = c.chord_angle_deg - exact;
         println!(
             "resolution {resolution}: overhang {:.5} m (scene {overhang:.5} m), chord angle {:.3} deg, \
@@ -88,9 +88,9 @@ fn a_clamp_box_between_grid_lines_clamps_at_its_edge_and_the_strip_follows_the_e
             c.overhang, c.chord_angle_deg
         );
         assert!(
-            summary.pin_mismatches.is_empty(),
+            summary.checks.pin_mismatches.is_empty(),
             "{:?}",
-            summary.pin_mismatches
+            summary.checks.pin_mismatches
         );
         if (c.overhang - overhang).abs() > 1e-9 || err.is_nan() || err.abs() >= 2.0 {
             failures.push(format!(
@@ -277,7 +277,11 @@ fn a_run_summary_reports_a_pin_box_the_disk_mesh_cannot_follow() {
     )
     .expect("the run");
     println!("{}", summary.paragraph());
-    let m = summary.pin_mismatches.first().expect("the clamp differs");
+    let m = summary
+        .checks
+        .pin_mismatches
+        .first()
+        .expect("the clamp differs");
     assert_eq!((m.pin, m.region), (0, "box"));
     assert!((m.region_box[2] - 0.0636).abs() < 1e-9, "{m:?}");
     assert!(m.held_box[2] < 0.0636 && m.largest_gap > 0.0, "{m:?}");

@@ -199,9 +199,17 @@ fn every_preset_runs_a_hanging_sheet() {
             &mut |_| {},
         )
         .unwrap_or_else(|e| panic!("{}: {e}", f.name));
-        assert_eq!(summary.frames, 16, "{}", f.name);
-        assert_eq!(summary.nan_recoveries, 0, "{}", f.name);
-        assert!(summary.energy.r#final.is_finite(), "{}", f.name);
-        assert!(close(summary.mass_final, f.density * 0.09), "{}", f.name);
+        assert_eq!(summary.extent.frames, 16, "{}", f.name);
+        assert_eq!(summary.effort.nan_recoveries, 0, "{}", f.name);
+        assert!(
+            summary.conservation.energy.r#final.is_finite(),
+            "{}",
+            f.name
+        );
+        assert!(
+            close(summary.conservation.mass_final, f.density * 0.09),
+            "{}",
+            f.name
+        );
     }
 }

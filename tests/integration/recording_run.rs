@@ -114,7 +114,7 @@ fn check_frames(ins: &Inspection, all_edges: bool, (low, high): (f64, f64)) {
 fn check_event_counts(ins: &Inspection, summary: &Summary) {
     let counts = ins.event_counts();
     let n = |k: &str| counts.get(k).copied().unwrap_or(0) as u64;
-    let a = summary.adapt.expect("adaptive run");
+    let a = summary.adaptivity.adapt.expect("adaptive run");
     assert_eq!(
         n("split") + n("closure_split") + n("bounce"),
         a.splits,
@@ -175,12 +175,15 @@ fn adaptive_run_holds_the_whole_schema() {
         .collect();
     assert!(!obstacles.is_empty(), "an obstacle entity");
     assert!(obstacles.iter().all(|p| ins.entities[*p].static_rows == 1));
-    assert_eq!(ins.frames.len() as u64, summary.frames);
-    assert_eq!(ins.entities["/cloth/mesh"].temporal as u64, summary.frames);
+    assert_eq!(ins.frames.len() as u64, summary.extent.frames);
+    assert_eq!(
+        ins.entities["/cloth/mesh"].temporal as u64,
+        summary.extent.frames
+    );
     let rec = summary.recording.as_ref().expect("recording");
-    assert_eq!(rec.frames, summary.frames);
+    assert_eq!(rec.frames, summary.extent.frames);
     assert_eq!(rec.bytes, ins.bytes);
-    assert!(summary.splits > 0, "the short run refines");
+    assert!(summary.adaptivity.splits > 0, "the short run refines");
     check_frames(&ins, false, review_band(&scene));
     check_event_counts(&ins, &summary);
     std::fs::remove_file(&out).ok();
@@ -211,7 +214,7 @@ fn every_frame_decodes_to_the_engine_mesh() {
         },
     )
     .expect("run");
-    assert_eq!(seen.len() as u64, summary.frames);
+    assert_eq!(seen.len() as u64, summary.extent.frames);
     let ins = inspect(&out).expect("decodes");
     for (n, (positions, triangles)) in seen.iter().enumerate() {
         let f = cloth_mesh_at(&out, n as i64).expect("frame decodes");
@@ -238,7 +241,7 @@ fn record_every_thins_frames_and_keeps_every_event() {
     };
     let summary = record(&scene, &out, opts).expect("run");
     let ins = inspect(&out).expect("decodes");
-    let last = summary.frames - 1;
+    let last = summary.extent.frames - 1;
     let expected: Vec<i64> = (0..=last)
         .filter(|f| f % every == 0 || *f == last)
         .map(|f| f as i64)
@@ -246,9 +249,9 @@ fn record_every_thins_frames_and_keeps_every_event() {
     let got: Vec<i64> = ins.frames.keys().copied().collect();
     assert_eq!(got, expected);
     assert!(
-        got.len() < summary.frames as usize,
+        got.len() < summary.extent.frames as usize,
         "{} frames simulated, recorded {got:?}",
-        summary.frames
+        summary.extent.frames
     );
     assert_eq!(
         summary.recording.as_ref().map(|r| r.frames),
@@ -344,7 +347,7 @@ fn numerical_failure_leaves_a_complete_recording() {
     assert!(frame > 1, "failed mid-way, at frame {frame}");
     let ins = inspect(&out).expect("decodes completely");
     assert!(ins.footer, "footer written");
-    assert_eq!(ins.frames.len() as u64, summary.frames);
+    assert_eq!(ins.frames.len() as u64, summary.extent.frames);
     assert_eq!(
         *ins.frames.keys().next_back().expect("frames"),
         frame as i64 - 1
@@ -457,14 +460,18 @@ fn step_plot_shows_the_step_taken_not_the_target() {
     );
     let out = temp_path("dt.rrd");
     let summary = record(&scene, &out, RunOptions::default()).expect("run");
-    let taken_ms = 1e3 * summary.sim_time / summary.steps as f64;
+    let taken_ms = 1e3 * summary.extent.sim_time / summary.extent.steps as f64;
     let ins = inspect(&out).expect("decodes");
     let plotted: Vec<f64> = ins
         .frames
         .values()
         .filter_map(|f| f.scalars.get("time/dt_ms").copied())
         .collect();
-    assert_eq!(plotted.len() as u64, summary.frames, "plotted {plotted:?}");
+    assert_eq!(
+        plotted.len() as u64,
+        summary.extent.frames,
+        "plotted {plotted:?}"
+    );
     for (n, ms) in plotted.iter().enumerate() {
         assert!(
             (ms - taken_ms).abs() <= 1e-9 * taken_ms,

@@ -295,7 +295,10 @@ thickness = 0.003
             (frames, summary)
         };
         let (one, s1) = run(1);
-        assert!(s1.splits > 0 && s1.contacts > 0.0, "it adapts and touches");
+        assert!(
+            s1.adaptivity.splits > 0 && s1.collision.contacts > 0.0,
+            "it adapts and touches"
+        );
         for threads in [2, 4] {
             let (other, _) = run(threads);
             assert_eq!(one.len(), other.len());

@@ -207,15 +207,15 @@ fn newton_iterations_converge_or_fail_the_step() {
     let summary = run_with(4, 1e-4, 1).expect("converges");
     let again = run_with(4, 1e-4, 4).expect("converges");
     assert_eq!(
-        summary.energy.r#final.to_bits(),
-        again.energy.r#final.to_bits(),
+        summary.conservation.energy.r#final.to_bits(),
+        again.conservation.energy.r#final.to_bits(),
         "same result at 1 and 4 threads"
     );
-    let steps = summary.solver.steps;
+    let steps = summary.effort.solver.steps;
     assert!(
-        summary.solver.newton_iterations > steps,
+        summary.effort.solver.newton_iterations > steps,
         "more than one solve a step: {steps} steps, {}",
-        summary.solver.describe()
+        summary.effort.solver.describe()
     );
     let err = run_with(2, 1e-9, 2).expect_err("cannot reach 1e-9");
     assert!(
@@ -248,12 +248,18 @@ fn an_unconverged_solve_is_retried_with_halved_steps_and_counted() {
     )
     .expect("the retries succeed");
     assert!(
-        summary.solver.failed_solves > 0,
+        summary.effort.solver.failed_solves > 0,
         "some solves failed: {}",
-        summary.solver.describe()
+        summary.effort.solver.describe()
     );
-    assert_eq!(summary.solver.failed_solves, summary.solver.cg_capped);
-    assert!(summary.nan_recoveries > 0, "their frames were retried");
+    assert_eq!(
+        summary.effort.solver.failed_solves,
+        summary.effort.solver.cg_capped
+    );
+    assert!(
+        summary.effort.nan_recoveries > 0,
+        "their frames were retried"
+    );
 }
 
 #[test]
@@ -281,13 +287,13 @@ fn solves_that_keep_failing_stop_the_run_with_a_message_and_a_complete_recording
     );
     assert!(message.contains("cg_max_iterations"), "{message}");
     assert!(
-        summary.solver.failed_solves >= 5,
+        summary.effort.solver.failed_solves >= 5,
         "every halving failed: {}",
-        summary.solver.describe()
+        summary.effort.solver.describe()
     );
     let ins = inspect(&out).expect("decodes completely");
     assert!(ins.footer, "footer written");
-    assert_eq!(ins.frames.len() as u64, summary.frames);
+    assert_eq!(ins.frames.len() as u64, summary.extent.frames);
     assert_eq!(ins.frames.len() as u64, frame, "frames 0 .. the failed one");
     std::fs::remove_file(&out).ok();
 }

@@ -57,7 +57,7 @@ fn a_varying_step_prints_its_range_and_a_mean_that_adds_up_to_the_time() {
     };
     assert!(text.contains(&format!("{count} steps of ")), "{text}");
     assert!(text.contains("(mean "), "{text}");
-    assert_eq!(count, s.steps_accepted);
+    assert_eq!(count, s.stepping.steps_accepted);
     assert!(smallest <= mean && mean <= largest, "{text}");
     assert!(largest > smallest * 1.01, "{text}");
     let total = count as f64 * mean;
@@ -65,8 +65,10 @@ fn a_varying_step_prints_its_range_and_a_mean_that_adds_up_to_the_time() {
         (total - time).abs() <= PRINTED * time,
         "{count} x {mean} = {total} s, not {time} s"
     );
-    assert!((s.dt_mean * s.steps_accepted as f64 - s.sim_time).abs() < 1e-9);
-    assert!((s.dt_max - largest).abs() <= PRINTED * largest);
+    assert!(
+        (s.stepping.dt_mean * s.stepping.steps_accepted as f64 - s.extent.sim_time).abs() < 1e-9
+    );
+    assert!((s.stepping.dt_max - largest).abs() <= PRINTED * largest);
 }
 
 #[test]
@@ -77,8 +79,8 @@ fn a_steady_step_prints_one_size_whose_count_adds_up_to_the_time() {
     assert!(!s.step_varied(), "{text}");
     let (count, sizes, time) = step_clause(&text);
     assert_eq!(sizes.len(), 1, "{text}");
-    assert_eq!(count, s.steps);
-    assert_eq!(count, s.steps_accepted);
+    assert_eq!(count, s.extent.steps);
+    assert_eq!(count, s.stepping.steps_accepted);
     assert!(!text.contains("(mean "), "{text}");
     let total = count as f64 * sizes[0];
     assert!(

@@ -2,6 +2,8 @@
 
 use proptest::prelude::*;
 
+use super::super::self_prims::edge;
+use super::broad::pair_prims;
 use super::*;
 use crate::math::Vector2;
 

@@ -29,19 +29,17 @@ impl Pipeline {
     ) -> Result<bool, MeshError> {
         let mut welded = false;
         loop {
-            let Some(panels) = state.world.mesh.panels() else {
-                return Ok(welded);
-            };
+            let seams = state.world.mesh.seams();
             let x = &state.world.x;
             let weld_gap = setup.model.material.sewing.weld_gap;
-            let closed = panels.seams.iter().enumerate().find_map(|(s, seam)| {
+            let closed = seams.iter().enumerate().find_map(|(s, seam)| {
                 let gap = seam.gap(x);
                 (seam.is_open() && gap < weld_gap).then_some((s, gap))
             });
             let Some((s, gap)) = closed else {
                 return Ok(welded);
             };
-            let seam = &panels.seams[s];
+            let seam = &seams[s];
             let centre = seam
                 .pairs
                 .iter()
@@ -74,11 +72,8 @@ impl Pipeline {
 /// whose pairs the mesh has joined (the seam just welded, and any other whose
 /// every pair that weld joined).
 fn mark_welded(state: &mut SimState) {
-    let Some(panels) = state.world.mesh.panels() else {
-        return;
-    };
     let time = state.world.time;
-    for (seam, s) in panels.seams.iter().zip(&mut state.seams) {
+    for (seam, s) in state.world.mesh.seams().iter().zip(&mut state.seams) {
         if s.is_open() && !seam.is_open() {
             *s = SeamState::Welded { time };
         }
