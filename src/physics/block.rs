@@ -80,7 +80,7 @@ mod tests;
 pub use terms::{ElementBlocks, ElementTerms};
 
 use super::elements::Elements;
-use super::shape::SHAPE_SLOTS;
+use super::kinds::{coupling_count, couplings};
 use crate::math::{Matrix3, Vector};
 pub(crate) use buckets::group_by_key;
 use buckets::sorted_unique_rows;
@@ -168,44 +168,9 @@ impl BlockPattern {
     pub fn build(vertices: usize, elements: &Elements, factor_tips: bool) -> BlockPattern {
         let n = vertices;
         // Every coupled pair, both ways, and the diagonal.
-        let mut pairs: Vec<(u32, u32)> = Vec::with_capacity(
-            n + 2 * elements.springs.len()
-                + 12 * elements.hinges.len()
-                + 6 * elements.membrane_triangles.len()
-                + SHAPE_SLOTS * (SHAPE_SLOTS - 1) * elements.shape_triangles.len(),
-        );
+        let mut pairs: Vec<(u32, u32)> = Vec::with_capacity(n + coupling_count(elements));
         pairs.extend((0..n as u32).map(|i| (i, i)));
-        for sp in &elements.springs {
-            let [a, b] = sp.v;
-            pairs.extend([(a, b), (b, a)]);
-        }
-        for hg in &elements.hinges {
-            for k in 0..4 {
-                for l in 0..4 {
-                    if k != l {
-                        pairs.push((hg.v[k], hg.v[l]));
-                    }
-                }
-            }
-        }
-        for t in &elements.membrane_triangles {
-            for i in t.v {
-                for j in t.v {
-                    if i != j {
-                        pairs.push((i, j));
-                    }
-                }
-            }
-        }
-        for t in &elements.shape_triangles {
-            for (k, i) in t.slots() {
-                for (l, j) in t.slots() {
-                    if k != l && i != j {
-                        pairs.push((i, j));
-                    }
-                }
-            }
-        }
+        couplings(elements, &mut pairs);
         let (row_start, columns) = sorted_unique_rows(n, &pairs);
         let rows = (0..n as u32)
             .flat_map(|i| {
@@ -223,6 +188,17 @@ impl BlockPattern {
         };
         p.diagonal = (0..n as u32).map(|i| p.slot(i, i)).collect();
         p.mirror = p.mirrors();
+        p.mark_factored(elements, factor_tips);
+        p.build_sources(elements);
+        p.build_csc();
+        p
+    }
+
+    /// Which blocks the factorization reads ([`BlockPattern::factored`]) and
+    /// the hinge tips whose blocks it leaves out, compensated on the diagonal.
+    fn mark_factored(&mut self, elements: &Elements, factor_tips: bool) {
+        let n = self.vertices();
+        let p = self;
         p.factored = (0..p.blocks())
             .map(|b| p.rows[b] == p.columns[b] || factor_tips)
             .collect();
@@ -251,9 +227,6 @@ impl BlockPattern {
             }
         }
         (p.compensation_start, p.compensation) = group_by_key(n, &tips);
-        p.build_sources(elements);
-        p.build_csc();
-        p
     }
 
     /// Number of vertices (block rows).

@@ -83,10 +83,9 @@ use rayon::prelude::*;
 
 use super::elements::Elements;
 use super::forces::PAR_MIN;
-use super::membrane::ColumnBlocks;
-use super::shape::{EdgeFold, ShapeJacobian};
+use super::kinds::KindLinear;
 use super::{Contact, Model, Preconditioner, Stepper};
-use crate::math::{Matrix3, Scalar, Vector, deterministic_sum};
+use crate::math::{Scalar, Vector, deterministic_sum};
 use crate::spec::Solver;
 use crate::world::World;
 
@@ -145,24 +144,8 @@ impl SolveFailure {
 /// Scratch memory of the implicit step, kept between steps.
 #[derive(Debug, Default, Clone)]
 pub struct ImplicitScratch {
-    /// Per spring: `h^2 K_e + h D_e`.
-    spring_block: Vec<Matrix3>,
-    spring_slot: Vec<Vector>,
-    hinge_grad: Vec<Vector>,
-    hinge_coef: Vec<Scalar>,
-    hinge_slot: Vec<Vector>,
-    shape_slot: Vec<Vector>,
-    shape_grad: Vec<ShapeJacobian>,
-    /// Per interior edge: its fold (scratch of `fold_angles`).
-    edge_folds: Vec<EdgeFold>,
-    /// Per shape triangle: its folds.
-    shape_folds: Vec<[Scalar; 3]>,
-    /// The fold splits at the step's start.
-    shape_splits: Vec<Scalar>,
-    /// Per membrane triangle: `h^2 K_t + h D_t` over its deformation gradient's
-    /// columns.
-    membrane_block: Vec<ColumnBlocks>,
-    membrane_slot: Vec<Vector>,
+    /// Every force element kind's terms of the linearised step ([`super::kinds`]).
+    kinds: KindLinear,
     /// `h^2` of the step being solved (scales the shape triangles' `M`).
     h2: Scalar,
     tri_slot: Vec<Vector>,

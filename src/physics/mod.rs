@@ -13,6 +13,7 @@ pub mod elements;
 pub mod explicit;
 pub mod forces;
 pub mod implicit;
+pub mod kinds;
 pub mod laplacian;
 pub mod membrane;
 pub mod multirate;

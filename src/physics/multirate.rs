@@ -20,8 +20,8 @@
 //! symplectic Euler exactly. (Holding the other levels still instead was tried
 //! first and is unstable at the level interfaces.)
 //!
-//! A kick computes only the springs (the capped sewing springs with their cap),
-//! hinges, shape triangles, membrane and wind triangles that touch the
+//! A kick computes only the force elements of every kind (`kinds.rs`; the
+//! capped sewing springs with their cap) and the wind triangles that touch the
 //! level's vertices. Element forces are computed in parallel and written back
 //! in a fixed order, so results do not depend on the thread count.
 
@@ -30,11 +30,9 @@ use rayon::prelude::*;
 mod rk4;
 pub use rk4::rk4_multirate;
 
-use super::bending::dihedral_angle_and_gradient;
 use super::elements::Elements;
-use super::forces::{ForceScratch, gather, solve_splits, spring_force, wind_share};
-use super::membrane::MEMBRANE_SLOTS;
-use super::sewing::cap_force;
+use super::forces::{ForceScratch, gather, wind_share};
+use super::kinds::{KindIds, KindKicks, element_vertices, for_each_element};
 use super::shape::SHAPE_SLOTS;
 use super::timestep::{SAFETY, vertex_limits};
 use super::{Model, Stepper};
@@ -48,12 +46,9 @@ struct Group {
     level: u8,
     substeps: u32,
     vertices: Vec<u32>,
-    springs: Vec<u32>,
-    /// The capped sewing springs among `springs`, as indices of
-    /// [`Elements::sewing_caps`].
-    caps: Vec<u32>,
-    hinges: Vec<u32>,
-    shape: Vec<u32>,
+    /// Per force element kind, its elements that touch the vertices.
+    kinds: KindIds,
+    /// The triangles that touch the vertices (for the wind).
     triangles: Vec<u32>,
     /// Vertices of other levels that the group's elements touch.
     halo: Vec<u32>,
@@ -125,39 +120,11 @@ fn assign_elements(groups: &mut [Group], mesh: &Mesh, el: &Elements) -> Vec<usiz
             mark[v as usize] = g.level as usize;
         }
     }
-    for (s, sp) in el.springs.iter().enumerate() {
-        touch(
-            groups,
-            sp.v.iter().map(|&v| mark[v as usize]),
-            s as u32,
-            |g| &mut g.springs,
-        );
-    }
-    for (c, cap) in el.sewing_caps.iter().enumerate() {
-        let sp = &el.springs[cap.spring as usize];
-        touch(
-            groups,
-            sp.v.iter().map(|&v| mark[v as usize]),
-            c as u32,
-            |g| &mut g.caps,
-        );
-    }
-    for (h, hg) in el.hinges.iter().enumerate() {
-        touch(
-            groups,
-            hg.v.iter().map(|&v| mark[v as usize]),
-            h as u32,
-            |g| &mut g.hinges,
-        );
-    }
-    for (p, st) in el.shape_triangles.iter().enumerate() {
-        touch(
-            groups,
-            st.slots().map(|(_, v)| mark[v as usize]),
-            p as u32,
-            |g| &mut g.shape,
-        );
-    }
+    for_each_element(el, |kind, e, vertices| {
+        touch(groups, vertices.iter().map(|&v| mark[v as usize]), e, |g| {
+            &mut g.kinds[kind]
+        });
+    });
     for (t, tri) in mesh.triangles.iter().enumerate() {
         touch(
             groups,
@@ -171,19 +138,20 @@ fn assign_elements(groups: &mut [Group], mesh: &Mesh, el: &Elements) -> Vec<usiz
 
 /// The vertices of other groups that group `g`'s elements touch, sorted.
 fn halo_of(g: &Group, mesh: &Mesh, el: &Elements, mark: &[usize]) -> Vec<u32> {
-    let mut halo: Vec<u32> = g
-        .springs
-        .iter()
-        .flat_map(|&s| el.springs[s as usize].v)
-        .chain(g.hinges.iter().flat_map(|&h| el.hinges[h as usize].v))
-        .chain(
-            g.shape
-                .iter()
-                .flat_map(|&p| el.shape_triangles[p as usize].slots().map(|(_, v)| v)),
-        )
-        .chain(g.triangles.iter().flat_map(|&t| mesh.triangles[t as usize]))
-        .filter(|&v| mark[v as usize] != g.level as usize)
-        .collect();
+    let mut halo: Vec<u32> = Vec::new();
+    let mut vertices = Vec::new();
+    for (kind, ids) in g.kinds.iter().enumerate() {
+        for &e in ids {
+            element_vertices(el, kind, e as usize, &mut vertices);
+            halo.extend(
+                vertices
+                    .iter()
+                    .filter(|&&v| mark[v as usize] != g.level as usize),
+            );
+        }
+    }
+    let triangles = g.triangles.iter().flat_map(|&t| mesh.triangles[t as usize]);
+    halo.extend(triangles.filter(|&v| mark[v as usize] != g.level as usize));
     halo.sort_unstable();
     halo.dedup();
     halo
@@ -226,19 +194,7 @@ pub fn symplectic_multirate(st: &mut Stepper, model: &Model, w: &mut World, big:
     let levels = take_levels(st, model, w);
     let mut rk = std::mem::take(&mut st.rk4_multirate);
     let scratch = &mut st.forces;
-    let n_springs = st.elements.springs.len();
-    scratch.spring.resize(n_springs, Vector::ZERO);
-    scratch
-        .hinge
-        .resize(4 * st.elements.hinges.len(), Vector::ZERO);
-    scratch.shape.resize(
-        SHAPE_SLOTS * st.elements.shape_triangles.len(),
-        Vector::ZERO,
-    );
-    scratch.membrane.resize(
-        MEMBRANE_SLOTS * st.elements.membrane_triangles.len(),
-        Vector::ZERO,
-    );
+    scratch.kinds.size(&st.elements);
     if model.external.wind.is_some() {
         scratch
             .triangle
@@ -311,67 +267,7 @@ fn level_forces(
     scratch: &mut ForceScratch,
     level: &mut LevelScratch,
 ) {
-    g.springs
-        .par_iter()
-        .with_min_len(512)
-        .map(|&s| {
-            let sp = &el.springs[s as usize];
-            let [a, b] = [sp.v[0] as usize, sp.v[1] as usize];
-            spring_force(x[a], x[b], v[a], v[b], sp.rest, sp.k, sp.c)
-        })
-        .collect_into_vec(&mut level.springs);
-    for (&s, &f) in g.springs.iter().zip(&level.springs) {
-        scratch.spring[s as usize] = f;
-    }
-    for &c in &g.caps {
-        let cap = &el.sewing_caps[c as usize];
-        scratch.spring[cap.spring as usize] = cap_force(el, cap, x, v);
-    }
-    g.hinges
-        .par_iter()
-        .with_min_len(256)
-        .map(|&h| {
-            let hg = &el.hinges[h as usize];
-            let (theta, grad) = dihedral_angle_and_gradient(hg.v.map(|i| x[i as usize]));
-            grad.map(|gk| gk * (-hg.k * theta))
-        })
-        .collect_into_vec(&mut level.hinges);
-    for (&h, f) in g.hinges.iter().zip(&level.hinges) {
-        scratch.hinge[4 * h as usize..4 * h as usize + 4].copy_from_slice(f);
-    }
-    if !g.shape.is_empty() {
-        // The splits couple every fold: they are solved over the whole mesh.
-        solve_splits(el, x, &mut scratch.folds, &mut scratch.splits);
-    }
-    let splits = &scratch.splits;
-    g.shape
-        .par_iter()
-        .with_min_len(128)
-        .map(|&p| {
-            let mut f = [Vector::ZERO; SHAPE_SLOTS];
-            el.shape_triangles[p as usize].forces(x, splits, &mut f);
-            f
-        })
-        .collect_into_vec(&mut level.shape);
-    for (&p, f) in g.shape.iter().zip(&level.shape) {
-        scratch.shape[SHAPE_SLOTS * p as usize..SHAPE_SLOTS * (p as usize + 1)].copy_from_slice(f);
-    }
-    // Membrane triangle t is mesh triangle t: the group's triangles are its own.
-    if !el.membrane_triangles.is_empty() {
-        g.triangles
-            .par_iter()
-            .with_min_len(256)
-            .map(|&t| {
-                let mut f = [Vector::ZERO; MEMBRANE_SLOTS];
-                el.membrane_triangles[t as usize].forces(x, v, &mut f);
-                f
-            })
-            .collect_into_vec(&mut level.membrane);
-        for (&t, f) in g.triangles.iter().zip(&level.membrane) {
-            let at = MEMBRANE_SLOTS * t as usize;
-            scratch.membrane[at..at + MEMBRANE_SLOTS].copy_from_slice(f);
-        }
-    }
+    scratch.kinds.kick(el, &g.kinds, x, v, &mut level.kinds);
     if let Some(wind) = &ext.wind {
         for &t in &g.triangles {
             let tri = triangles[t as usize];
@@ -405,8 +301,5 @@ pub struct Rk4MultirateScratch {
 /// their slots.
 #[derive(Debug, Clone, Default)]
 struct LevelScratch {
-    springs: Vec<Vector>,
-    hinges: Vec<[Vector; 4]>,
-    shape: Vec<[Vector; SHAPE_SLOTS]>,
-    membrane: Vec<[Vector; MEMBRANE_SLOTS]>,
+    kinds: KindKicks,
 }

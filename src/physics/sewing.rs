@@ -21,10 +21,10 @@
 //!
 //! The capped springs stay in [`Elements::springs`], so every per-vertex list,
 //! the block pattern and the solvers treat them as springs; [`Elements::sewing_caps`]
-//! lists them with their caps. Each place that evaluates springs computes every
-//! spring as usual and then overwrites the few capped ones (forces, energy,
-//! the implicit blocks, the multirate kicks), so the loops over the ordinary
-//! springs are unchanged.
+//! lists them with their caps. The springs kind (`kinds/springs.rs`) computes
+//! every spring as usual and then overwrites the few capped ones (forces,
+//! energy, the implicit blocks), so the loops over the ordinary springs are
+//! unchanged; a multirate kick looks each of its springs up among the caps.
 //! Within `d0` a capped spring's force, energy and blocks are the uncapped
 //! spring's to the last bit, so a cap that is never reached changes nothing.
 

@@ -19,8 +19,8 @@
 //! at 0.5 the largest deviation was still 0.94% of E0; at 0.4 it only
 //! oscillated (largest deviation 0.6% of E0, -0.05% at the end). So 0.4.
 
-use super::bending::dihedral_angle_and_gradient;
 use super::elements::Elements;
+use super::kinds::gershgorin;
 use crate::math::{Scalar, Vector};
 use crate::mesh::Mesh;
 use crate::spec::Integrator;
@@ -76,58 +76,9 @@ fn gershgorin_rows(
     let n = mesh.vertex_count();
     let mut stiff = vec![0.0; n];
     let mut damp = vec![0.0; n];
-    for s in &el.springs {
-        for &v in &s.v {
-            stiff[v as usize] += 2.0 * s.k;
-            damp[v as usize] += 2.0 * s.c;
-        }
-    }
     // A garment's stencils are laid flat one by one (`Mesh::lay_flat`).
     let mut flat: Vec<Vector> = mesh.material.iter().map(|m| m.extend(0.0)).collect();
-    let garment = mesh.panels().is_some();
-    for hg in &el.hinges {
-        if garment {
-            mesh.lay_flat(&hg.v, &mut flat);
-        }
-        let (_, g) = dihedral_angle_and_gradient(hg.v.map(|i| flat[i as usize]));
-        let sum: Scalar = g.iter().map(|gi| gi.length()).sum();
-        for k in 0..4 {
-            stiff[hg.v[k] as usize] += hg.k * g[k].length() * sum;
-        }
-    }
-    for t in &el.shape_triangles {
-        // Gershgorin bound of J^T M J at the flat rest state.
-        if garment {
-            let ids: Vec<u32> = t.slots().map(|(_, v)| v).collect();
-            mesh.lay_flat(&ids, &mut flat);
-        }
-        let (_, jac) = t.angles(&flat);
-        let row: [Scalar; 3] = [0, 1, 2].map(|a| jac[a].iter().map(|g| g.length()).sum());
-        for (k, v) in t.slots() {
-            for (ma, ja) in t.m.iter().zip(&jac) {
-                for (mab, rb) in ma.iter().zip(&row) {
-                    stiff[v as usize] += (mab * ja[k].length() * rb).abs();
-                }
-            }
-        }
-    }
-    for t in &el.membrane_triangles {
-        // Gershgorin bound of the rest stiffness (Gauss-Newton; no stress at rest).
-        if garment {
-            mesh.lay_flat(&t.v, &mut flat);
-        }
-        let (gauss_newton, _) = t.stiffness(&flat);
-        for i in 0..3 {
-            let mut rows = Vector::ZERO;
-            for j in 0..3 {
-                let b = t.block(&gauss_newton, i, j);
-                rows += b.x_axis.abs() + b.y_axis.abs() + b.z_axis.abs();
-            }
-            let bound = rows.max_element();
-            stiff[t.v[i] as usize] += bound;
-            damp[t.v[i] as usize] += t.damping * bound;
-        }
-    }
+    gershgorin(el, mesh, &mut flat, &mut stiff, &mut damp);
     for i in 0..n {
         stiff[i] /= el.mass[i];
         damp[i] = (damp[i] + drag_per_area * el.vertex_area[i]) / el.mass[i];

@@ -217,7 +217,7 @@ fn cylinder_energy_ratio(res: u32, model_kind: BendingModel, r: Scalar) -> Scala
     let stretch_springs = m.edges.len();
     let energy: Scalar = match model_kind {
         BendingModel::ShapeOperator => {
-            let splits = drape::physics::forces::splits_at(&el, &x);
+            let splits = drape::physics::kinds::splits_at(&el, &x);
             el.shape_triangles
                 .iter()
                 .map(|t| t.energy(&x, &splits))
@@ -607,7 +607,7 @@ fn partly_refined_sheet_bends_like_the_continuum_in(alternate: bool, region: &st
         let sheet = |m: &Mesh| {
             let el = Elements::build(m, &mat);
             let x: Vec<Vector> = m.material.iter().map(|&p| shape(p)).collect();
-            let splits = drape::physics::forces::splits_at(&el, &x);
+            let splits = drape::physics::kinds::splits_at(&el, &x);
             let e: Scalar = el
                 .shape_triangles
                 .iter()

@@ -153,7 +153,11 @@ pub(crate) fn capped_forces(
         .map(|c| {
             let sp = &el.springs[c.spring as usize];
             let d = x[sp.v[1] as usize].distance(x[sp.v[0] as usize]);
-            (scratch.spring[c.spring as usize], c.max_force, sp.k * d)
+            (
+                scratch.kinds.springs[c.spring as usize],
+                c.max_force,
+                sp.k * d,
+            )
         })
         .collect()
 }

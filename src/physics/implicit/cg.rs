@@ -11,8 +11,6 @@ use rayon::prelude::*;
 use super::{ImplicitScratch, SolveFailure, without};
 use crate::math::{Scalar, Vector, deterministic_sum, deterministic_sum2};
 use crate::physics::forces::PAR_MIN;
-use crate::physics::membrane::MEMBRANE_SLOTS;
-use crate::physics::shape::{SHAPE_SLOTS, rates, spread};
 use crate::physics::{Model, Stepper};
 
 /// Vectors of the iteration, kept between steps.
@@ -144,50 +142,8 @@ fn apply_operator(st: &mut Stepper, which: Which, held: &[bool], filtered: bool)
     } else {
         &s.cg.p
     };
-    s.spring_slot
-        .par_iter_mut()
-        .zip(s.spring_block.par_iter())
-        .zip(el.springs.par_iter())
-        .with_min_len(PAR_MIN)
-        .for_each(|((q, block), sp)| {
-            *q = *block * (input[sp.v[0] as usize] - input[sp.v[1] as usize]);
-        });
-    s.hinge_slot
-        .par_chunks_exact_mut(4)
-        .zip(s.hinge_grad.par_chunks_exact(4))
-        .zip(s.hinge_coef.par_iter())
-        .zip(el.hinges.par_iter())
-        .with_min_len(PAR_MIN / 4)
-        .for_each(|(((slot, g), coef), hg)| {
-            let gp: Scalar = (0..4).map(|k| g[k].dot(input[hg.v[k] as usize])).sum();
-            for k in 0..4 {
-                slot[k] = g[k] * (coef * gp);
-            }
-        });
-    let h2 = s.h2;
-    s.shape_slot
-        .par_chunks_exact_mut(SHAPE_SLOTS)
-        .zip(s.shape_grad.par_iter())
-        .zip(el.shape_triangles.par_iter())
-        .with_min_len(PAR_MIN / SHAPE_SLOTS)
-        .for_each(|((slot, jac), t)| {
-            let c = t.times_m(rates(t, jac, input));
-            spread(jac, c.map(|c| c * h2), slot);
-        });
-    s.membrane_slot
-        .par_chunks_exact_mut(MEMBRANE_SLOTS)
-        .zip(s.membrane_block.par_iter())
-        .zip(el.membrane_triangles.par_iter())
-        .with_min_len(PAR_MIN / MEMBRANE_SLOTS)
-        .for_each(|((slot, block), t)| t.apply(block, input, slot));
-    let (spring_slot, hinge_slot, shape_slot, diag_mass, filter) = (
-        &s.spring_slot,
-        &s.hinge_slot,
-        &s.shape_slot,
-        &s.diag_mass,
-        &s.filter,
-    );
-    let membrane_slot = &s.membrane_slot;
+    s.kinds.product(el, input, s.h2);
+    let (kinds, diag_mass, filter) = (&s.kinds, &s.diag_mass, &s.filter);
     s.cg.ap
         .par_iter_mut()
         .enumerate()
@@ -199,21 +155,7 @@ fn apply_operator(st: &mut Stepper, which: Which, held: &[bool], filtered: bool)
                 return;
             }
             let mut acc = input[i] * diag_mass[i];
-            for &e in el.spring_first.of(i) {
-                acc += spring_slot[e as usize];
-            }
-            for &e in el.spring_second.of(i) {
-                acc -= spring_slot[e as usize];
-            }
-            for &k in el.hinge_slots.of(i) {
-                acc += hinge_slot[k as usize];
-            }
-            for &k in el.shape_slots.of(i) {
-                acc += shape_slot[k as usize];
-            }
-            for &k in el.membrane_slots.of(i) {
-                acc += membrane_slot[k as usize];
-            }
+            kinds.gather_product(el, i, &mut acc);
             *out = if filtered {
                 without(filter[i], acc)
             } else {

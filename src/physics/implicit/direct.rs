@@ -265,22 +265,10 @@ fn iterate(
                 let failure = SolveFailure::not_converged(total, norm, reference, tolerance);
                 break 'restart Err(failure);
             }
-            if fresh
-                && since_factor >= TIPS_CONSIDER
-                && !a.factor_tips
-                && a.preconditioner != Preconditioner::Laplacian
-            {
-                st.stats.solve_s += started.elapsed().as_secs_f64();
-                let switched = switch_to_full_factor(
-                    a,
-                    pattern,
-                    &st.elements,
-                    factorization_cost,
-                    since_factor,
-                    &mut st.stats,
-                )?;
-                started = Instant::now();
-                if switched {
+            if fresh && since_factor >= TIPS_CONSIDER {
+                let (el, stats) = (&st.elements, &mut st.stats);
+                let cost = (factorization_cost, since_factor);
+                if tips_switched(a, pattern, el, cost, stats, &mut started)? {
                     since_factor = 0;
                     continue 'restart;
                 }
@@ -295,13 +283,9 @@ fn iterate(
                     (restart_norm, norm, goal),
                 )
             {
-                st.stats.solve_s += started.elapsed().as_secs_f64();
-                refactor(a, pattern, mass, &mut st.stats)?;
-                a.policy.factored(true);
-                started = Instant::now();
+                renew(a, pattern, mass, &mut st.stats, &mut started)?;
                 fresh = true;
                 since_factor = 0;
-                residual(a, pattern);
                 continue 'restart;
             }
             let Some(next) = pcg_step(a, pattern, rz) else {
@@ -319,6 +303,51 @@ fn iterate(
     }
     st.stats.solve_s += started.elapsed().as_secs_f64();
     outcome
+}
+
+/// With a fresh factor that leaves out the tips, after `cost.1` iterations
+/// (the factorization costing `cost.0` of them): whether it switched to the
+/// full factor ([`switch_to_full_factor`]), after which the solve restarts.
+/// `started` times the solve, paused while it decides.
+fn tips_switched(
+    a: &mut DirectScratch,
+    pattern: &BlockPattern,
+    elements: &Elements,
+    (factorization_cost, since_factor): (Scalar, u32),
+    stats: &mut StepStats,
+    started: &mut Instant,
+) -> Result<bool, SolveFailure> {
+    if a.factor_tips || a.preconditioner == Preconditioner::Laplacian {
+        return Ok(false);
+    }
+    stats.solve_s += started.elapsed().as_secs_f64();
+    let switched = switch_to_full_factor(
+        a,
+        pattern,
+        elements,
+        factorization_cost,
+        since_factor,
+        stats,
+    )?;
+    *started = Instant::now();
+    Ok(switched)
+}
+
+/// Factors anew in the middle of a solve ([`give_up`]) and restarts from the
+/// residual; `started` times the solve, paused while it factors.
+fn renew(
+    a: &mut DirectScratch,
+    pattern: &BlockPattern,
+    mass: &[Scalar],
+    stats: &mut StepStats,
+    started: &mut Instant,
+) -> Result<(), SolveFailure> {
+    stats.solve_s += started.elapsed().as_secs_f64();
+    refactor(a, pattern, mass, stats)?;
+    a.policy.factored(true);
+    *started = Instant::now();
+    residual(a, pattern);
+    Ok(())
 }
 
 /// Whether to factor anew at the start of a solve with a valid factor, by the

@@ -5,8 +5,6 @@ use rayon::prelude::*;
 use super::{Group, Rk4MultirateScratch, level_forces, take_levels};
 use crate::math::{Scalar, Vector};
 use crate::physics::forces::gather;
-use crate::physics::membrane::MEMBRANE_SLOTS;
-use crate::physics::shape::SHAPE_SLOTS;
 use crate::physics::{Model, Stepper};
 use crate::world::World;
 
@@ -46,14 +44,7 @@ pub fn rk4_multirate(st: &mut Stepper, model: &Model, w: &mut World, big: Scalar
 /// once they have grown to the mesh).
 fn size_force_scratch(st: &mut Stepper, model: &Model, w: &World) {
     let (scratch, el) = (&mut st.forces, &st.elements);
-    scratch.spring.resize(el.springs.len(), Vector::ZERO);
-    scratch.hinge.resize(4 * el.hinges.len(), Vector::ZERO);
-    scratch
-        .shape
-        .resize(SHAPE_SLOTS * el.shape_triangles.len(), Vector::ZERO);
-    scratch
-        .membrane
-        .resize(MEMBRANE_SLOTS * el.membrane_triangles.len(), Vector::ZERO);
+    scratch.kinds.size(el);
     if model.external.wind.is_some() {
         scratch
             .triangle

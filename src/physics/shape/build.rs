@@ -46,6 +46,45 @@ pub(crate) fn build_shape_triangles_into(
         a.is_some_and(|p| p != u32::MAX) && a == b && b == c
     };
     let n = mesh.triangles.len();
+    stencils(mesh, area, &held, scratch);
+    let splits = number_splits(mesh, &held, scratch);
+    let ShapeScratch {
+        stencil,
+        across,
+        share,
+        ..
+    } = scratch;
+    out.clear();
+    for t in (0..n).filter(|&t| !held(t)) {
+        let mut st = stencil[t];
+        st.share = [0, 1, 2].map(|a| {
+            if st.interior[a] {
+                0.5 * share[t][a]
+            } else {
+                0.0
+            }
+        });
+        st.k = plate_k(mesh, t, area[t], bending);
+        st.m = match kept(t, &st, &across[t]) {
+            Some(m) => m,
+            // The energy at zero splits: `M_ab = share_a share_b K_ab`.
+            None => [0, 1, 2].map(|a| [0, 1, 2].map(|b| st.share[a] * st.share[b] * st.k[a][b])),
+        };
+        out.push(st);
+    }
+    splits as usize
+}
+
+/// Into `scratch`: each triangle's stencil (`m` zero), its neighbours, twice
+/// its part of each edge's fold and whether it is wide enough to take split
+/// unknowns; `held(t)` says whether a clamp holds triangle `t`.
+fn stencils(
+    mesh: &Mesh,
+    area: &[Scalar],
+    held: &impl Fn(usize) -> bool,
+    scratch: &mut ShapeScratch,
+) {
+    let n = mesh.triangles.len();
     let ShapeScratch {
         stencil,
         across,
@@ -87,6 +126,12 @@ pub(crate) fn build_shape_triangles_into(
     }
     wide.clear();
     wide.extend((0..n).map(|t| min_angle(mesh, t) >= SPLIT_MIN_ANGLE_DEG));
+}
+
+/// Numbers the split unknowns of the edges that take one into the stencils'
+/// `split` and `split_sign`; returns their count.
+fn number_splits(mesh: &Mesh, held: &impl Fn(usize) -> bool, scratch: &mut ShapeScratch) -> u32 {
+    let ShapeScratch { stencil, wide, .. } = scratch;
     let mut splits = 0u32;
     for e in &mesh.edges {
         // The edge's triangles not held by a clamp, with the sign of their part.
@@ -117,25 +162,7 @@ pub(crate) fn build_shape_triangles_into(
         }
         splits += 1;
     }
-    out.clear();
-    for t in (0..n).filter(|&t| !held(t)) {
-        let mut st = stencil[t];
-        st.share = [0, 1, 2].map(|a| {
-            if st.interior[a] {
-                0.5 * share[t][a]
-            } else {
-                0.0
-            }
-        });
-        st.k = plate_k(mesh, t, area[t], bending);
-        st.m = match kept(t, &st, &across[t]) {
-            Some(m) => m,
-            // The energy at zero splits: `M_ab = share_a share_b K_ab`.
-            None => [0, 1, 2].map(|a| [0, 1, 2].map(|b| st.share[a] * st.share[b] * st.k[a][b])),
-        };
-        out.push(st);
-    }
-    splits as usize
+    splits
 }
 
 /// The smallest corner angle (degrees, material space) of a triangle whose

@@ -20,17 +20,17 @@ use crate::physics::forces::PAR_MIN;
 macro_rules! element_blocks {
     ($s:expr, $el:expr) => {
         ElementBlocks {
-            springs: &$s.spring_block,
+            springs: &$s.kinds.springs.block,
             hinges: &$el.hinges,
-            hinge_gradients: &$s.hinge_grad,
-            hinge_coefficients: &$s.hinge_coef,
+            hinge_gradients: &$s.kinds.hinges.grad,
+            hinge_coefficients: &$s.kinds.hinges.coef,
             diagonal_mass: &$s.diag_mass,
             shape_triangles: &$el.shape_triangles,
             fold_edges: &$el.fold_edges,
-            edge_folds: &$s.edge_folds,
+            edge_folds: &$s.kinds.shapes.edge_folds,
             h2: $s.h2,
             membrane_triangles: &$el.membrane_triangles,
-            membrane_blocks: &$s.membrane_block,
+            membrane_blocks: &$s.kinds.membrane.block,
         }
     };
 }

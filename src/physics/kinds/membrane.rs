@@ -1,0 +1,199 @@
+//! The membrane triangles kind (`membrane.rs`): one force slot per corner; in
+//! the implicit step the block `h^2 K_t + h D_t` over the deformation
+//! gradient's columns.
+
+use rayon::prelude::*;
+
+use super::ForceKind;
+use super::springs::matrix_diagonal;
+use crate::math::{Scalar, Vector, deterministic_sum};
+use crate::mesh::Mesh;
+use crate::physics::elements::Elements;
+use crate::physics::forces::PAR_MIN;
+use crate::physics::membrane::{ColumnBlocks, MEMBRANE_SLOTS};
+
+/// The membrane triangles of [`Elements::membrane_triangles`].
+#[derive(Debug, Clone, Copy, Default)]
+pub struct MembraneTriangles;
+
+/// The membrane triangles' terms of the linearised step.
+#[derive(Debug, Default, Clone)]
+pub struct MembraneLinear {
+    /// Per triangle: `h^2 K_t + h D_t` over its deformation gradient's columns.
+    pub block: Vec<ColumnBlocks>,
+    /// Per triangle and corner: its right-hand side slot, then its slot of a product.
+    pub slot: Vec<Vector>,
+}
+
+impl ForceKind for MembraneTriangles {
+    type Forces = Vec<Vector>;
+    type Linear = MembraneLinear;
+    type Kick = Vec<[Vector; MEMBRANE_SLOTS]>;
+    const ENERGY_RANK: usize = 1;
+
+    fn count(el: &Elements) -> usize {
+        el.membrane_triangles.len()
+    }
+
+    fn element_vertices(el: &Elements, e: usize, out: &mut Vec<u32>) {
+        out.clear();
+        out.extend(el.membrane_triangles[e].v);
+    }
+
+    fn kick(
+        el: &Elements,
+        ids: &[u32],
+        x: &[Vector],
+        v: &[Vector],
+        out: &mut Vec<Vector>,
+        kick: &mut Vec<[Vector; MEMBRANE_SLOTS]>,
+    ) {
+        ids.par_iter()
+            .with_min_len(256)
+            .map(|&t| {
+                let mut f = [Vector::ZERO; MEMBRANE_SLOTS];
+                el.membrane_triangles[t as usize].forces(x, v, &mut f);
+                f
+            })
+            .collect_into_vec(kick);
+        for (&t, f) in ids.iter().zip(kick.iter()) {
+            let at = MEMBRANE_SLOTS * t as usize;
+            out[at..at + MEMBRANE_SLOTS].copy_from_slice(f);
+        }
+    }
+
+    fn size_forces(el: &Elements, out: &mut Vec<Vector>) {
+        out.resize(MEMBRANE_SLOTS * el.membrane_triangles.len(), Vector::ZERO);
+    }
+
+    fn forces(el: &Elements, x: &[Vector], v: &[Vector], out: &mut Vec<Vector>) {
+        Self::size_forces(el, out);
+        out.par_chunks_exact_mut(MEMBRANE_SLOTS)
+            .with_min_len(PAR_MIN / MEMBRANE_SLOTS)
+            .zip(el.membrane_triangles.par_iter())
+            .for_each(|(f, t)| t.forces(x, v, f));
+    }
+
+    #[inline(always)]
+    fn gather_force(el: &Elements, out: &Vec<Vector>, i: usize, f: &mut Vector) {
+        for &s in el.membrane_slots.of(i) {
+            *f += out[s as usize];
+        }
+    }
+
+    fn energy(el: &Elements, x: &[Vector]) -> Scalar {
+        deterministic_sum(el.membrane_triangles.len(), |t| {
+            el.membrane_triangles[t].energy(x)
+        })
+    }
+
+    /// Per membrane triangle: the block `h^2 K_t + h D_t` over the columns and the
+    /// slots `h f_t - h^2 K_t v`.
+    fn linearise(
+        el: &Elements,
+        x: &[Vector],
+        v: &[Vector],
+        h: Scalar,
+        k_term: Scalar,
+        lin: &mut MembraneLinear,
+    ) {
+        let count = el.membrane_triangles.len();
+        lin.block.resize(count, ColumnBlocks::ZERO);
+        lin.slot.resize(MEMBRANE_SLOTS * count, Vector::ZERO);
+        lin.slot
+            .par_chunks_exact_mut(MEMBRANE_SLOTS)
+            .zip(lin.block.par_iter_mut())
+            .zip(el.membrane_triangles.par_iter())
+            .with_min_len(PAR_MIN / MEMBRANE_SLOTS)
+            .for_each(|((slot, block), t)| {
+                let (gauss_newton, geometric) = t.stiffness(x);
+                let stiff = gauss_newton.combine(1.0, &geometric, 1.0);
+                *block = gauss_newton.combine(h * h + h * t.damping, &geometric, h * h);
+                let mut kv = [Vector::ZERO; MEMBRANE_SLOTS];
+                t.apply(&stiff, v, &mut kv);
+                t.forces(x, v, slot);
+                for (f, kv) in slot.iter_mut().zip(kv) {
+                    *f = *f * h - kv * (h * h * k_term);
+                }
+            });
+    }
+
+    #[inline(always)]
+    fn gather_linear(
+        el: &Elements,
+        lin: &MembraneLinear,
+        i: usize,
+        _h: Scalar,
+        jacobi: bool,
+        rhs: &mut Vector,
+        diag: &mut Vector,
+    ) {
+        for &k in el.membrane_slots.of(i) {
+            *rhs += lin.slot[k as usize];
+            if jacobi {
+                let (t, slot) = (k as usize / MEMBRANE_SLOTS, k as usize % MEMBRANE_SLOTS);
+                let m = el.membrane_triangles[t].block(&lin.block[t], slot, slot);
+                *diag += matrix_diagonal(&m);
+            }
+        }
+    }
+
+    fn product(el: &Elements, lin: &mut MembraneLinear, p: &[Vector], _h2: Scalar) {
+        lin.slot
+            .par_chunks_exact_mut(MEMBRANE_SLOTS)
+            .zip(lin.block.par_iter())
+            .zip(el.membrane_triangles.par_iter())
+            .with_min_len(PAR_MIN / MEMBRANE_SLOTS)
+            .for_each(|((slot, block), t)| t.apply(block, p, slot));
+    }
+
+    #[inline(always)]
+    fn gather_product(el: &Elements, lin: &MembraneLinear, i: usize, acc: &mut Vector) {
+        for &k in el.membrane_slots.of(i) {
+            *acc += lin.slot[k as usize];
+        }
+    }
+
+    fn coupling_count(el: &Elements) -> usize {
+        6 * el.membrane_triangles.len()
+    }
+
+    fn couplings(el: &Elements, pairs: &mut Vec<(u32, u32)>) {
+        for t in &el.membrane_triangles {
+            for i in t.v {
+                for j in t.v {
+                    if i != j {
+                        pairs.push((i, j));
+                    }
+                }
+            }
+        }
+    }
+
+    fn gershgorin(
+        el: &Elements,
+        mesh: &Mesh,
+        flat: &mut [Vector],
+        stiff: &mut [Scalar],
+        damp: &mut [Scalar],
+    ) {
+        let garment = mesh.panels().is_some();
+        for t in &el.membrane_triangles {
+            // Gershgorin bound of the rest stiffness (Gauss-Newton; no stress at rest).
+            if garment {
+                mesh.lay_flat(&t.v, flat);
+            }
+            let (gauss_newton, _) = t.stiffness(flat);
+            for i in 0..3 {
+                let mut rows = Vector::ZERO;
+                for j in 0..3 {
+                    let b = t.block(&gauss_newton, i, j);
+                    rows += b.x_axis.abs() + b.y_axis.abs() + b.z_axis.abs();
+                }
+                let bound = rows.max_element();
+                stiff[t.v[i] as usize] += bound;
+                damp[t.v[i] as usize] += t.damping * bound;
+            }
+        }
+    }
+}
