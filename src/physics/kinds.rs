@@ -130,6 +130,44 @@ pub trait ForceKind {
     );
 }
 
+/// A multirate kick's forces: `force(e)`, the `N` slot forces of element `e`,
+/// for every element in `ids`, computed in parallel (at least `min_len` a
+/// task) into the scratch `kick` and then written into the element's slots
+/// of `out` (`N` per element), in `ids`' order.
+pub(crate) fn kick_slots<const N: usize>(
+    ids: &[u32],
+    min_len: usize,
+    out: &mut [Vector],
+    kick: &mut Vec<[Vector; N]>,
+    force: impl Fn(usize) -> [Vector; N] + Sync + Send,
+) {
+    use rayon::prelude::*;
+    ids.par_iter()
+        .with_min_len(min_len)
+        .map(|&e| force(e as usize))
+        .collect_into_vec(kick);
+    for (&e, f) in ids.iter().zip(kick.iter()) {
+        let at = N * e as usize;
+        out[at..at + N].copy_from_slice(f);
+    }
+}
+
+/// Adds to `pairs` every ordered pair `(i, j)` of an element's slots `(k, i)`
+/// and `(l, j)` (local slot, vertex) with `k != l` and `i != j`, in slot
+/// order: the couplings of an element whose blocks join all its vertices.
+pub(crate) fn slot_pairs(
+    slots: impl Iterator<Item = (usize, u32)> + Clone,
+    pairs: &mut Vec<(u32, u32)>,
+) {
+    for (k, i) in slots.clone() {
+        for (l, j) in slots.clone() {
+            if k != l && i != j {
+                pairs.push((i, j));
+            }
+        }
+    }
+}
+
 /// Generates, from the list of kinds (`field: Kind`), the per-kind scratch
 /// structs and the loops over kinds. Invoked once, below.
 macro_rules! kind_list {

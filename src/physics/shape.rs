@@ -222,7 +222,7 @@ pub type ShapeJacobian = [[Vector; SHAPE_SLOTS]; 3];
 
 impl ShapeTriangle {
     /// The used slots with their vertices.
-    pub fn slots(&self) -> impl Iterator<Item = (usize, u32)> + '_ {
+    pub fn slots(&self) -> impl Iterator<Item = (usize, u32)> + Clone + '_ {
         (0..SHAPE_SLOTS)
             .filter(|&k| k < 3 || self.interior[k - 3])
             .map(|k| (k, self.v[k]))

@@ -4,7 +4,7 @@
 
 use rayon::prelude::*;
 
-use super::ForceKind;
+use super::{ForceKind, kick_slots};
 use crate::math::{Scalar, Vector, deterministic_sum};
 use crate::mesh::Mesh;
 use crate::physics::bending::dihedral_angle_and_gradient;
@@ -49,17 +49,11 @@ impl ForceKind for Hinges {
         out: &mut Vec<Vector>,
         kick: &mut Vec<[Vector; 4]>,
     ) {
-        ids.par_iter()
-            .with_min_len(256)
-            .map(|&h| {
-                let hg = &el.hinges[h as usize];
-                let (theta, grad) = dihedral_angle_and_gradient(hg.v.map(|i| x[i as usize]));
-                grad.map(|gk| gk * (-hg.k * theta))
-            })
-            .collect_into_vec(kick);
-        for (&h, f) in ids.iter().zip(kick.iter()) {
-            out[4 * h as usize..4 * h as usize + 4].copy_from_slice(f);
-        }
+        kick_slots(ids, 256, out, kick, |h| {
+            let hg = &el.hinges[h];
+            let (theta, grad) = dihedral_angle_and_gradient(hg.v.map(|i| x[i as usize]));
+            grad.map(|gk| gk * (-hg.k * theta))
+        });
     }
 
     fn size_forces(el: &Elements, out: &mut Vec<Vector>) {

@@ -4,8 +4,8 @@
 
 use rayon::prelude::*;
 
-use super::ForceKind;
 use super::springs::matrix_diagonal;
+use super::{ForceKind, kick_slots, slot_pairs};
 use crate::math::{Scalar, Vector, deterministic_sum};
 use crate::mesh::Mesh;
 use crate::physics::elements::Elements;
@@ -48,18 +48,11 @@ impl ForceKind for MembraneTriangles {
         out: &mut Vec<Vector>,
         kick: &mut Vec<[Vector; MEMBRANE_SLOTS]>,
     ) {
-        ids.par_iter()
-            .with_min_len(256)
-            .map(|&t| {
-                let mut f = [Vector::ZERO; MEMBRANE_SLOTS];
-                el.membrane_triangles[t as usize].forces(x, v, &mut f);
-                f
-            })
-            .collect_into_vec(kick);
-        for (&t, f) in ids.iter().zip(kick.iter()) {
-            let at = MEMBRANE_SLOTS * t as usize;
-            out[at..at + MEMBRANE_SLOTS].copy_from_slice(f);
-        }
+        kick_slots(ids, 256, out, kick, |t| {
+            let mut f = [Vector::ZERO; MEMBRANE_SLOTS];
+            el.membrane_triangles[t].forces(x, v, &mut f);
+            f
+        });
     }
 
     fn size_forces(el: &Elements, out: &mut Vec<Vector>) {
@@ -160,13 +153,7 @@ impl ForceKind for MembraneTriangles {
 
     fn couplings(el: &Elements, pairs: &mut Vec<(u32, u32)>) {
         for t in &el.membrane_triangles {
-            for i in t.v {
-                for j in t.v {
-                    if i != j {
-                        pairs.push((i, j));
-                    }
-                }
-            }
+            slot_pairs(t.v.into_iter().enumerate(), pairs);
         }
     }
 

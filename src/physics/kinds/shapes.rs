@@ -6,7 +6,7 @@
 
 use rayon::prelude::*;
 
-use super::ForceKind;
+use super::{ForceKind, kick_slots, slot_pairs};
 use crate::math::{Scalar, Vector, deterministic_sum};
 use crate::mesh::Mesh;
 use crate::physics::elements::Elements;
@@ -176,18 +176,11 @@ impl ForceKind for ShapeTriangles {
             solve_splits(el, x, &mut out.folds, &mut out.splits);
         }
         let splits = &out.splits;
-        ids.par_iter()
-            .with_min_len(128)
-            .map(|&p| {
-                let mut f = [Vector::ZERO; SHAPE_SLOTS];
-                el.shape_triangles[p as usize].forces(x, splits, &mut f);
-                f
-            })
-            .collect_into_vec(kick);
-        for (&p, f) in ids.iter().zip(kick.iter()) {
-            let at = SHAPE_SLOTS * p as usize;
-            out.slots[at..at + SHAPE_SLOTS].copy_from_slice(f);
-        }
+        kick_slots(ids, 128, &mut out.slots, kick, |p| {
+            let mut f = [Vector::ZERO; SHAPE_SLOTS];
+            el.shape_triangles[p].forces(x, splits, &mut f);
+            f
+        });
     }
 
     fn size_forces(el: &Elements, out: &mut ShapeForces) {
@@ -323,13 +316,7 @@ impl ForceKind for ShapeTriangles {
 
     fn couplings(el: &Elements, pairs: &mut Vec<(u32, u32)>) {
         for t in &el.shape_triangles {
-            for (k, i) in t.slots() {
-                for (l, j) in t.slots() {
-                    if k != l && i != j {
-                        pairs.push((i, j));
-                    }
-                }
-            }
+            slot_pairs(t.slots(), pairs);
         }
     }
 
