@@ -9,7 +9,7 @@
 # the table. Usage, from anywhere:
 #
 #   benches/blender/garmentcode.sh [-p NAME] [-n RUNS] [-d DRAPE] [-w WORKDIR]
-#                                  [-s CAP] [-T SECONDS] [-P PYTHON] [-G CHECK]
+#                                  [-s CAP] [-q QUALITY] [-T SECONDS] [-P PYTHON] [-G CHECK]
 #
 #   -p NAME     the pattern scene scenes/garmentcode/NAME.toml (default shirt)
 #   -n RUNS     timed runs of each simulator (default 3)
@@ -17,6 +17,7 @@
 #   -w WORKDIR  inputs, frames, logs and JSON (default benches/blender/garmentcode, git-ignored)
 #   -s CAP      Blender's sewing_force_max in N per sewn pair (default 0: no cap,
 #               Blender's default; `drape`: drape's largest initial pull of a pair)
+#   -q QUALITY  Blender's substeps per frame (default: drape's steps per frame)
 #   -T SECONDS  Blender's simulated time (default: drape's, up to the frame it
 #               came to rest on)
 #   -P PYTHON   a python3 with numpy and libigl, for garment-check.py (default python3)
@@ -32,6 +33,7 @@ runs=3
 drape="drape"
 work="$here/garmentcode"
 cap=0
+quality=()
 duration=""
 py=python3
 check="$root/../shared/tools/garment-check.py"
@@ -42,10 +44,11 @@ while [[ $# -gt 0 ]]; do
     -d) drape="$2"; shift 2 ;;
     -w) work="$2"; shift 2 ;;
     -s) cap="$2"; shift 2 ;;
+    -q) quality=(--quality "$2"); shift 2 ;;
     -T) duration="$2"; shift 2 ;;
     -P) py="$2"; shift 2 ;;
     -G) check="$2"; shift 2 ;;
-    -h|--help) sed -n '2,25p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,26p' "$0"; exit 0 ;;
     *) echo "unknown option $1" >&2; exit 2 ;;
   esac
 done
@@ -212,7 +215,7 @@ EOF
   out="$work/blender_run$i.json"
   if ! blender -b --factory-startup -t 0 --python "$here/skirt.py" -- \
       --skirt "$work/garment.obj" --body "$work/body.obj" --params "$work/params.json" \
-      --duration "$bduration" --weightless "$weightless" "${capargs[@]}" "${frames[@]}" \
+      --duration "$bduration" --weightless "$weightless" "${capargs[@]}" "${quality[@]}" "${frames[@]}" \
       --out "$out" >"$work/blender_run$i.log" 2>&1 || [[ ! -s "$out" ]]; then
     echo "blender run failed, see $work/blender_run$i.log" >&2
     exit 1
