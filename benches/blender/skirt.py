@@ -37,21 +37,26 @@ import common  # noqa: E402  (the scene set-up, timed loop and read-back drape_s
 from skirt_measure import read_obj  # noqa: E402  (the OBJ reader skirt_measure.py uses)
 
 # ------------------------------------------------- drape's scene, skirt_rest.toml
-# Keep in sync with skirt_rest.toml.
-GRAVITY = -9.81  # m/s^2
-DENSITY = 0.2  # kg/m^2
-STRETCH = 300.0  # N/m
-BENDING = 2.0e-5  # N m
-DAMPING = 0.001  # s, stiffness-proportional
-DRAG = 0.1  # kg/(m^2 s)
-SEWING_STIFFNESS = 50.0  # N/m per m of seam
-WELD_GAP = 0.005  # m
-SELF_THICKNESS = 0.003  # m
-BODY_THICKNESS = 0.004  # m
-FRICTION_KINETIC = 0.4
-PIN_BOX = ((-0.15, -0.02), (0.15, 0.0))  # material (u, v), m, both panels
-DT = 0.005  # s, drape's step before it is rounded to fill a frame
-DURATION = 2.0  # s
+# Keep in sync with skirt_rest.toml. --params FILE.json replaces any of them
+# (garmentcode.sh writes one from its scene): the same keys in lower case,
+# `pin_box` and `self_thickness` null for none.
+SKIRT = {
+    "gravity": -9.81,  # m/s^2
+    "density": 0.2,  # kg/m^2
+    "stretch": 300.0,  # N/m
+    "bending": 2.0e-5,  # N m
+    "damping": 0.001,  # s, stiffness-proportional
+    "drag": 0.1,  # kg/(m^2 s)
+    "sewing_stiffness": 50.0,  # N/m per m of seam
+    "weld_gap": 0.005,  # m
+    "self_thickness": 0.003,  # m
+    "body_thickness": 0.004,  # m
+    "friction_kinetic": 0.4,
+    "pin_box": [[-0.15, -0.02], [0.15, 0.0]],  # material (u, v), m, every panel
+    "dt": 0.005,  # s, drape's step before it is rounded to fill a frame
+    "duration": 2.0,  # s
+}
+P = dict(SKIRT)  # the scene simulated: SKIRT with --params applied (main)
 
 # Blender's cloth solver clock: gravity enters as 0.001 g per solver time unit
 # squared (cloth_calc_force), so one unit is T = sqrt(0.001) s when gravity is
@@ -69,7 +74,13 @@ def parse_args():
                    help="cloth steps per frame (default: drape's, ceil(1 / (fps dt)) = 7 at 30 fps)")
     p.add_argument("--collision-quality", type=int, default=2, help="Blender's default 2")
     p.add_argument("--fps", type=float, default=30.0)
-    p.add_argument("--duration", type=float, default=DURATION, help="simulated seconds (default 2)")
+    p.add_argument("--duration", type=float, default=None,
+                   help="simulated seconds (default: the scene's, 2 for the skirt)")
+    p.add_argument("--params", default=None,
+                   help="JSON of drape's scene values that replace the skirt's (SKIRT's keys)")
+    p.add_argument("--weightless", type=float, default=0.0,
+                   help="gravity off for this many seconds from the start, then on (the cloth's "
+                        "effector weight for gravity, keyed per frame); drape's weightless phase")
     p.add_argument("--sewing-force-max", type=float, default=None,
                    help="Blender's max sewing force in N (converted to solver units); default: "
                         "drape's largest initial pull of one sewn pair (stiffness x its share "
@@ -116,12 +127,21 @@ def seam_pair_shares(obj):
 
 def main():
     args = parse_args()
+    if args.params:
+        with open(args.params) as fh:
+            given = json.load(fh)
+        unknown = sorted(set(given) - set(SKIRT))
+        if unknown:
+            raise SystemExit(f"--params: unknown keys {unknown}; known: {sorted(SKIRT)}")
+        P.update(given)
+    if args.duration is None:
+        args.duration = P["duration"]
     fps = args.fps
     frames = int(round(args.duration * fps))
-    quality = args.quality if args.quality is not None else math.ceil(1.0 / (fps * DT) - 1e-9)
+    quality = args.quality if args.quality is not None else math.ceil(1.0 / (fps * P["dt"]) - 1e-9)
 
     common.clear_scene()
-    scene = common.set_up_scene(fps, frames, GRAVITY)
+    scene = common.set_up_scene(fps, frames, P["gravity"])
 
     # ------------------------------------------------------------------ body
     body_obj = read_obj(args.body)
@@ -134,8 +154,8 @@ def main():
     body.modifiers.new("Collision", "COLLISION")
     coll = body.collision
     # Contact distance = cloth distance_min + collider thickness_outer = drape's 4 mm.
-    coll.thickness_outer = BODY_THICKNESS - common.BLENDER_DISTANCE_MIN_FLOOR
-    coll.cloth_friction = 100.0 * FRICTION_KINETIC  # Blender's one coefficient is this x 0.01
+    coll.thickness_outer = P["body_thickness"] - common.BLENDER_DISTANCE_MIN_FLOOR
+    coll.cloth_friction = 100.0 * P["friction_kinetic"]  # Blender's one coefficient is this x 0.01
 
     # ----------------------------------------------------------------- skirt
     sk = read_obj(args.skirt)
@@ -145,7 +165,8 @@ def main():
     me = bpy.data.meshes.new("skirt")
     # The sewing pairs are loose edges: with use_sewing_springs each becomes a
     # zero-length spring (cloth_build_springs).
-    me.from_pydata(sk["v"], [tuple(p) for p in pairs], sk["faces"])
+    # A corner pair that two stitches share (the same two vertices) is one edge.
+    me.from_pydata(sk["v"], sorted({tuple(sorted(p)) for p in pairs}), sk["faces"])
     me.validate()
     me.update()
     cloth = bpy.data.objects.new("skirt", me)
@@ -153,8 +174,9 @@ def main():
     if len(me.vertices) != n:
         raise SystemExit("the skirt mesh changed its vertices on building")
     loose = [e for e in me.edges if e.is_loose]
-    if len(loose) != len(pairs):
-        raise SystemExit(f"{len(loose)} loose edges for {len(pairs)} sewing pairs")
+    distinct = len({tuple(sorted(p)) for p in pairs})
+    if len(loose) != distinct:
+        raise SystemExit(f"{len(loose)} loose edges for {distinct} distinct sewing pairs")
 
     # Rest shape: the flat pattern (drape's material space): every rest length
     # and rest bending angle then comes from it, as in drape. Both panels' patterns
@@ -169,12 +191,14 @@ def main():
     flat.value = 0.0
 
     # Pins: the vertices inside drape's pin box in pattern coordinates.
-    (u0, v0), (u1, v1) = PIN_BOX
-    eps = 1e-9
-    pinned = [i for i, (u, v) in enumerate(uv)
-              if u0 - eps <= u <= u1 + eps and v0 - eps <= v <= v1 + eps]
-    group = cloth.vertex_groups.new(name="pin")
-    group.add(pinned, 1.0, "REPLACE")
+    pinned = []
+    if P["pin_box"] is not None:
+        (u0, v0), (u1, v1) = P["pin_box"]
+        eps = 1e-9
+        pinned = [i for i, (u, v) in enumerate(uv)
+                  if u0 - eps <= u <= u1 + eps and v0 - eps <= v <= v1 + eps]
+        group = cloth.vertex_groups.new(name="pin")
+        group.add(pinned, 1.0, "REPLACE")
 
     # --------------------------------------------- drape's material, converted
     faces = sk["faces"]
@@ -192,8 +216,8 @@ def main():
     # Blender: one k for every spring, = tension_stiffness / avg_spring_len. The
     # uniform k with the same energy under a uniform biaxial stretch as drape's
     # springs: k sum(L^2) = sum(k_e L_e^2) = stretch * 3 * area.
-    k_uniform = STRETCH * 3.0 * area / sum_l2  # N/m
-    total_mass = DENSITY * area
+    k_uniform = P["stretch"] * 3.0 * area / sum_l2  # N/m
+    total_mass = P["density"] * area
     mass_per_vertex = total_mass / n
 
     mod = cloth.modifiers.new("Cloth", "CLOTH")
@@ -203,7 +227,8 @@ def main():
     s.time_scale = 1.0 / (fps * T)
     s.mass = mass_per_vertex
     s.rest_shape_key = flat
-    s.vertex_group_mass = "pin"  # weight 1: pinned (hard constraint, goal >= 0.999)
+    if pinned:
+        s.vertex_group_mass = "pin"  # weight 1: pinned (hard constraint, goal >= 0.999)
     s.tension_stiffness = k_uniform * T * T * avg_len
     s.compression_stiffness = k_uniform * T * T * avg_len
     s.tension_stiffness_max = s.tension_stiffness  # no structural vertex group
@@ -211,7 +236,7 @@ def main():
     s.shear_stiffness = k_uniform * T * T * avg_len  # unused: triangles get no shear springs
     s.shear_stiffness_max = s.shear_stiffness
     # drape: c = damping * k per spring (kg/s); Blender: one absolute c per spring.
-    c_spring = DAMPING * k_uniform * T
+    c_spring = P["damping"] * k_uniform * T
     s.tension_damping = c_spring
     s.compression_damping = c_spring
     s.shear_damping = c_spring
@@ -222,19 +247,19 @@ def main():
     # equilateral triangles holds 2 B / sqrt(3) per radian, hence k = 4 B / L and
     # bending_stiffness = 40 B / L^2 (solver units: B T^2).
     s.bending_model = "ANGULAR"
-    s.bending_stiffness = 40.0 * BENDING * T * T / (avg_len * avg_len)
+    s.bending_stiffness = 40.0 * P["bending"] * T * T / (avg_len * avg_len)
     s.bending_stiffness_max = s.bending_stiffness
     s.bending_damping = 0.0  # explicit in Blender; drape's is ~1e-9 in these units
     # Air: Blender's drag is -0.01 air_damping v per vertex; drape's -drag A_i v.
-    s.air_damping = DRAG * (area / n) * T / 0.01
+    s.air_damping = P["drag"] * (area / n) * T / 0.01
     s.use_internal_springs = False
     s.use_pressure = False
     s.use_sewing_springs = True
-    # drape's pull of a pair: SEWING_STIFFNESS * share * gap, no cap. Blender's sewing
+    # drape's pull of a pair: sewing stiffness x share * gap, no cap. Blender's sewing
     # spring has the structural k (tension_stiffness / avg_spring_len) and a cap.
     shares = seam_pair_shares(sk)
     gaps0 = [math.dist(sk["v"][a], sk["v"][b]) for a, b in pairs]
-    drape_pull0 = [SEWING_STIFFNESS * sh * g for sh, g in zip(shares, gaps0)]
+    drape_pull0 = [P["sewing_stiffness"] * sh * g for sh, g in zip(shares, gaps0)]
     sew_max_n = max(drape_pull0) if args.sewing_force_max is None else args.sewing_force_max
     s.sewing_force_max = sew_max_n * T * T
     s.shrink_min = 0.0
@@ -242,11 +267,28 @@ def main():
     c.use_collision = True
     c.distance_min = common.BLENDER_DISTANCE_MIN_FLOOR
     c.collision_quality = args.collision_quality
-    c.use_self_collision = True
-    # Self contacts are triangle pairs closer than 2 x self_distance_min (collision.cc).
-    c.self_distance_min = 0.5 * SELF_THICKNESS
+    c.use_self_collision = P["self_thickness"] is not None
+    if c.use_self_collision:
+        # Self contacts are triangle pairs closer than 2 x self_distance_min (collision.cc).
+        c.self_distance_min = 0.5 * P["self_thickness"]
     c.impulse_clamp = 0.0
     c.self_impulse_clamp = 0.0
+
+    # The weightless phase: frame_set(f) steps the cloth from frame f - 1 to f
+    # with the settings of frame f, so gravity's weight is 0 up to frame
+    # frame_start + the weightless frames (the steps of the first --weightless s,
+    # rounded up to whole frames) and 1 from the next (constant keys: a step).
+    weightless_frames = int(math.ceil(args.weightless * fps - 1e-9))
+    if weightless_frames > 0:
+        w = s.effector_weights
+        w.gravity = 0.0
+        w.keyframe_insert("gravity", frame=scene.frame_start)
+        w.keyframe_insert("gravity", frame=scene.frame_start + weightless_frames)
+        w.gravity = 1.0
+        w.keyframe_insert("gravity", frame=scene.frame_start + weightless_frames + 1)
+        for fc in cloth.animation_data.action.fcurves:
+            for kp in fc.keyframe_points:
+                kp.interpolation = "CONSTANT"
 
     cache = mod.point_cache
     cache.frame_start = scene.frame_start
@@ -265,14 +307,16 @@ def main():
         gap_per_frame.append(max(math.dist(pts[a], pts[b]) for a, b in pairs))
         if args.frames_dir:
             write_frame(os.path.join(args.frames_dir, f"frame_{k:05d}.obj"), pts, sk)
-    closed = next((k for k, g in enumerate(gap_per_frame) if g < WELD_GAP), None)
+    closed = next((k for k, g in enumerate(gap_per_frame) if g < P["weld_gap"]), None)
 
     overhead = common.no_cloth_frame_stepping(scene, mod)
 
     out = {
         "engine": "blender",
         "blender_version": bpy.app.version_string,
-        "scene": "skirt_rest",
+        "scene": "skirt_rest" if not args.params else os.path.abspath(args.params),
+        "params": P,
+        "weightless_s": weightless_frames / fps,
         "skirt_obj": os.path.abspath(args.skirt),
         "body_obj": os.path.abspath(args.body),
         "vertices": n,
@@ -308,8 +352,8 @@ def main():
             "sewing_force_max_n": sew_max_n,
             "sewing_spring_k_n_per_m": k_uniform,
             "drape_initial_pull_per_pair_n": {"max": max(drape_pull0), "min": min(drape_pull0)},
-            "drape_sewing_k_per_pair_n_per_m": {"max": SEWING_STIFFNESS * max(shares),
-                                                "min": SEWING_STIFFNESS * min(shares)},
+            "drape_sewing_k_per_pair_n_per_m": {"max": P["sewing_stiffness"] * max(shares),
+                                                "min": P["sewing_stiffness"] * min(shares)},
             "rest_shape_key": s.rest_shape_key.name if s.rest_shape_key else None,
             "pin_group": s.vertex_group_mass,
             "collision_quality": c.collision_quality,

@@ -1,7 +1,8 @@
 """Seam gaps and penetration of a skirt's OBJ frames, the same way for drape and Blender.
 
     python3 benches/blender/skirt_measure.py --body BODY.obj --frames DIR \
-        [--fps 30] [--weld-gap 0.005] [--out FILE.json]
+        [--fps 30] [--weld-gap 0.005] [--rest-speed 0.05 --rest-window 0.5] [--out FILE.json]
+    python3 benches/blender/skirt_measure.py --no-body --frames DIR ...
 
 DIR holds one OBJ per frame (`frame_00000.obj`, `frame_00001.obj`, ... in
 name order, frame 0 the start): drape's `--obj-dir` output, or what skirt.py
@@ -21,7 +22,14 @@ writes for Blender. Per frame it measures
   that hold the point (a lower bound where parts overlap).
 
 The seams are closed at the first frame whose every pair is within
-`--weld-gap` (drape's weld_gap, 5 mm). Pure Python (no numpy), so that
+`--weld-gap` (drape's weld_gap, 5 mm). Per frame it also takes the largest
+vertex move since the previous frame (where both have the same vertices:
+not across drape's welds), and the frame at rest by drape's criterion
+(`simulation.rest`): the first frame with the seams closed since the frame
+`--rest-window` s before it and every move over that window under
+`--rest-speed` / fps. `--no-body` skips the penetration (for a body that is
+not a union of convex parts, such as a scanned one: garment-check.py
+measures that). Pure Python (no numpy), so that
 Blender's bundled interpreter can import the OBJ reader too.
 """
 
@@ -199,6 +207,10 @@ def measure_frame(body, obj, contact):
     by_seam = {}
     for (a, b), seam, g in zip(obj["pairs"], obj["pair_seam"], gaps):
         by_seam[seam or "?"] = max(by_seam.get(seam or "?", 0.0), g)
+    m = {"vertices": len(v), "pairs": len(gaps), "gap_max": max(gaps) if gaps else None,
+         "gap_by_seam": by_seam, "lowest_z": min(p[2] for p in v)}
+    if body is None:
+        return m
     signed = [body.signed_distance(p) for p in v]
     depths = [max(0.0, -s) for s in signed]
     inside = [d for d in depths if d > 0.0]
@@ -215,18 +227,37 @@ def measure_frame(body, obj, contact):
     }
 
 
-def measure(body_path, frames_dir, fps, weld_gap, contact):
-    body = Body(body_path)
+def measure(body_path, frames_dir, fps, weld_gap, contact, rest_speed=0.05, rest_window=0.5):
+    body = Body(body_path) if body_path else None
     names = sorted(f for f in os.listdir(frames_dir) if f.endswith(".obj"))
     frames = []
+    prev = None
     for k, name in enumerate(names):
-        m = measure_frame(body, read_obj(os.path.join(frames_dir, name)), contact)
+        obj = read_obj(os.path.join(frames_dir, name))
+        m = measure_frame(body, obj, contact)
         m["frame"] = k
         m["time_s"] = k / fps
+        m["move_max"] = (max(math.dist(p, q) for p, q in zip(obj["v"], prev))
+                         if prev is not None and len(prev) == len(obj["v"]) else None)
+        prev = obj["v"]
         frames.append(m)
 
     def closed(m):
         return m["gap_max"] is None or m["gap_max"] < weld_gap
+
+    window = int(round(rest_window * fps))
+    still = rest_speed / fps
+    rest = next((m for m in frames[window:] if all(
+        closed(w) and w["move_max"] is not None and w["move_max"] < still
+        for w in frames[m["frame"] - window + 1:m["frame"] + 1]) and closed(frames[m["frame"] - window])),
+        None)
+    rest_keys = {
+        "rest_speed_m_s": rest_speed,
+        "rest_window_s": rest_window,
+        "rest_frame": rest["frame"] if rest else None,
+        "rest_s": rest["time_s"] if rest else None,
+        "final_move_max_m": frames[-1]["move_max"] if frames else None,
+    }
 
     first_closed = next((m for m in frames if closed(m)), None)
     reopened = None
@@ -234,10 +265,10 @@ def measure(body_path, frames_dir, fps, weld_gap, contact):
         reopened = next((m["frame"] for m in frames[first_closed["frame"]:] if not closed(m)), None)
     gaps_after = [m["gap_max"] for m in frames[first_closed["frame"]:]] if first_closed else []
     gaps_after = [g for g in gaps_after if g is not None]
-    pen = [m["penetration_max"] for m in frames]
-    return {
-        "body": {"path": body_path, "vertices": body.vertex_count, "triangles": body.face_count,
-                 "convex_parts": len(body.parts)},
+    out = {
+        "body": None if body is None else {
+            "path": body_path, "vertices": body.vertex_count, "triangles": body.face_count,
+            "convex_parts": len(body.parts)},
         "frames_dir": frames_dir,
         "frames": len(frames),
         "fps": fps,
@@ -248,43 +279,56 @@ def measure(body_path, frames_dir, fps, weld_gap, contact):
         "seams_reopened_frame": reopened,
         "gap_max_after_closing_m": max(gaps_after) if gaps_after else (0.0 if first_closed else None),
         "final_gap_max_m": frames[-1]["gap_max"] if frames else None,
-        "penetration_final_m": pen[-1] if pen else None,
-        "penetration_max_m": max(pen) if pen else None,
-        "penetration_max_frame": pen.index(max(pen)) if pen else None,
-        "vertices_inside_final": frames[-1]["vertices_inside"] if frames else None,
-        "vertices_inside_max": max(m["vertices_inside"] for m in frames) if frames else None,
         "final_lowest_z": frames[-1]["lowest_z"] if frames else None,
-        "contact_distance_m": contact,
-        "clearance_min_final_m": frames[-1]["clearance_min"] if frames else None,
-        "clearance_min_m": min(m["clearance_min"] for m in frames) if frames else None,
-        "vertices_within_contact_final": frames[-1]["vertices_within_contact"] if frames else None,
-        "per_frame": frames,
+        **rest_keys,
     }
+    if body is not None:
+        pen = [m["penetration_max"] for m in frames]
+        out.update({
+            "penetration_final_m": pen[-1] if pen else None,
+            "penetration_max_m": max(pen) if pen else None,
+            "penetration_max_frame": pen.index(max(pen)) if pen else None,
+            "vertices_inside_final": frames[-1]["vertices_inside"] if frames else None,
+            "vertices_inside_max": max(m["vertices_inside"] for m in frames) if frames else None,
+            "contact_distance_m": contact,
+            "clearance_min_final_m": frames[-1]["clearance_min"] if frames else None,
+            "clearance_min_m": min(m["clearance_min"] for m in frames) if frames else None,
+            "vertices_within_contact_final": frames[-1]["vertices_within_contact"] if frames else None,
+        })
+    out["per_frame"] = frames
+    return out
 
 
 def main(argv):
     p = argparse.ArgumentParser(prog="skirt_measure.py")
-    p.add_argument("--body", required=True, help="the body OBJ both simulators collided with")
+    p.add_argument("--body", default=None, help="the body OBJ both simulators collided with")
+    p.add_argument("--no-body", action="store_true", help="no penetration (no --body)")
     p.add_argument("--frames", required=True, help="directory of per-frame OBJ files")
     p.add_argument("--fps", type=float, default=30.0)
     p.add_argument("--weld-gap", type=float, default=0.005, help="m (drape's cloth.sewing.weld_gap)")
     p.add_argument("--contact", type=float, default=0.004,
                    help="m: count vertices closer than this to the body (drape's obstacle thickness)")
+    p.add_argument("--rest-speed", type=float, default=0.05, help="m/s (drape's simulation.rest)")
+    p.add_argument("--rest-window", type=float, default=0.5, help="s (drape's simulation.rest)")
     p.add_argument("--label", default=None)
     p.add_argument("--out", default=None)
     args = p.parse_args(argv)
-    r = measure(args.body, args.frames, args.fps, args.weld_gap, args.contact)
+    if (args.body is None) != args.no_body:
+        p.error("give --body BODY.obj or --no-body")
+    r = measure(args.body, args.frames, args.fps, args.weld_gap, args.contact,
+                args.rest_speed, args.rest_window)
     r["label"] = args.label
     text = json.dumps(r, indent=1)
     if args.out:
         with open(args.out, "w") as fh:
             fh.write(text + "\n")
     short = {k: r[k] for k in ("label", "frames", "initial_gap_max_m", "seams_closed_frame",
+                               "rest_frame", "rest_s", "final_move_max_m",
                                "seams_closed_s", "seams_reopened_frame", "gap_max_after_closing_m",
                                "final_gap_max_m", "penetration_final_m", "penetration_max_m",
                                "penetration_max_frame", "vertices_inside_final",
                                "vertices_inside_max", "final_lowest_z", "clearance_min_final_m",
-                               "clearance_min_m", "vertices_within_contact_final")}
+                               "clearance_min_m", "vertices_within_contact_final") if k in r}
     print(json.dumps(short))
 
 
