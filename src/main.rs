@@ -115,14 +115,15 @@ pub(crate) struct SceneArgs {
     overrides: Vec<String>,
 }
 
+/// Where a run's results go and how it runs: the options `drape run` and
+/// `drape garment` share.
 #[derive(Args)]
-pub(crate) struct RunArgs {
-    #[command(flatten)]
-    scene: SceneArgs,
+pub(crate) struct OutputArgs {
     /// Output recording (default: the scene's name + `.rrd` in the current directory).
     #[arg(long, short, value_name = "FILE.rrd", conflicts_with = "no_record")]
     out: Option<PathBuf>,
-    /// Do not write a recording file (with --spawn or --connect: stream to the viewer only).
+    /// Do not write a recording file (with `drape run --spawn` or `--connect`: stream to the
+    /// viewer only).
     #[arg(long)]
     no_record: bool,
     /// Write a machine-readable summary (JSON) here.
@@ -131,6 +132,22 @@ pub(crate) struct RunArgs {
     /// Write every recorded frame as an OBJ file into this directory.
     #[arg(long, value_name = "DIR")]
     obj_dir: Option<PathBuf>,
+    /// Worker threads, 1 to 256 (default: one per core). Results are identical at any count.
+    // The cap: with --threads 10000 a 0.05 s run had not finished after 60 s on a
+    // 2-core machine (thousands of threads scheduled every step): it looked like a hang.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=256))]
+    threads: Option<u32>,
+    /// No progress bar.
+    #[arg(long, short)]
+    quiet: bool,
+}
+
+#[derive(Args)]
+pub(crate) struct RunArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    #[command(flatten)]
+    output: OutputArgs,
     /// Record (and export OBJ for) every K-th frame only; frame 0 and the last are always recorded.
     #[arg(long, value_name = "K", default_value_t = 1,
           value_parser = clap::value_parser!(u64).range(1..))]
@@ -165,14 +182,6 @@ pub(crate) struct RunArgs {
     /// Also stream the run live to a running viewer, e.g. rerun+http://127.0.0.1:9876/proxy.
     #[arg(long, value_name = "URL")]
     connect: Option<String>,
-    /// Worker threads, 1 to 256 (default: one per core). Results are identical at any count.
-    // The cap: with --threads 10000 a 0.05 s run had not finished after 60 s on a
-    // 2-core machine (thousands of threads scheduled every step): it looked like a hang.
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=256))]
-    threads: Option<u32>,
-    /// No progress bar.
-    #[arg(long, short)]
-    quiet: bool,
     /// Sample the cloth at the material points in this file (a bench plan's
     /// `points.json`) at every recorded frame; with --samples-out.
     #[arg(long, value_name = "POINTS.json", requires = "samples_out")]

@@ -9,7 +9,7 @@ use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
 
 use crate::cli::run::run_scene;
-use crate::{ColourChoice, EdgeChoice, RunArgs, SceneArgs};
+use crate::{ColourChoice, EdgeChoice, OutputArgs, RunArgs, SceneArgs};
 use drape::garmentcode::body::check_body;
 use drape::garmentcode::scene_text::{Body, BodyUp, Draping, scene};
 use drape::scene::load_scene_str_in;
@@ -37,24 +37,8 @@ pub struct GarmentArgs {
     /// Override a value of the scene, e.g. `--set cloth.max_edge=0.03` (repeatable).
     #[arg(long = "set", value_name = "KEY=VALUE")]
     overrides: Vec<String>,
-    /// Output recording (default: the pattern's name + `.rrd`).
-    #[arg(long, short, value_name = "FILE.rrd", conflicts_with = "no_record")]
-    out: Option<PathBuf>,
-    /// Do not write a recording file.
-    #[arg(long)]
-    no_record: bool,
-    /// Write a machine-readable summary (JSON) here.
-    #[arg(long, value_name = "FILE.json")]
-    summary: Option<PathBuf>,
-    /// Write every recorded frame as an OBJ file into this directory.
-    #[arg(long, value_name = "DIR")]
-    obj_dir: Option<PathBuf>,
-    /// Worker threads, 1 to 256 (default: one per core). Results are identical at any count.
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=256))]
-    threads: Option<u32>,
-    /// No progress bar.
-    #[arg(long, short)]
-    quiet: bool,
+    #[command(flatten)]
+    output: OutputArgs,
 }
 
 /// The body options `drape garment` and `drape garment-plan` share.
@@ -146,10 +130,7 @@ pub fn cmd_garment(args: GarmentArgs) -> Result<ExitCode> {
             scene: None,
             overrides: args.overrides.clone(),
         },
-        out: args.out,
-        no_record: args.no_record,
-        summary: args.summary,
-        obj_dir: args.obj_dir,
+        output: args.output,
         record_every: 1,
         edges: EdgeChoice::Review,
         no_edges: false,
@@ -158,8 +139,6 @@ pub fn cmd_garment(args: GarmentArgs) -> Result<ExitCode> {
         no_decisions: false,
         spawn: false,
         connect: None,
-        threads: args.threads,
-        quiet: args.quiet,
         sample_at: None,
         samples_out: None,
     };

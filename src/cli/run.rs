@@ -55,11 +55,11 @@ pub fn run_scene(scene: Scene, args: &RunArgs) -> Result<ExitCode> {
     let sim = drape::sim::build(&scene.resolve()?)?;
     // Create the OBJ directory before the recording is opened, so that an unusable
     // one fails with its own message and leaves no recording behind.
-    if let Some(dir) = &args.obj_dir {
+    if let Some(dir) = &args.output.obj_dir {
         create_obj_dir(dir)?;
     }
     // Open the summary now so that an unwritable path fails before a long run.
-    let summary_file = match &args.summary {
+    let summary_file = match &args.output.summary {
         Some(path) => Some(
             std::fs::File::create(path)
                 .with_context(|| format!("cannot write summary {}", path.display()))?,
@@ -71,7 +71,7 @@ pub fn run_scene(scene: Scene, args: &RunArgs) -> Result<ExitCode> {
         None => None,
     };
     let interrupt = interrupt_on_ctrl_c()?;
-    let bar = progress_bar(args.quiet);
+    let bar = progress_bar(args.output.quiet);
     let mut on_progress = |p: Progress| {
         bar.set_length(p.frames);
         bar.set_position(p.frame);
@@ -96,7 +96,7 @@ pub fn run_scene(scene: Scene, args: &RunArgs) -> Result<ExitCode> {
     if let (Some(samples), Some(path)) = (samples, &args.samples_out) {
         samples.store(path)?;
     }
-    report_outcome(outcome, args.summary.as_deref(), summary_file)
+    report_outcome(outcome, args.output.summary.as_deref(), summary_file)
 }
 
 /// Prints the run's summary and writes it to `summary_file` (opened before the run, at
@@ -140,15 +140,16 @@ fn report_outcome(
 /// OBJ export, threads, live viewer, frame stride, which edges to record and what colours the
 /// triangles.
 fn run_options(args: &RunArgs, scene: &Scene) -> RunOptions {
-    let record = (!args.no_record).then(|| {
-        args.out
+    let record = (!args.output.no_record).then(|| {
+        args.output
+            .out
             .clone()
             .unwrap_or_else(|| PathBuf::from(format!("{}.rrd", scene.name)))
     });
     RunOptions {
         record,
-        obj_dir: args.obj_dir.clone(),
-        threads: args.threads.map(|n| n as usize),
+        obj_dir: args.output.obj_dir.clone(),
+        threads: args.output.threads.map(|n| n as usize),
         live: if args.spawn {
             Some(LiveViewer::Spawn)
         } else {

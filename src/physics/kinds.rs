@@ -37,6 +37,8 @@ pub use shapes::{
 };
 pub use springs::{SpringLinear, Springs};
 
+use rayon::prelude::*;
+
 use super::elements::Elements;
 use crate::math::{Scalar, Vector};
 use crate::mesh::Mesh;
@@ -141,7 +143,6 @@ pub(crate) fn kick_slots<const N: usize>(
     kick: &mut Vec<[Vector; N]>,
     force: impl Fn(usize) -> [Vector; N] + Sync + Send,
 ) {
-    use rayon::prelude::*;
     ids.par_iter()
         .with_min_len(min_len)
         .map(|&e| force(e as usize))
