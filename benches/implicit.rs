@@ -274,6 +274,7 @@ fn creased(mesh: &drape::mesh::Mesh) -> drape::mesh::Mesh {
         refine_strain: None,
         refine_obstacle: None,
         alternate_diagonals: true,
+        gate: None,
     };
     let mut adapter = Adapter::new(&config, &world, 0.15).expect("the adapter starts");
     adapter

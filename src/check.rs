@@ -280,7 +280,7 @@ fn not_modelled(
 fn describe_adapt(s: &mut String, scene: &Scene, a: &AdaptConfig) {
     let _ = writeln!(
         s,
-        "adaptive meshing: {}, {}, levels 0..{}, {}{}{}",
+        "adaptive meshing: {}, {}, levels 0..{}, {}{}{}{}",
         match a.method {
             AdaptMethod::Edge =>
                 "edge (paper B: longest-edge splits, Delaunay flips, guarded collapses)",
@@ -320,6 +320,13 @@ fn describe_adapt(s: &mut String, scene: &Scene, a: &AdaptConfig) {
             format!(", rollback (up to {} per step)", a.max_rollbacks)
         } else {
             String::new()
+        },
+        match a.gate {
+            Some(g) => format!(
+                ", a pass applied when it replaces at least {} of the triangles or a split reads {} or more",
+                g.min_change, g.urgent_ratio
+            ),
+            None => String::new(),
         }
     );
     if scene.adapt.as_ref().is_some_and(|x| x.multirate) {

@@ -20,7 +20,8 @@ mod pin;
 mod rest;
 mod sequence;
 pub use adapt::{
-    Adapt, AdaptCriterion, AdaptEvery, AdaptMethod, DEFAULT_HYSTERESIS, Measurement, RedDiagonals,
+    Adapt, AdaptCriterion, AdaptEvery, AdaptMethod, DEFAULT_HYSTERESIS, DEFAULT_URGENT_RATIO,
+    Measurement, RedDiagonals,
 };
 pub use curve::{Curve, SideCurve};
 pub use garment::{

@@ -12,6 +12,7 @@ pub mod decision;
 pub mod edge;
 mod edge_collapse;
 mod edge_pass;
+pub mod gate;
 mod marks;
 pub mod proximity;
 mod readings;
@@ -28,6 +29,7 @@ mod tri_list;
 
 pub use check::{ConsistencyError, boundary_length, check_consistency};
 pub use decision::{Reading, Reason, Refusal, Term, TriangleDecision, TriangleState};
+pub use gate::RemeshGate;
 pub use marks::{edge_angles, edge_angles_into};
 
 use crate::math::{Scalar, Vector};
@@ -104,6 +106,10 @@ pub struct AdaptStats {
     pub passes: u64,
     /// Passes that changed the mesh.
     pub changed_passes: u64,
+    /// Passes the remesh gate deferred (`adapt.min_change`: too small a change
+    /// and no urgent split); they changed nothing. The passes applied are
+    /// `passes - deferred_passes`.
+    pub deferred_passes: u64,
     /// Largest number of operations in one pass.
     pub max_ops_per_pass: u64,
     /// Merges that the criterion split again before the next pass had run
@@ -186,6 +192,9 @@ pub struct AdaptConfig {
     /// Red-green: flip the corner squares of red splits so that refined grids
     /// alternate their diagonals (`red_green/mesh.rs`, "Alternating diagonals").
     pub alternate_diagonals: bool,
+    /// Red-green: apply a pass only when it changes enough (`gate.rs`; `None`:
+    /// every pass is applied).
+    pub gate: Option<RemeshGate>,
 }
 
 impl AdaptConfig {
@@ -206,6 +215,10 @@ impl AdaptConfig {
             refine_strain: a.refine_strain.filter(|s| *s != 0.0),
             refine_obstacle: a.refine_obstacle.filter(|r| *r != 0.0),
             alternate_diagonals: a.diagonals.unwrap_or_default() == RedDiagonals::Alternating,
+            gate: (a.min_change > 0.0).then_some(RemeshGate {
+                min_change: a.min_change,
+                urgent_ratio: a.urgent_ratio,
+            }),
         })
     }
 }

@@ -32,6 +32,15 @@ impl Adapter {
         debug_assert_eq!(angles.len(), world.mesh.edges.len(), "stale edge angles");
         let marks = self.red_green().marks(c, world, angles, known);
         self.stats.passes += 1;
+        if let Some(gate) = &c.gate
+            && !gate.applies(&self.red_green().pass_size(world, &marks))
+        {
+            // Deferred: nothing changes, and the latest applied pass's merges
+            // and refusals stay the ones the next applied pass is held to.
+            self.stats.deferred_passes += 1;
+            self.stats.note_levels(world, c.max_level);
+            return Ok(false);
+        }
         self.red_green().pass_merges.clear();
         let refusals = self.red_green().refusal_events(world, &marks, step);
         let mut ops: Vec<(RedGreenOp, Reason)> = marks

@@ -6,6 +6,7 @@
 use std::collections::{HashMap, HashSet};
 
 use super::decision::{Reading, Reason, Refusal};
+use super::gate::PassSize;
 use super::red_green::{Applied, RedGreen, RedGreenOp};
 use super::transfer::{Origin, PanelCorners, VertexOrder, compact, transfer};
 use super::{AdaptConfig, AdaptEvent, EventKind, Measured};
@@ -118,6 +119,41 @@ impl RedGreenState {
             }
         }
         marks
+    }
+
+    /// What the pass of `marks` would do, as the remesh gate weighs it: the
+    /// triangles of `world`'s mesh owned by the leaves it splits and by the
+    /// children of the parents it merges (those the level rule lets merge),
+    /// and its splits' largest reading.
+    pub(super) fn pass_size(&self, world: &World, marks: &PassMarks) -> PassSize {
+        let candidates: Vec<u32> = marks.merges.iter().map(|m| m.0).collect();
+        let (merged, _) = self.hierarchy.select_merges(&candidates);
+        let mut leaves: Vec<u32> = marks.splits.iter().map(|m| m.0).collect();
+        for p in merged {
+            leaves.extend(self.hierarchy.children(p).unwrap_or_default());
+        }
+        leaves.sort_unstable();
+        let replaced = match leaves.is_empty() {
+            true => 0,
+            false => self
+                .owner
+                .iter()
+                .filter(|l| leaves.binary_search(l).is_ok())
+                .count(),
+        };
+        let worst_ratio = marks
+            .splits
+            .iter()
+            .filter_map(|(_, r)| match r {
+                Reason::Criterion { reading, .. } => Some(reading.ratio),
+                _ => None,
+            })
+            .fold(0.0, Scalar::max);
+        PassSize {
+            replaced,
+            triangles: world.mesh.triangles.len(),
+            worst_ratio,
+        }
     }
 
     /// The events of the merges the level rule refuses this pass that it did

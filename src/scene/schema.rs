@@ -186,6 +186,10 @@ pub(crate) fn allowed(path: &str) -> Option<&'static str> {
         "adapt.max_level" => "an integer >= 1 (at most 254; even with method = \"tensor\")",
         "adapt.min_edge_length" => "a finite number >= 0 (m, material space; 0: no limit)",
         "adapt.every" => "an integer >= 1 (steps) or \"frame\"",
+        "adapt.min_change" => {
+            "a finite number in [0, 1] (a fraction of the triangles; 0: off; method = \"red_green\" only)"
+        }
+        "adapt.urgent_ratio" => "a finite number >= 1 (a ratio of the criterion; with min_change)",
         "adapt.rollback" => "true or false",
         "adapt.max_rollbacks" => "an integer >= 0",
         "adapt.multirate" => "true or false (explicit integrators only)",

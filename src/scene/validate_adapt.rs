@@ -59,6 +59,7 @@ pub(super) fn adapt(
     if a.method == AdaptMethod::Tensor {
         tensor(a, shape, stiffness)?;
     }
+    gate(a)?;
     if a.multirate && integrator == Integrator::Implicit {
         let path = keys(&["adapt", "multirate"]);
         let why = "multirate stepping is for the explicit integrators (symplectic_euler, rk4)";
@@ -149,6 +150,34 @@ fn criterion(a: &Adapt) -> Result<(), Issue> {
                 num(h)
             ),
         ));
+    }
+    Ok(())
+}
+
+/// The remesh gate's keys: `min_change` in [0, 1] (0: off), with red-green
+/// only; `urgent_ratio` >= 1.
+fn gate(a: &Adapt) -> Result<(), Issue> {
+    let path = keys(&["adapt", "urgent_ratio"]);
+    finite(&path, a.urgent_ratio)?;
+    if a.urgent_ratio < 1.0 {
+        let why = format!(
+            "{} is out of range: must be >= 1 (a ratio of the criterion, 1 at its threshold)",
+            num(a.urgent_ratio)
+        );
+        return Err(out_of_range(path, why));
+    }
+    let path = keys(&["adapt", "min_change"]);
+    finite(&path, a.min_change)?;
+    if !(0.0..=1.0).contains(&a.min_change) {
+        let why = format!(
+            "{} is out of range: must be in [0, 1] (a fraction of the triangles; 0: off)",
+            num(a.min_change)
+        );
+        return Err(out_of_range(path, why));
+    }
+    if a.min_change > 0.0 && a.method != AdaptMethod::RedGreen {
+        let why = "min_change gates the passes of method = \"red_green\" only";
+        return Err(Issue::new(path, Kind::NotApplicable, why));
     }
     Ok(())
 }

@@ -342,15 +342,21 @@ impl Pipeline {
     }
 
     /// After the state's mesh changed (remeshing, or a restored start): rebuilds
-    /// `setup`'s force elements (timed as the state's `rebuild_s`) and forgets the
-    /// step size, the air power, and the state's (now stale) contacts and warm
-    /// start. The pipeline calls it after its
-    /// own remeshing and restores; call it after changing a state's mesh outside the
-    /// pipeline (for a state saved elsewhere, whose contacts and warm start still
-    /// fit its mesh, [`Pipeline::attach`] keeps them).
+    /// `setup`'s force elements and, with `dt = "auto"`, the new mesh's step
+    /// (timed together as the state's `rebuild_s`), and forgets the air power
+    /// and the state's (now stale) contacts and warm start. The pipeline calls
+    /// it after its own remeshing and restores; call it after changing a
+    /// state's mesh outside the pipeline (for a state saved elsewhere, whose
+    /// contacts and warm start still fit its mesh, [`Pipeline::attach`] keeps
+    /// them).
     pub fn mesh_changed(&mut self, setup: &Setup, state: &mut SimState) {
         let started = std::time::Instant::now();
         self.attach(setup, state);
+        if setup.settings.step == StepSize::Auto {
+            // The step depends on the mesh and its elements alone: the value
+            // the next step would compute, computed here to count as rebuilding.
+            self.step_size(setup, &state.world);
+        }
         state.effort.solver.rebuild_s += started.elapsed().as_secs_f64();
         state.contacts.clear();
         state.warm_start.clear();

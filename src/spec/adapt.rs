@@ -62,6 +62,26 @@ pub struct Adapt {
     /// "Alternating diagonals".
     #[serde(default)]
     pub diagonals: Option<RedDiagonals>,
+    /// Red-green only: apply an adaptation pass only when its operations would
+    /// replace at least this fraction of the mesh's triangles, or when one of
+    /// its splits is urgent (`urgent_ratio`); a deferred pass changes nothing.
+    /// 0 (the default): every pass is applied. See `src/adapt/gate.rs`.
+    #[serde(default)]
+    pub min_change: f64,
+    /// With `min_change`: a pass with a split whose criterion reads at least
+    /// this ratio (1: at the threshold) is applied whatever its size
+    /// ([`DEFAULT_URGENT_RATIO`] unless set).
+    #[serde(default = "default_urgent_ratio")]
+    pub urgent_ratio: f64,
+}
+
+/// The urgent ratio of the remesh gate when a scene does not set
+/// `adapt.urgent_ratio`: a triangle twice as coarse as its target is refined
+/// at the next pass.
+pub const DEFAULT_URGENT_RATIO: f64 = 2.0;
+
+fn default_urgent_ratio() -> f64 {
+    DEFAULT_URGENT_RATIO
 }
 
 /// How the simulation mesh triangulates the children of a red (1-4) split.

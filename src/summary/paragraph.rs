@@ -104,13 +104,21 @@ impl Adaptivity {
                 " Adaptive: not started, as remeshing waits until every seam is welded.".into()
             }
             Some(a) => format!(
-                " Adaptive: {} splits ({} forced), {} merges ({} bounced), {} rollbacks, max level {}{}.",
+                " Adaptive: {} splits ({} forced), {} merges ({} bounced), {} rollbacks, max level {}{}{}.",
                 a.splits,
                 a.closure_splits,
                 a.merges,
                 a.bounces,
                 a.rollbacks,
                 self.max_level,
+                match a.deferred_passes {
+                    0 => String::new(),
+                    d => format!(
+                        "; {} of {} passes applied, {d} deferred (min_change)",
+                        a.passes - d,
+                        a.passes
+                    ),
+                },
                 match a.started_at > 0.0 {
                     true => format!(
                         "; remeshing from t = {:.3} s, once every seam was welded",

@@ -28,6 +28,7 @@ fn sizing(refine_angle: Scalar, max_level: u8) -> AdaptConfig {
         refine_strain: None,
         refine_obstacle: None,
         alternate_diagonals: true,
+        gate: None,
     }
 }
 

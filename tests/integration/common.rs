@@ -61,6 +61,7 @@ pub fn angle_config(method: AdaptMethod) -> AdaptConfig {
         refine_strain: None,
         refine_obstacle: None,
         alternate_diagonals: true,
+        gate: None,
     }
 }
 

@@ -52,6 +52,7 @@ mod pins_attached;
 mod presets;
 mod recording;
 mod recording_run;
+mod remesh_gate;
 mod remesh_ops;
 mod resting_contact;
 mod scene_errors;

@@ -151,6 +151,8 @@ impl Pipeline {
             return Ok(false);
         };
         let step = state.ledger.steps_done;
+        // The criterion's obstacle planes are part of the pass's cost.
+        let started = Instant::now();
         self.obstacle_planes.clear();
         if config.refine_obstacle.is_some() {
             let w = &state.world;
@@ -162,7 +164,6 @@ impl Pipeline {
             obstacle_planes: &self.obstacle_planes,
         };
         let old_vertices = state.world.x.len();
-        let started = Instant::now();
         let changed = ad.remesh_with(config, &mut state.world, step, known)?;
         self.angles_fresh = false;
         if !changed {
