@@ -90,8 +90,9 @@ fn write_file(
 /// [`write_frame_obj`] for a plain cloth; for a garment, one `v` line per vertex,
 /// one `vt` line per distinct (vertex, corner coordinate) (a vertex on a welded
 /// seam has one per panel), a `g NAME` line wherever the panel changes, one
-/// `f a/ta b/tb c/tc` line per triangle, and for each open seam a `g NAME` line
-/// (the seam's name) and one `l a b` line per pair (first side first).
+/// `f a/ta b/tb c/tc` line per triangle, and for each open seam a `# seam NAME`
+/// comment and a `g NAME` line (the seam's name) and one `l a b` line per pair
+/// (first side first).
 ///
 /// [`crate::mesh::load_obj`] reads such a file back as the same panels (names,
 /// triangles' panels, corner coordinates), home coordinates and open seams (their
@@ -175,6 +176,7 @@ fn write_garment(
         writeln!(out, "f {a}/{ta} {b}/{tb} {c}/{tc}")?;
     }
     for seam in panels.seams.iter().filter(|s| s.is_open()) {
+        writeln!(out, "# seam {}", seam.name)?;
         writeln!(out, "g {}", seam.name)?;
         for &[a, b] in &seam.pairs {
             writeln!(out, "l {} {}", u64::from(a) + 1, u64::from(b) + 1)?;
