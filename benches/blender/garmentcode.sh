@@ -72,12 +72,12 @@ rm -rf "$tmp" && mkdir -p "$tmp"
     --set simulation.duration=0.034 -q >"$tmp/garment.log" 2>&1
 # Where two panels start joined (a centre front or back seam whose sides
 # coincide), frame 0 holds pairs of `v` lines at one position. drape's OBJ
-# reader takes equal positions for one vertex, which would join the panels
-# at those points before any seam does (and refuse the mesh where they meet
-# in a single point); each repeat is moved by the least step of its x (one
-# unit in the last place: 5e-324 m at x = 0, under 1e-16 m on the shirt,
-# less than its neighbours along the seam already lie apart), so both
-# simulators read the same distinct vertices.
+# reader keeps two `v` lines an `l` pairs distinct, but took equal positions
+# for one vertex when this bench was measured; each repeat is still moved by
+# the least step of its x (one unit in the last place: 5e-324 m at x = 0,
+# under 1e-16 m on the shirt, less than its neighbours along the seam
+# already lie apart), as measured, so both simulators read the same
+# distinct vertices.
 python3 - "$tmp/garment/frame_00000.obj" "$work/garment.obj" <<'EOF'
 import math, sys
 seen, moved = set(), 0

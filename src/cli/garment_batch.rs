@@ -124,10 +124,38 @@ pub fn cmd_garment_plan(args: GarmentPlanArgs) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// One CSV row from a job's summary (`None`: the job has written none yet).
-fn row(name: &str, summary: Option<&Value>) -> String {
-    let Some(s) = summary else {
-        return format!("{name},,,,,,,,,missing");
+/// What a job has left in its summary file.
+enum Summary {
+    /// No file: the job has not started, or failed before its run.
+    Missing,
+    /// An empty file: the job is running, or was killed (e.g. by a time limit)
+    /// before it wrote its summary at the end.
+    Empty,
+    /// The summary.
+    Written(Value),
+}
+
+impl Summary {
+    /// Reads `path`; a file that is not JSON is an error.
+    fn read(path: &Path) -> Result<Summary> {
+        let Ok(text) = std::fs::read_to_string(path) else {
+            return Ok(Summary::Missing);
+        };
+        if text.trim().is_empty() {
+            return Ok(Summary::Empty);
+        }
+        let value = serde_json::from_str::<Value>(&text)
+            .with_context(|| format!("{}: not a drape summary", path.display()))?;
+        Ok(Summary::Written(value))
+    }
+}
+
+/// One CSV row from a job's summary.
+fn row(name: &str, summary: &Summary) -> String {
+    let s = match summary {
+        Summary::Missing => return format!("{name},,,,,,,,,missing"),
+        Summary::Empty => return format!("{name},,,,,,,,,empty"),
+        Summary::Written(s) => s,
     };
     let num = |v: Option<&Value>| v.and_then(Value::as_f64);
     let seams = s.get("seams").and_then(Value::as_array);
@@ -172,16 +200,9 @@ pub fn cmd_garment_collect(args: GarmentCollectArgs) -> Result<ExitCode> {
     );
     let mut missing = 0;
     for name in names.lines().filter_map(|l| l.split('\t').next()) {
-        let path = args.dir.join(format!("{name}.json"));
-        let summary = match std::fs::read_to_string(&path) {
-            Ok(text) => Some(
-                serde_json::from_str::<Value>(&text)
-                    .with_context(|| format!("{}: not a drape summary", path.display()))?,
-            ),
-            Err(_) => None,
-        };
-        missing += usize::from(summary.is_none());
-        csv.push_str(&row(name, summary.as_ref()));
+        let summary = Summary::read(&args.dir.join(format!("{name}.json")))?;
+        missing += usize::from(!matches!(summary, Summary::Written(_)));
+        csv.push_str(&row(name, &summary));
         csv.push('\n');
     }
     let out = args.dir.join(CSV_FILE);
@@ -189,7 +210,10 @@ pub fn cmd_garment_collect(args: GarmentCollectArgs) -> Result<ExitCode> {
     print!("{csv}");
     println!("written to {}", out.display());
     if missing > 0 {
-        eprintln!("{missing} jobs have no summary yet (status `missing`)");
+        eprintln!(
+            "{missing} jobs have no summary (status `missing`: no file; `empty`: still \
+             running, or killed before the end)"
+        );
         return Ok(ExitCode::from(1));
     }
     Ok(ExitCode::SUCCESS)

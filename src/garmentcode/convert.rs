@@ -2,8 +2,8 @@
 //! control points, outlines that wind counter-clockwise, and stitches as
 //! seams.
 //!
-//! GarmentCode's panel faces the way its outline winds (counter-clockwise
-//! seen from the front of the fabric), while drape meshes every outline
+//! GarmentCode's panel faces the way its outline winds along its sides,
+//! curves included (counter-clockwise seen from the front of the fabric), while drape meshes every outline
 //! counter-clockwise and faces it along the placement's +z. A clockwise panel
 //! is therefore mirrored (u -> -u, which keeps every length and area) and
 //! placed with an extra half turn about its v axis, which puts each point
@@ -15,17 +15,20 @@ use super::json::{EdgeJson, PanelJson, SpecFile};
 use super::{Labelled, Why};
 use crate::garment::SEAM_LENGTH_TOLERANCE;
 use crate::math::{Matrix3, Scalar, Vector2, rotation_from_euler_deg};
-use crate::mesh::side_length;
+use crate::mesh::{side_length, side_points};
 use crate::spec::{
     Curve, Gather, PanelSpec, Placement, SeamDirection, SeamSide, SeamSpec, SideCurve,
 };
 
 /// One panel converted, with its labelled sides.
 pub struct Converted {
-    /// The panel.
+    /// The panel, as its outline winds in GarmentCode (not yet turned over).
     pub panel: PanelSpec,
     /// Its labelled sides.
     pub labels: Vec<Labelled>,
+    /// Whether its outline winds clockwise (along its sides, curves included):
+    /// GarmentCode faces it along its placement's -z.
+    pub clockwise: bool,
 }
 
 /// Converts panel `name` of `file`.
@@ -33,7 +36,7 @@ pub fn panel(file: &SpecFile, name: &str, p: &PanelJson) -> Result<Converted, Wh
     let scale = 1.0 / file.properties.units_in_meter;
     let absolute = file.properties.curvature_coords == "absolute";
     let corners = loop_corners(name, p)?;
-    let mut outline: Vec<[f64; 2]> = corners
+    let outline: Vec<[f64; 2]> = corners
         .iter()
         .map(|&c| scaled(p.vertices[c], scale))
         .collect();
@@ -63,28 +66,40 @@ pub fn panel(file: &SpecFile, name: &str, p: &PanelJson) -> Result<Converted, Wh
             });
         }
     }
-    let mut rotation = p.rotation;
-    if signed_area(&outline) < 0.0 {
-        for c in &mut outline {
-            c[0] = -c[0];
-        }
-        for c in &mut curves {
-            c.curve = mirrored(c.curve);
-        }
-        let turned =
-            rotation_from_euler_deg(p.rotation) * Matrix3::from_rotation_y(std::f64::consts::PI);
-        rotation = euler_deg(&turned);
-    }
+    let clockwise = outline_signed_area(&outline, &curves) < 0.0;
     let panel = PanelSpec {
         name: name.into(),
         outline,
         curves,
         placement: Placement::Flat {
             position: p.translation.map(|t| t * scale),
-            rotation,
+            rotation: p.rotation,
         },
     };
-    Ok(Converted { panel, labels })
+    Ok(Converted {
+        panel,
+        labels,
+        clockwise,
+    })
+}
+
+/// Turns `panel` over: its outline mirrored (u -> -u, which keeps every
+/// length and area and reverses the way it winds) and its placement given a
+/// half turn about its v axis, which keeps each point where it was and faces
+/// the panel the other way (drape faces a panel along its placement's +z
+/// whichever way its outline winds).
+pub fn turn_over(panel: &mut PanelSpec) {
+    for c in &mut panel.outline {
+        c[0] = -c[0];
+    }
+    for c in &mut panel.curves {
+        c.curve = mirrored(c.curve);
+    }
+    if let Placement::Flat { rotation, .. } = &mut panel.placement {
+        let turned =
+            rotation_from_euler_deg(*rotation) * Matrix3::from_rotation_y(std::f64::consts::PI);
+        *rotation = euler_deg(&turned);
+    }
 }
 
 /// The corner each edge starts at, checking that the edges form one loop.
@@ -226,14 +241,28 @@ fn mirrored(c: Curve) -> Curve {
     }
 }
 
-/// Twice the signed area of a polygon (positive: counter-clockwise).
-fn signed_area(outline: &[[f64; 2]]) -> Scalar {
+/// Segments a curved side is sampled with to tell which way an outline winds.
+const WINDING_SEGMENTS: usize = 64;
+
+/// Twice the signed area of an outline along its sides, curves included
+/// (positive: counter-clockwise). The corners alone can wind the other way:
+/// a circle skirt's panel has arcs of more than half a turn at its waist and
+/// hem, and its four corners wind opposite to its shape.
+fn outline_signed_area(outline: &[[f64; 2]], curves: &[SideCurve]) -> Scalar {
     let n = outline.len();
-    (0..n)
-        .map(|i| {
-            let (p, q) = (outline[i], outline[(i + 1) % n]);
-            p[0] * q[1] - q[0] * p[1]
-        })
+    let mut points = Vec::new();
+    for k in 0..n {
+        let (a, b) = (
+            Vector2::from_array(outline[k]),
+            Vector2::from_array(outline[(k + 1) % n]),
+        );
+        let curve = curves.iter().find(|c| c.side == k + 1).map(|c| &c.curve);
+        let segments = if curve.is_some() { WINDING_SEGMENTS } else { 1 };
+        points.extend_from_slice(&side_points(curve, a, b, segments)[..segments]);
+    }
+    let m = points.len();
+    (0..m)
+        .map(|i| points[i].perp_dot(points[(i + 1) % m]))
         .sum()
 }
 

@@ -16,6 +16,7 @@
 
 pub mod body;
 mod convert;
+mod facing;
 mod json;
 pub mod scene_text;
 
@@ -170,6 +171,7 @@ pub fn parse(text: &str) -> Result<Pattern, Why> {
         return Err(Why::NoPanels);
     }
     let mut panels = Vec::with_capacity(names.len());
+    let mut clockwise = Vec::with_capacity(names.len());
     let mut labels = Vec::new();
     for name in &names {
         let Some(p) = spec.pattern.panels.get(name) else {
@@ -180,6 +182,7 @@ pub fn parse(text: &str) -> Result<Pattern, Why> {
         };
         let converted = convert::panel(&spec, name, p)?;
         panels.push(converted.panel);
+        clockwise.push(converted.clockwise);
         labels.extend(converted.labels);
     }
     let seams = spec
@@ -189,6 +192,16 @@ pub fn parse(text: &str) -> Result<Pattern, Why> {
         .enumerate()
         .map(|(i, s)| convert::stitch(i, s, &panels))
         .collect::<Result<Vec<_>, _>>()?;
+    // drape faces a panel whichever way its outline winds: one GarmentCode
+    // faces along -z (clockwise) is turned over, unless a seam needs it facing
+    // the other way, and one it faces along +z is turned over where a seam
+    // needs it.
+    let turned = facing::turned_over(&names, &seams);
+    for ((panel, cw), turn) in panels.iter_mut().zip(clockwise).zip(turned) {
+        if cw != turn {
+            convert::turn_over(panel);
+        }
+    }
     Ok(Pattern {
         panels,
         seams,

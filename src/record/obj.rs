@@ -2,8 +2,8 @@
 //!
 //! A plain cloth is written with one texture coordinate per vertex
 //! ([`write_frame_obj`]); a garment with one per distinct corner coordinate,
-//! its panels as groups and its open seams as `l` elements
-//! ([`write_mesh_obj`]), so that drape reads the file back as the same panels
+//! its panels as groups and its open seams as `l` elements, each seam in a
+//! group of its own ([`write_mesh_obj`]), so that drape reads the file back as the same panels
 //! and seams.
 
 use std::collections::HashMap;
@@ -90,15 +90,18 @@ fn write_file(
 /// [`write_frame_obj`] for a plain cloth; for a garment, one `v` line per vertex,
 /// one `vt` line per distinct (vertex, corner coordinate) (a vertex on a welded
 /// seam has one per panel), a `g NAME` line wherever the panel changes, one
-/// `f a/ta b/tb c/tc` line per triangle and one `l a b` line per pair of each
-/// open seam (first side first).
+/// `f a/ta b/tb c/tc` line per triangle, and for each open seam a `# seam NAME`
+/// comment and a `g NAME` line (the seam's name) and one `l a b` line per pair
+/// (first side first).
 ///
 /// [`crate::mesh::load_obj`] reads such a file back as the same panels (names,
 /// triangles' panels, corner coordinates), home coordinates and open seams (their
-/// pairs; their names follow the new file's lines), as long as no two vertices
-/// share a position (equal positions are read as one vertex) and the vertices are
-/// numbered in the order the triangles first use them (otherwise they come back
-/// renumbered in that order). A welded seam comes back as its shared vertices.
+/// pairs, each seam in its own group however its ends meet another's; their
+/// names follow the new file's lines), as long as no two vertices share a
+/// position that an open seam does not pair (equal positions are read as one
+/// vertex, except the two vertices of a pair) and the vertices are numbered in
+/// the order the triangles first use them (otherwise they come back renumbered
+/// in that order). A welded seam comes back as its shared vertices.
 ///
 /// Fails as [`write_frame_obj`] does, and with [`RecordError::InvalidFrame`] if
 /// `positions` does not have one entry per vertex of `mesh`.
@@ -174,6 +177,7 @@ fn write_garment(
     }
     for seam in panels.seams.iter().filter(|s| s.is_open()) {
         writeln!(out, "# seam {}", seam.name)?;
+        writeln!(out, "g {}", seam.name)?;
         for &[a, b] in &seam.pairs {
             writeln!(out, "l {} {}", u64::from(a) + 1, u64::from(b) + 1)?;
         }

@@ -84,3 +84,39 @@ fn a_pattern_folder_becomes_one_job_per_pattern_and_the_summaries_one_csv() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A job killed before it ends (by `timeout`, say) leaves its summary file
+/// empty: the collector writes the table with that job `empty` and exits 1,
+/// rather than stopping at the file.
+#[test]
+fn an_empty_summary_of_a_killed_job_collects_as_empty() {
+    let dir = temp_dir("garment-batch-empty");
+    let patterns = dir.join("patterns");
+    std::fs::create_dir_all(&patterns).expect("patterns dir");
+    for name in ["hoody_mean", "shirt_mean"] {
+        let file = format!("{name}_specification.json");
+        std::fs::copy(examples().join(&file), patterns.join(&file)).expect("copy pattern");
+    }
+    let body = examples().join("mean_all.obj");
+    let plan = drape(
+        &dir,
+        &[
+            "garment-plan",
+            "patterns",
+            "--body",
+            &body.to_string_lossy(),
+            "--out",
+            "jobs",
+        ],
+    );
+    assert!(plan.status.success(), "{plan:?}");
+    std::fs::write(dir.join("jobs/hoody_mean.json"), "").expect("empty summary");
+    let collect = drape(&dir, &["garment-collect", "jobs"]);
+    assert_eq!(collect.status.code(), Some(1), "{collect:?}");
+    let csv = std::fs::read_to_string(dir.join("jobs/garments.csv")).expect("csv");
+    let rows: Vec<&str> = csv.lines().collect();
+    assert_eq!(rows.len(), 3, "{csv}");
+    assert_eq!(rows[1], "hoody_mean,,,,,,,,,empty", "{csv}");
+    assert_eq!(rows[2], "shirt_mean,,,,,,,,,missing", "{csv}");
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -32,6 +32,7 @@ mod garment_phases;
 mod garment_recording;
 mod garment_remesh;
 mod garmentcode;
+mod garmentcode_facing;
 mod garments;
 mod gradient;
 mod inspect_cli;

@@ -1,17 +1,22 @@
 //! The objects tobj reads, merged over one vertex set; the planar rest shape of
 //! a flat mesh without texture coordinates.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
+use super::text::ObjText;
 use crate::math::{Scalar, Vector, Vector2};
 
 /// The triangles of every object of an OBJ file over one vertex set.
 pub(super) struct MergedObj {
-    /// Vertex positions, one per distinct position in the file, in the order
-    /// the faces first use them.
+    /// Vertex positions, one per distinct [`VertexKey`] the faces use, in the
+    /// order the faces first use them.
     pub positions: Vec<Vector>,
-    /// The vertex of each position (keyed by its coordinates' bits).
-    pub index_of: HashMap<[u64; 3], u32>,
+    /// The vertex of each key.
+    index_of: HashMap<VertexKey, u32>,
+    /// The positions (keyed by their coordinates' bits) at which an `l`
+    /// element pairs two different `v` lines: there each `v` line is a vertex
+    /// of its own.
+    split: HashSet<[u64; 3]>,
     /// Triangles as indices into `positions`, in file order.
     pub triangles: Vec<[u32; 3]>,
     /// Each triangle's corners' texture coordinates times `uv_scale` (zero for
@@ -25,17 +30,80 @@ pub(super) struct MergedObj {
     pub without_uv: usize,
 }
 
-/// The key under which [`MergedObj::index_of`] finds a position.
-pub(super) fn position_key(p: Vector) -> [u64; 3] {
+/// What makes two `v` lines one vertex.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+enum VertexKey {
+    /// Every `v` line at this position (its coordinates' bits) is one vertex.
+    Position([u64; 3]),
+    /// This `v` line (0-based), at a split position, is a vertex of its own.
+    Line(usize),
+}
+
+impl MergedObj {
+    /// The key of `v` line `line` at `position`.
+    fn key(&self, line: usize, position: Vector) -> VertexKey {
+        let bits = position_key(position);
+        if self.split.contains(&bits) {
+            VertexKey::Line(line)
+        } else {
+            VertexKey::Position(bits)
+        }
+    }
+
+    /// The vertex of `v` line `line` (0-based) of `text`, `None` when no face
+    /// uses it (nor, where positions merge, another `v` line at its position).
+    pub fn vertex_of_line(&self, text: &ObjText, line: usize) -> Option<u32> {
+        let position = text.positions.get(line).copied().flatten()?;
+        self.index_of.get(&self.key(line, position)).copied()
+    }
+}
+
+/// The key under which positions merge: the coordinates' bits.
+fn position_key(p: Vector) -> [u64; 3] {
     p.to_array().map(f64::to_bits)
 }
 
-/// Merges all objects into one vertex set, keyed by exact position: equal
-/// positions are one vertex, whichever objects or `v` lines they come from.
-pub(super) fn merge_models(models: &[tobj::Model], uv_scale: Scalar) -> MergedObj {
+/// The positions at which an `l` element pairs two different `v` lines.
+fn split_positions(text: &ObjText) -> HashSet<[u64; 3]> {
+    let mut split = HashSet::new();
+    for element in &text.lines {
+        for w in element.vertices.windows(2) {
+            let (Some(Some(a)), Some(Some(b))) =
+                (text.positions.get(w[0]), text.positions.get(w[1]))
+            else {
+                continue;
+            };
+            if w[0] != w[1] && position_key(*a) == position_key(*b) {
+                split.insert(position_key(*a));
+            }
+        }
+    }
+    split
+}
+
+/// The `v` line (0-based) of corner `p` of a tobj mesh read from
+/// [`ObjText::faces_text`], whose x is the line's index, and its position.
+fn corner_line(text: &ObjText, mesh: &tobj::Mesh, p: usize) -> Option<(usize, Vector)> {
+    let x = mesh.positions[3 * p];
+    let line = (x >= 0.0 && x.fract() == 0.0).then_some(x as usize)?;
+    Some((line, text.positions.get(line).copied().flatten()?))
+}
+
+/// Merges all objects into one vertex set: the `v` lines at one position are
+/// one vertex, whichever objects use them, except at a position where an `l`
+/// element pairs two different `v` lines (the two sides of a seam that lie on
+/// each other), where each `v` line is a vertex of its own. `None` if a corner
+/// does not name a `v` line of `text` (tobj's models were not read from
+/// [`ObjText::faces_text`]).
+pub(super) fn merge_models(
+    models: &[tobj::Model],
+    text: &ObjText,
+    uv_scale: Scalar,
+) -> Option<MergedObj> {
     let mut merged = MergedObj {
         positions: Vec::new(),
         index_of: HashMap::new(),
+        split: split_positions(text),
         triangles: Vec::new(),
         uvs: Vec::new(),
         model_of: Vec::new(),
@@ -49,15 +117,11 @@ pub(super) fn merge_models(models: &[tobj::Model], uv_scale: Scalar) -> MergedOb
             let mut tri = [0u32; 3];
             let mut uv = [Vector2::ZERO; 3];
             for (k, &p) in corners.iter().enumerate() {
-                let p = p as usize;
-                let pos = Vector::new(
-                    m.positions[3 * p],
-                    m.positions[3 * p + 1],
-                    m.positions[3 * p + 2],
-                );
+                let (line, pos) = corner_line(text, m, p as usize)?;
                 let next = merged.positions.len() as u32;
+                let key = merged.key(line, pos);
                 let positions = &mut merged.positions;
-                tri[k] = *merged.index_of.entry(position_key(pos)).or_insert_with(|| {
+                tri[k] = *merged.index_of.entry(key).or_insert_with(|| {
                     positions.push(pos);
                     next
                 });
@@ -76,7 +140,7 @@ pub(super) fn merge_models(models: &[tobj::Model], uv_scale: Scalar) -> MergedOb
             merged.model_of.push(model_index as u32);
         }
     }
-    merged
+    Some(merged)
 }
 
 /// Coordinates of the points in the plane of the mesh; `Err(distance)` if not flat.

@@ -3,7 +3,9 @@
 //! Texture coordinates (`vt`), when every face corner has one, become material
 //! coordinates (times `uv_scale`). Without them the mesh must be flat, and its own
 //! planar shape is the rest shape. Faces of all objects share one vertex set:
-//! equal positions are one vertex, whichever `v` lines give them.
+//! equal positions are one vertex, whichever `v` lines give them, except where
+//! an `l` element pairs two different `v` lines at one position (the two sides
+//! of a seam lying on each other): there each `v` line is a vertex of its own.
 //!
 //! # Garments
 //!
@@ -28,9 +30,11 @@
 //! - **Seams** come from `l` elements (Blender exports sewing edges as loose
 //!   edges from one side of a seam to the other): each pairs its consecutive
 //!   vertices, which must be boundary vertices of the mesh not joined by an
-//!   edge. The pairs are grouped into open seams along the boundary, each
-//!   named `lN` after the line of its first element ([`seams`] gives the rule);
-//!   how they are sewn is the physics model's (`[cloth.sewing]`).
+//!   edge. The pairs are grouped into open seams along the boundary, the pairs
+//!   of one object or group (`o`, `g`) only, each seam named `lN` after the
+//!   line of its first element ([`seams`] gives the rule); how they are sewn
+//!   is the physics model's (`[cloth.sewing]`). Two vertices an `l` pairs may
+//!   lie at one position (in `v` lines of their own).
 //!
 //! tobj reads the faces; the loader reads the text itself too ([`text`]),
 //! for what tobj lets through and for the `l` elements, which it hides from
@@ -122,7 +126,10 @@ pub fn load_obj(path: &Path, uv_scale: Scalar) -> Result<ObjCloth, ObjError> {
     let name = path.display().to_string();
     let text = scan_text(path, &name)?;
     let models = read_models(&text, &name)?;
-    let merged = merge_models(&models, uv_scale);
+    let merged = merge_models(&models, &text, uv_scale).ok_or_else(|| ObjError::Read {
+        path: name.clone(),
+        reason: "a face corner names no `v` line".into(),
+    })?;
     if merged.with_uv > 0 && merged.without_uv > 0 {
         return Err(ObjError::PartialTexcoords { path: name });
     }

@@ -4,7 +4,7 @@
 use std::collections::{HashMap, HashSet};
 
 use super::ObjError;
-use super::merge::{MergedObj, position_key};
+use super::merge::MergedObj;
 use super::text::{LineElement, ObjText};
 use crate::mesh::{Edge, Seam};
 
@@ -14,6 +14,8 @@ struct Pair {
     ends: [u32; 2],
     /// The line of its `l` element.
     line: usize,
+    /// The object or group its `l` element lies in.
+    group: usize,
 }
 
 /// What the seams are checked against: the mesh's edges and panels.
@@ -27,10 +29,11 @@ pub(super) struct SeamMesh<'a> {
 /// Reads the seams of the file's `l` elements: each element pairs its
 /// consecutive vertices. Pairs are oriented with the first vertex in the
 /// lower-numbered (home) panel, or the lower-numbered vertex within one panel;
-/// the same pair given twice counts once. Two pairs are on one seam when their
-/// first vertices are joined by a boundary edge and so are their second ones,
-/// or the first of each and the second of the other (then one is turned
-/// round). A seam is named `lN`, N the line of its first element (`lN_2`,
+/// the same pair given twice in one object or group (`o`, `g`) counts once.
+/// Two pairs of one object or group are on one seam when their first vertices
+/// are joined by a boundary edge and so are their second ones, or the first of
+/// each and the second of the other (then one is turned round); pairs of
+/// different objects or groups are on different seams. A seam is named `lN`, N the line of its first element (`lN_2`,
 /// `lN_3`, ... for further seams that start on that line).
 pub(super) fn read_seams(
     text: &ObjText,
@@ -86,7 +89,7 @@ fn read_pairs(
         }
     }
     let mut pairs = Vec::new();
-    let mut seen: HashSet<[u32; 2]> = HashSet::new();
+    let mut seen: HashSet<(usize, [u32; 2])> = HashSet::new();
     for element in &text.lines {
         let bad = |reason: String| ObjError::BadLine {
             path: name.to_string(),
@@ -113,10 +116,11 @@ fn read_pairs(
             }
             let key = |v: u32| (mesh.of_vertex[v as usize], v);
             let ends = if key(a) <= key(b) { [a, b] } else { [b, a] };
-            if seen.insert(ends) {
+            if seen.insert((element.group, ends)) {
                 pairs.push(Pair {
                     ends,
                     line: element.line,
+                    group: element.group,
                 });
             }
         }
@@ -135,14 +139,12 @@ fn element_vertices(
         .vertices
         .iter()
         .map(|&i| {
-            let v = text.positions[i]
-                .and_then(|p| merged.index_of.get(&position_key(p)).copied())
-                .ok_or_else(|| {
-                    format!(
-                        "`l` vertex {} is used by no face, so it is not a vertex of the cloth",
-                        i + 1
-                    )
-                })?;
+            let v = merged.vertex_of_line(text, i).ok_or_else(|| {
+                format!(
+                    "`l` vertex {} is used by no face, so it is not a vertex of the cloth",
+                    i + 1
+                )
+            })?;
             if !on_boundary[v as usize] {
                 return Err(format!(
                     "`l` vertex {} is not a boundary vertex: it lies on no boundary edge of \
@@ -155,8 +157,8 @@ fn element_vertices(
         .collect()
 }
 
-/// Groups the pairs into seams (each group in file order, the groups in the
-/// order of their first pairs) and says which pairs to turn round so that each
+/// Groups the pairs into seams, pairs of one object or group only (each seam
+/// in file order, the seams in the order of their first pairs) and says which pairs to turn round so that each
 /// seam's first vertices are on one side.
 fn group_pairs(pairs: &[Pair], edges: &[Edge]) -> (Vec<Vec<usize>>, Vec<bool>) {
     let mut boundary: HashMap<u32, Vec<u32>> = HashMap::new();
@@ -181,7 +183,7 @@ fn group_pairs(pairs: &[Pair], edges: &[Edge]) -> (Vec<Vec<usize>>, Vec<bool>) {
         for &u in boundary.get(&a).into_iter().flatten() {
             for (side, turned) in [(0, false), (1, true)] {
                 for &j in at_end[side].get(&u).into_iter().flatten() {
-                    if boundary_edge(b, pairs[j].ends[1 - side]) {
+                    if pairs[j].group == p.group && boundary_edge(b, pairs[j].ends[1 - side]) {
                         links[i].push((j, turned));
                         links[j].push((i, turned));
                     }

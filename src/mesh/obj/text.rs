@@ -1,7 +1,9 @@
 //! The loader's own pass over the OBJ text: what tobj lets through unchecked,
-//! the `v` positions as tobj reads them, and the `l` elements, which tobj does
-//! not keep.
+//! the `v` positions as tobj reads them, the `l` elements, which tobj does
+//! not keep, and the text tobj reads the faces from, whose `v` lines are
+//! stand-ins that tell which `v` line each face corner uses.
 
+use std::collections::HashMap;
 use std::path::Path;
 
 use super::ObjError;
@@ -9,8 +11,12 @@ use crate::math::Vector;
 
 /// What the text scan found.
 pub(super) struct ObjText {
-    /// The file's text with every `l` line left empty, for tobj: tobj reads an
-    /// `l` of three or more vertices as a face. Line numbers are unchanged.
+    /// The file's text for tobj, line numbers unchanged: every `l` line left
+    /// empty (tobj reads an `l` of three or more vertices as a face), and every
+    /// `v` line tobj accepts replaced by a stand-in whose x is the line's
+    /// 0-based index among the `v` lines ([`stand_in`]), so that the position
+    /// of a corner in tobj's models is which `v` line it uses. A `v` line tobj
+    /// refuses stays as it is, for tobj to refuse.
     pub faces_text: String,
     /// Each `v` line's position as tobj reads it (`None` where tobj refuses it).
     pub positions: Vec<Option<Vector>>,
@@ -24,11 +30,15 @@ pub(super) struct LineElement {
     pub line: usize,
     /// Its vertices as 0-based indices of the file's `v` lines, each in range.
     pub vertices: Vec<usize>,
+    /// The object or group it lies in: one number per distinct name of the
+    /// `o` and `g` lines, in order of first appearance, 0 before any.
+    pub group: usize,
 }
 
 /// An `l` element before its indices are checked against the whole file.
 struct RawLine {
     line: usize,
+    group: usize,
     /// Each vertex's text and its 0-based index (negative ones resolved).
     vertices: Vec<(String, i64)>,
 }
@@ -48,6 +58,7 @@ pub(super) fn scan_text(path: &Path, name: &str) -> Result<ObjText, ObjError> {
     let (mut with, mut without) = (0usize, 0usize);
     let mut positions = Vec::new();
     let mut raw_lines = Vec::new();
+    let mut groups = Groups::default();
     let mut faces_text = String::with_capacity(text.len());
     for (n, line) in text.lines().enumerate() {
         let tokens: Vec<&str> = line.split_whitespace().collect();
@@ -64,7 +75,14 @@ pub(super) fn scan_text(path: &Path, name: &str) -> Result<ObjText, ObjError> {
                     ));
                 }
                 if kind == "v" {
-                    positions.push(tobj_position(&tokens[1..]));
+                    let position = tobj_position(&tokens[1..]);
+                    if position.is_some() {
+                        faces_text.push_str(&stand_in(positions.len(), &tokens[1..]));
+                        faces_text.push('\n');
+                        positions.push(position);
+                        continue;
+                    }
+                    positions.push(position);
                 }
             }
             Some("f") => {
@@ -81,8 +99,11 @@ pub(super) fn scan_text(path: &Path, name: &str) -> Result<ObjText, ObjError> {
                     }
                 }
             }
+            Some("o" | "g") => groups.enter(line),
             Some("l") => {
-                raw_lines.push(line_element(&tokens[1..], n + 1, positions.len(), name)?);
+                let mut element = line_element(&tokens[1..], n + 1, positions.len(), name)?;
+                element.group = groups.current;
+                raw_lines.push(element);
                 faces_text.push('\n');
                 continue;
             }
@@ -102,6 +123,25 @@ pub(super) fn scan_text(path: &Path, name: &str) -> Result<ObjText, ObjError> {
         positions,
         lines,
     })
+}
+
+/// The objects and groups (`o`, `g`) the scan has met, by name.
+#[derive(Default)]
+struct Groups {
+    /// The number of each name (from 1; 0 is before any `o` or `g`).
+    number: HashMap<String, usize>,
+    /// The number of the name the scan is in.
+    current: usize,
+}
+
+impl Groups {
+    /// Enters the object or group of the `o` or `g` line `line`, named as
+    /// tobj names it: the rest of the line, trimmed.
+    fn enter(&mut self, line: &str) {
+        let name = line.trim_start()[1..].trim().to_owned();
+        let next = self.number.len() + 1;
+        self.current = *self.number.entry(name).or_insert(next);
+    }
 }
 
 /// The file's text; a read error or a file that is not UTF-8 is [`ObjError::Read`].
@@ -135,6 +175,22 @@ fn tobj_position(tokens: &[&str]) -> Option<Vector> {
         }
     }
     Some(Vector::from_array(p))
+}
+
+/// The stand-in for `v` line `index` (0-based) whose values after `v` are
+/// `tokens`, which [`tobj_position`] accepts: `v index 0 0`, followed by the
+/// line's values after its third when it has more than four (colours, which
+/// tobj then reads, or refuses, as it would on the line itself). A homogeneous
+/// `w` (exactly four values) is dropped; the loader divides by it itself.
+fn stand_in(index: usize, tokens: &[&str]) -> String {
+    let mut line = format!("v {index} 0 0");
+    if tokens.len() > 4 {
+        for t in &tokens[3..] {
+            line.push(' ');
+            line.push_str(t);
+        }
+    }
+    line
 }
 
 /// Parses the vertices of the `l` element on line `line` (1-based), given
@@ -173,7 +229,11 @@ fn line_element(
         };
         vertices.push((token.to_string(), absolute));
     }
-    Ok(RawLine { line, vertices })
+    Ok(RawLine {
+        line,
+        group: 0,
+        vertices,
+    })
 }
 
 /// Checks every `l` index against the file's `v` lines.
@@ -201,6 +261,7 @@ fn check_line_indices(
                 .collect::<Result<Vec<usize>, ObjError>>()?;
             Ok(LineElement {
                 line: element.line,
+                group: element.group,
                 vertices,
             })
         })
