@@ -273,8 +273,10 @@ pub struct RestSummary {
     pub at_rest: bool,
     /// When it came to rest, s (`None`: it did not).
     pub time: Option<Scalar>,
-    /// The largest vertex speed at the end, m/s.
-    pub speed: Scalar,
+    /// The largest vertex speed over the last frame, m/s (`None`, `null` in
+    /// the JSON, when the last frame changed the mesh, as a weld does, or
+    /// the run ended before its first frame).
+    pub speed: Option<Scalar>,
     /// The rest speed, m/s (`simulation.rest.speed`).
     pub threshold: Scalar,
     /// The rest window, s (`simulation.rest.window`).
@@ -289,11 +291,17 @@ impl RestSummary {
                 " At rest at t = {t:.3} s (every vertex under {} m/s for {} s).",
                 self.threshold, self.window
             ),
-            None => format!(
-                " Not at rest: the fastest vertex moves at {:.4} m/s at the end (rest: under {} \
-                 m/s for {} s with every seam welded).",
-                self.speed, self.threshold, self.window
-            ),
+            None => {
+                let speed = match self.speed {
+                    Some(speed) => format!("the fastest vertex moves at {speed:.4} m/s at the end"),
+                    None => "the last frame changed the mesh (a weld), so no speed is measured"
+                        .to_string(),
+                };
+                format!(
+                    " Not at rest: {speed} (rest: under {} m/s for {} s with every seam welded).",
+                    self.threshold, self.window
+                )
+            }
         }
     }
 }
@@ -341,5 +349,34 @@ impl Summary {
     /// level, automatic step, retried frames or the adaptive step.
     pub fn step_varied(&self) -> bool {
         self.stepping.dt_max - self.stepping.dt > 1e-9 * self.stepping.dt_max
+    }
+}
+
+#[cfg(test)]
+mod rest_sentence_tests {
+    use super::RestSummary;
+
+    fn not_at_rest(speed: Option<f64>) -> String {
+        RestSummary {
+            at_rest: false,
+            time: None,
+            speed,
+            threshold: 0.05,
+            window: 0.5,
+        }
+        .sentence()
+    }
+
+    #[test]
+    fn a_run_whose_last_frame_welded_says_no_speed_was_measured_not_inf() {
+        let s = not_at_rest(None);
+        assert!(s.contains("no speed is measured"), "{s}");
+        assert!(!s.contains("inf"), "{s}");
+    }
+
+    #[test]
+    fn a_run_not_at_rest_gives_its_fastest_vertex() {
+        let s = not_at_rest(Some(0.125));
+        assert!(s.contains("moves at 0.1250 m/s"), "{s}");
     }
 }

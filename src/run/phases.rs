@@ -25,8 +25,10 @@ pub(super) struct Phases {
     calm_since: Option<Scalar>,
     /// When the rest criterion was met, s.
     at_rest: Option<Scalar>,
-    /// The largest vertex speed over the last frame, m/s.
-    speed: Scalar,
+    /// The largest vertex speed over the last frame, m/s (`None` before the
+    /// first frame and after a frame that changed the mesh, as a weld does:
+    /// its positions are not comparable with the frame before).
+    speed: Option<Scalar>,
     /// Positions at the last frame end and the time then.
     last: (Vec<Vector>, Scalar),
 }
@@ -41,7 +43,7 @@ impl Phases {
             rest: scene.simulation.rest,
             calm_since: None,
             at_rest: None,
-            speed: Scalar::INFINITY,
+            speed: None,
             last: (world.x.clone(), world.time),
         }
     }
@@ -62,19 +64,17 @@ impl Phases {
     pub(super) fn after_frame(&mut self, world: &World) -> bool {
         let (before, then) = &self.last;
         let elapsed = world.time - then;
-        self.speed = if before.len() == world.x.len() && elapsed > 0.0 {
+        self.speed = (before.len() == world.x.len() && elapsed > 0.0).then(|| {
             let moved = world.x.iter().zip(before).map(|(x, y)| x.distance(*y));
             moved.fold(0.0, Scalar::max) / elapsed
-        } else {
-            // The first frame, or a mesh that changed: not yet comparable.
-            Scalar::INFINITY
-        };
+        });
         self.last.0.clone_from(&world.x);
         self.last.1 = world.time;
         let Some(rest) = self.rest else {
             return false;
         };
-        if self.speed > rest.speed || any_open(world) {
+        // The first frame, or a mesh that changed, is not calm: not yet comparable.
+        if self.speed.is_none_or(|speed| speed > rest.speed) || any_open(world) {
             self.calm_since = None;
             return false;
         }
