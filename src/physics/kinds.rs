@@ -32,15 +32,18 @@ mod springs;
 pub use hinges::{HingeLinear, Hinges};
 pub use membrane::{MembraneLinear, MembraneTriangles};
 pub use shapes::{
-    ShapeForces, ShapeLinear, ShapeTriangles, edge_folds, fold_angles, fold_angles_and_splits,
-    solve_splits, splits_at,
+    ShapeBlocks, ShapeForces, ShapeLinear, ShapeTriangles, edge_folds, fold_angles,
+    fold_angles_and_splits, solve_splits, splits_at,
 };
+#[cfg(test)]
+pub(crate) use shapes::{ShapeOp, frobenius, moved_angles};
 pub use springs::{SpringLinear, Springs};
 
 use rayon::prelude::*;
 
+use super::block::{Band, BlockPattern};
 use super::elements::Elements;
-use crate::math::{Scalar, Vector};
+use crate::math::{Matrix3, Scalar, Vector};
 use crate::mesh::Mesh;
 
 /// One kind of force element: its forces, its energy, its terms of the
@@ -120,6 +123,58 @@ pub trait ForceKind {
     /// Adds every ordered pair of distinct vertices that one of the kind's
     /// blocks couples (each as often as it comes).
     fn couplings(el: &Elements, pairs: &mut Vec<(u32, u32)>);
+    /// Pattern data of the blocks the kind adds in place, band by band
+    /// ([`ForceKind::add_in_place`]); `()` for a kind that adds none.
+    type InPlace: std::fmt::Debug + Default + Clone + Send + Sync;
+
+    /// For the direct solver's assembly (`block.rs`, "Assembly"): calls
+    /// `f(i, j, value, negate)` for every block `(i, j)` (`j <= i`) that an
+    /// element adds to the lower triangle of the implicit matrix from a value
+    /// of [`ForceKind::block_values`], element by element in element order:
+    /// `value` its index there, `negate` true where the block is subtracted.
+    /// Default: none.
+    fn listed_blocks(_el: &Elements, _f: impl FnMut(u32, u32, u32, bool)) {}
+    /// Writes the values that [`ForceKind::listed_blocks`] index into `lin`,
+    /// after [`ForceKind::linearise`] (the direct solver only). Default: none.
+    fn write_blocks(_el: &Elements, _lin: &mut Self::Linear) {}
+    /// The values that [`ForceKind::listed_blocks`] index.
+    fn block_values(_lin: &Self::Linear) -> &[Matrix3] {
+        &[]
+    }
+    /// The pattern of the blocks the kind adds in place instead
+    /// ([`ForceKind::add_in_place`]), from the built pattern `p`.
+    fn in_place_pattern(_el: &Elements, _p: &BlockPattern) -> Self::InPlace {
+        Self::InPlace::default()
+    }
+    /// Adds the kind's in-place blocks (`h2` the step squared) whose row lies
+    /// in `band` straight into its lower blocks, after every kind's listed
+    /// blocks, and the norms of those the factorization drops to the band's
+    /// diagonal compensation. Default: none.
+    fn add_in_place(
+        _el: &Elements,
+        _lin: &Self::Linear,
+        _data: &Self::InPlace,
+        _h2: Scalar,
+        _band: &mut Band<'_>,
+    ) {
+    }
+    /// Calls `f(i, j)` for the pairs whose blocks the reduced factorization
+    /// keeps for the kind (`block.rs`, "The factored matrix"), each way.
+    /// Default: none.
+    fn factored_pairs(_el: &Elements, _f: impl FnMut(u32, u32)) {}
+    /// Calls `f(vertex, term)` for each term that compensates on `vertex`'s
+    /// diagonal a block that the factorization drops (`factored(i, j)`: whether
+    /// it keeps block `(i, j)`), in the order they are summed. Default: none.
+    fn dropped_terms(
+        _el: &Elements,
+        _factored: impl Fn(u32, u32) -> bool,
+        _f: impl FnMut(u32, u32),
+    ) {
+    }
+    /// Compensation term `term` of [`ForceKind::dropped_terms`].
+    fn dropped_block(_lin: &Self::Linear, _term: u32) -> Matrix3 {
+        Matrix3::ZERO
+    }
     /// Adds each vertex's Gershgorin bound of this kind's rest stiffness to
     /// `stiff` and of its damping to `damp`; `flat` holds the material
     /// positions (a garment's stencils laid flat one by one into it).
@@ -167,6 +222,33 @@ pub(crate) fn slot_pairs(
             }
         }
     }
+}
+
+/// Calls `f(k, l)` for every block that an element with vertices `v` adds to
+/// the lower triangle: local vertices `k` and `l`, both set in `active` (bit
+/// `k`), with `v[l] <= v[k]`; `k` outer and `l` inner, each ascending. The
+/// pattern (where each block goes) and the values both enumerate through
+/// here, so they agree.
+#[inline(always)]
+pub(crate) fn lower_pairs(v: &[u32], active: u32, mut f: impl FnMut(usize, usize)) {
+    for k in (0..v.len()).filter(|&k| active >> k & 1 != 0) {
+        for l in (0..v.len()).filter(|&l| active >> l & 1 != 0) {
+            if v[l] <= v[k] {
+                f(k, l);
+            }
+        }
+    }
+}
+
+/// The most lower blocks ([`lower_pairs`], all slots active) of one of the
+/// elements `vertices`: the stretch each element owns in its kind's values.
+pub(crate) fn lower_stride<'a>(vertices: impl Iterator<Item = &'a [u32]>) -> usize {
+    let count = |v: &[u32]| {
+        let mut c = 0;
+        lower_pairs(v, u32::MAX, |_, _| c += 1);
+        c
+    };
+    vertices.map(count).max().unwrap_or(0)
 }
 
 /// Generates, from the list of kinds (`field: Kind`), the per-kind scratch
@@ -332,6 +414,84 @@ macro_rules! kind_list {
             pub fn gather_product(&self, el: &Elements, i: usize, acc: &mut Vector) {
                 $(<$kind as ForceKind>::gather_product(el, &self.$field, i, acc);)+
             }
+        }
+
+        impl KindLinear {
+            /// Every kind's [`ForceKind::write_blocks`].
+            pub fn write_blocks(&mut self, el: &Elements) {
+                $(<$kind as ForceKind>::write_blocks(el, &mut self.$field);)+
+            }
+
+            /// Every kind's [`ForceKind::block_values`], in the list's order.
+            pub fn block_values(&self) -> [&[Matrix3]; KIND_COUNT] {
+                [$(<$kind as ForceKind>::block_values(&self.$field)),+]
+            }
+
+            /// Every kind's [`ForceKind::add_in_place`] into `band`, kind by kind.
+            #[inline(always)]
+            pub fn add_in_place(
+                &self,
+                el: &Elements,
+                data: &KindInPlace,
+                h2: Scalar,
+                band: &mut Band<'_>,
+            ) {
+                $(<$kind as ForceKind>::add_in_place(el, &self.$field, &data.$field, h2, band);)+
+            }
+
+            /// Adds to `m`, kind by kind, the compensation terms `terms[kind]`
+            /// ([`ForceKind::dropped_block`]).
+            #[inline(always)]
+            pub fn add_dropped(&self, terms: [&[u32]; KIND_COUNT], m: &mut Matrix3) {
+                $(
+                    for &t in terms[Place::$field as usize] {
+                        *m += <$kind as ForceKind>::dropped_block(&self.$field, t);
+                    }
+                )+
+            }
+        }
+
+        /// The pattern data of every kind's in-place blocks.
+        #[derive(Debug, Default, Clone)]
+        pub struct KindInPlace {
+            $(
+                #[doc = concat!("The in-place pattern of [`", stringify!($kind), "`].")]
+                pub(crate) $field: <$kind as ForceKind>::InPlace,
+            )+
+        }
+
+        impl KindInPlace {
+            /// Every kind's [`ForceKind::in_place_pattern`] on the built pattern `p`.
+            pub fn build(el: &Elements, p: &BlockPattern) -> KindInPlace {
+                KindInPlace {
+                    $($field: <$kind as ForceKind>::in_place_pattern(el, p),)+
+                }
+            }
+        }
+
+        /// Every kind's [`ForceKind::listed_blocks`], kind by kind, as
+        /// `f(kind, i, j, value, negate)` (`kind` the place in the list).
+        pub fn listed_blocks(el: &Elements, mut f: impl FnMut(usize, u32, u32, u32, bool)) {
+            $(<$kind as ForceKind>::listed_blocks(el, |i, j, value, negate| {
+                f(Place::$field as usize, i, j, value, negate)
+            });)+
+        }
+
+        /// Every kind's [`ForceKind::factored_pairs`].
+        pub fn factored_pairs(el: &Elements, mut f: impl FnMut(u32, u32)) {
+            $(<$kind as ForceKind>::factored_pairs(el, &mut f);)+
+        }
+
+        /// Every kind's [`ForceKind::dropped_terms`], kind by kind, as
+        /// `f(kind, vertex, term)`.
+        pub fn dropped_terms(
+            el: &Elements,
+            factored: impl Fn(u32, u32) -> bool,
+            mut f: impl FnMut(usize, u32, u32),
+        ) {
+            $(<$kind as ForceKind>::dropped_terms(el, &factored, |vertex, term| {
+                f(Place::$field as usize, vertex, term)
+            });)+
         }
 
         /// The elastic energy of every kind at `x`, summed in the kinds'

@@ -4,10 +4,11 @@
 
 use rayon::prelude::*;
 
-use super::{ForceKind, kick_slots};
-use crate::math::{Scalar, Vector, deterministic_sum};
+use super::{ForceKind, kick_slots, lower_pairs, lower_stride};
+use crate::math::{Matrix3, Scalar, Vector, deterministic_sum};
 use crate::mesh::Mesh;
 use crate::physics::bending::dihedral_angle_and_gradient;
+use crate::physics::block::outer;
 use crate::physics::elements::Elements;
 use crate::physics::forces::PAR_MIN;
 
@@ -24,12 +25,22 @@ pub struct HingeLinear {
     pub coef: Vec<Scalar>,
     /// Per hinge and vertex: its right-hand side slot, then its slot of a product.
     pub slot: Vec<Vector>,
+    /// Per hinge, its lower blocks `h^2 k g_k g_l^T` in [`lower_pairs`]
+    /// order, each hinge a stretch of [`stride`] (the direct solver only).
+    pub lower: Vec<Matrix3>,
+}
+
+/// The length of each hinge's stretch of [`HingeLinear::lower`]: the most
+/// lower blocks of a hinge (10 for four distinct vertices).
+fn stride(el: &Elements) -> usize {
+    lower_stride(el.hinges.iter().map(|h| &h.v[..]))
 }
 
 impl ForceKind for Hinges {
     type Forces = Vec<Vector>;
     type Linear = HingeLinear;
     type Kick = Vec<[Vector; 4]>;
+    type InPlace = ();
     const ENERGY_RANK: usize = 2;
 
     fn count(el: &Elements) -> usize {
@@ -173,6 +184,66 @@ impl ForceKind for Hinges {
                 }
             }
         }
+    }
+
+    /// Its lower blocks `h^2 k g_k g_l^T`, a stretch per hinge.
+    fn listed_blocks(el: &Elements, mut f: impl FnMut(u32, u32, u32, bool)) {
+        let stride = stride(el);
+        for (e, hg) in el.hinges.iter().enumerate() {
+            let mut value = (e * stride) as u32;
+            lower_pairs(&hg.v, 0b1111, |k, l| {
+                f(hg.v[k], hg.v[l], value, false);
+                value += 1;
+            });
+        }
+    }
+
+    fn write_blocks(el: &Elements, lin: &mut HingeLinear) {
+        if el.hinges.is_empty() {
+            return;
+        }
+        let stride = stride(el);
+        lin.lower.resize(stride * el.hinges.len(), Matrix3::ZERO);
+        lin.lower
+            .par_chunks_mut(stride)
+            .zip(lin.grad.par_chunks_exact(4))
+            .zip(lin.coef.par_iter())
+            .zip(el.hinges.par_iter())
+            .with_min_len(PAR_MIN / 4)
+            .for_each(|(((out, g), &c), hinge)| {
+                let mut w = 0;
+                lower_pairs(&hinge.v, 0b1111, |k, l| {
+                    out[w] = outer(g[k], g[l]) * c;
+                    w += 1;
+                });
+            });
+    }
+
+    fn block_values(lin: &HingeLinear) -> &[Matrix3] {
+        &lin.lower
+    }
+
+    /// The factorization drops a hinge's tip-tip block unless another kind
+    /// couples the tips (`block.rs`, "The factored matrix"): `c g_p g_p^T` on
+    /// tip `p`'s diagonal and `c g_q g_q^T` on `q`'s (terms: slots `4 h + k`).
+    fn dropped_terms(
+        el: &Elements,
+        factored: impl Fn(u32, u32) -> bool,
+        mut f: impl FnMut(u32, u32),
+    ) {
+        for (h, hg) in el.hinges.iter().enumerate() {
+            let (tip_p, tip_q) = (hg.v[2], hg.v[3]);
+            if !factored(tip_p, tip_q) {
+                f(tip_p, 4 * h as u32 + 2);
+                f(tip_q, 4 * h as u32 + 3);
+            }
+        }
+    }
+
+    #[inline(always)]
+    fn dropped_block(lin: &HingeLinear, k: u32) -> Matrix3 {
+        let g = lin.grad[k as usize];
+        outer(g, g) * lin.coef[k as usize / 4]
     }
 
     fn gershgorin(

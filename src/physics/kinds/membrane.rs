@@ -5,8 +5,8 @@
 use rayon::prelude::*;
 
 use super::springs::matrix_diagonal;
-use super::{ForceKind, kick_slots, slot_pairs};
-use crate::math::{Scalar, Vector, deterministic_sum};
+use super::{ForceKind, kick_slots, lower_pairs, lower_stride, slot_pairs};
+use crate::math::{Matrix3, Scalar, Vector, deterministic_sum};
 use crate::mesh::Mesh;
 use crate::physics::elements::Elements;
 use crate::physics::forces::PAR_MIN;
@@ -23,12 +23,22 @@ pub struct MembraneLinear {
     pub block: Vec<ColumnBlocks>,
     /// Per triangle and corner: its right-hand side slot, then its slot of a product.
     pub slot: Vec<Vector>,
+    /// Per triangle, its lower blocks in [`lower_pairs`] order, each triangle
+    /// a stretch of [`stride`] (the direct solver only).
+    pub lower: Vec<Matrix3>,
+}
+
+/// The length of each triangle's stretch of [`MembraneLinear::lower`]: the
+/// most lower blocks of a triangle (6).
+fn stride(el: &Elements) -> usize {
+    lower_stride(el.membrane_triangles.iter().map(|t| &t.v[..]))
 }
 
 impl ForceKind for MembraneTriangles {
     type Forces = Vec<Vector>;
     type Linear = MembraneLinear;
     type Kick = Vec<[Vector; MEMBRANE_SLOTS]>;
+    type InPlace = ();
     const ENERGY_RANK: usize = 1;
 
     fn count(el: &Elements) -> usize {
@@ -154,6 +164,55 @@ impl ForceKind for MembraneTriangles {
     fn couplings(el: &Elements, pairs: &mut Vec<(u32, u32)>) {
         for t in &el.membrane_triangles {
             slot_pairs(t.v.into_iter().enumerate(), pairs);
+        }
+    }
+
+    /// Its lower blocks over the columns, a stretch per triangle.
+    fn listed_blocks(el: &Elements, mut f: impl FnMut(u32, u32, u32, bool)) {
+        let stride = stride(el);
+        for (e, t) in el.membrane_triangles.iter().enumerate() {
+            let mut value = (e * stride) as u32;
+            lower_pairs(&t.v, 0b111, |k, l| {
+                f(t.v[k], t.v[l], value, false);
+                value += 1;
+            });
+        }
+    }
+
+    fn write_blocks(el: &Elements, lin: &mut MembraneLinear) {
+        if el.membrane_triangles.is_empty() {
+            return;
+        }
+        let stride = stride(el);
+        lin.lower
+            .resize(stride * el.membrane_triangles.len(), Matrix3::ZERO);
+        lin.lower
+            .par_chunks_mut(stride)
+            .zip(el.membrane_triangles.par_iter())
+            .zip(lin.block.par_iter())
+            .with_min_len(PAR_MIN / 4)
+            .for_each(|((out, t), m)| {
+                let mut w = 0;
+                lower_pairs(&t.v, 0b111, |k, l| {
+                    out[w] = t.block(m, k, l);
+                    w += 1;
+                });
+            });
+    }
+
+    fn block_values(lin: &MembraneLinear) -> &[Matrix3] {
+        &lin.lower
+    }
+
+    /// A membrane triangle couples the ends of its edges, as the springs do:
+    /// the factorization keeps them.
+    fn factored_pairs(el: &Elements, mut f: impl FnMut(u32, u32)) {
+        for t in &el.membrane_triangles {
+            for i in t.v {
+                for j in t.v {
+                    f(i, j);
+                }
+            }
         }
     }
 

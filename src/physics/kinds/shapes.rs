@@ -4,14 +4,21 @@
 //! ([`Elements::fold_edges`], [`Elements::fold_splits`]); in the implicit step
 //! the Gauss-Newton block `J^T M J` of the folds' Jacobian `J`.
 
+mod blocks;
+
+#[cfg(test)]
+pub(crate) use blocks::{ShapeOp, frobenius, moved_angles};
+
 use rayon::prelude::*;
 
 use super::{ForceKind, kick_slots, slot_pairs};
 use crate::math::{Scalar, Vector, deterministic_sum};
 use crate::mesh::Mesh;
+use crate::physics::block::{Band, BlockPattern};
 use crate::physics::elements::Elements;
 use crate::physics::forces::PAR_MIN;
 use crate::physics::shape::{EdgeFold, SHAPE_SLOTS, ShapeJacobian, rates, spread};
+pub use blocks::ShapeBlocks;
 
 /// The shape triangles of [`Elements::shape_triangles`].
 #[derive(Debug, Clone, Copy, Default)]
@@ -152,6 +159,7 @@ impl ForceKind for ShapeTriangles {
     type Forces = ShapeForces;
     type Linear = ShapeLinear;
     type Kick = Vec<[Vector; SHAPE_SLOTS]>;
+    type InPlace = ShapeBlocks;
     const ENERGY_RANK: usize = 3;
 
     fn count(el: &Elements) -> usize {
@@ -318,6 +326,22 @@ impl ForceKind for ShapeTriangles {
         for t in &el.shape_triangles {
             slot_pairs(t.slots(), pairs);
         }
+    }
+
+    fn in_place_pattern(el: &Elements, p: &BlockPattern) -> ShapeBlocks {
+        ShapeBlocks::build(el, p)
+    }
+
+    /// Every block, in place (module [`blocks`]): the bulk of the assembly.
+    #[inline(always)]
+    fn add_in_place(
+        el: &Elements,
+        lin: &ShapeLinear,
+        data: &ShapeBlocks,
+        h2: Scalar,
+        band: &mut Band<'_>,
+    ) {
+        data.add(el, &lin.edge_folds, h2, band);
     }
 
     fn gershgorin(

@@ -32,6 +32,7 @@ impl ForceKind for Springs {
     type Forces = Vec<Vector>;
     type Linear = SpringLinear;
     type Kick = Vec<Vector>;
+    type InPlace = ();
     const ENERGY_RANK: usize = 0;
 
     fn count(el: &Elements) -> usize {
@@ -195,6 +196,30 @@ impl ForceKind for Springs {
         for sp in &el.springs {
             let [a, b] = sp.v;
             pairs.extend([(a, b), (b, a)]);
+        }
+    }
+
+    /// One value per spring, its block: added on both ends' diagonal blocks
+    /// and subtracted off it.
+    fn listed_blocks(el: &Elements, mut f: impl FnMut(u32, u32, u32, bool)) {
+        for (e, sp) in el.springs.iter().enumerate() {
+            let ([a, b], e) = (sp.v, e as u32);
+            f(a, a, e, false);
+            f(b, b, e, false);
+            f(a, b, e, a != b);
+        }
+    }
+
+    fn block_values(lin: &SpringLinear) -> &[Matrix3] {
+        &lin.block
+    }
+
+    /// A spring's ends: the factorization keeps its coupling.
+    fn factored_pairs(el: &Elements, mut f: impl FnMut(u32, u32)) {
+        for sp in &el.springs {
+            let [a, b] = sp.v;
+            f(a, b);
+            f(b, a);
         }
     }
 
