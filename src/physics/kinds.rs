@@ -29,20 +29,20 @@ mod membrane;
 mod shapes;
 mod springs;
 
-pub use hinges::{HingeLinear, Hinges};
-pub use membrane::{MembraneLinear, MembraneTriangles};
+pub use hinges::{Hinge, HingeLinear, HingeSet, Hinges};
+pub use membrane::{MembraneLinear, MembraneSet, MembraneTriangles};
 pub use shapes::{
-    ShapeBlocks, ShapeForces, ShapeLinear, ShapeTriangles, edge_folds, fold_angles,
-    fold_angles_and_splits, solve_splits, splits_at,
+    RebuildCounts, ShapeBlocks, ShapeForces, ShapeLinear, ShapeSet, ShapeTriangles, edge_folds,
+    fold_angles, fold_angles_and_splits, solve_splits, splits_at,
 };
 #[cfg(test)]
 pub(crate) use shapes::{ShapeOp, frobenius, moved_angles};
-pub use springs::{SpringLinear, Springs};
+pub use springs::{Spring, SpringLinear, SpringSet, Springs};
 
 use rayon::prelude::*;
 
 use super::block::{Band, BlockPattern};
-use super::elements::Elements;
+use super::elements::{BuildContext, Elements};
 use crate::math::{Matrix3, Scalar, Vector};
 use crate::mesh::Mesh;
 
@@ -50,6 +50,12 @@ use crate::mesh::Mesh;
 /// linearised implicit step and its share of the explicit step bound. Every
 /// function runs over all elements of the kind in `el`.
 pub trait ForceKind {
+    /// The kind's elements of one mesh and their incidence lists, built by
+    /// [`ForceKind::build`] and held in [`Elements::kinds`].
+    type Set: std::fmt::Debug + Default + Clone + PartialEq + Send + Sync;
+    /// What [`ForceKind::build`] leaves to [`ForceKind::deferred`], which may
+    /// run beside other work that reads the rebuilt elements (`()`: nothing).
+    type Deferred: Default + Send;
     /// The element pass's scratch of this kind (its per-slot forces and
     /// whatever it computes on the way).
     type Forces: std::fmt::Debug + Default + Clone + Send + Sync;
@@ -61,6 +67,17 @@ pub trait ForceKind {
     /// The place of this kind's energy in the elastic energy's sum.
     const ENERGY_RANK: usize;
 
+    /// Makes `set` the kind's elements of the mesh of `cx` (after a remesh:
+    /// reusing its buffers, and keeping of its elements what it can), but for
+    /// what it defers ([`ForceKind::Deferred`]).
+    fn build(cx: &BuildContext<'_>, set: &mut Self::Set);
+    /// The deferred part of the build, made from the built `set`. Default:
+    /// nothing.
+    fn deferred(_set: &Self::Set) -> Self::Deferred {
+        Self::Deferred::default()
+    }
+    /// Puts the deferred part into `set`. Default: nothing.
+    fn install(_set: &mut Self::Set, _deferred: Self::Deferred) {}
     /// The number of elements.
     fn count(el: &Elements) -> usize;
     /// Into `out` (cleared first): the vertices of element `e`, in slot order.
@@ -305,6 +322,43 @@ macro_rules! kind_list {
                     <$kind as ForceKind>::element_vertices(el, e, out);
                 }
             )+
+        }
+
+        /// Every kind's elements and incidence lists of one mesh.
+        #[derive(Debug, Default, Clone, PartialEq)]
+        pub struct KindSets {
+            $(
+                #[doc = concat!("The elements of [`", stringify!($kind), "`].")]
+                pub $field: <$kind as ForceKind>::Set,
+            )+
+        }
+
+        /// What every kind's build defers ([`ForceKind::Deferred`]).
+        #[derive(Default)]
+        pub struct KindDeferred {
+            $(
+                #[doc = concat!("The deferred part of [`", stringify!($kind), "`].")]
+                pub $field: <$kind as ForceKind>::Deferred,
+            )+
+        }
+
+        impl KindSets {
+            /// Every kind's [`ForceKind::build`], kind by kind.
+            pub fn build(&mut self, cx: &BuildContext<'_>) {
+                $(<$kind as ForceKind>::build(cx, &mut self.$field);)+
+            }
+
+            /// Every kind's [`ForceKind::deferred`].
+            pub fn deferred(&self) -> KindDeferred {
+                KindDeferred {
+                    $($field: <$kind as ForceKind>::deferred(&self.$field),)+
+                }
+            }
+
+            /// Every kind's [`ForceKind::install`].
+            pub fn install(&mut self, deferred: KindDeferred) {
+                $(<$kind as ForceKind>::install(&mut self.$field, deferred.$field);)+
+            }
         }
 
         /// Every kind's multirate scratch.

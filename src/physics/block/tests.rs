@@ -105,17 +105,21 @@ struct Terms {
 impl Terms {
     fn new(elements: &Elements, x: &[Vector]) -> Terms {
         let mut kinds = KindLinear::default();
-        kinds.springs.block = (0..elements.springs.len())
+        kinds.springs.block = (0..elements.kinds.springs.springs.len())
             .map(|e| noise_symmetric(e, 1))
             .collect();
-        kinds.hinges.grad = (0..4 * elements.hinges.len())
+        kinds.hinges.grad = (0..4 * elements.kinds.hinges.hinges.len())
             .map(|k| noise_vector(k, 2))
             .collect();
-        kinds.hinges.coef = (0..elements.hinges.len())
+        kinds.hinges.coef = (0..elements.kinds.hinges.hinges.len())
             .map(|h| 1.5 + noise(h, 3))
             .collect();
-        elements.fold_edges.compute(x, &mut kinds.shapes.edge_folds);
-        kinds.membrane.block = (0..elements.membrane_triangles.len())
+        elements
+            .kinds
+            .shapes
+            .fold_edges
+            .compute(x, &mut kinds.shapes.edge_folds);
+        kinds.membrane.block = (0..elements.kinds.membrane.triangles.len())
             .map(|t| ColumnBlocks {
                 aa: noise_symmetric(t, 5),
                 ab: Matrix3::from_cols(
@@ -146,14 +150,14 @@ impl Terms {
 /// Shape triangle `t`'s angle gradients by slot, read from its edges' folds.
 fn shape_jacobian(terms: &ElementBlocks<'_>, t: usize) -> ShapeJacobian {
     let edges = &terms.kinds.shapes.edge_folds;
-    terms.elements.fold_edges.angles(t, edges).1
+    terms.elements.kinds.shapes.fold_edges.angles(t, edges).1
 }
 
 /// Block `(k, l)` of shape triangle `tri` computed alone, from the Jacobians:
 /// `h^2 sum_ab M_ab J_ak J_bl^T`, summed as the per-triangle pass does (the
 /// tests' reference).
 fn shape_block(terms: &ElementBlocks<'_>, tri: usize, k: usize, l: usize) -> Matrix3 {
-    let m = &terms.elements.shape_triangles[tri].m;
+    let m = &terms.elements.kinds.shapes.triangles[tri].m;
     let jac = &shape_jacobian(terms, tri);
     let mut out = Matrix3::ZERO;
     for a in moved_angles(k) {
@@ -198,7 +202,7 @@ fn mirrors_and_dropped_blocks_match_the_searches() {
                 assert_eq!(p.mirror[b], p.slot(p.columns[b], p.rows[b]), "block {b}");
             }
             let mut bands = vec![Vec::new(); p.bands()];
-            for (ti, t) in elements.shape_triangles.iter().enumerate() {
+            for (ti, t) in elements.kinds.shapes.triangles.iter().enumerate() {
                 let mut ops = Vec::new();
                 for (k, i) in t.slots() {
                     for (l, j) in t.slots() {
@@ -245,13 +249,13 @@ fn mirrors_and_dropped_blocks_match_the_searches() {
 /// what the flat array and its index lists must reproduce to the last bit.
 fn per_term_sum(p: &BlockPattern, el: &Elements, t: &ElementBlocks<'_>) -> Vec<Matrix3> {
     let mut acc = vec![Matrix3::ZERO; p.blocks()];
-    for (e, sp) in el.springs.iter().enumerate() {
+    for (e, sp) in el.kinds.springs.springs.iter().enumerate() {
         let [a, b] = sp.v;
         acc[p.diagonal[a as usize] as usize] += t.kinds.springs.block[e];
         acc[p.diagonal[b as usize] as usize] += t.kinds.springs.block[e];
         acc[p.lower_slot(a, b) as usize] += -t.kinds.springs.block[e];
     }
-    for (h, hg) in el.hinges.iter().enumerate() {
+    for (h, hg) in el.kinds.hinges.hinges.iter().enumerate() {
         let g = &t.kinds.hinges.grad[4 * h..4 * h + 4];
         for k in 0..4 {
             for l in 0..4 {
@@ -262,7 +266,7 @@ fn per_term_sum(p: &BlockPattern, el: &Elements, t: &ElementBlocks<'_>) -> Vec<M
             }
         }
     }
-    for (ti, tri) in el.membrane_triangles.iter().enumerate() {
+    for (ti, tri) in el.kinds.membrane.triangles.iter().enumerate() {
         for k in 0..3 {
             for l in 0..3 {
                 if tri.v[l] <= tri.v[k] {
@@ -272,7 +276,7 @@ fn per_term_sum(p: &BlockPattern, el: &Elements, t: &ElementBlocks<'_>) -> Vec<M
             }
         }
     }
-    for (ti, tri) in el.shape_triangles.iter().enumerate() {
+    for (ti, tri) in el.kinds.shapes.triangles.iter().enumerate() {
         for (k, i) in tri.slots() {
             for (l, j) in tri.slots() {
                 if j <= i {
@@ -299,14 +303,14 @@ fn dense(p: &BlockPattern, el: &Elements, t: &ElementBlocks<'_>) -> (Vec<Matrix3
         a[s] += m;
         scale[s] += size;
     };
-    for (e, sp) in el.springs.iter().enumerate() {
+    for (e, sp) in el.kinds.springs.springs.iter().enumerate() {
         let [x, y] = sp.v;
         let k = t.kinds.springs.block[e];
         for (i, j, m) in [(x, x, k), (y, y, k), (x, y, -k), (y, x, -k)] {
             add(i, j, m, norm(&m));
         }
     }
-    for (h, hg) in el.hinges.iter().enumerate() {
+    for (h, hg) in el.kinds.hinges.hinges.iter().enumerate() {
         let g = &t.kinds.hinges.grad[4 * h..4 * h + 4];
         for k in 0..4 {
             for l in 0..4 {
@@ -315,7 +319,7 @@ fn dense(p: &BlockPattern, el: &Elements, t: &ElementBlocks<'_>) -> (Vec<Matrix3
             }
         }
     }
-    for (ti, tri) in el.membrane_triangles.iter().enumerate() {
+    for (ti, tri) in el.kinds.membrane.triangles.iter().enumerate() {
         let (c, uv) = (&t.kinds.membrane.block[ti], [tri.du, tri.dv]);
         for k in 0..3 {
             for l in 0..3 {
@@ -327,7 +331,7 @@ fn dense(p: &BlockPattern, el: &Elements, t: &ElementBlocks<'_>) -> (Vec<Matrix3
             }
         }
     }
-    for (ti, tri) in el.shape_triangles.iter().enumerate() {
+    for (ti, tri) in el.kinds.shapes.triangles.iter().enumerate() {
         let jac = &shape_jacobian(t, ti);
         for (k, i) in tri.slots() {
             for (l, j) in tri.slots() {
@@ -386,7 +390,7 @@ fn gather_matches_the_per_term_sum_and_a_dense_assembly() {
             // and its dropped shape blocks' norms (one vertex in 7 is free of
             // both projections in `assemble`).
             let mut sigma = vec![0.0; p.vertices()];
-            for (ti, tri) in el.shape_triangles.iter().enumerate() {
+            for (ti, tri) in el.kinds.shapes.triangles.iter().enumerate() {
                 for (k, i) in tri.slots() {
                     for (l, j) in tri.slots() {
                         if i != j && !p.factored[p.lower_slot(i, j) as usize] {
@@ -396,7 +400,7 @@ fn gather_matches_the_per_term_sum_and_a_dense_assembly() {
                 }
             }
             let mut tips = vec![Matrix3::ZERO; p.vertices()];
-            for (h, hg) in el.hinges.iter().enumerate() {
+            for (h, hg) in el.kinds.hinges.hinges.iter().enumerate() {
                 if !p.factored[p.slot(hg.v[2], hg.v[3]) as usize] {
                     for k in [2, 3] {
                         let g = t.kinds.hinges.grad[4 * h + k];

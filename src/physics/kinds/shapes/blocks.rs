@@ -94,8 +94,8 @@ impl ShapeBlocks {
             let ops = self.op_start[tri] as usize..self.op_start[tri + 1] as usize;
             add_shape(
                 band,
-                &el.shape_triangles[tri],
-                &el.fold_edges.angles(tri, edges).1,
+                &el.kinds.shapes.triangles[tri],
+                &el.kinds.shapes.fold_edges.angles(tri, edges).1,
                 h2,
                 &self.ops[ops],
             );
@@ -108,7 +108,7 @@ impl ShapeBlocks {
 /// block is in the lower triangle (`v[l] <= v[k]`), marked when the
 /// factorization drops it.
 fn shape_ops(el: &Elements, p: &BlockPattern) -> (Vec<u32>, Vec<ShapeOp>) {
-    let shapes = &el.shape_triangles;
+    let shapes = &el.kinds.shapes.triangles;
     let (mut start, mut ops) = (Vec::with_capacity(shapes.len() + 1), Vec::new());
     start.push(0);
     for t in shapes {
@@ -137,7 +137,7 @@ fn shape_ops(el: &Elements, p: &BlockPattern) -> (Vec<u32>, Vec<ShapeOp>) {
 /// Per band, the shape triangles with a used slot in it, ascending.
 fn bands(el: &Elements, p: &BlockPattern) -> (Vec<u32>, Vec<u32>) {
     let mut tagged: Vec<(u32, u32)> = Vec::new();
-    for (ti, t) in el.shape_triangles.iter().enumerate() {
+    for (ti, t) in el.kinds.shapes.triangles.iter().enumerate() {
         let active = shape_active(t);
         let mut bands = [u32::MAX; SHAPE_SLOTS];
         for (k, band) in bands.iter_mut().enumerate() {
