@@ -237,9 +237,9 @@ impl Stepper {
     /// (incrementally: [`Elements::rebuild`]).
     ///
     /// With the direct solver, the new mesh's block pattern and its ordering
-    /// are made here too, on one thread while the fold splits' system is
-    /// factored on another (both only read the rebuilt elements, so the
-    /// results do not depend on the thread count).
+    /// are made here too, on one thread while the kinds' deferred parts (the
+    /// fold splits' system) are made on another (both only read the rebuilt
+    /// elements, so the results do not depend on the thread count).
     pub fn rebuild(&mut self, model: &Model, world: &World) {
         let clamped = world.pins.clamped(world.mesh.vertex_count());
         (self.elements).rebuild_but_deferred(&world.mesh, &model.material, &clamped);
