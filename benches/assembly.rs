@@ -31,7 +31,10 @@ const RESOLUTIONS: [u32; 2] = [63, 127];
 /// The elements the assembly visits (module docs).
 fn elements(sheet: &Sheet) -> u64 {
     let e = &sheet.stepper.elements;
-    (e.springs.len() + e.hinges.len() + e.shape_triangles.len() + e.membrane_triangles.len()) as u64
+    (e.kinds.springs.springs.len()
+        + e.kinds.hinges.hinges.len()
+        + e.kinds.shapes.triangles.len()
+        + e.kinds.membrane.triangles.len()) as u64
 }
 
 /// The sheet with the shape operator and the default direct solver.
@@ -77,9 +80,9 @@ fn per_element() {
         } = &mut sheet;
         let e = &stepper.elements;
         let (springs, bending, membrane) = (
-            e.springs.len(),
-            e.hinges.len() + e.shape_triangles.len(),
-            e.membrane_triangles.len(),
+            e.kinds.springs.springs.len(),
+            e.kinds.hinges.hinges.len() + e.kinds.shapes.triangles.len(),
+            e.kinds.membrane.triangles.len(),
         );
         let count = (springs + bending + membrane) as f64;
         stepper.assemble_implicit(model, world, DT);

@@ -243,7 +243,7 @@ fn remesh_tables(c: &mut Criterion) {
             "  {} -> {} triangles: {:?}",
             mesh.triangles.len(),
             creased.triangles.len(),
-            rebuilt.last_rebuild()
+            rebuilt.kinds.shapes.last_rebuild()
         );
     }
     group.finish();

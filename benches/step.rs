@@ -171,7 +171,7 @@ fn consistency_check(spec: &str) {
         "drape: {n} vertices, {stretch} stretch + {} hinge springs, dt {dt:.4e} s, \
          after {steps} steps: mean z {mean_z:.9e}, rms z {rms_z:.9e}, \
          rms in-plane speed {rms_vxy:.9e}",
-        stepper.elements.springs.len() - stretch
+        stepper.elements.kinds.springs.springs.len() - stretch
     );
 }
 

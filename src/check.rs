@@ -158,7 +158,7 @@ fn describe_forces(
             let _ = writeln!(
                 s,
                 "  stretch: membrane \"triangles\" (constant-strain, orthotropic St. Venant-Kirchhoff), {} triangles, warp {} N/m, weft {} N/m, shear {} N/m",
-                el.membrane_triangles.len(),
+                el.kinds.membrane.triangles.len(),
                 m.warp,
                 m.weft,
                 m.shear
@@ -214,7 +214,7 @@ fn describe_bending(s: &mut String, el: &Elements, mat: &MaterialParams, stretch
             let _ = writeln!(
                 s,
                 "  bending: shape operator (curvature tensor per triangle from its edge angles), {} triangles, rigidity {} N m",
-                el.shape_triangles.len(),
+                el.kinds.shapes.triangles.len(),
                 mat.bending
             );
         }
@@ -222,7 +222,7 @@ fn describe_bending(s: &mut String, el: &Elements, mat: &MaterialParams, stretch
             let _ = writeln!(
                 s,
                 "  bending: dihedral angle, {} hinges, rigidity {} N m",
-                el.hinges.len(),
+                el.kinds.hinges.hinges.len(),
                 mat.bending
             );
         }
@@ -230,7 +230,7 @@ fn describe_bending(s: &mut String, el: &Elements, mat: &MaterialParams, stretch
             let _ = writeln!(
                 s,
                 "  bending: hinge springs (paper A), {} springs, rigidity {} N m",
-                el.springs.len() - stretch_springs,
+                el.kinds.springs.springs.len() - stretch_springs,
                 mat.bending
             );
         }

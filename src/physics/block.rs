@@ -1,56 +1,51 @@
 //! The implicit system matrix assembled into a fixed 3x3-block sparsity pattern.
 //!
 //! [`BlockPattern`] is built once per mesh topology: one block per vertex pair
-//! coupled by a spring, a membrane triangle, a hinge or a shape triangle (both
-//! triangles stored, columns sorted per row), and what the blocks of the lower
-//! triangle sum: per block its springs and its hinge and membrane terms, per
-//! band of rows its shape triangles (below), each in element order.
+//! that a force element couples (every kind's couplings,
+//! [`super::kinds::ForceKind::couplings`]; both triangles stored, columns
+//! sorted per row), and what the blocks of the lower triangle sum: per block
+//! and per kind the kind's listed blocks, and each kind's own pattern of the
+//! blocks it adds in place.
 //!
 //! # Assembly
 //! Each step assembles the lower blocks of `A` ([`BlockPattern::gather`]) with
-//! no atomics, locks or allocation once the scratch has grown to the mesh:
-//! 1. Parallel over elements, every hinge and membrane triangle writes the
-//!    blocks it adds to the lower triangle (pairs of its vertices `(i, j)` with
-//!    `j <= i`) into its own fixed-size stretch of a flat array
-//!    ([`ElementTerms`]), hinges first, each kind in element order.
+//! no atomics, locks or allocation once the scratch has grown to the mesh, and
+//! with no dispatch on the element kind per block:
+//! 1. Parallel over elements, each kind writes the values of its listed
+//!    blocks into its own terms ([`super::kinds::ForceKind::write_blocks`]; a
+//!    hinge's ten lower blocks, a membrane triangle's six, each element its own
+//!    fixed-size stretch; a spring's one block is its linearised block).
 //! 2. Parallel over bands of [`BAND_ROWS`] rows, each band owning its rows'
-//!    blocks: every lower block sums its springs' blocks (read where the
-//!    linearisation left them: added on the diagonal, subtracted off it) and
-//!    its hinge and membrane terms, by precomputed index lists of plain 3x3
-//!    additions (no dispatch on the element kind); then each shape triangle
-//!    with a slot in the band, in triangle order, forms its products
-//!    `sum_b M_ab J_bl` once and adds its blocks `h^2 sum_a J_ak (M J)_al^T`
-//!    with their row in the band straight into them, by its precomputed slots,
-//!    and the Frobenius norm of each dropped block into the diagonal
-//!    compensation of both its vertices that lie in the band (the lower block
-//!    serves its transpose too); last the mass on the diagonal. A triangle's
-//!    Jacobian is read from its edges' folds ([`ElementBlocks::shape_jacobian`]).
+//!    blocks: every lower block sums, kind by kind in the list's order, the
+//!    kind's values by its precomputed index list (element order; a spring's
+//!    block added on the diagonal, subtracted off it), by plain 3x3 additions;
+//!    then each kind adds its in-place blocks with their row in the band
+//!    ([`super::kinds::ForceKind::add_in_place`]: the shape triangles, whose
+//!    21 blocks each are formed and added in the band's cache rather than
+//!    stored, `kinds/shapes/blocks.rs`), with the norms of those the
+//!    factorization drops into the band's diagonal compensation; last the mass
+//!    on the diagonal.
 //!
-//! The shape triangles are the bulk (21 blocks each, against 3 per spring).
-//! Summed per block from the Jacobians, a triangle's products would be formed
-//! again for every block it adds to, and once more for the compensation
-//! (`perf` put two thirds of a shape-operator sheet's assembly there). Formed
-//! once per triangle but written to a flat array like the hinges' terms, its
-//! blocks would cost 12 MB of memory traffic a step at 4,096 vertices, and
-//! gathering them took as long as computing them (measured). Added in place,
-//! they go straight into the band's blocks, which stay in the cache; a
-//! triangle with slots in two bands forms its products in both (a third of the
-//! triangles, with bands of 512 rows on a 65 x 65 grid).
-//!
-//! Every block sums its terms in one fixed order (springs, hinges, membrane
-//! triangles, shape triangles, each in element order, then the mass), whatever
-//! the thread count; and it is the order and the arithmetic of summing each
-//! block's terms one by one, each computed alone, so the values are those to
-//! the last bit. The upper blocks are not stored: [`BlockPattern::project`]
-//! and [`BlockPattern::multiply_lower`] read one as its mirror's transpose.
+//! Every block sums its terms in one fixed order (the listed blocks kind by
+//! kind, then the in-place blocks kind by kind, each kind's in element order,
+//! then the mass: with today's kinds springs, hinges, membrane triangles,
+//! shape triangles), whatever the thread count; and it is the order and the
+//! arithmetic of summing each block's terms one by one, each computed alone,
+//! so the values are those to the last bit. The upper blocks are not stored:
+//! [`BlockPattern::project`] and [`BlockPattern::multiply_lower`] read one as
+//! its mirror's transpose.
 //!
 //! The pattern also carries the scalar compressed-column (CSC) structure of the
 //! lower triangle that the sparse Cholesky factorization reads ([`super::cholesky`]),
 //! with, for every scalar entry, the block and the component it comes from.
 //!
 //! # The factored matrix
-//! The factorization reads only the blocks of vertex pairs joined by a spring or
-//! a membrane triangle's edge (and the diagonal). The only other blocks are the couplings between the two wing tips
+//! The factorization reads only the diagonal and the blocks of the pairs the
+//! kinds keep ([`super::kinds::ForceKind::factored_pairs`]: vertex pairs
+//! joined by a spring or a membrane triangle's edge); each kind compensates on
+//! the diagonal for the blocks it adds that are dropped
+//! ([`super::kinds::ForceKind::dropped_terms`] and the in-place blocks' norms).
+//! With dihedral hinges the only other blocks are the couplings between the two wing tips
 //! `p`, `q` of a hinge, and keeping them more than doubles the factor: on a 65 x 65
 //! grid its stored values go from 0.80 to 1.99 million and a numerical factorization
 //! from 11 to 45 ms (measured on this machine with a probe that factored a test matrix on the pattern). So the
@@ -73,45 +68,74 @@ mod band;
 mod buckets;
 mod csc;
 mod sources;
-mod terms;
 #[cfg(test)]
 mod tests;
 
-pub use terms::{ElementBlocks, ElementTerms};
+pub use band::Band;
 
 use super::elements::Elements;
-use super::kinds::{coupling_count, couplings};
-use crate::math::{Matrix3, Vector};
+use super::kinds::{
+    KIND_COUNT, KindInPlace, KindLinear, coupling_count, couplings, dropped_terms, factored_pairs,
+};
+use crate::math::{Matrix3, Scalar, Vector};
 pub(crate) use buckets::group_by_key;
 use buckets::sorted_unique_rows;
-use sources::TermLayout;
 
 /// Rows per band of the assembly (module docs, "Assembly"). Any size gives the
 /// same sums (a block's terms come in the same order whichever band holds its
 /// row); 512 rows share a 65 x 65 grid among 9 bands, enough to balance two to
 /// four threads, while the triangles that straddle two bands (their slots span
 /// about three grid rows) stay a third of them.
-const BAND_ROWS: usize = 512;
+pub(crate) const BAND_ROWS: usize = 512;
 
-/// One lower block `(k, l)` (slots) of a shape triangle, which the assembly
-/// computes and adds to block `slot`. When the factorization drops it, its
-/// Frobenius norm also compensates the diagonals of both its vertices, `v[k]`
-/// and `v[l]` (its transpose, the upper block, has the same norm):
-/// `[[s I, -B], [-B^T, s I]]` is positive semi-definite for `s >= |B|`, so the
-/// factored matrix stays positive definite (the tighter rank-one compensation
-/// `B B^T / |B|`, each such `B = u v^T` involving a tip, saves about 1 % of the
-/// iterations, not worth its code).
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct ShapeOp {
-    /// The lower block it adds to.
-    slot: u32,
-    /// Its row slot.
-    k: u8,
-    /// Its column slot.
-    l: u8,
-    /// Whether the factorization drops it (pair of used slots on distinct
-    /// vertices whose block is not factored).
-    dropped: bool,
+/// The bit of a listed block's entry that marks it subtracted
+/// ([`super::kinds::ForceKind::listed_blocks`]); the other bits index the
+/// kind's values.
+const NEGATE: u32 = 1 << 31;
+
+/// What one step's assembly reads: the elements, every kind's terms of the
+/// linearised step (with the values of their listed blocks written,
+/// [`KindLinear::write_blocks`]), `h^2`, and per vertex its mass plus `h`
+/// times its drag coefficient, kg.
+#[derive(Debug, Clone, Copy)]
+pub struct ElementBlocks<'a> {
+    /// The force elements.
+    pub elements: &'a Elements,
+    /// Every kind's terms of the linearised step.
+    pub kinds: &'a KindLinear,
+    /// `h^2`, the scale of the blocks added in place.
+    pub h2: Scalar,
+    /// Per vertex: mass plus `h` times its drag coefficient, kg.
+    pub diagonal_mass: &'a [Scalar],
+}
+
+/// Lists grouped by key (block or vertex), CSR-like: `entries[start[k]..start[k
+/// + 1]]` belong to key `k`; no entries at all for a kind that has none.
+#[derive(Debug, Clone, Default)]
+struct Lists {
+    start: Vec<u32>,
+    entries: Vec<u32>,
+}
+
+impl Lists {
+    /// Groups `(key, entry)` pairs by key (keys below `keys`), each key's
+    /// entries in their order in `pairs`.
+    fn grouped(keys: usize, pairs: &[(u32, u32)]) -> Lists {
+        if pairs.is_empty() {
+            return Lists::default();
+        }
+        let (start, entries) = group_by_key(keys, pairs);
+        Lists { start, entries }
+    }
+
+    /// The entries of key `k`.
+    #[inline(always)]
+    fn of(&self, k: usize) -> &[u32] {
+        if self.entries.is_empty() {
+            return &[];
+        }
+        &self.entries[self.start[k] as usize..self.start[k + 1] as usize]
+    }
 }
 
 /// A fixed 3x3-block sparsity pattern for one mesh topology (module docs).
@@ -127,32 +151,19 @@ pub struct BlockPattern {
     diagonal: Vec<u32>,
     /// Per block: the block holding its transpose.
     mirror: Vec<u32>,
-    /// Per block: true when the factorization reads it (diagonal, spring pair or
-    /// membrane triangle edge).
+    /// Per block: true when the factorization reads it (the diagonal and the
+    /// pairs of [`super::kinds::ForceKind::factored_pairs`]).
     factored: Vec<bool>,
-    /// Per vertex, CSC-like: the hinge slots `4 h + k` (k a wing tip) whose
-    /// dropped tip-tip coupling is compensated on this vertex's diagonal.
-    compensation_start: Vec<u32>,
-    compensation: Vec<u32>,
-    /// Per shape triangle, CSC-like: the blocks the assembly computes
-    /// ([`ShapeOp`]), in the order of its slot pairs `(k, l)`.
-    shape_op_start: Vec<u32>,
-    shape_ops: Vec<ShapeOp>,
-    /// Per band of [`BAND_ROWS`] rows, CSC-like: the shape triangles with a
-    /// used slot in the band, ascending.
-    band_shape_start: Vec<u32>,
-    band_shapes: Vec<u32>,
-    /// Per block (lower blocks only; empty range for upper ones): the springs
-    /// whose block it adds (diagonal) or subtracts (coupling), in spring order.
-    spring_start: Vec<u32>,
-    springs: Vec<u32>,
-    /// Per block (lower blocks only): the indices of its hinge and membrane
-    /// terms in [`ElementTerms`], ascending (hinges, then membrane triangles,
-    /// each in element order).
-    term_start: Vec<u32>,
-    terms: Vec<u32>,
-    /// Where each element's terms lie in [`ElementTerms`].
-    layout: TermLayout,
+    /// Per kind (list order), per vertex: the terms that compensate on its
+    /// diagonal the blocks the factorization drops
+    /// ([`super::kinds::ForceKind::dropped_terms`]).
+    dropped: [Lists; KIND_COUNT],
+    /// Per kind (list order), per block (lower blocks only; none for upper
+    /// ones): the indices of the kind's values it sums, in element order, each
+    /// with [`NEGATE`] where subtracted.
+    listed: [Lists; KIND_COUNT],
+    /// Every kind's pattern of the blocks it adds in place.
+    in_place: KindInPlace,
     /// Scalar CSC structure of the lower triangle: column pointers.
     csc_column_start: Vec<u32>,
     /// Scalar CSC row indices.
@@ -162,9 +173,10 @@ pub struct BlockPattern {
 }
 
 impl BlockPattern {
-    /// The pattern of `elements`' springs and hinges on `vertices` vertices;
-    /// `factor_tips`: the factorization reads the hinge tip-tip blocks too (module
-    /// docs), otherwise they are compensated on the diagonal.
+    /// The pattern of `elements` on `vertices` vertices; `factor_tips`: the
+    /// factorization reads every block (module docs, "The factored matrix"),
+    /// otherwise only the diagonal and the kinds' factored pairs, the others
+    /// compensated on the diagonal.
     pub fn build(vertices: usize, elements: &Elements, factor_tips: bool) -> BlockPattern {
         let n = vertices;
         // Every coupled pair, both ways, and the diagonal.
@@ -190,43 +202,30 @@ impl BlockPattern {
         p.mirror = p.mirrors();
         p.mark_factored(elements, factor_tips);
         p.build_sources(elements);
+        p.in_place = KindInPlace::build(elements, &p);
         p.build_csc();
         p
     }
 
     /// Which blocks the factorization reads ([`BlockPattern::factored`]) and
-    /// the hinge tips whose blocks it leaves out, compensated on the diagonal.
+    /// the terms that compensate on the diagonal for those it drops.
     fn mark_factored(&mut self, elements: &Elements, factor_tips: bool) {
         let n = self.vertices();
         let p = self;
         p.factored = (0..p.blocks())
             .map(|b| p.rows[b] == p.columns[b] || factor_tips)
             .collect();
-        for sp in &elements.springs {
-            let [a, b] = sp.v;
-            for (i, j) in [(a, b), (b, a)] {
-                let s = p.slot(i, j) as usize;
-                p.factored[s] = true;
-            }
-        }
-        // A membrane triangle couples the ends of its edges, as the springs do.
-        for t in &elements.membrane_triangles {
-            for i in t.v {
-                for j in t.v {
-                    let s = p.slot(i, j) as usize;
-                    p.factored[s] = true;
-                }
-            }
-        }
-        let mut tips: Vec<(u32, u32)> = Vec::new();
-        for (h, hg) in elements.hinges.iter().enumerate() {
-            let (tip_p, tip_q) = (hg.v[2], hg.v[3]);
-            if !p.factored[p.slot(tip_p, tip_q) as usize] {
-                tips.push((tip_p, 4 * h as u32 + 2));
-                tips.push((tip_q, 4 * h as u32 + 3));
-            }
-        }
-        (p.compensation_start, p.compensation) = group_by_key(n, &tips);
+        factored_pairs(elements, |i, j| {
+            let s = p.slot(i, j) as usize;
+            p.factored[s] = true;
+        });
+        let mut terms: [Vec<(u32, u32)>; KIND_COUNT] = Default::default();
+        dropped_terms(
+            elements,
+            |i, j| p.factored[p.slot(i, j) as usize],
+            |kind, vertex, term| terms[kind].push((vertex, term)),
+        );
+        p.dropped = terms.map(|t| Lists::grouped(n, &t));
     }
 
     /// Number of vertices (block rows).
@@ -235,7 +234,7 @@ impl BlockPattern {
     }
 
     /// Number of bands of [`BAND_ROWS`] rows.
-    fn bands(&self) -> usize {
+    pub(crate) fn bands(&self) -> usize {
         self.vertices().div_ceil(BAND_ROWS)
     }
 
@@ -250,7 +249,7 @@ impl BlockPattern {
     }
 
     /// The block index of `(i, j)`; the pair must be in the pattern.
-    fn slot(&self, i: u32, j: u32) -> u32 {
+    pub(crate) fn slot(&self, i: u32, j: u32) -> u32 {
         let (s, e) = (
             self.row_start[i as usize] as usize,
             self.row_start[i as usize + 1] as usize,
@@ -258,6 +257,11 @@ impl BlockPattern {
         let found = self.columns[s..e].binary_search(&j);
         debug_assert!(found.is_ok(), "block ({i}, {j}) missing from the pattern");
         (s + found.unwrap_or(0)) as u32
+    }
+
+    /// Whether the factorization reads block `slot`.
+    pub(crate) fn is_factored(&self, slot: u32) -> bool {
+        self.factored[slot as usize]
     }
 
     /// The block of the lower triangle joining `i` and `j` (either order).
@@ -292,6 +296,6 @@ impl BlockPattern {
 }
 
 /// `a b^T`.
-pub(super) fn outer(a: Vector, b: Vector) -> Matrix3 {
+pub(crate) fn outer(a: Vector, b: Vector) -> Matrix3 {
     Matrix3::from_cols(a * b.x, a * b.y, a * b.z)
 }

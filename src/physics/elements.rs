@@ -1,11 +1,13 @@
-//! Force elements built from the mesh and the material: springs, bending hinges,
-//! lumped masses, and the per-vertex incidence lists used to gather forces.
+//! Force elements built from the mesh and the material: lumped masses, the
+//! triangles at each vertex, and every force element kind's elements with
+//! their per-vertex incidence lists ([`KindSets`], each kind's
+//! [`super::kinds::ForceKind::Set`] built by the kind from a [`BuildContext`]).
 //!
 //! Everything here derives from material coordinates, so it is rebuilt whenever
 //! the mesh changes and means the same physical sheet at every resolution. The
-//! rebuild after a remesh is incremental ([`Elements::rebuild`], module
-//! [`reuse`]): the buffers are reused and shape triangles whose stencil did not
-//! change keep their matrix. It gains little: `cargo bench --bench implicit --
+//! rebuild after a remesh is incremental ([`Elements::rebuild`]): the buffers
+//! are reused and shape triangles whose stencil did not change keep their
+//! matrix (`kinds/shapes/reuse.rs`). It gains little: `cargo bench --bench implicit --
 //! remesh_and_back` (a 63 x 63 grid refined along one crease and back, 7,938
 //! and 8,442 triangles, 7,560 of the refined mesh's matrices kept, 882
 //! computed) measured 2.568 ms for the two fresh builds against 2.456 ms for the
@@ -54,19 +56,11 @@
 //!   reproduce a cylinder imposed on a grid, but a loaded strip is about 20% too
 //!   soft (see `shape.rs` for why and the numbers).
 
-mod reuse;
-
-pub use reuse::RebuildCounts;
-
-use super::membrane::{MEMBRANE_SLOTS, Membrane, MembraneTriangle};
-use super::sewing::{SpringCap, sewing_springs};
-use super::shape::{
-    FoldEdges, FoldSplits, SHAPE_SLOTS, ShapeScratch, ShapeTriangle, build_shape_triangles_into,
-};
-use crate::math::{Scalar, Vector2};
+use super::kinds::{KindDeferred, KindSets};
+use super::membrane::Membrane;
+use crate::math::Scalar;
 use crate::mesh::Mesh;
 use crate::spec::{BendingModel, Sewing, StiffnessRule};
-use reuse::{Previous, Reuse};
 
 /// Material parameters the elements are built from (per area, mesh independent).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -91,28 +85,6 @@ pub struct MaterialParams {
     pub sewing: Sewing,
 }
 
-/// A linear spring with damping along its axis.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Spring {
-    /// End vertices `[a, b]`.
-    pub v: [u32; 2],
-    /// Rest length, m.
-    pub rest: Scalar,
-    /// Stiffness, N/m.
-    pub k: Scalar,
-    /// Damping coefficient, N s/m.
-    pub c: Scalar,
-}
-
-/// A dihedral bending hinge: `v[0], v[1]` span the edge, `v[2], v[3]` are the wing tips.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Hinge {
-    /// Vertices: edge start, edge end, tip of the first wing, tip of the second.
-    pub v: [u32; 4],
-    /// Angular stiffness, N m (energy `k theta^2 / 2`).
-    pub k: Scalar,
-}
-
 /// Compressed per-vertex lists (CSR): `entries[offsets[i]..offsets[i+1]]` belong to vertex i.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Incidence {
@@ -125,7 +97,11 @@ pub struct Incidence {
 impl Incidence {
     /// Refills the lists from `(vertex, entry)` pairs, reusing the buffers;
     /// entries keep their order.
-    fn fill(&mut self, vertices: usize, pairs: impl Iterator<Item = (u32, u32)> + Clone) {
+    pub(crate) fn fill(
+        &mut self,
+        vertices: usize,
+        pairs: impl Iterator<Item = (u32, u32)> + Clone,
+    ) {
         let offsets = &mut self.offsets;
         offsets.clear();
         offsets.resize(vertices + 1, 0);
@@ -156,6 +132,24 @@ impl Incidence {
     }
 }
 
+/// What a kind builds its elements from ([`super::kinds::ForceKind::build`]).
+#[derive(Debug, Clone, Copy)]
+pub struct BuildContext<'a> {
+    /// The mesh.
+    pub mesh: &'a Mesh,
+    /// The material.
+    pub mat: &'a MaterialParams,
+    /// Each triangle's rest area, m^2.
+    pub area: &'a [Scalar],
+    /// Per vertex the pin that holds it for good, or `u32::MAX` (empty: no
+    /// clamp).
+    pub clamped: &'a [u32],
+    /// The triangles at each vertex of the mesh the elements were built for
+    /// before (empty before the first build), for a kind that keeps what it
+    /// can of its previous elements.
+    pub previous_vertex_triangles: &'a Incidence,
+}
+
 /// All force elements of one mesh, with their per-vertex gather lists.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Elements {
@@ -163,40 +157,10 @@ pub struct Elements {
     pub mass: Vec<Scalar>,
     /// Rest area attributed to each vertex (a third of each adjacent triangle), m^2.
     pub vertex_area: Vec<Scalar>,
-    /// Stretch springs (one per edge, with [`Membrane::Springs`]), then hinge
-    /// springs when that bending model is on, then the sewing springs of a
-    /// garment's open seams.
-    pub springs: Vec<Spring>,
-    /// The sewing springs with a maximum force, in spring order (empty unless a
-    /// seam has `max_force`; `super::sewing`).
-    pub sewing_caps: Vec<SpringCap>,
-    /// Continuum membrane triangles, one per triangle (with [`Membrane::Triangles`]).
-    pub membrane_triangles: Vec<MembraneTriangle>,
-    /// Dihedral hinges (only with the dihedral model and non-zero rigidity).
-    pub hinges: Vec<Hinge>,
-    /// Shape-operator bending elements, one per triangle (only with that model and
-    /// non-zero rigidity).
-    pub shape_triangles: Vec<ShapeTriangle>,
-    /// The factored system of the shape triangles' fold splits.
-    pub fold_splits: FoldSplits,
-    /// The shape triangles' interior edges, each once (their folds are
-    /// computed per edge).
-    pub fold_edges: FoldEdges,
-    /// Springs where the vertex is the first end (`v[0]`).
-    pub spring_first: Incidence,
-    /// Springs where the vertex is the second end (`v[1]`).
-    pub spring_second: Incidence,
-    /// Hinge slots `4 * hinge + k` where the vertex is `v[k]`.
-    pub hinge_slots: Incidence,
-    /// Shape-triangle slots `SHAPE_SLOTS * element + k` where the vertex is `v[k]`
-    /// (used slots only).
-    pub shape_slots: Incidence,
-    /// Membrane-triangle slots `MEMBRANE_SLOTS * element + k` where the vertex is `v[k]`.
-    pub membrane_slots: Incidence,
     /// Triangles at each vertex (for per-triangle forces such as wind).
     pub vertex_triangles: Incidence,
-    /// What these elements were built from, for the next [`Elements::rebuild`].
-    previous: Previous,
+    /// Every force element kind's elements and incidence lists.
+    pub kinds: KindSets,
     /// Scratch memory of [`Elements::rebuild`] (never part of a comparison).
     scratch: Scratch,
 }
@@ -205,11 +169,7 @@ pub struct Elements {
 #[derive(Debug, Clone, Default)]
 struct Scratch {
     area: Vec<Scalar>,
-    shapes: Vec<ShapeTriangle>,
-    shape: ShapeScratch,
-    shape_pairs: Vec<(u32, u32)>,
-    reuse: Reuse,
-    counts: RebuildCounts,
+    previous_vertex_triangles: Incidence,
 }
 
 /// Scratch memory holds nothing the elements mean: two element sets are equal
@@ -221,7 +181,7 @@ impl PartialEq for Scratch {
 }
 
 impl Elements {
-    /// Builds masses, springs and bending elements for `mesh` from the material,
+    /// Builds masses and every kind's elements for `mesh` from the material,
     /// with no clamp.
     pub fn build(mesh: &Mesh, mat: &MaterialParams) -> Elements {
         Self::build_clamped(mesh, mat, &[])
@@ -239,24 +199,21 @@ impl Elements {
 
     /// Makes these the elements of `mesh` (after a remesh), equal to
     /// [`Elements::build_clamped`]'s bit for bit, incrementally: every buffer is
-    /// reused, and each shape triangle whose whole stencil was already in the
-    /// mesh these elements were built for keeps its matrix instead of computing
-    /// it again (module [`reuse`]). [`Elements::last_rebuild`] says how many did.
+    /// reused, and a kind may keep what it can of its previous elements (each
+    /// shape triangle whose whole stencil was already in the mesh these
+    /// elements were built for keeps its matrix instead of computing it again;
+    /// `kinds/shapes/reuse.rs`).
     pub fn rebuild(&mut self, mesh: &Mesh, mat: &MaterialParams, clamped: &[u32]) {
-        let splits = self.rebuild_but_splits(mesh, mat, clamped);
-        self.fold_splits = self.renewed_fold_splits(splits);
+        self.rebuild_but_deferred(mesh, mat, clamped);
+        let deferred = self.kinds.deferred();
+        self.kinds.install(deferred);
     }
 
-    /// [`Elements::rebuild`] but for the fold splits' system, which is left
-    /// that of the mesh before: [`Elements::renewed_fold_splits`] makes it,
-    /// given the number of split unknowns this returns, and may run beside
-    /// other work that reads the rebuilt elements.
-    pub fn rebuild_but_splits(
-        &mut self,
-        mesh: &Mesh,
-        mat: &MaterialParams,
-        clamped: &[u32],
-    ) -> usize {
+    /// [`Elements::rebuild`] but for what the kinds defer (the shape
+    /// triangles' fold splits' system, left that of the mesh before):
+    /// [`Elements::deferred`] makes it and may run beside other work that
+    /// reads the rebuilt elements; [`Elements::install`] puts it in place.
+    pub fn rebuild_but_deferred(&mut self, mesh: &Mesh, mat: &MaterialParams, clamped: &[u32]) {
         let n = mesh.vertex_count();
         let scratch = &mut self.scratch;
         scratch.area.clear();
@@ -274,95 +231,10 @@ impl Elements {
         self.mass.clear();
         self.mass
             .extend(self.vertex_area.iter().map(|a| mat.density * a));
-        stretch_springs(mesh, mat, area, &mut self.springs);
-        membrane_triangles(mesh, mat, area, &mut self.membrane_triangles);
-        scratch.shapes.clear();
-        let mut kept = 0;
-        let mut splits = 0;
-        if mat.bending > 0.0 && mat.bending_model == BendingModel::ShapeOperator {
-            let (old, previous) = (&self.shape_triangles, &self.previous);
-            let reuse = &mut scratch.reuse;
-            reuse.match_previous(previous, &self.vertex_triangles, mesh, mat);
-            let reuse = &*reuse;
-            splits = build_shape_triangles_into(
-                mesh,
-                area,
-                mat.bending,
-                clamped,
-                &mut scratch.shape,
-                |t, stencil, across| {
-                    let m = reuse.kept(previous, old, t, stencil, across, clamped);
-                    kept += usize::from(m.is_some());
-                    m
-                },
-                &mut scratch.shapes,
-            );
-        }
-        scratch.counts = RebuildCounts {
-            kept,
-            computed: scratch.shapes.len() - kept,
-        };
-        std::mem::swap(&mut self.shape_triangles, &mut scratch.shapes);
-        self.fold_edges = FoldEdges::build(&self.shape_triangles, n);
-        edge_bending(mesh, mat, area, &mut self.springs, &mut self.hinges);
-        sewing_springs(mesh, mat, &mut self.springs, &mut self.sewing_caps);
-        self.fill_tables(n, mesh);
-        self.previous
-            .record(mesh, mat, clamped, &self.shape_triangles);
-        splits
-    }
-
-    /// The fold splits' system of the current shape triangles, whose split
-    /// indices run over `0..splits` (reusing what it shares with the present
-    /// one: [`FoldSplits::renew`]).
-    pub fn renewed_fold_splits(&self, splits: usize) -> FoldSplits {
-        self.fold_splits
-            .renew(&self.shape_triangles, splits)
-            .expect("the plate matrices of a valid mesh are positive definite")
-    }
-
-    /// How the last [`Elements::rebuild`] made its shape triangles.
-    pub fn last_rebuild(&self) -> RebuildCounts {
-        self.scratch.counts
-    }
-
-    /// Total mass, kg.
-    pub fn total_mass(&self) -> Scalar {
-        self.mass.iter().sum()
-    }
-
-    /// Refills the per-vertex gather lists of the current elements.
-    fn fill_tables(&mut self, n: usize, mesh: &Mesh) {
-        let springs = &self.springs;
-        let ends = |end: usize| {
-            let pairs = springs.iter().enumerate();
-            pairs.map(move |(s, sp)| (sp.v[end], s as u32))
-        };
-        self.spring_first.fill(n, ends(0));
-        self.spring_second.fill(n, ends(1));
-        self.hinge_slots.fill(
-            n,
-            self.hinges
-                .iter()
-                .enumerate()
-                .flat_map(|(h, hg)| (0..4).map(move |k| (hg.v[k], (4 * h + k) as u32))),
+        std::mem::swap(
+            &mut scratch.previous_vertex_triangles,
+            &mut self.vertex_triangles,
         );
-        self.membrane_slots.fill(
-            n,
-            self.membrane_triangles
-                .iter()
-                .enumerate()
-                .flat_map(|(t, m)| {
-                    (0..MEMBRANE_SLOTS).map(move |k| (m.v[k], (MEMBRANE_SLOTS * t + k) as u32))
-                }),
-        );
-        let pairs = &mut self.scratch.shape_pairs;
-        pairs.clear();
-        pairs.extend(self.shape_triangles.iter().enumerate().flat_map(|(p, st)| {
-            st.slots()
-                .map(move |(k, v)| (v, (SHAPE_SLOTS * p + k) as u32))
-        }));
-        self.shape_slots.fill(n, pairs.iter().copied());
         self.vertex_triangles.fill(
             n,
             mesh.triangles
@@ -370,152 +242,38 @@ impl Elements {
                 .enumerate()
                 .flat_map(|(t, tri)| tri.iter().map(move |&v| (v, t as u32))),
         );
+        let cx = BuildContext {
+            mesh,
+            mat,
+            area,
+            clamped,
+            previous_vertex_triangles: &scratch.previous_vertex_triangles,
+        };
+        self.kinds.build(&cx);
+    }
+
+    /// What the kinds defer of the last [`Elements::rebuild_but_deferred`],
+    /// made from the rebuilt elements.
+    pub fn deferred(&self) -> KindDeferred {
+        self.kinds.deferred()
+    }
+
+    /// Puts what [`Elements::deferred`] made in place.
+    pub fn install(&mut self, deferred: KindDeferred) {
+        self.kinds.install(deferred);
+    }
+
+    /// Total mass, kg.
+    pub fn total_mass(&self) -> Scalar {
+        self.mass.iter().sum()
     }
 }
 
-/// The stiffening of a level-`level` spring under the stiffness rule (paper A:
-/// `2^(n/2)`; consistent: none).
-fn level_factor(rule: StiffnessRule, level: u8) -> Scalar {
+/// The stiffening of a level-`level` element under the stiffness rule (paper
+/// A: `2^(n/2)`; consistent: none).
+pub(crate) fn level_factor(rule: StiffnessRule, level: u8) -> Scalar {
     match rule {
         StiffnessRule::Consistent => 1.0,
         StiffnessRule::PaperA => (2.0 as Scalar).powf(level as Scalar / 2.0),
     }
-}
-
-/// One stretch spring per edge (module docs: stiffness derivations) with the
-/// springs membrane, none with the triangles; `area` is each triangle's rest area.
-fn stretch_springs(mesh: &Mesh, mat: &MaterialParams, area: &[Scalar], springs: &mut Vec<Spring>) {
-    springs.clear();
-    if mat.membrane != Membrane::Springs {
-        return;
-    }
-    for (e, edge) in mesh.edges.iter().enumerate() {
-        let rest = mesh.rest_length(e);
-        let tris = edge
-            .triangles
-            .iter()
-            .filter(|&&t| t != crate::mesh::NO_TRIANGLE);
-        let level = tris
-            .clone()
-            .map(|&t| mesh.levels[t as usize])
-            .max()
-            .unwrap_or(0);
-        let k = match mat.stiffness_rule {
-            StiffnessRule::Consistent => {
-                mat.stretch * tris.map(|&t| area[t as usize]).sum::<Scalar>() / (rest * rest)
-            }
-            StiffnessRule::PaperA => mat.stretch * level_factor(mat.stiffness_rule, level),
-        };
-        springs.push(Spring {
-            v: edge.vertices,
-            rest,
-            k,
-            c: mat.damping * k,
-        });
-    }
-}
-
-/// One membrane triangle per triangle with the triangles membrane (`membrane.rs`),
-/// none with the springs; `area` is each triangle's rest area.
-fn membrane_triangles(
-    mesh: &Mesh,
-    mat: &MaterialParams,
-    area: &[Scalar],
-    out: &mut Vec<MembraneTriangle>,
-) {
-    out.clear();
-    let Membrane::Triangles(moduli) = &mat.membrane else {
-        return;
-    };
-    out.extend(
-        mesh.triangles
-            .iter()
-            .zip(area)
-            .enumerate()
-            .map(|(t, (tri, &a))| {
-                MembraneTriangle::new(*tri, mesh.corners(t), a, moduli, mat.damping)
-            }),
-    );
-}
-
-/// The bending elements of the edge-based models: dihedral hinges (into
-/// `hinges`, cleared first) or hinge springs (appended to `springs`); none for
-/// the shape-operator model or zero rigidity.
-fn edge_bending(
-    mesh: &Mesh,
-    mat: &MaterialParams,
-    area: &[Scalar],
-    springs: &mut Vec<Spring>,
-    hinges: &mut Vec<Hinge>,
-) {
-    hinges.clear();
-    if mat.bending <= 0.0 || mat.bending_model == BendingModel::ShapeOperator {
-        return;
-    }
-    for (e, edge) in mesh
-        .edges
-        .iter()
-        .enumerate()
-        .filter(|(_, e)| e.is_interior())
-    {
-        let [t0, t1] = edge.triangles;
-        // Orient the edge as it runs in t0 (counter-clockwise) so that the
-        // signed angle has a consistent meaning.
-        let [a, b] = oriented_in(&mesh.triangles[t0 as usize], edge.vertices);
-        let (p, q) = (
-            mesh.opposite_vertex(t0, edge),
-            mesh.opposite_vertex(t1, edge),
-        );
-        let level = mesh.levels[t0 as usize].max(mesh.levels[t1 as usize]);
-        match mat.bending_model {
-            BendingModel::Dihedral => {
-                let len = mesh.rest_length(e);
-                let k = mat.bending * len * len / (area[t0 as usize] + area[t1 as usize]);
-                hinges.push(Hinge { v: [a, b, p, q], k });
-            }
-            BendingModel::ShapeOperator => unreachable!("returned above"),
-            BendingModel::HingeSpring => {
-                let rest = tip_distance(mesh, e);
-                let k = mat.bending / (rest * rest) * level_factor(mat.stiffness_rule, level);
-                springs.push(Spring {
-                    v: [p, q],
-                    rest,
-                    k,
-                    c: mat.damping * k,
-                });
-            }
-        }
-    }
-}
-
-/// The edge `[a, b]` in the order it runs inside triangle `tri`.
-fn oriented_in(tri: &[u32; 3], [a, b]: [u32; 2]) -> [u32; 2] {
-    for k in 0..3 {
-        if tri[k] == a && tri[(k + 1) % 3] == b {
-            return [a, b];
-        }
-    }
-    [b, a]
-}
-
-fn material_distance(material: &[Vector2], p: u32, q: u32) -> Scalar {
-    material[p as usize].distance(material[q as usize])
-}
-
-/// The rest distance between the wing tips of interior edge `e`. On a garment the
-/// second wing may lie in another panel's pattern: it is unfolded into the first
-/// wing's pattern about their shared edge ([`Mesh::unfold`]).
-fn tip_distance(mesh: &Mesh, e: usize) -> Scalar {
-    let edge = &mesh.edges[e];
-    let [t0, t1] = edge.triangles;
-    let (p, q) = (
-        mesh.opposite_vertex(t0, edge),
-        mesh.opposite_vertex(t1, edge),
-    );
-    if mesh.panels().is_none() {
-        return material_distance(&mesh.material, p, q);
-    }
-    let (t0, t1) = (t0 as usize, t1 as usize);
-    let unfolded = mesh.unfold(t0, t1, edge.vertices, q);
-    mesh.corner_at(t0, p).distance(unfolded)
 }

@@ -1,12 +1,17 @@
 //! Force element kinds: each kind of force element (springs, dihedral hinges,
 //! shape triangles, membrane triangles) implements [`ForceKind`] in its own
-//! file under `kinds/`, and [`kind_list!`] names them once. Every consumer
-//! loops over that list through the types it generates: the element pass and
+//! file under `kinds/`, and [`kind_list!`] names them once. Each kind owns its
+//! elements of one mesh and their incidence lists ([`ForceKind::Set`], all
+//! kinds' in [`KindSets`], held by [`Elements`]) and builds them
+//! ([`ForceKind::build`]). Every consumer loops over that list through the
+//! types it generates: the element build ([`KindSets`]), the element pass and
 //! the per-vertex gather of the explicit integrators ([`KindForces`]), the
 //! elastic energy ([`elastic_energy`]), the implicit step's linearisation, its
-//! right-hand side and Jacobi diagonal and the CG solver's matrix-free product
-//! ([`KindLinear`]), the block pattern of the direct solver ([`couplings`])
-//! and the explicit step bound ([`gershgorin`]).
+//! right-hand side and Jacobi diagonal, the CG solver's matrix-free product
+//! and the direct solver's block assembly ([`KindLinear`], [`KindInPlace`],
+//! [`listed_blocks`]), the block pattern's couplings and factored pairs
+//! ([`couplings`], [`factored_pairs`], [`dropped_terms`]) and the explicit
+//! step bound ([`gershgorin`]).
 //!
 //! The dispatch is static: the list expands to one call per kind, each a loop
 //! over that kind's elements, so no element pays for a virtual call.
@@ -14,39 +19,56 @@
 //! # Order
 //! Each vertex sums its kinds' slots in the list's order (and each kind's slots
 //! in its incidence lists' order), so results do not depend on the thread
-//! count and stay the same bit for bit as long as the list's order does. The
-//! elastic energy sums the kinds' energies in an order of its own, each kind's
-//! [`ForceKind::ENERGY_RANK`] (springs, membrane, hinges, shape triangles).
+//! count and stay the same bit for bit as long as the list's order does. Each
+//! block of the direct solver's matrix sums every kind's listed blocks in the
+//! list's order, then every kind's in-place blocks (`block.rs`, "Assembly").
+//! The elastic energy sums the kinds' energies in an order of its own, each
+//! kind's [`ForceKind::ENERGY_RANK`] (springs, membrane, hinges, shape
+//! triangles).
 //!
 //! # Adding a kind
 //! A new file under `kinds/` with a type that implements [`ForceKind`] (its
-//! elements read from [`Elements`]), and one line in the [`kind_list!`]
-//! invocation below, at the end (a kind inserted earlier changes the order of
-//! every sum after it).
+//! elements in its own [`ForceKind::Set`], built from a
+//! [`super::elements::BuildContext`]; the direct solver's hooks have
+//! defaults that add nothing), and one line in the [`kind_list!`] invocation
+//! below, at the end (a kind inserted earlier changes the order of every sum
+//! after it).
 
+#[macro_use]
+mod list;
 mod hinges;
 mod membrane;
 mod shapes;
 mod springs;
 
-pub use hinges::{HingeLinear, Hinges};
-pub use membrane::{MembraneLinear, MembraneTriangles};
+pub use hinges::{Hinge, HingeLinear, HingeSet, Hinges};
+pub use membrane::{MembraneLinear, MembraneSet, MembraneTriangles};
 pub use shapes::{
-    ShapeForces, ShapeLinear, ShapeTriangles, edge_folds, fold_angles, fold_angles_and_splits,
-    solve_splits, splits_at,
+    RebuildCounts, ShapeBlocks, ShapeForces, ShapeLinear, ShapeSet, ShapeTriangles, edge_folds,
+    fold_angles, fold_angles_and_splits, solve_splits, splits_at,
 };
-pub use springs::{SpringLinear, Springs};
+#[cfg(test)]
+pub(crate) use shapes::{ShapeOp, frobenius, moved_angles};
+pub use springs::{Spring, SpringLinear, SpringSet, Springs};
 
 use rayon::prelude::*;
 
-use super::elements::Elements;
-use crate::math::{Scalar, Vector};
+use super::block::{Band, BlockPattern};
+use super::elements::{BuildContext, Elements};
+use crate::math::{Matrix3, Scalar, Vector};
 use crate::mesh::Mesh;
 
-/// One kind of force element: its forces, its energy, its terms of the
-/// linearised implicit step and its share of the explicit step bound. Every
-/// function runs over all elements of the kind in `el`.
+/// One kind of force element: its elements and their build, its forces, its
+/// energy, its terms of the linearised implicit step and of the direct
+/// solver's matrix, and its share of the explicit step bound. Every function
+/// runs over all elements of the kind in `el` (its set in [`Elements::kinds`]).
 pub trait ForceKind {
+    /// The kind's elements of one mesh and their incidence lists, built by
+    /// [`ForceKind::build`] and held in [`Elements::kinds`].
+    type Set: std::fmt::Debug + Default + Clone + PartialEq + Send + Sync;
+    /// What [`ForceKind::build`] leaves to [`ForceKind::deferred`], which may
+    /// run beside other work that reads the rebuilt elements (`()`: nothing).
+    type Deferred: Default + Send;
     /// The element pass's scratch of this kind (its per-slot forces and
     /// whatever it computes on the way).
     type Forces: std::fmt::Debug + Default + Clone + Send + Sync;
@@ -58,6 +80,17 @@ pub trait ForceKind {
     /// The place of this kind's energy in the elastic energy's sum.
     const ENERGY_RANK: usize;
 
+    /// Makes `set` the kind's elements of the mesh of `cx` (after a remesh:
+    /// reusing its buffers, and keeping of its elements what it can), but for
+    /// what it defers ([`ForceKind::Deferred`]).
+    fn build(cx: &BuildContext<'_>, set: &mut Self::Set);
+    /// The deferred part of the build, made from the built `set`. Default:
+    /// nothing.
+    fn deferred(_set: &Self::Set) -> Self::Deferred {
+        Self::Deferred::default()
+    }
+    /// Puts the deferred part into `set`. Default: nothing.
+    fn install(_set: &mut Self::Set, _deferred: Self::Deferred) {}
     /// The number of elements.
     fn count(el: &Elements) -> usize;
     /// Into `out` (cleared first): the vertices of element `e`, in slot order.
@@ -120,6 +153,58 @@ pub trait ForceKind {
     /// Adds every ordered pair of distinct vertices that one of the kind's
     /// blocks couples (each as often as it comes).
     fn couplings(el: &Elements, pairs: &mut Vec<(u32, u32)>);
+    /// Pattern data of the blocks the kind adds in place, band by band
+    /// ([`ForceKind::add_in_place`]); `()` for a kind that adds none.
+    type InPlace: std::fmt::Debug + Default + Clone + Send + Sync;
+
+    /// For the direct solver's assembly (`block.rs`, "Assembly"): calls
+    /// `f(i, j, value, negate)` for every block `(i, j)` (`j <= i`) that an
+    /// element adds to the lower triangle of the implicit matrix from a value
+    /// of [`ForceKind::block_values`], element by element in element order:
+    /// `value` its index there, `negate` true where the block is subtracted.
+    /// Default: none.
+    fn listed_blocks(_el: &Elements, _f: impl FnMut(u32, u32, u32, bool)) {}
+    /// Writes the values that [`ForceKind::listed_blocks`] index into `lin`,
+    /// after [`ForceKind::linearise`] (the direct solver only). Default: none.
+    fn write_blocks(_el: &Elements, _lin: &mut Self::Linear) {}
+    /// The values that [`ForceKind::listed_blocks`] index.
+    fn block_values(_lin: &Self::Linear) -> &[Matrix3] {
+        &[]
+    }
+    /// The pattern of the blocks the kind adds in place instead
+    /// ([`ForceKind::add_in_place`]), from the built pattern `p`.
+    fn in_place_pattern(_el: &Elements, _p: &BlockPattern) -> Self::InPlace {
+        Self::InPlace::default()
+    }
+    /// Adds the kind's in-place blocks (`h2` the step squared) whose row lies
+    /// in `band` straight into its lower blocks, after every kind's listed
+    /// blocks, and the norms of those the factorization drops to the band's
+    /// diagonal compensation. Default: none.
+    fn add_in_place(
+        _el: &Elements,
+        _lin: &Self::Linear,
+        _data: &Self::InPlace,
+        _h2: Scalar,
+        _band: &mut Band<'_>,
+    ) {
+    }
+    /// Calls `f(i, j)` for the pairs whose blocks the reduced factorization
+    /// keeps for the kind (`block.rs`, "The factored matrix"), each way.
+    /// Default: none.
+    fn factored_pairs(_el: &Elements, _f: impl FnMut(u32, u32)) {}
+    /// Calls `f(vertex, term)` for each term that compensates on `vertex`'s
+    /// diagonal a block that the factorization drops (`factored(i, j)`: whether
+    /// it keeps block `(i, j)`), in the order they are summed. Default: none.
+    fn dropped_terms(
+        _el: &Elements,
+        _factored: impl Fn(u32, u32) -> bool,
+        _f: impl FnMut(u32, u32),
+    ) {
+    }
+    /// Compensation term `term` of [`ForceKind::dropped_terms`].
+    fn dropped_block(_lin: &Self::Linear, _term: u32) -> Matrix3 {
+        Matrix3::ZERO
+    }
     /// Adds each vertex's Gershgorin bound of this kind's rest stiffness to
     /// `stiff` and of its damping to `damp`; `flat` holds the material
     /// positions (a garment's stencils laid flat one by one into it).
@@ -169,200 +254,31 @@ pub(crate) fn slot_pairs(
     }
 }
 
-/// Generates, from the list of kinds (`field: Kind`), the per-kind scratch
-/// structs and the loops over kinds. Invoked once, below.
-macro_rules! kind_list {
-    ($($field:ident: $kind:ty),+ $(,)?) => {
-        /// The number of force element kinds.
-        pub const KIND_COUNT: usize = [$(stringify!($field)),+].len();
-
-        // Each energy rank is below the number of kinds and taken once.
-        const _: () = {
-            let ranks = [$(<$kind as ForceKind>::ENERGY_RANK),+];
-            let mut i = 0;
-            while i < ranks.len() {
-                assert!(ranks[i] < ranks.len());
-                let mut j = i + 1;
-                while j < ranks.len() {
-                    assert!(ranks[i] != ranks[j]);
-                    j += 1;
-                }
-                i += 1;
-            }
-        };
-
-        /// Each kind's place in the list.
-        #[allow(non_camel_case_types)]
-        #[derive(Debug, Clone, Copy)]
-        enum Place {
-            $($field,)+
-        }
-
-        /// Per kind, element indices (for example those that touch a
-        /// multirate group), in the list's order.
-        pub type KindIds = [Vec<u32>; KIND_COUNT];
-
-        /// Calls `f(kind, element, vertices)` for every element of every
-        /// kind, kind by kind, each kind in element order (`kind` its place
-        /// in the list).
-        pub fn for_each_element(el: &Elements, mut f: impl FnMut(usize, u32, &[u32])) {
-            let mut vertices = Vec::new();
-            $(
-                for e in 0..<$kind as ForceKind>::count(el) {
-                    <$kind as ForceKind>::element_vertices(el, e, &mut vertices);
-                    f(Place::$field as usize, e as u32, &vertices);
-                }
-            )+
-        }
-
-        /// Into `out` (cleared first): the vertices of element `e` of the kind
-        /// at place `kind` in the list.
-        pub fn element_vertices(el: &Elements, kind: usize, e: usize, out: &mut Vec<u32>) {
-            $(
-                if kind == Place::$field as usize {
-                    <$kind as ForceKind>::element_vertices(el, e, out);
-                }
-            )+
-        }
-
-        /// Every kind's multirate scratch.
-        #[derive(Debug, Default, Clone)]
-        pub struct KindKicks {
-            $(
-                #[doc = concat!("The kick scratch of [`", stringify!($kind), "`].")]
-                pub $field: <$kind as ForceKind>::Kick,
-            )+
-        }
-
-        /// The element pass's scratch of every kind.
-        #[derive(Debug, Default, Clone)]
-        pub struct KindForces {
-            $(
-                #[doc = concat!("The scratch of [`", stringify!($kind), "`].")]
-                pub $field: <$kind as ForceKind>::Forces,
-            )+
-        }
-
-        impl KindForces {
-            /// Sizes every kind's scratch for `el`.
-            pub fn size(&mut self, el: &Elements) {
-                $(<$kind as ForceKind>::size_forces(el, &mut self.$field);)+
-            }
-
-            /// Every kind's element pass at `(x, v)`.
-            pub fn compute(&mut self, el: &Elements, x: &[Vector], v: &[Vector]) {
-                $(<$kind as ForceKind>::forces(el, x, v, &mut self.$field);)+
-            }
-
-            /// Every kind's [`ForceKind::kick`] of its elements in `ids`.
-            pub fn kick(
-                &mut self,
-                el: &Elements,
-                ids: &KindIds,
-                x: &[Vector],
-                v: &[Vector],
-                kicks: &mut KindKicks,
-            ) {
-                $(<$kind as ForceKind>::kick(
-                    el,
-                    &ids[Place::$field as usize],
-                    x,
-                    v,
-                    &mut self.$field,
-                    &mut kicks.$field,
-                );)+
-            }
-
-            /// Adds every kind's slots of vertex `i` to `f`, kind by kind.
-            #[inline(always)]
-            pub fn gather(&self, el: &Elements, i: usize, f: &mut Vector) {
-                $(<$kind as ForceKind>::gather_force(el, &self.$field, i, f);)+
+/// Calls `f(k, l)` for every block that an element with vertices `v` adds to
+/// the lower triangle: local vertices `k` and `l`, both set in `active` (bit
+/// `k`), with `v[l] <= v[k]`; `k` outer and `l` inner, each ascending. The
+/// pattern (where each block goes) and the values both enumerate through
+/// here, so they agree.
+#[inline(always)]
+pub(crate) fn lower_pairs(v: &[u32], active: u32, mut f: impl FnMut(usize, usize)) {
+    for k in (0..v.len()).filter(|&k| active >> k & 1 != 0) {
+        for l in (0..v.len()).filter(|&l| active >> l & 1 != 0) {
+            if v[l] <= v[k] {
+                f(k, l);
             }
         }
+    }
+}
 
-        /// The linearised implicit step's terms of every kind.
-        #[derive(Debug, Default, Clone)]
-        pub struct KindLinear {
-            $(
-                #[doc = concat!("The terms of [`", stringify!($kind), "`].")]
-                pub $field: <$kind as ForceKind>::Linear,
-            )+
-        }
-
-        impl KindLinear {
-            /// Every kind's [`ForceKind::linearise`].
-            pub fn linearise(
-                &mut self,
-                el: &Elements,
-                x: &[Vector],
-                v: &[Vector],
-                h: Scalar,
-                k_term: Scalar,
-            ) {
-                $(<$kind as ForceKind>::linearise(el, x, v, h, k_term, &mut self.$field);)+
-            }
-
-            /// Every kind's [`ForceKind::linearise_solved`].
-            pub fn linearise_solved(&mut self, el: &Elements, v: &[Vector], h: Scalar, k_term: Scalar) {
-                $(<$kind as ForceKind>::linearise_solved(el, v, h, k_term, &mut self.$field);)+
-            }
-
-            /// Adds every kind's right-hand side slots (and with `jacobi`
-            /// diagonal) of vertex `i`, kind by kind.
-            #[inline(always)]
-            pub fn gather(
-                &self,
-                el: &Elements,
-                i: usize,
-                h: Scalar,
-                jacobi: bool,
-                rhs: &mut Vector,
-                diag: &mut Vector,
-            ) {
-                $(<$kind as ForceKind>::gather_linear(el, &self.$field, i, h, jacobi, rhs, diag);)+
-            }
-
-            /// Every kind's element pass of the product with `p`.
-            pub fn product(&mut self, el: &Elements, p: &[Vector], h2: Scalar) {
-                $(<$kind as ForceKind>::product(el, &mut self.$field, p, h2);)+
-            }
-
-            /// Adds every kind's product slots of vertex `i` to `acc`, kind by kind.
-            #[inline(always)]
-            pub fn gather_product(&self, el: &Elements, i: usize, acc: &mut Vector) {
-                $(<$kind as ForceKind>::gather_product(el, &self.$field, i, acc);)+
-            }
-        }
-
-        /// The elastic energy of every kind at `x`, summed in the kinds'
-        /// [`ForceKind::ENERGY_RANK`] order, J.
-        pub fn elastic_energy(el: &Elements, x: &[Vector]) -> Scalar {
-            let mut by_rank = [0.0; KIND_COUNT];
-            $(by_rank[<$kind as ForceKind>::ENERGY_RANK] = <$kind as ForceKind>::energy(el, x);)+
-            by_rank.into_iter().reduce(|a, b| a + b).unwrap_or(0.0)
-        }
-
-        /// The sum of every kind's [`ForceKind::coupling_count`].
-        pub fn coupling_count(el: &Elements) -> usize {
-            0 $(+ <$kind as ForceKind>::coupling_count(el))+
-        }
-
-        /// Every kind's [`ForceKind::couplings`], kind by kind.
-        pub fn couplings(el: &Elements, pairs: &mut Vec<(u32, u32)>) {
-            $(<$kind as ForceKind>::couplings(el, pairs);)+
-        }
-
-        /// Every kind's [`ForceKind::gershgorin`], kind by kind.
-        pub fn gershgorin(
-            el: &Elements,
-            mesh: &Mesh,
-            flat: &mut [Vector],
-            stiff: &mut [Scalar],
-            damp: &mut [Scalar],
-        ) {
-            $(<$kind as ForceKind>::gershgorin(el, mesh, flat, stiff, damp);)+
-        }
+/// The most lower blocks ([`lower_pairs`], all slots active) of one of the
+/// elements `vertices`: the stretch each element owns in its kind's values.
+pub(crate) fn lower_stride<'a>(vertices: impl Iterator<Item = &'a [u32]>) -> usize {
+    let count = |v: &[u32]| {
+        let mut c = 0;
+        lower_pairs(v, u32::MAX, |_, _| c += 1);
+        c
     };
+    vertices.map(count).max().unwrap_or(0)
 }
 
 // The force element kinds, in the order each vertex sums them.

@@ -25,9 +25,10 @@ pub mod timestep;
 pub mod work;
 
 pub use crate::spec::{Preconditioner, Refactor, Solver};
-pub use elements::{Elements, Hinge, MaterialParams, Spring};
+pub use elements::{Elements, MaterialParams};
 pub use forces::{Energy, ExternalForces, WindForce};
 pub use implicit::SolveFailure;
+pub use kinds::{Hinge, Spring};
 pub use membrane::{Membrane, MembraneTriangle, Orthotropic};
 pub use sewing::SpringCap;
 pub use shape::{SHAPE_SLOTS, ShapeTriangle};
@@ -236,12 +237,12 @@ impl Stepper {
     /// (incrementally: [`Elements::rebuild`]).
     ///
     /// With the direct solver, the new mesh's block pattern and its ordering
-    /// are made here too, on one thread while the fold splits' system is
-    /// factored on another (both only read the rebuilt elements, so the
-    /// results do not depend on the thread count).
+    /// are made here too, on one thread while the kinds' deferred parts (the
+    /// fold splits' system) are made on another (both only read the rebuilt
+    /// elements, so the results do not depend on the thread count).
     pub fn rebuild(&mut self, model: &Model, world: &World) {
         let clamped = world.pins.clamped(world.mesh.vertex_count());
-        let splits = (self.elements).rebuild_but_splits(&world.mesh, &model.material, &clamped);
+        (self.elements).rebuild_but_deferred(&world.mesh, &model.material, &clamped);
         self.held.resize(world.mesh.vertex_count(), false);
         self.contacts.clear();
         self.contact_push.clear();
@@ -250,15 +251,15 @@ impl Stepper {
         let direct =
             model.integrator == Integrator::Implicit && model.solver.solver == Solver::Direct;
         let (elements, implicit) = (&self.elements, &mut self.implicit);
-        let (fold_splits, ()) = rayon::join(
-            || elements.renewed_fold_splits(splits),
+        let (deferred, ()) = rayon::join(
+            || elements.deferred(),
             || {
                 if direct {
                     implicit.prepare_direct(elements, model.solver.preconditioner);
                 }
             },
         );
-        self.elements.fold_splits = fold_splits;
+        self.elements.install(deferred);
     }
 
     /// Advances `world` by `dt` seconds with `model`'s integrator. `warm_start`: the

@@ -19,9 +19,10 @@
 //! energy the run checks each frame (`sim::pipeline`) is the energy the forces
 //! do work against.
 //!
-//! The capped springs stay in [`Elements::springs`], so every per-vertex list,
-//! the block pattern and the solvers treat them as springs; [`Elements::sewing_caps`]
-//! lists them with their caps. The springs kind (`kinds/springs.rs`) computes
+//! The capped springs stay in the springs kind's springs
+//! ([`super::kinds::SpringSet`]), so every per-vertex list, the block pattern
+//! and the solvers treat them as springs; its `caps` lists them with their
+//! caps. The springs kind (`kinds/springs.rs`) computes
 //! every spring as usual and then overwrites the few capped ones (forces,
 //! energy, the implicit blocks), so the loops over the ordinary springs are
 //! unchanged; a multirate kick looks each of its springs up among the caps.
@@ -29,15 +30,16 @@
 //! spring's to the last bit, so a cap that is never reached changes nothing.
 
 use super::block::outer;
-use super::elements::{Elements, MaterialParams, Spring};
+use super::elements::{Elements, MaterialParams};
 use super::forces::spring_force;
+use super::kinds::Spring;
 use crate::math::{Matrix3, Scalar, Vector, deterministic_sum};
 use crate::mesh::Mesh;
 
 /// A sewing spring with a maximum force.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SpringCap {
-    /// The spring's index in [`Elements::springs`] (a zero-length spring).
+    /// The spring's index in [`super::kinds::SpringSet::springs`] (a zero-length spring).
     pub spring: u32,
     /// The largest force it pulls with, N.
     pub max_force: Scalar,
@@ -49,7 +51,7 @@ pub struct SpringCap {
 /// depend on how finely it is sampled; damped like the stretch springs. A seam
 /// with a `max_force` caps each pair's force at it times the same share, each
 /// such spring listed in `caps` (cleared first).
-pub(super) fn sewing_springs(
+pub(crate) fn sewing_springs(
     mesh: &Mesh,
     mat: &MaterialParams,
     springs: &mut Vec<Spring>,
@@ -126,7 +128,7 @@ pub fn capped_spring_stiffness(d: Vector, k: Scalar, max_force: Scalar) -> Matri
 /// Writes the capped springs' forces at `(x, v)` over their slots in `slots`
 /// (one per spring, the force on its first end).
 pub fn cap_forces(el: &Elements, x: &[Vector], v: &[Vector], slots: &mut [Vector]) {
-    for cap in &el.sewing_caps {
+    for cap in &el.kinds.springs.caps {
         slots[cap.spring as usize] = cap_force(el, cap, x, v);
     }
 }
@@ -134,7 +136,7 @@ pub fn cap_forces(el: &Elements, x: &[Vector], v: &[Vector], slots: &mut [Vector
 /// The force of one capped spring on its first end.
 #[inline]
 pub(super) fn cap_force(el: &Elements, cap: &SpringCap, x: &[Vector], v: &[Vector]) -> Vector {
-    let sp = &el.springs[cap.spring as usize];
+    let sp = &el.kinds.springs.springs[cap.spring as usize];
     let [a, b] = [sp.v[0] as usize, sp.v[1] as usize];
     capped_spring_force(x[a], x[b], v[a], v[b], sp.k, sp.c, cap.max_force)
 }
@@ -143,9 +145,9 @@ pub(super) fn cap_force(el: &Elements, cap: &SpringCap, x: &[Vector], v: &[Vecto
 /// springs of their Huber energy minus the quadratic energy the plain sum
 /// counted, `-k (l - d0)^2 / 2` beyond the cap and exactly zero within it, J.
 pub fn cap_energy_change(el: &Elements, x: &[Vector]) -> Scalar {
-    deterministic_sum(el.sewing_caps.len(), |c| {
-        let cap = &el.sewing_caps[c];
-        let sp = &el.springs[cap.spring as usize];
+    deterministic_sum(el.kinds.springs.caps.len(), |c| {
+        let cap = &el.kinds.springs.caps[c];
+        let sp = &el.kinds.springs.springs[cap.spring as usize];
         let len = x[sp.v[1] as usize].distance(x[sp.v[0] as usize]);
         let beyond = len - cap.max_force / sp.k;
         if sp.k * len <= cap.max_force {

@@ -72,7 +72,7 @@ proptest! {
             el.rebuild(&w.mesh, &mat, &c);
             let fresh = Elements::build_clamped(&w.mesh, &mat, &c);
             prop_assert!(el == fresh, "pass after shape {}: the rebuilt elements differ from a fresh build", j);
-            kept += el.last_rebuild().kept;
+            kept += el.kinds.shapes.last_rebuild().kept;
         }
         if bending_model == BendingModel::ShapeOperator && ad.stats.splits > 0 {
             prop_assert!(kept > 0, "no shape triangle was kept over {} splits", ad.stats.splits);
@@ -89,20 +89,28 @@ fn a_rebuild_keeps_nothing_it_cannot_match() {
     let mat = material(BendingModel::ShapeOperator);
     let mut el = Elements::build(&m, &mat);
     let all = m.triangles.len();
-    assert_eq!(el.last_rebuild().computed, all, "a build from nothing");
+    assert_eq!(
+        el.kinds.shapes.last_rebuild().computed,
+        all,
+        "a build from nothing"
+    );
     el.rebuild(&m, &mat, &[]);
     assert_eq!(
-        el.last_rebuild().kept,
+        el.kinds.shapes.last_rebuild().kept,
         all,
         "the same mesh again keeps every matrix: {:?}",
-        el.last_rebuild()
+        el.kinds.shapes.last_rebuild()
     );
     let stiffer = MaterialParams {
         bending: 2e-5,
         ..mat
     };
     el.rebuild(&m, &stiffer, &[]);
-    assert_eq!(el.last_rebuild().computed, all, "another rigidity");
+    assert_eq!(
+        el.kinds.shapes.last_rebuild().computed,
+        all,
+        "another rigidity"
+    );
     assert!(el == Elements::build(&m, &stiffer));
 }
 
@@ -154,8 +162,8 @@ fn the_pipelines_remeshes_rebuild_incrementally() {
         );
         if after > before {
             remeshes += 1;
-            kept += el.last_rebuild().kept;
-            computed += el.last_rebuild().computed;
+            kept += el.kinds.shapes.last_rebuild().kept;
+            computed += el.kinds.shapes.last_rebuild().computed;
         }
     }
     assert!(remeshes > 0, "the cantilever should remesh");

@@ -366,7 +366,7 @@ fn membrane_stiffness_blocks_match_finite_differences_of_the_forces() {
         .collect();
     let v = vec![Vector::ZERO; x.len()];
     let (mut tension, mut compression) = (0, 0);
-    for t in &el.membrane_triangles {
+    for t in &el.kinds.membrane.triangles {
         let (gauss_newton, geometric) = t.stiffness(&x);
         let (a, b) = t.columns(&x);
         let [euu, evv, g] = green_strain(a, b);

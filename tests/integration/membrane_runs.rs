@@ -79,8 +79,14 @@ fn obj_cloth_with_texture_coordinates_runs_with_both_membranes() {
             "{membrane}: the bulge is stretched ({elastic} J)"
         );
         if membrane == "triangles" {
-            assert_eq!(el.membrane_triangles.len(), world.mesh.triangles.len());
-            assert!(el.springs.is_empty(), "no stretch springs with triangles");
+            assert_eq!(
+                el.kinds.membrane.triangles.len(),
+                world.mesh.triangles.len()
+            );
+            assert!(
+                el.kinds.springs.springs.is_empty(),
+                "no stretch springs with triangles"
+            );
         }
     }
     std::fs::remove_dir_all(&dir).ok();

@@ -218,12 +218,16 @@ fn cylinder_energy_ratio(res: u32, model_kind: BendingModel, r: Scalar) -> Scala
     let energy: Scalar = match model_kind {
         BendingModel::ShapeOperator => {
             let splits = drape::physics::kinds::splits_at(&el, &x);
-            el.shape_triangles
+            el.kinds
+                .shapes
+                .triangles
                 .iter()
                 .map(|t| t.energy(&x, &splits))
                 .sum()
         }
         BendingModel::Dihedral => el
+            .kinds
+            .hinges
             .hinges
             .iter()
             .map(|h| {
@@ -231,7 +235,7 @@ fn cylinder_energy_ratio(res: u32, model_kind: BendingModel, r: Scalar) -> Scala
                 0.5 * h.k * theta * theta
             })
             .sum(),
-        BendingModel::HingeSpring => el.springs[stretch_springs..]
+        BendingModel::HingeSpring => el.kinds.springs.springs[stretch_springs..]
             .iter()
             .map(|s| {
                 let d = x[s.v[0] as usize].distance(x[s.v[1] as usize]) - s.rest;
@@ -609,7 +613,9 @@ fn partly_refined_sheet_bends_like_the_continuum_in(alternate: bool, region: &st
             let x: Vec<Vector> = m.material.iter().map(|&p| shape(p)).collect();
             let splits = drape::physics::kinds::splits_at(&el, &x);
             let e: Scalar = el
-                .shape_triangles
+                .kinds
+                .shapes
+                .triangles
                 .iter()
                 .map(|t| t.energy(&x, &splits))
                 .sum();

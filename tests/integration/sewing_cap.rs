@@ -148,10 +148,12 @@ pub(crate) fn capped_forces(
         &v,
         &mut scratch,
     );
-    el.sewing_caps
+    el.kinds
+        .springs
+        .caps
         .iter()
         .map(|c| {
-            let sp = &el.springs[c.spring as usize];
+            let sp = &el.kinds.springs.springs[c.spring as usize];
             let d = x[sp.v[1] as usize].distance(x[sp.v[0] as usize]);
             (
                 scratch.kinds.springs[c.spring as usize],
@@ -269,11 +271,11 @@ fn an_obj_garments_seams_take_max_force_from_cloth_sewing() {
     std::fs::remove_dir_all(&dir).ok();
     let seams = &sim.state.world.mesh.panels().expect("a garment").seams;
     let el = &sim.pipe.stepper().elements;
-    let caps: Scalar = el.sewing_caps.iter().map(|c| c.max_force).sum();
+    let caps: Scalar = el.kinds.springs.caps.iter().map(|c| c.max_force).sum();
     println!(
         "{} seams, {} capped pairs, caps sum to {caps:.12} N (30 N/m over the 1 m seam)",
         seams.len(),
-        el.sewing_caps.len()
+        el.kinds.springs.caps.len()
     );
     assert!(seams.iter().all(|s| s.is_open()));
     assert!((caps - 30.0).abs() < 1e-9, "{caps}");

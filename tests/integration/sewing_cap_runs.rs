@@ -33,7 +33,7 @@ fn sewing_force_never_exceeds_its_cap_while_a_10_cm_seam_closes() {
     let (mut worst, mut uncapped, mut steps): (Scalar, Scalar, usize) = (0.0, 0.0, 0);
     while seam_state(&sim, 0) == SeamState::Open && steps < 200 {
         let el = &sim.pipe.stepper().elements;
-        assert!(!el.sewing_caps.is_empty());
+        assert!(!el.kinds.springs.caps.is_empty());
         for (f, cap, kd) in capped_forces(el, &sim.state.world.mesh.triangles, &sim.state.world.x) {
             worst = worst.max(f.length() / cap);
             uncapped = uncapped.max(kd / cap);
@@ -107,7 +107,7 @@ fn a_cap_that_is_never_reached_changes_no_bit_of_a_run() {
         let set = format!("simulation.integrator={integrator}");
         let without = two_squares(0.03, &[set.as_str()]);
         let with = two_squares(0.03, &[set.as_str(), never]);
-        assert!(!with.pipe.stepper().elements.sewing_caps.is_empty());
+        assert!(!with.pipe.stepper().elements.kinds.springs.caps.is_empty());
         let h = match integrator {
             "implicit" => 0.005,
             _ => {

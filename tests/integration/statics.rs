@@ -138,17 +138,29 @@ pub fn solve(
         rank[i] = r;
     }
     let groups: Vec<Vec<usize>> = el
+        .kinds
+        .springs
         .springs
         .iter()
         .map(|s| s.v.map(|v| v as usize).to_vec())
-        .chain(el.hinges.iter().map(|h| h.v.map(|v| v as usize).to_vec()))
         .chain(
-            el.membrane_triangles
+            el.kinds
+                .hinges
+                .hinges
+                .iter()
+                .map(|h| h.v.map(|v| v as usize).to_vec()),
+        )
+        .chain(
+            el.kinds
+                .membrane
+                .triangles
                 .iter()
                 .map(|t| t.v.map(|v| v as usize).to_vec()),
         )
         .chain(
-            el.shape_triangles
+            el.kinds
+                .shapes
+                .triangles
                 .iter()
                 .map(|t| t.slots().map(|(_, v)| v as usize).collect()),
         )
@@ -282,10 +294,16 @@ fn newton_direction(
 ) -> Vec<Scalar> {
     let mut dx = f.to_vec();
     k.solve(&mut dx);
-    if el.fold_splits.count() == 0 {
+    if el.kinds.shapes.fold_splits.count() == 0 {
         return dx;
     }
-    let jac: Vec<_> = el.shape_triangles.iter().map(|t| t.angles(x).1).collect();
+    let jac: Vec<_> = el
+        .kinds
+        .shapes
+        .triangles
+        .iter()
+        .map(|t| t.angles(x).1)
+        .collect();
     let apply = |p: &[Scalar]| -> Vec<Scalar> {
         let mut y = unfactored.mul(p);
         let at = |v: u32| match rank[v as usize] {
@@ -293,15 +311,19 @@ fn newton_direction(
             r => Vector::new(p[3 * r], p[3 * r + 1], p[3 * r + 2]),
         };
         let rates: Vec<[Scalar; 3]> = el
-            .shape_triangles
+            .kinds
+            .shapes
+            .triangles
             .iter()
             .zip(&jac)
             .map(|(t, j)| [0, 1, 2].map(|a| t.slots().map(|(s, v)| j[a][s].dot(at(v))).sum()))
             .collect();
         let mut splits = Vec::new();
-        el.fold_splits
-            .solve(&el.shape_triangles, &rates, &mut splits);
-        for ((t, j), r) in el.shape_triangles.iter().zip(&jac).zip(&rates) {
+        el.kinds
+            .shapes
+            .fold_splits
+            .solve(&el.kinds.shapes.triangles, &rates, &mut splits);
+        for ((t, j), r) in el.kinds.shapes.triangles.iter().zip(&jac).zip(&rates) {
             let (exact, fixed) = (t.moments(*r, &splits), t.times_m(*r));
             for (s, v) in t.slots() {
                 let rv = rank[v as usize];
@@ -357,7 +379,7 @@ fn assemble(el: &Elements, x: &[Vector], rank: &[usize], k: &mut Envelope) {
             }
         }
     };
-    for s in &el.springs {
+    for s in &el.kinds.springs.springs {
         let [a, b] = [s.v[0] as usize, s.v[1] as usize];
         let d = x[b] - x[a];
         let len = d.length();
@@ -370,7 +392,7 @@ fn assemble(el: &Elements, x: &[Vector], rank: &[usize], k: &mut Envelope) {
         add_block(a, b, -m);
         add_block(b, a, -m);
     }
-    for t in &el.membrane_triangles {
+    for t in &el.kinds.membrane.triangles {
         let (gauss_newton, geometric) = t.stiffness(x);
         let m = gauss_newton.combine(1.0, &geometric, 1.0);
         for i in 0..3 {
@@ -379,7 +401,7 @@ fn assemble(el: &Elements, x: &[Vector], rank: &[usize], k: &mut Envelope) {
             }
         }
     }
-    for h in &el.hinges {
+    for h in &el.kinds.hinges.hinges {
         let (_, g) =
             drape::physics::bending::dihedral_angle_and_gradient(h.v.map(|i| x[i as usize]));
         for i in 0..4 {
@@ -389,7 +411,7 @@ fn assemble(el: &Elements, x: &[Vector], rank: &[usize], k: &mut Envelope) {
             }
         }
     }
-    for t in &el.shape_triangles {
+    for t in &el.kinds.shapes.triangles {
         let (_, jac) = t.angles(x);
         for (i, vi) in t.slots() {
             for (j, vj) in t.slots() {

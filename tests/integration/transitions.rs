@@ -85,7 +85,9 @@ fn second_level_transitions_bend_like_the_unrefined_sheet() {
         let height = |p: &Vector2| (h[0] * p.x * p.x + h[1] * p.y * p.y) / (2.0 * rs);
         let x: Vec<Vector> = m.material.iter().map(|p| p.extend(height(p))).collect();
         let splits = drape::physics::kinds::splits_at(&el, &x);
-        el.shape_triangles
+        el.kinds
+            .shapes
+            .triangles
             .iter()
             .map(|t| t.energy(&x, &splits))
             .sum::<Scalar>()

@@ -1,32 +1,29 @@
 //! The per-step passes over a [`BlockPattern`] (block module docs,
-//! "Assembly"): the lower blocks gathered from the element terms, the diagonal
+//! "Assembly"): the lower blocks gathered from the kinds' terms, the diagonal
 //! compensation of the dropped blocks, the projected system, and products.
 
 use rayon::prelude::*;
 
 use super::super::forces::PAR_MIN_ROWS;
 use super::band::Band;
-use super::{BlockPattern, ElementBlocks, ElementTerms, outer};
+use super::{BlockPattern, ElementBlocks, outer};
 use crate::math::{Matrix3, Scalar, Vector};
 
 impl BlockPattern {
     /// Sums the lower blocks of `M + h D + h^2 K` into `lower` (one entry per
     /// block; the upper ones are left as they are, zero when first grown), and
-    /// the norms of the dropped shape blocks per vertex into `element` (module
-    /// docs, "Assembly"): the hinges' and membrane triangles' blocks into
-    /// `element` first, then band by band, each lower block's springs and
-    /// hinge and membrane terms, its shape triangles' blocks, and the mass on the
-    /// diagonal.
+    /// the norms of the dropped in-place blocks per vertex into `sigma` (module
+    /// docs, "Assembly"): band by band, each lower block's listed blocks kind
+    /// by kind, the kinds' in-place blocks, and the mass on the diagonal.
     pub fn gather(
         &self,
         terms: &ElementBlocks<'_>,
-        element: &mut ElementTerms,
+        sigma: &mut Vec<Scalar>,
         lower: &mut Vec<Matrix3>,
     ) {
-        self.element_terms(terms, element);
         lower.resize(self.blocks(), Matrix3::ZERO);
-        element.sigma.resize(self.vertices(), 0.0);
-        let flat = &element.blocks;
+        sigma.resize(self.vertices(), 0.0);
+        let values = terms.kinds.block_values();
         let band = |b: usize, lower: &mut [Matrix3], sigma: &mut [Scalar]| {
             let rows = self.band_rows(b);
             let mut band = Band {
@@ -35,9 +32,9 @@ impl BlockPattern {
                 lower,
                 sigma,
             };
-            self.gather_band(terms, flat, &mut band);
+            self.gather_band(terms, &values, &mut band);
         };
-        self.for_each_band(0..self.bands(), lower, &mut element.sigma, &band);
+        self.for_each_band(0..self.bands(), lower, sigma, &band);
     }
 
     /// Runs `f(band, lower, sigma)` for the bands in `bands`, in parallel, each
@@ -70,31 +67,26 @@ impl BlockPattern {
         }
     }
 
-    /// Per vertex: the diagonal compensation of the dropped tip-tip blocks (module
-    /// docs) and of the dropped shape blocks (their norms in `element`, from
-    /// [`Self::gather`]),
-    /// projected like the system (`S c g g^T S`).
+    /// Per vertex: the diagonal compensation of the dropped blocks (module
+    /// docs, "The factored matrix"): the kinds' compensation terms, kind by
+    /// kind, then the norms `sigma` of the dropped in-place blocks (from
+    /// [`Self::gather`]), projected like the system (`S c g g^T S`).
     pub fn compensation(
         &self,
         terms: &ElementBlocks<'_>,
-        element: &ElementTerms,
+        sigma: &[Scalar],
         projection: &[Option<Vector>],
         extra: &mut Vec<Matrix3>,
     ) {
         extra.resize(self.vertices(), Matrix3::ZERO);
-        let sigma = &element.sigma;
         extra
             .par_iter_mut()
             .enumerate()
             .with_min_len(PAR_MIN_ROWS)
             .for_each(|(i, out)| {
-                let range =
-                    self.compensation_start[i] as usize..self.compensation_start[i + 1] as usize;
                 let mut m = Matrix3::ZERO;
-                for &k in &self.compensation[range] {
-                    let g = terms.hinge_gradients[k as usize];
-                    m += outer(g, g) * terms.hinge_coefficients[k as usize / 4];
-                }
+                let dropped = std::array::from_fn(|kind| self.dropped[kind].of(i));
+                terms.kinds.add_dropped(dropped, &mut m);
                 m += Matrix3::from_diagonal(Vector::splat(sigma[i]));
                 *out = match projection[i] {
                     None => m,

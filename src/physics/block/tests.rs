@@ -4,13 +4,14 @@
 //! term in element order (to the last bit), a dense sum of every element's
 //! full formula (to 1e-12), and the same matrix at one and two threads.
 
-use super::{BlockPattern, ElementBlocks, ElementTerms, ShapeOp, outer};
+use super::{BlockPattern, ElementBlocks, outer};
 use crate::adapt::{AdaptConfig, Adapter};
 use crate::math::{Matrix3, Scalar, Vector};
 use crate::mesh::{Mesh, rectangle};
 use crate::physics::elements::{Elements, MaterialParams};
+use crate::physics::kinds::{KindLinear, ShapeOp, frobenius, moved_angles};
 use crate::physics::membrane::{ColumnBlocks, Membrane, Orthotropic};
-use crate::physics::shape::EdgeFold;
+use crate::physics::shape::ShapeJacobian;
 use crate::physics::{Model, forces::PAR_MIN};
 use crate::scene::{BendingModel, DiagonalPattern, default_scene};
 use crate::world::World;
@@ -93,72 +94,89 @@ fn noise_symmetric(i: usize, salt: u64) -> Matrix3 {
     m + m.transpose()
 }
 
-/// Element terms of one step: pseudo-random blocks, gradients and masses, and
-/// the shape triangles' true Jacobians at `x` (their zeros are structural).
+/// Terms of one step: pseudo-random blocks, gradients and masses, and the
+/// shape triangles' true folds at `x` (their Jacobians' zeros are structural),
+/// with the kinds' block values written.
 struct Terms {
-    springs: Vec<Matrix3>,
-    hinge_gradients: Vec<Vector>,
-    hinge_coefficients: Vec<Scalar>,
+    kinds: KindLinear,
     diagonal_mass: Vec<Scalar>,
-    edge_folds: Vec<EdgeFold>,
-    membrane_blocks: Vec<ColumnBlocks>,
 }
 
 impl Terms {
     fn new(elements: &Elements, x: &[Vector]) -> Terms {
+        let mut kinds = KindLinear::default();
+        kinds.springs.block = (0..elements.kinds.springs.springs.len())
+            .map(|e| noise_symmetric(e, 1))
+            .collect();
+        kinds.hinges.grad = (0..4 * elements.kinds.hinges.hinges.len())
+            .map(|k| noise_vector(k, 2))
+            .collect();
+        kinds.hinges.coef = (0..elements.kinds.hinges.hinges.len())
+            .map(|h| 1.5 + noise(h, 3))
+            .collect();
+        elements
+            .kinds
+            .shapes
+            .fold_edges
+            .compute(x, &mut kinds.shapes.edge_folds);
+        kinds.membrane.block = (0..elements.kinds.membrane.triangles.len())
+            .map(|t| ColumnBlocks {
+                aa: noise_symmetric(t, 5),
+                ab: Matrix3::from_cols(
+                    noise_vector(3 * t, 6),
+                    noise_vector(3 * t + 1, 6),
+                    noise_vector(3 * t + 2, 6),
+                ),
+                bb: noise_symmetric(t, 9),
+            })
+            .collect();
+        kinds.write_blocks(elements);
         Terms {
-            springs: (0..elements.springs.len())
-                .map(|e| noise_symmetric(e, 1))
-                .collect(),
-            hinge_gradients: (0..4 * elements.hinges.len())
-                .map(|k| noise_vector(k, 2))
-                .collect(),
-            hinge_coefficients: (0..elements.hinges.len())
-                .map(|h| 1.5 + noise(h, 3))
-                .collect(),
+            kinds,
             diagonal_mass: (0..x.len()).map(|i| 2.0 + noise(i, 4)).collect(),
-            edge_folds: {
-                let mut edges = Vec::new();
-                elements.fold_edges.compute(x, &mut edges);
-                edges
-            },
-            membrane_blocks: (0..elements.membrane_triangles.len())
-                .map(|t| ColumnBlocks {
-                    aa: noise_symmetric(t, 5),
-                    ab: Matrix3::from_cols(
-                        noise_vector(3 * t, 6),
-                        noise_vector(3 * t + 1, 6),
-                        noise_vector(3 * t + 2, 6),
-                    ),
-                    bb: noise_symmetric(t, 9),
-                })
-                .collect(),
         }
     }
 
     fn view<'a>(&'a self, elements: &'a Elements) -> ElementBlocks<'a> {
         ElementBlocks {
-            springs: &self.springs,
-            hinges: &elements.hinges,
-            hinge_gradients: &self.hinge_gradients,
-            hinge_coefficients: &self.hinge_coefficients,
-            diagonal_mass: &self.diagonal_mass,
-            shape_triangles: &elements.shape_triangles,
-            fold_edges: &elements.fold_edges,
-            edge_folds: &self.edge_folds,
+            elements,
+            kinds: &self.kinds,
             h2: 0.7e-4,
-            membrane_triangles: &elements.membrane_triangles,
-            membrane_blocks: &self.membrane_blocks,
+            diagonal_mass: &self.diagonal_mass,
         }
     }
+}
+
+/// Shape triangle `t`'s angle gradients by slot, read from its edges' folds.
+fn shape_jacobian(terms: &ElementBlocks<'_>, t: usize) -> ShapeJacobian {
+    let edges = &terms.kinds.shapes.edge_folds;
+    terms.elements.kinds.shapes.fold_edges.angles(t, edges).1
+}
+
+/// Block `(k, l)` of shape triangle `tri` computed alone, from the Jacobians:
+/// `h^2 sum_ab M_ab J_ak J_bl^T`, summed as the per-triangle pass does (the
+/// tests' reference).
+fn shape_block(terms: &ElementBlocks<'_>, tri: usize, k: usize, l: usize) -> Matrix3 {
+    let m = &terms.elements.kinds.shapes.triangles[tri].m;
+    let jac = &shape_jacobian(terms, tri);
+    let mut out = Matrix3::ZERO;
+    for a in moved_angles(k) {
+        let row = &m[a];
+        let right = match l {
+            0..3 => jac[0][l] * row[0] + jac[1][l] * row[1] + jac[2][l] * row[2],
+            _ => jac[l - 3][l] * row[l - 3],
+        };
+        out += outer(jac[a][k], right);
+    }
+    out * terms.h2
 }
 
 /// The assembly's outputs: lower blocks, compensation, projected system.
 fn assemble(p: &BlockPattern, terms: &ElementBlocks<'_>) -> [Vec<Matrix3>; 3] {
     let n = p.vertices();
-    let mut element = ElementTerms::default();
+    let mut sigma = Vec::new();
     let (mut lower, mut extra, mut system) = (Vec::new(), Vec::new(), Vec::new());
-    p.gather(terms, &mut element, &mut lower);
+    p.gather(terms, &mut sigma, &mut lower);
     let projection: Vec<Option<Vector>> = (0..n)
         .map(|i| match i % 7 {
             0 => Some(Vector::ZERO),
@@ -166,7 +184,7 @@ fn assemble(p: &BlockPattern, terms: &ElementBlocks<'_>) -> [Vec<Matrix3>; 3] {
             _ => None,
         })
         .collect();
-    p.compensation(terms, &element, &projection, &mut extra);
+    p.compensation(terms, &sigma, &projection, &mut extra);
     let scale: Vec<Scalar> = (0..n).map(|i| 1.0 + noise(i, 11)).collect();
     p.project(&lower, &projection, &scale, &mut system);
     [lower, extra, system]
@@ -184,7 +202,7 @@ fn mirrors_and_dropped_blocks_match_the_searches() {
                 assert_eq!(p.mirror[b], p.slot(p.columns[b], p.rows[b]), "block {b}");
             }
             let mut bands = vec![Vec::new(); p.bands()];
-            for (ti, t) in elements.shape_triangles.iter().enumerate() {
+            for (ti, t) in elements.kinds.shapes.triangles.iter().enumerate() {
                 let mut ops = Vec::new();
                 for (k, i) in t.slots() {
                     for (l, j) in t.slots() {
@@ -201,8 +219,9 @@ fn mirrors_and_dropped_blocks_match_the_searches() {
                         }
                     }
                 }
-                let range = p.shape_op_start[ti] as usize..p.shape_op_start[ti + 1] as usize;
-                assert_eq!(&p.shape_ops[range], &ops[..], "triangle {ti}");
+                let shapes = &p.in_place.shapes;
+                let range = shapes.op_start[ti] as usize..shapes.op_start[ti + 1] as usize;
+                assert_eq!(&shapes.ops[range], &ops[..], "triangle {ti}");
                 for b in 0..p.bands() {
                     if t.slots()
                         .any(|(_, i)| p.band_rows(b).contains(&(i as usize)))
@@ -212,11 +231,12 @@ fn mirrors_and_dropped_blocks_match_the_searches() {
                 }
             }
             for (b, expected) in bands.iter().enumerate() {
-                let range = p.band_shape_start[b] as usize..p.band_shape_start[b + 1] as usize;
-                assert_eq!(&p.band_shapes[range], &expected[..], "band {b}");
+                let shapes = &p.in_place.shapes;
+                let range = shapes.band_start[b] as usize..shapes.band_start[b + 1] as usize;
+                assert_eq!(&shapes.band_shapes[range], &expected[..], "band {b}");
             }
             assert_eq!(
-                p.shape_ops.iter().all(|op| !op.dropped),
+                p.in_place.shapes.ops.iter().all(|op| !op.dropped),
                 factor_tips,
                 "the reduced pattern drops tip blocks, the full one none"
             );
@@ -229,38 +249,38 @@ fn mirrors_and_dropped_blocks_match_the_searches() {
 /// what the flat array and its index lists must reproduce to the last bit.
 fn per_term_sum(p: &BlockPattern, el: &Elements, t: &ElementBlocks<'_>) -> Vec<Matrix3> {
     let mut acc = vec![Matrix3::ZERO; p.blocks()];
-    for (e, sp) in el.springs.iter().enumerate() {
+    for (e, sp) in el.kinds.springs.springs.iter().enumerate() {
         let [a, b] = sp.v;
-        acc[p.diagonal[a as usize] as usize] += t.springs[e];
-        acc[p.diagonal[b as usize] as usize] += t.springs[e];
-        acc[p.lower_slot(a, b) as usize] += -t.springs[e];
+        acc[p.diagonal[a as usize] as usize] += t.kinds.springs.block[e];
+        acc[p.diagonal[b as usize] as usize] += t.kinds.springs.block[e];
+        acc[p.lower_slot(a, b) as usize] += -t.kinds.springs.block[e];
     }
-    for (h, hg) in el.hinges.iter().enumerate() {
-        let g = &t.hinge_gradients[4 * h..4 * h + 4];
+    for (h, hg) in el.kinds.hinges.hinges.iter().enumerate() {
+        let g = &t.kinds.hinges.grad[4 * h..4 * h + 4];
         for k in 0..4 {
             for l in 0..4 {
                 if hg.v[l] <= hg.v[k] {
                     let slot = p.slot(hg.v[k], hg.v[l]) as usize;
-                    acc[slot] += outer(g[k], g[l]) * t.hinge_coefficients[h];
+                    acc[slot] += outer(g[k], g[l]) * t.kinds.hinges.coef[h];
                 }
             }
         }
     }
-    for (ti, tri) in el.membrane_triangles.iter().enumerate() {
+    for (ti, tri) in el.kinds.membrane.triangles.iter().enumerate() {
         for k in 0..3 {
             for l in 0..3 {
                 if tri.v[l] <= tri.v[k] {
                     let slot = p.slot(tri.v[k], tri.v[l]) as usize;
-                    acc[slot] += tri.block(&t.membrane_blocks[ti], k, l);
+                    acc[slot] += tri.block(&t.kinds.membrane.block[ti], k, l);
                 }
             }
         }
     }
-    for (ti, tri) in el.shape_triangles.iter().enumerate() {
+    for (ti, tri) in el.kinds.shapes.triangles.iter().enumerate() {
         for (k, i) in tri.slots() {
             for (l, j) in tri.slots() {
                 if j <= i {
-                    acc[p.slot(i, j) as usize] += t.shape_block(ti, k, l);
+                    acc[p.slot(i, j) as usize] += shape_block(t, ti, k, l);
                 }
             }
         }
@@ -277,30 +297,30 @@ fn per_term_sum(p: &BlockPattern, el: &Elements, t: &ElementBlocks<'_>) -> Vec<M
 fn dense(p: &BlockPattern, el: &Elements, t: &ElementBlocks<'_>) -> (Vec<Matrix3>, Vec<Scalar>) {
     let mut a = vec![Matrix3::ZERO; p.blocks()];
     let mut scale = vec![0.0; p.blocks()];
-    let norm = super::terms::frobenius;
+    let norm = frobenius;
     let mut add = |i: u32, j: u32, m: Matrix3, size: Scalar| {
         let s = p.slot(i, j) as usize;
         a[s] += m;
         scale[s] += size;
     };
-    for (e, sp) in el.springs.iter().enumerate() {
+    for (e, sp) in el.kinds.springs.springs.iter().enumerate() {
         let [x, y] = sp.v;
-        let k = t.springs[e];
+        let k = t.kinds.springs.block[e];
         for (i, j, m) in [(x, x, k), (y, y, k), (x, y, -k), (y, x, -k)] {
             add(i, j, m, norm(&m));
         }
     }
-    for (h, hg) in el.hinges.iter().enumerate() {
-        let g = &t.hinge_gradients[4 * h..4 * h + 4];
+    for (h, hg) in el.kinds.hinges.hinges.iter().enumerate() {
+        let g = &t.kinds.hinges.grad[4 * h..4 * h + 4];
         for k in 0..4 {
             for l in 0..4 {
-                let m = outer(g[k], g[l]) * t.hinge_coefficients[h];
+                let m = outer(g[k], g[l]) * t.kinds.hinges.coef[h];
                 add(hg.v[k], hg.v[l], m, norm(&m));
             }
         }
     }
-    for (ti, tri) in el.membrane_triangles.iter().enumerate() {
-        let (c, uv) = (&t.membrane_blocks[ti], [tri.du, tri.dv]);
+    for (ti, tri) in el.kinds.membrane.triangles.iter().enumerate() {
+        let (c, uv) = (&t.kinds.membrane.block[ti], [tri.du, tri.dv]);
         for k in 0..3 {
             for l in 0..3 {
                 let size = [(c.aa, 0, 0), (c.ab, 0, 1), (c.ab, 1, 0), (c.bb, 1, 1)]
@@ -311,8 +331,8 @@ fn dense(p: &BlockPattern, el: &Elements, t: &ElementBlocks<'_>) -> (Vec<Matrix3
             }
         }
     }
-    for (ti, tri) in el.shape_triangles.iter().enumerate() {
-        let jac = &t.shape_jacobian(ti);
+    for (ti, tri) in el.kinds.shapes.triangles.iter().enumerate() {
+        let jac = &shape_jacobian(t, ti);
         for (k, i) in tri.slots() {
             for (l, j) in tri.slots() {
                 let (mut m, mut size) = (Matrix3::ZERO, 0.0);
@@ -359,7 +379,7 @@ fn gather_matches_the_per_term_sum_and_a_dense_assembly() {
                         "block {s}: not the per-term sum"
                     );
                 }
-                let error = super::terms::frobenius(&(got - a[s]));
+                let error = frobenius(&(got - a[s]));
                 assert!(
                     error <= 1e-12 * scale[s],
                     "block {s}: {error:e} of {:e}",
@@ -370,28 +390,28 @@ fn gather_matches_the_per_term_sum_and_a_dense_assembly() {
             // and its dropped shape blocks' norms (one vertex in 7 is free of
             // both projections in `assemble`).
             let mut sigma = vec![0.0; p.vertices()];
-            for (ti, tri) in el.shape_triangles.iter().enumerate() {
+            for (ti, tri) in el.kinds.shapes.triangles.iter().enumerate() {
                 for (k, i) in tri.slots() {
                     for (l, j) in tri.slots() {
                         if i != j && !p.factored[p.lower_slot(i, j) as usize] {
-                            sigma[i as usize] += super::terms::frobenius(&t.shape_block(ti, k, l));
+                            sigma[i as usize] += frobenius(&shape_block(&t, ti, k, l));
                         }
                     }
                 }
             }
-            for i in (0..p.vertices()).filter(|i| ![0, 3].contains(&(i % 7))) {
-                let mut expected = Matrix3::from_diagonal(Vector::splat(sigma[i]));
-                for &k in &p.compensation
-                    [p.compensation_start[i] as usize..p.compensation_start[i + 1] as usize]
-                {
-                    let g = t.hinge_gradients[k as usize];
-                    expected += outer(g, g) * t.hinge_coefficients[k as usize / 4];
+            let mut tips = vec![Matrix3::ZERO; p.vertices()];
+            for (h, hg) in el.kinds.hinges.hinges.iter().enumerate() {
+                if !p.factored[p.slot(hg.v[2], hg.v[3]) as usize] {
+                    for k in [2, 3] {
+                        let g = t.kinds.hinges.grad[4 * h + k];
+                        tips[hg.v[k] as usize] += outer(g, g) * t.kinds.hinges.coef[h];
+                    }
                 }
-                let error = super::terms::frobenius(&(extra[i] - expected));
-                assert!(
-                    error <= 1e-12 * super::terms::frobenius(&expected),
-                    "vertex {i}"
-                );
+            }
+            for i in (0..p.vertices()).filter(|i| ![0, 3].contains(&(i % 7))) {
+                let expected = Matrix3::from_diagonal(Vector::splat(sigma[i])) + tips[i];
+                let error = frobenius(&(extra[i] - expected));
+                assert!(error <= 1e-12 * frobenius(&expected), "vertex {i}");
             }
         }
     }

@@ -74,7 +74,7 @@ use super::SolveFailure;
 use super::cg::dot;
 use super::refactor::RefactorPolicy;
 use crate::math::{Matrix3, Scalar, Vector};
-use crate::physics::block::{BlockPattern, ElementTerms};
+use crate::physics::block::BlockPattern;
 use crate::physics::cholesky::Factorization;
 use crate::physics::elements::Elements;
 use crate::physics::forces::PAR_MIN;
@@ -116,8 +116,9 @@ pub(super) struct DirectScratch {
     tips_break_even: Option<Scalar>,
     /// The lower blocks of `A` (the upper ones are their mirrors' transposes).
     lower: Vec<Matrix3>,
-    /// Every element's lower blocks, gathered into `lower`.
-    element: ElementTerms,
+    /// Per vertex: the norms of the dropped in-place blocks that compensate
+    /// on its diagonal ([`BlockPattern::gather`]).
+    sigma: Vec<Scalar>,
     /// `A_s`, the projected matrix.
     system: Vec<Matrix3>,
     /// Per vertex: the diagonal compensation added to the factored matrix.

@@ -38,8 +38,10 @@ pub(super) fn linearise(st: &mut Stepper, model: &Model, w: &World, h: Scalar, n
     let mut splits = std::mem::take(&mut shapes.splits);
     rayon::join(
         || {
-            el.fold_splits
-                .solve(&el.shape_triangles, &folds, &mut splits)
+            el.kinds
+                .shapes
+                .fold_splits
+                .solve(&el.kinds.shapes.triangles, &folds, &mut splits)
         },
         || {
             s.kinds.linearise(el, x, v, h, k_term);

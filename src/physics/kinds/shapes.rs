@@ -1,19 +1,31 @@
 //! The shape triangles kind (`shape.rs`): `SHAPE_SLOTS` force slots per
 //! triangle (used slots only in the incidence lists); the folds are computed
 //! per interior edge and their splits solved over the whole mesh first
-//! ([`Elements::fold_edges`], [`Elements::fold_splits`]); in the implicit step
+//! ([`ShapeSet::fold_edges`], [`ShapeSet::fold_splits`]); in the implicit step
 //! the Gauss-Newton block `J^T M J` of the folds' Jacobian `J`.
+
+mod blocks;
+mod reuse;
+mod set;
+
+#[cfg(test)]
+pub(crate) use blocks::{ShapeOp, frobenius, moved_angles};
 
 use rayon::prelude::*;
 
 use super::{ForceKind, kick_slots, slot_pairs};
 use crate::math::{Scalar, Vector, deterministic_sum};
 use crate::mesh::Mesh;
-use crate::physics::elements::Elements;
+use crate::physics::block::{Band, BlockPattern};
+use crate::physics::elements::{BuildContext, Elements};
 use crate::physics::forces::PAR_MIN;
+use crate::physics::shape::FoldSplits;
 use crate::physics::shape::{EdgeFold, SHAPE_SLOTS, ShapeJacobian, rates, spread};
+pub use blocks::ShapeBlocks;
+pub use reuse::RebuildCounts;
+pub use set::ShapeSet;
 
-/// The shape triangles of [`Elements::shape_triangles`].
+/// The shape triangles kind: the triangles of [`ShapeSet`].
 #[derive(Debug, Clone, Copy, Default)]
 pub struct ShapeTriangles;
 
@@ -51,7 +63,7 @@ pub struct ShapeLinear {
 /// [`solve_splits`]); empty without shape triangles.
 pub fn splits_at(el: &Elements, x: &[Vector]) -> Vec<Scalar> {
     let (mut folds, mut splits) = (Vec::new(), Vec::new());
-    if !el.shape_triangles.is_empty() {
+    if !el.kinds.shapes.triangles.is_empty() {
         solve_splits(el, x, &mut folds, &mut splits);
     }
     splits
@@ -70,7 +82,10 @@ pub fn fold_angles_and_splits(
     splits: &mut Vec<Scalar>,
 ) {
     fold_angles(el, x, edges, folds, gradients);
-    el.fold_splits.solve(&el.shape_triangles, folds, splits);
+    el.kinds
+        .shapes
+        .fold_splits
+        .solve(&el.kinds.shapes.triangles, folds, splits);
 }
 
 /// Into `folds` and `gradients`: each shape triangle's folds at `x` and their
@@ -83,8 +98,8 @@ pub fn fold_angles(
     folds: &mut Vec<[Scalar; 3]>,
     gradients: &mut Vec<ShapeJacobian>,
 ) {
-    let shapes = el.shape_triangles.len();
-    el.fold_edges.compute(x, edges);
+    let shapes = el.kinds.shapes.triangles.len();
+    el.kinds.shapes.fold_edges.compute(x, edges);
     let edges = &*edges;
     folds.resize(shapes, [0.0; 3]);
     gradients.resize(shapes, [[Vector::ZERO; SHAPE_SLOTS]; 3]);
@@ -93,7 +108,7 @@ pub fn fold_angles(
         .zip(gradients.par_iter_mut())
         .enumerate()
         .with_min_len(PAR_MIN / SHAPE_SLOTS)
-        .for_each(|(t, (folds, jac))| (*folds, *jac) = el.fold_edges.angles(t, edges));
+        .for_each(|(t, (folds, jac))| (*folds, *jac) = el.kinds.shapes.fold_edges.angles(t, edges));
 }
 
 /// Into `edges` and `folds`: each interior edge's fold at `x` and each shape
@@ -106,14 +121,14 @@ pub fn edge_folds(
     edges: &mut Vec<EdgeFold>,
     folds: &mut Vec<[Scalar; 3]>,
 ) {
-    el.fold_edges.compute(x, edges);
+    el.kinds.shapes.fold_edges.compute(x, edges);
     let edges = &*edges;
-    folds.resize(el.shape_triangles.len(), [0.0; 3]);
+    folds.resize(el.kinds.shapes.triangles.len(), [0.0; 3]);
     folds
         .par_iter_mut()
         .enumerate()
         .with_min_len(PAR_MIN)
-        .for_each(|(t, folds)| *folds = el.fold_edges.folds(t, edges));
+        .for_each(|(t, folds)| *folds = el.kinds.shapes.fold_edges.folds(t, edges));
 }
 
 /// Into `folds` and `splits`: each shape triangle's folds at `x` and the
@@ -125,13 +140,16 @@ pub fn solve_splits(
     folds: &mut Vec<[Scalar; 3]>,
     splits: &mut Vec<Scalar>,
 ) {
-    folds.resize(el.shape_triangles.len(), [0.0; 3]);
+    folds.resize(el.kinds.shapes.triangles.len(), [0.0; 3]);
     folds
         .par_iter_mut()
         .with_min_len(PAR_MIN)
-        .zip(el.shape_triangles.par_iter())
+        .zip(el.kinds.shapes.triangles.par_iter())
         .for_each(|(f, t)| *f = t.folds(x));
-    el.fold_splits.solve(&el.shape_triangles, folds, splits);
+    el.kinds
+        .shapes
+        .fold_splits
+        .solve(&el.kinds.shapes.triangles, folds, splits);
 }
 
 impl ShapeTriangles {
@@ -149,18 +167,37 @@ impl ShapeTriangles {
 }
 
 impl ForceKind for ShapeTriangles {
+    type Set = ShapeSet;
+    type Deferred = FoldSplits;
     type Forces = ShapeForces;
     type Linear = ShapeLinear;
     type Kick = Vec<[Vector; SHAPE_SLOTS]>;
+    type InPlace = ShapeBlocks;
     const ENERGY_RANK: usize = 3;
 
+    /// One shape triangle per triangle not held by a clamp (shape-operator
+    /// model), incrementally ([`ShapeSet`]); the fold splits' system is
+    /// deferred.
+    fn build(cx: &BuildContext<'_>, set: &mut ShapeSet) {
+        set.rebuild(cx);
+    }
+
+    /// The fold splits' system of the rebuilt triangles.
+    fn deferred(set: &ShapeSet) -> FoldSplits {
+        set.renewed_fold_splits()
+    }
+
+    fn install(set: &mut ShapeSet, fold_splits: FoldSplits) {
+        set.fold_splits = fold_splits;
+    }
+
     fn count(el: &Elements) -> usize {
-        el.shape_triangles.len()
+        el.kinds.shapes.triangles.len()
     }
 
     fn element_vertices(el: &Elements, e: usize, out: &mut Vec<u32>) {
         out.clear();
-        out.extend(el.shape_triangles[e].slots().map(|(_, v)| v));
+        out.extend(el.kinds.shapes.triangles[e].slots().map(|(_, v)| v));
     }
 
     /// The splits couple every fold: they are solved over the whole mesh.
@@ -178,14 +215,14 @@ impl ForceKind for ShapeTriangles {
         let splits = &out.splits;
         kick_slots(ids, 128, &mut out.slots, kick, |p| {
             let mut f = [Vector::ZERO; SHAPE_SLOTS];
-            el.shape_triangles[p].forces(x, splits, &mut f);
+            el.kinds.shapes.triangles[p].forces(x, splits, &mut f);
             f
         });
     }
 
     fn size_forces(el: &Elements, out: &mut ShapeForces) {
         out.slots
-            .resize(SHAPE_SLOTS * el.shape_triangles.len(), Vector::ZERO);
+            .resize(SHAPE_SLOTS * el.kinds.shapes.triangles.len(), Vector::ZERO);
     }
 
     fn forces(el: &Elements, x: &[Vector], _v: &[Vector], out: &mut ShapeForces) {
@@ -203,7 +240,9 @@ impl ForceKind for ShapeTriangles {
             .par_chunks_exact_mut(SHAPE_SLOTS)
             .with_min_len(PAR_MIN / SHAPE_SLOTS)
             .zip(
-                el.shape_triangles
+                el.kinds
+                    .shapes
+                    .triangles
                     .par_iter()
                     .zip(folds.par_iter().zip(jacs.par_iter())),
             )
@@ -214,15 +253,15 @@ impl ForceKind for ShapeTriangles {
 
     #[inline(always)]
     fn gather_force(el: &Elements, out: &ShapeForces, i: usize, f: &mut Vector) {
-        for &s in el.shape_slots.of(i) {
+        for &s in el.kinds.shapes.slots.of(i) {
             *f += out.slots[s as usize];
         }
     }
 
     fn energy(el: &Elements, x: &[Vector]) -> Scalar {
         let splits = splits_at(el, x);
-        deterministic_sum(el.shape_triangles.len(), |t| {
-            el.shape_triangles[t].energy(x, &splits)
+        deterministic_sum(el.kinds.shapes.triangles.len(), |t| {
+            el.kinds.shapes.triangles[t].energy(x, &splits)
         })
     }
 
@@ -248,16 +287,16 @@ impl ForceKind for ShapeTriangles {
         k_term: Scalar,
         lin: &mut ShapeLinear,
     ) {
-        let shapes = el.shape_triangles.len();
+        let shapes = el.kinds.shapes.triangles.len();
         lin.slot.resize(SHAPE_SLOTS * shapes, Vector::ZERO);
         let (edges, splits) = (&lin.edge_folds, &lin.splits);
         lin.slot
             .par_chunks_exact_mut(SHAPE_SLOTS)
-            .zip(el.shape_triangles.par_iter())
+            .zip(el.kinds.shapes.triangles.par_iter())
             .enumerate()
             .with_min_len(PAR_MIN / SHAPE_SLOTS)
             .for_each(|(i, (slot, t))| {
-                let (theta, jac) = el.fold_edges.angles(i, edges);
+                let (theta, jac) = el.kinds.shapes.fold_edges.angles(i, edges);
                 let jac = &jac;
                 let jv = t.times_m(rates(t, jac, v));
                 let moment = t.moments(theta, splits);
@@ -276,13 +315,13 @@ impl ForceKind for ShapeTriangles {
         rhs: &mut Vector,
         diag: &mut Vector,
     ) {
-        for &k in el.shape_slots.of(i) {
+        for &k in el.kinds.shapes.slots.of(i) {
             *rhs += lin.slot[k as usize];
             let (t, slot) = (k as usize / SHAPE_SLOTS, k as usize % SHAPE_SLOTS);
             if !jacobi {
                 continue;
             }
-            let (m, jac) = (&el.shape_triangles[t].m, &lin.grad[t]);
+            let (m, jac) = (&el.kinds.shapes.triangles[t].m, &lin.grad[t]);
             for a in 0..3 {
                 for b in 0..3 {
                     *diag += jac[a][slot] * jac[b][slot] * (h * h * m[a][b]);
@@ -295,7 +334,7 @@ impl ForceKind for ShapeTriangles {
         lin.slot
             .par_chunks_exact_mut(SHAPE_SLOTS)
             .zip(lin.grad.par_iter())
-            .zip(el.shape_triangles.par_iter())
+            .zip(el.kinds.shapes.triangles.par_iter())
             .with_min_len(PAR_MIN / SHAPE_SLOTS)
             .for_each(|((slot, jac), t)| {
                 let c = t.times_m(rates(t, jac, p));
@@ -305,19 +344,35 @@ impl ForceKind for ShapeTriangles {
 
     #[inline(always)]
     fn gather_product(el: &Elements, lin: &ShapeLinear, i: usize, acc: &mut Vector) {
-        for &k in el.shape_slots.of(i) {
+        for &k in el.kinds.shapes.slots.of(i) {
             *acc += lin.slot[k as usize];
         }
     }
 
     fn coupling_count(el: &Elements) -> usize {
-        SHAPE_SLOTS * (SHAPE_SLOTS - 1) * el.shape_triangles.len()
+        SHAPE_SLOTS * (SHAPE_SLOTS - 1) * el.kinds.shapes.triangles.len()
     }
 
     fn couplings(el: &Elements, pairs: &mut Vec<(u32, u32)>) {
-        for t in &el.shape_triangles {
+        for t in &el.kinds.shapes.triangles {
             slot_pairs(t.slots(), pairs);
         }
+    }
+
+    fn in_place_pattern(el: &Elements, p: &BlockPattern) -> ShapeBlocks {
+        ShapeBlocks::build(el, p)
+    }
+
+    /// Every block, in place (module [`blocks`]): the bulk of the assembly.
+    #[inline(always)]
+    fn add_in_place(
+        el: &Elements,
+        lin: &ShapeLinear,
+        data: &ShapeBlocks,
+        h2: Scalar,
+        band: &mut Band<'_>,
+    ) {
+        data.add(el, &lin.edge_folds, h2, band);
     }
 
     fn gershgorin(
@@ -328,7 +383,7 @@ impl ForceKind for ShapeTriangles {
         _damp: &mut [Scalar],
     ) {
         let garment = mesh.panels().is_some();
-        for t in &el.shape_triangles {
+        for t in &el.kinds.shapes.triangles {
             // Gershgorin bound of J^T M J at the flat rest state.
             if garment {
                 let ids: Vec<u32> = t.slots().map(|(_, v)| v).collect();

@@ -9,15 +9,128 @@ use super::ForceKind;
 use crate::math::{Matrix3, Scalar, Vector, deterministic_sum};
 use crate::mesh::Mesh;
 use crate::physics::block::outer;
-use crate::physics::elements::Elements;
+use crate::physics::elements::{BuildContext, Elements, Incidence, MaterialParams, level_factor};
 use crate::physics::forces::{PAR_MIN, spring_force};
+use crate::physics::membrane::Membrane;
 use crate::physics::sewing::{
-    cap_energy_change, cap_force, cap_forces, capped_spring_force, capped_spring_stiffness,
+    SpringCap, cap_energy_change, cap_force, cap_forces, capped_spring_force,
+    capped_spring_stiffness, sewing_springs,
 };
+use crate::spec::{BendingModel, StiffnessRule};
 
-/// The springs of [`Elements::springs`] (with [`Elements::sewing_caps`]).
+/// The springs kind: the springs of [`SpringSet`] (with their caps).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Springs;
+/// A linear spring with damping along its axis.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Spring {
+    /// End vertices `[a, b]`.
+    pub v: [u32; 2],
+    /// Rest length, m.
+    pub rest: Scalar,
+    /// Stiffness, N/m.
+    pub k: Scalar,
+    /// Damping coefficient, N s/m.
+    pub c: Scalar,
+}
+
+/// The springs of one mesh and their incidence lists.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SpringSet {
+    /// Stretch springs (one per edge, with [`Membrane::Springs`]), then hinge
+    /// springs when that bending model is on, then the sewing springs of a
+    /// garment's open seams.
+    pub springs: Vec<Spring>,
+    /// The sewing springs with a maximum force, in spring order (empty unless a
+    /// seam has `max_force`; `sewing.rs`).
+    pub caps: Vec<SpringCap>,
+    /// Springs where the vertex is the first end (`v[0]`).
+    pub first: Incidence,
+    /// Springs where the vertex is the second end (`v[1]`).
+    pub second: Incidence,
+}
+
+/// One stretch spring per edge (`elements.rs`, "Stiffness derivations") with
+/// the springs membrane, none with the triangles; `area` is each triangle's
+/// rest area.
+fn stretch_springs(mesh: &Mesh, mat: &MaterialParams, area: &[Scalar], springs: &mut Vec<Spring>) {
+    springs.clear();
+    if mat.membrane != Membrane::Springs {
+        return;
+    }
+    for (e, edge) in mesh.edges.iter().enumerate() {
+        let rest = mesh.rest_length(e);
+        let tris = edge
+            .triangles
+            .iter()
+            .filter(|&&t| t != crate::mesh::NO_TRIANGLE);
+        let level = tris
+            .clone()
+            .map(|&t| mesh.levels[t as usize])
+            .max()
+            .unwrap_or(0);
+        let k = match mat.stiffness_rule {
+            StiffnessRule::Consistent => {
+                mat.stretch * tris.map(|&t| area[t as usize]).sum::<Scalar>() / (rest * rest)
+            }
+            StiffnessRule::PaperA => mat.stretch * level_factor(mat.stiffness_rule, level),
+        };
+        springs.push(Spring {
+            v: edge.vertices,
+            rest,
+            k,
+            c: mat.damping * k,
+        });
+    }
+}
+
+/// A spring between the two wing tips of each interior edge with the
+/// hinge-spring bending model and non-zero rigidity, appended to `springs`
+/// (`elements.rs`, "Stiffness derivations").
+fn hinge_springs(mesh: &Mesh, mat: &MaterialParams, springs: &mut Vec<Spring>) {
+    if mat.bending <= 0.0 || mat.bending_model != BendingModel::HingeSpring {
+        return;
+    }
+    for (e, edge) in mesh
+        .edges
+        .iter()
+        .enumerate()
+        .filter(|(_, e)| e.is_interior())
+    {
+        let [t0, t1] = edge.triangles;
+        let (p, q) = (
+            mesh.opposite_vertex(t0, edge),
+            mesh.opposite_vertex(t1, edge),
+        );
+        let level = mesh.levels[t0 as usize].max(mesh.levels[t1 as usize]);
+        let rest = tip_distance(mesh, e);
+        let k = mat.bending / (rest * rest) * level_factor(mat.stiffness_rule, level);
+        springs.push(Spring {
+            v: [p, q],
+            rest,
+            k,
+            c: mat.damping * k,
+        });
+    }
+}
+
+/// The rest distance between the wing tips of interior edge `e`. On a garment the
+/// second wing may lie in another panel's pattern: it is unfolded into the first
+/// wing's pattern about their shared edge ([`Mesh::unfold`]).
+fn tip_distance(mesh: &Mesh, e: usize) -> Scalar {
+    let edge = &mesh.edges[e];
+    let [t0, t1] = edge.triangles;
+    let (p, q) = (
+        mesh.opposite_vertex(t0, edge),
+        mesh.opposite_vertex(t1, edge),
+    );
+    if mesh.panels().is_none() {
+        return mesh.material[p as usize].distance(mesh.material[q as usize]);
+    }
+    let (t0, t1) = (t0 as usize, t1 as usize);
+    let unfolded = mesh.unfold(t0, t1, edge.vertices, q);
+    mesh.corner_at(t0, p).distance(unfolded)
+}
 
 /// The springs' terms of the linearised step.
 #[derive(Debug, Default, Clone)]
@@ -29,22 +142,42 @@ pub struct SpringLinear {
 }
 
 impl ForceKind for Springs {
+    type Set = SpringSet;
+    type Deferred = ();
     type Forces = Vec<Vector>;
     type Linear = SpringLinear;
     type Kick = Vec<Vector>;
+    type InPlace = ();
     const ENERGY_RANK: usize = 0;
 
+    /// Stretch springs, then hinge springs, then sewing springs, and their
+    /// ends' incidence lists.
+    fn build(cx: &BuildContext<'_>, set: &mut SpringSet) {
+        let (mesh, mat) = (cx.mesh, cx.mat);
+        stretch_springs(mesh, mat, cx.area, &mut set.springs);
+        hinge_springs(mesh, mat, &mut set.springs);
+        sewing_springs(mesh, mat, &mut set.springs, &mut set.caps);
+        let n = mesh.vertex_count();
+        let springs = &set.springs;
+        let ends = |end: usize| {
+            let pairs = springs.iter().enumerate();
+            pairs.map(move |(s, sp)| (sp.v[end], s as u32))
+        };
+        set.first.fill(n, ends(0));
+        set.second.fill(n, ends(1));
+    }
+
     fn count(el: &Elements) -> usize {
-        el.springs.len()
+        el.kinds.springs.springs.len()
     }
 
     fn element_vertices(el: &Elements, e: usize, out: &mut Vec<u32>) {
         out.clear();
-        out.extend(el.springs[e].v);
+        out.extend(el.kinds.springs.springs[e].v);
     }
 
     /// The capped sewing springs among `ids` get their capped force
-    /// ([`Elements::sewing_caps`] is in spring order).
+    /// ([`SpringSet::caps`] is in spring order).
     fn kick(
         el: &Elements,
         ids: &[u32],
@@ -53,13 +186,13 @@ impl ForceKind for Springs {
         out: &mut Vec<Vector>,
         kick: &mut Vec<Vector>,
     ) {
-        let caps = &el.sewing_caps;
+        let caps = &el.kinds.springs.caps;
         ids.par_iter()
             .with_min_len(512)
             .map(|&s| match caps.binary_search_by_key(&s, |c| c.spring) {
                 Ok(c) => cap_force(el, &caps[c], x, v),
                 Err(_) => {
-                    let sp = &el.springs[s as usize];
+                    let sp = &el.kinds.springs.springs[s as usize];
                     let [a, b] = [sp.v[0] as usize, sp.v[1] as usize];
                     spring_force(x[a], x[b], v[a], v[b], sp.rest, sp.k, sp.c)
                 }
@@ -71,14 +204,14 @@ impl ForceKind for Springs {
     }
 
     fn size_forces(el: &Elements, out: &mut Vec<Vector>) {
-        out.resize(el.springs.len(), Vector::ZERO);
+        out.resize(el.kinds.springs.springs.len(), Vector::ZERO);
     }
 
     fn forces(el: &Elements, x: &[Vector], v: &[Vector], out: &mut Vec<Vector>) {
         Self::size_forces(el, out);
         out.par_iter_mut()
             .with_min_len(PAR_MIN)
-            .zip(el.springs.par_iter())
+            .zip(el.kinds.springs.springs.par_iter())
             .for_each(|(f, s)| {
                 let [a, b] = [s.v[0] as usize, s.v[1] as usize];
                 *f = spring_force(x[a], x[b], v[a], v[b], s.rest, s.k, s.c);
@@ -88,22 +221,22 @@ impl ForceKind for Springs {
 
     #[inline(always)]
     fn gather_force(el: &Elements, out: &Vec<Vector>, i: usize, f: &mut Vector) {
-        for &s in el.spring_first.of(i) {
+        for &s in el.kinds.springs.first.of(i) {
             *f += out[s as usize];
         }
-        for &s in el.spring_second.of(i) {
+        for &s in el.kinds.springs.second.of(i) {
             *f -= out[s as usize];
         }
     }
 
     fn energy(el: &Elements, x: &[Vector]) -> Scalar {
-        let stretch = deterministic_sum(el.springs.len(), |s| {
-            let sp = &el.springs[s];
+        let stretch = deterministic_sum(el.kinds.springs.springs.len(), |s| {
+            let sp = &el.kinds.springs.springs[s];
             let stretch = x[sp.v[1] as usize].distance(x[sp.v[0] as usize]) - sp.rest;
             0.5 * sp.k * stretch * stretch
         });
         // The capped sewing springs' energy is Huber, not quadratic (`sewing.rs`).
-        if el.sewing_caps.is_empty() {
+        if el.kinds.springs.caps.is_empty() {
             stretch
         } else {
             stretch + cap_energy_change(el, x)
@@ -119,12 +252,14 @@ impl ForceKind for Springs {
         k_term: Scalar,
         lin: &mut SpringLinear,
     ) {
-        lin.block.resize(el.springs.len(), Matrix3::ZERO);
-        lin.slot.resize(el.springs.len(), Vector::ZERO);
+        lin.block
+            .resize(el.kinds.springs.springs.len(), Matrix3::ZERO);
+        lin.slot
+            .resize(el.kinds.springs.springs.len(), Vector::ZERO);
         lin.block
             .par_iter_mut()
             .zip(lin.slot.par_iter_mut())
-            .zip(el.springs.par_iter())
+            .zip(el.kinds.springs.springs.par_iter())
             .with_min_len(PAR_MIN)
             .for_each(|((block, slot), sp)| {
                 let [a, b] = [sp.v[0] as usize, sp.v[1] as usize];
@@ -152,13 +287,13 @@ impl ForceKind for Springs {
         rhs: &mut Vector,
         diag: &mut Vector,
     ) {
-        for &e in el.spring_first.of(i) {
+        for &e in el.kinds.springs.first.of(i) {
             *rhs += lin.slot[e as usize];
             if jacobi {
                 *diag += matrix_diagonal(&lin.block[e as usize]);
             }
         }
-        for &e in el.spring_second.of(i) {
+        for &e in el.kinds.springs.second.of(i) {
             *rhs -= lin.slot[e as usize];
             if jacobi {
                 *diag += matrix_diagonal(&lin.block[e as usize]);
@@ -170,7 +305,7 @@ impl ForceKind for Springs {
         lin.slot
             .par_iter_mut()
             .zip(lin.block.par_iter())
-            .zip(el.springs.par_iter())
+            .zip(el.kinds.springs.springs.par_iter())
             .with_min_len(PAR_MIN)
             .for_each(|((q, block), sp)| {
                 *q = *block * (p[sp.v[0] as usize] - p[sp.v[1] as usize]);
@@ -179,22 +314,46 @@ impl ForceKind for Springs {
 
     #[inline(always)]
     fn gather_product(el: &Elements, lin: &SpringLinear, i: usize, acc: &mut Vector) {
-        for &e in el.spring_first.of(i) {
+        for &e in el.kinds.springs.first.of(i) {
             *acc += lin.slot[e as usize];
         }
-        for &e in el.spring_second.of(i) {
+        for &e in el.kinds.springs.second.of(i) {
             *acc -= lin.slot[e as usize];
         }
     }
 
     fn coupling_count(el: &Elements) -> usize {
-        2 * el.springs.len()
+        2 * el.kinds.springs.springs.len()
     }
 
     fn couplings(el: &Elements, pairs: &mut Vec<(u32, u32)>) {
-        for sp in &el.springs {
+        for sp in &el.kinds.springs.springs {
             let [a, b] = sp.v;
             pairs.extend([(a, b), (b, a)]);
+        }
+    }
+
+    /// One value per spring, its block: added on both ends' diagonal blocks
+    /// and subtracted off it.
+    fn listed_blocks(el: &Elements, mut f: impl FnMut(u32, u32, u32, bool)) {
+        for (e, sp) in el.kinds.springs.springs.iter().enumerate() {
+            let ([a, b], e) = (sp.v, e as u32);
+            f(a, a, e, false);
+            f(b, b, e, false);
+            f(a, b, e, a != b);
+        }
+    }
+
+    fn block_values(lin: &SpringLinear) -> &[Matrix3] {
+        &lin.block
+    }
+
+    /// A spring's ends: the factorization keeps its coupling.
+    fn factored_pairs(el: &Elements, mut f: impl FnMut(u32, u32)) {
+        for sp in &el.kinds.springs.springs {
+            let [a, b] = sp.v;
+            f(a, b);
+            f(b, a);
         }
     }
 
@@ -205,7 +364,7 @@ impl ForceKind for Springs {
         stiff: &mut [Scalar],
         damp: &mut [Scalar],
     ) {
-        for s in &el.springs {
+        for s in &el.kinds.springs.springs {
             for &v in &s.v {
                 stiff[v as usize] += 2.0 * s.k;
                 damp[v as usize] += 2.0 * s.c;
@@ -250,9 +409,9 @@ fn capped_springs(
     h: Scalar,
     k_term: Scalar,
 ) {
-    for cap in &el.sewing_caps {
+    for cap in &el.kinds.springs.caps {
         let e = cap.spring as usize;
-        let sp = &el.springs[e];
+        let sp = &el.kinds.springs.springs[e];
         let [a, b] = [sp.v[0] as usize, sp.v[1] as usize];
         let d = x[b] - x[a];
         let (_, nn) = axis(d);

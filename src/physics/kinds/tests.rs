@@ -4,7 +4,7 @@ use super::*;
 use crate::math::Vector;
 use crate::mesh::Mesh;
 use crate::physics::Model;
-use crate::physics::elements::{Incidence, MaterialParams, Spring};
+use crate::physics::elements::{Incidence, MaterialParams};
 use crate::physics::membrane::{Membrane, Orthotropic};
 use crate::scene::{BendingModel, default_scene};
 use crate::world::World;
@@ -46,15 +46,16 @@ fn element_sets() -> Vec<(Elements, Vec<Vector>)> {
         ..fabric
     };
     let mut with_spring = Elements::build(&mesh, &dihedral);
-    with_spring.springs.push(Spring {
+    with_spring.kinds.springs.springs.push(Spring {
         v: [0, 40],
         rest: 0.01,
         k: 3.0,
         c: 0.0,
     });
     let n = mesh.vertex_count();
-    with_spring.spring_first = incidence(n, &with_spring.springs, 0);
-    with_spring.spring_second = incidence(n, &with_spring.springs, 1);
+    let set = &mut with_spring.kinds.springs;
+    set.first = incidence(n, &set.springs, 0);
+    set.second = incidence(n, &set.springs, 1);
     vec![
         (Elements::build(&mesh, &shape), x.clone()),
         (with_spring, x),

@@ -179,16 +179,18 @@ mod tests {
             .collect();
         for clamp in [&[][..], &clamped[..]] {
             let el = Elements::build_clamped(&mesh, &model.material, clamp);
-            let folds = FoldEdges::build(&el.shape_triangles, mesh.vertex_count());
+            let folds = FoldEdges::build(&el.kinds.shapes.triangles, mesh.vertex_count());
             let sides: usize = el
-                .shape_triangles
+                .kinds
+                .shapes
+                .triangles
                 .iter()
                 .map(|t| t.interior.iter().filter(|&&i| i).count())
                 .sum();
             let shared = sides - folds.len();
             println!(
                 "{} shape triangles, {sides} interior sides, {} edges, {shared} shared",
-                el.shape_triangles.len(),
+                el.kinds.shapes.triangles.len(),
                 folds.len()
             );
             let interior = mesh.edges.iter().filter(|e| e.is_interior()).count();
@@ -196,13 +198,13 @@ mod tests {
                 assert_eq!(folds.len(), interior);
                 assert_eq!(shared, interior);
             } else {
-                assert!(el.shape_triangles.len() < mesh.triangles.len());
+                assert!(el.kinds.shapes.triangles.len() < mesh.triangles.len());
                 assert!(folds.len() < interior && shared < folds.len());
             }
             let mut edges = Vec::new();
             folds.compute(&x, &mut edges);
             let mut worst: Scalar = 0.0;
-            for (t, shape) in el.shape_triangles.iter().enumerate() {
+            for (t, shape) in el.kinds.shapes.triangles.iter().enumerate() {
                 let (theta, jac) = shape.angles(&x);
                 let (read, read_jac) = folds.angles(t, &edges);
                 assert_eq!(theta, read, "triangle {t}");

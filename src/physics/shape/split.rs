@@ -234,11 +234,11 @@ mod tests {
 
     /// The splits of `s` for `el`'s shape triangles at made-up folds, as bits.
     fn solved(s: &FoldSplits, el: &Elements) -> Vec<u64> {
-        let folds: Vec<[Scalar; 3]> = (0..el.shape_triangles.len())
+        let folds: Vec<[Scalar; 3]> = (0..el.kinds.shapes.triangles.len())
             .map(|t| [0, 1, 2].map(|a| ((7 * t + 3 * a) % 11) as Scalar * 0.01 - 0.05))
             .collect();
         let mut out = Vec::new();
-        s.solve(&el.shape_triangles, &folds, &mut out);
+        s.solve(&el.kinds.shapes.triangles, &folds, &mut out);
         out.iter().map(|v| v.to_bits()).collect()
     }
 
@@ -261,11 +261,11 @@ mod tests {
         let base = Elements::build(&coarse, &fabric);
         for (mesh, mat) in [(&coarse, &fabric), (&coarse, &stiffer), (&fine, &fabric)] {
             let el = Elements::build(mesh, mat);
-            let count = el.fold_splits.count();
+            let count = el.kinds.shapes.fold_splits.count();
             assert!(count > 0, "the grid has split unknowns");
-            let new = FoldSplits::new(&el.shape_triangles, count).expect("factored");
-            let renewed = (base.fold_splits)
-                .renew(&el.shape_triangles, count)
+            let new = FoldSplits::new(&el.kinds.shapes.triangles, count).expect("factored");
+            let renewed = (base.kinds.shapes.fold_splits)
+                .renew(&el.kinds.shapes.triangles, count)
                 .expect("factored");
             assert!(renewed == new, "the renewed system's matrix differs");
             assert_eq!(solved(&renewed, &el), solved(&new, &el));

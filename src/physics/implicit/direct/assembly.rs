@@ -15,30 +15,23 @@ use crate::physics::block::{BlockPattern, ElementBlocks};
 use crate::physics::elements::Elements;
 use crate::physics::forces::PAR_MIN;
 
-/// The element terms of the linearised step in `s` ([`ElementBlocks`]), by
-/// field, so that `s.direct` stays free to borrow.
+/// What the assembly reads of `s` ([`ElementBlocks`]), by field, so that
+/// `s.direct` stays free to borrow.
 macro_rules! element_blocks {
     ($s:expr, $el:expr) => {
         ElementBlocks {
-            springs: &$s.kinds.springs.block,
-            hinges: &$el.hinges,
-            hinge_gradients: &$s.kinds.hinges.grad,
-            hinge_coefficients: &$s.kinds.hinges.coef,
-            diagonal_mass: &$s.diag_mass,
-            shape_triangles: &$el.shape_triangles,
-            fold_edges: &$el.fold_edges,
-            edge_folds: &$s.kinds.shapes.edge_folds,
+            elements: $el,
+            kinds: &$s.kinds,
             h2: $s.h2,
-            membrane_triangles: &$el.membrane_triangles,
-            membrane_blocks: &$s.kinds.membrane.block,
+            diagonal_mass: &$s.diag_mass,
         }
     };
 }
 
-/// Gathers the lower blocks of `A` from the element terms (all but the shape
-/// triangles' slots, which it does not read) into the block pattern, built
-/// first for a new mesh; the linearisation calls it while the fold splits are
-/// solved. Returns the pattern.
+/// Writes every kind's block values ([`crate::physics::kinds::KindLinear::write_blocks`])
+/// and gathers the lower blocks of `A` into the block pattern, built first for
+/// a new mesh; the linearisation calls it while the fold splits are solved
+/// (the kinds' terms that need them are not read). Returns the pattern.
 pub(in crate::physics::implicit) fn gather(
     s: &mut ImplicitScratch,
     el: &Elements,
@@ -58,8 +51,9 @@ pub(in crate::physics::implicit) fn gather(
     if built && a.new_mesh {
         a.pattern_s += started.elapsed().as_secs_f64();
     }
+    s.kinds.write_blocks(el);
     let terms = element_blocks!(s, el);
-    pattern.gather(&terms, &mut s.direct.element, &mut s.direct.lower);
+    pattern.gather(&terms, &mut s.direct.sigma, &mut s.direct.lower);
     pattern
 }
 
@@ -76,9 +70,9 @@ pub(in crate::physics::implicit) fn assemble(st: &mut Stepper, held: &[bool]) ->
         None => gather(s, &st.elements),
     };
     split_prescribed(s, held);
-    let terms = element_blocks!(s, st.elements);
+    let terms = element_blocks!(s, &st.elements);
     let a = &mut s.direct;
-    pattern.compensation(&terms, &a.element, &a.projection, &mut a.compensation);
+    pattern.compensation(&terms, &a.sigma, &a.projection, &mut a.compensation);
     // b_s = S (b - A dv_c).
     a.ap.resize(n, Vector::ZERO);
     pattern.multiply_lower(&a.lower, &a.prescribed, &mut a.ap);

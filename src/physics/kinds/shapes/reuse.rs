@@ -24,16 +24,17 @@
 //! springs, hinges, masses and gather lists cost a few flops per element, less
 //! than finding each one's predecessor would.
 
-use super::{Incidence, MaterialParams};
 use crate::math::Vector2;
 use crate::mesh::Mesh;
 use crate::mesh::PairMap;
+use crate::physics::elements::{Incidence, MaterialParams};
 use crate::physics::shape::{SHAPE_SLOTS, ShapeMatrix, ShapeTriangle};
 
 /// No match.
 const NONE: u32 = u32::MAX;
 
-/// How [`super::Elements::rebuild`] made its shape triangles the last time.
+/// How the last rebuild of the shape triangles ([`super::ShapeSet`]) made
+/// them.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct RebuildCounts {
     /// Shape triangles whose matrix was kept from the previous mesh.
@@ -44,7 +45,7 @@ pub struct RebuildCounts {
 
 /// What a set of elements was built from.
 #[derive(Debug, Clone, Default, PartialEq)]
-pub(super) struct Previous {
+pub(crate) struct Previous {
     material: Vec<Vector2>,
     triangles: Vec<[u32; 3]>,
     levels: Vec<u8>,
@@ -58,7 +59,7 @@ pub(super) struct Previous {
 
 impl Previous {
     /// Records what elements with shape triangles `shapes` were just built from.
-    pub(super) fn record(
+    pub(crate) fn record(
         &mut self,
         mesh: &Mesh,
         mat: &MaterialParams,
@@ -93,7 +94,7 @@ fn clamp_of(clamped: &[u32], v: u32) -> u32 {
 
 /// The matching of a new mesh against the previous one.
 #[derive(Debug, Clone, Default)]
-pub(super) struct Reuse {
+pub(crate) struct Reuse {
     by_point: PairMap<[u64; 2], u32>,
     /// Per new vertex: the previous vertex at its material point, or `NONE`.
     old_vertex: Vec<u32>,
@@ -111,7 +112,7 @@ impl Reuse {
 
     /// Matches `mesh`'s vertices and triangles against `previous` (whose
     /// triangles at each vertex are `old_at`), for rigidity and model `mat`.
-    pub(super) fn match_previous(
+    pub(crate) fn match_previous(
         &mut self,
         previous: &Previous,
         old_at: &Incidence,
@@ -159,7 +160,7 @@ impl Reuse {
     /// The matrix new triangle `t` keeps from `old_shapes` (the previous shape
     /// triangles), given its stencil and neighbours, or `None` (module docs:
     /// when a shape triangle is kept).
-    pub(super) fn kept(
+    pub(crate) fn kept(
         &self,
         previous: &Previous,
         old_shapes: &[ShapeTriangle],
