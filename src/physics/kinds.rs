@@ -32,14 +32,11 @@
 //! [`super::elements::BuildContext`]; the direct solver's hooks have
 //! defaults that add nothing), and one line in the [`kind_list!`] invocation
 //! below, at the end (a kind inserted earlier changes the order of every sum
-//! after it).
+//! after it): `field: Type`, the file being `kinds/field.rs` (the list
+//! declares each kind's module).
 
 #[macro_use]
 mod list;
-mod hinges;
-mod membrane;
-mod shapes;
-mod springs;
 
 pub use hinges::{Hinge, HingeLinear, HingeSet, Hinges};
 pub use membrane::{MembraneLinear, MembraneSet, MembraneTriangles};

@@ -2,10 +2,14 @@
 //! structs of every kind's sets, scratch and terms, and the loops over kinds
 //! (module docs of `kinds.rs`).
 
-/// Generates, from the list of kinds (`field: Kind`), the per-kind scratch
-/// structs and the loops over kinds. Invoked once, in `kinds.rs`.
+/// Generates, from the list of kinds (`field: Kind`), each kind's module
+/// (`kinds/field.rs`), the per-kind scratch structs and the loops over
+/// kinds. Invoked once, in `kinds.rs`.
 macro_rules! kind_list {
     ($($field:ident: $kind:ty),+ $(,)?) => {
+        // Each kind's file, `kinds/FIELD.rs`.
+        $(mod $field;)+
+
         /// The number of force element kinds.
         pub const KIND_COUNT: usize = [$(stringify!($field)),+].len();
 
