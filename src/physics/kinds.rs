@@ -267,6 +267,26 @@ pub(crate) fn lower_pairs(v: &[u32], active: u32, mut f: impl FnMut(usize, usize
     }
 }
 
+/// The listed blocks ([`ForceKind::listed_blocks`]) of a kind whose
+/// elements (their vertices, in element order) each own a stretch of
+/// `stride` values: `f(v[k], v[l], value, false)` for every lower pair of
+/// the slots in `active` ([`lower_pairs`]), values counting up from the
+/// element's stretch.
+pub(crate) fn stretch_blocks<'a>(
+    elements: impl Iterator<Item = &'a [u32]>,
+    active: u32,
+    stride: usize,
+    mut f: impl FnMut(u32, u32, u32, bool),
+) {
+    for (e, v) in elements.enumerate() {
+        let mut value = (e * stride) as u32;
+        lower_pairs(v, active, |k, l| {
+            f(v[k], v[l], value, false);
+            value += 1;
+        });
+    }
+}
+
 /// The most lower blocks ([`lower_pairs`], all slots active) of one of the
 /// elements `vertices`: the stretch each element owns in its kind's values.
 pub(crate) fn lower_stride<'a>(vertices: impl Iterator<Item = &'a [u32]>) -> usize {

@@ -4,7 +4,7 @@
 
 use rayon::prelude::*;
 
-use super::{ForceKind, kick_slots, lower_pairs, lower_stride};
+use super::{ForceKind, kick_slots, lower_pairs, lower_stride, stretch_blocks};
 use crate::math::{Matrix3, Scalar, Vector, deterministic_sum};
 use crate::mesh::Mesh;
 use crate::physics::bending::dihedral_angle_and_gradient;
@@ -257,15 +257,9 @@ impl ForceKind for Hinges {
     }
 
     /// Its lower blocks `h^2 k g_k g_l^T`, a stretch per hinge.
-    fn listed_blocks(el: &Elements, mut f: impl FnMut(u32, u32, u32, bool)) {
-        let stride = stride(el);
-        for (e, hg) in el.kinds.hinges.hinges.iter().enumerate() {
-            let mut value = (e * stride) as u32;
-            lower_pairs(&hg.v, 0b1111, |k, l| {
-                f(hg.v[k], hg.v[l], value, false);
-                value += 1;
-            });
-        }
+    fn listed_blocks(el: &Elements, f: impl FnMut(u32, u32, u32, bool)) {
+        let hinges = el.kinds.hinges.hinges.iter().map(|h| &h.v[..]);
+        stretch_blocks(hinges, 0b1111, stride(el), f);
     }
 
     fn write_blocks(el: &Elements, lin: &mut HingeLinear) {

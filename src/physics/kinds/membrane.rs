@@ -5,7 +5,7 @@
 use rayon::prelude::*;
 
 use super::springs::matrix_diagonal;
-use super::{ForceKind, kick_slots, lower_pairs, lower_stride, slot_pairs};
+use super::{ForceKind, kick_slots, lower_pairs, lower_stride, slot_pairs, stretch_blocks};
 use crate::math::{Matrix3, Scalar, Vector, deterministic_sum};
 use crate::mesh::Mesh;
 use crate::physics::elements::{BuildContext, Elements, Incidence};
@@ -208,15 +208,9 @@ impl ForceKind for MembraneTriangles {
     }
 
     /// Its lower blocks over the columns, a stretch per triangle.
-    fn listed_blocks(el: &Elements, mut f: impl FnMut(u32, u32, u32, bool)) {
-        let stride = stride(el);
-        for (e, t) in el.kinds.membrane.triangles.iter().enumerate() {
-            let mut value = (e * stride) as u32;
-            lower_pairs(&t.v, 0b111, |k, l| {
-                f(t.v[k], t.v[l], value, false);
-                value += 1;
-            });
-        }
+    fn listed_blocks(el: &Elements, f: impl FnMut(u32, u32, u32, bool)) {
+        let triangles = el.kinds.membrane.triangles.iter().map(|t| &t.v[..]);
+        stretch_blocks(triangles, 0b111, stride(el), f);
     }
 
     fn write_blocks(el: &Elements, lin: &mut MembraneLinear) {
