@@ -12,7 +12,7 @@ use drape::mesh::{self, ObjCloth};
 use drape::record::obj::write_mesh_obj;
 use drape::spec::Garment;
 
-use crate::obj_garments::{line_of, load, panels, temp_dir};
+use crate::obj_garments::{TWO_PANELS, line_of, load, panels, temp_dir};
 
 /// Front and back panels sewn by `l` on one side and welded on the other (the
 /// back's right edge shares its positions with a third panel, `side`, with
@@ -153,42 +153,15 @@ fn exported_garment_frame_reads_back_as_the_same_panels_corners_and_seams() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// Front and back panels whose sewn edges lie on each other: the back's left
+/// Front and back panels whose sewn edges lie on each other: [`TWO_PANELS`]
+/// with the back moved onto the front's right edge, so that the back's left
 /// edge has the front's right edge's positions, in `v` lines of its own, and
 /// each `l` pairs two `v` lines at one position.
-const SIDES_ON_EACH_OTHER: &str = "\
-o front
-v 0 0 0
-v 1 0 0
-v 0 0 0.5
-v 1 0 0.5
-v 0 0 1
-v 1 0 1
-vt 0 0
-vt 1 0
-vt 0 0.5
-vt 1 0.5
-vt 0 1
-vt 1 1
-f 1/1 2/2 4/4
-f 1/1 4/4 3/3
-f 3/3 4/4 6/6
-f 3/3 6/6 5/5
-o back
-v 1 0 0
-v 2 0 0
-v 1 0 0.5
-v 2 0 0.5
-v 1 0 1
-v 2 0 1
-f 7/1 8/2 10/4
-f 7/1 10/4 9/3
-f 9/3 10/4 12/6
-f 9/3 12/6 11/5
-l 2 7
-l 4 9
-l 6 11
-";
+fn sides_on_each_other() -> String {
+    TWO_PANELS
+        .replace("v 1.1 ", "v 1 ")
+        .replace("v 2.1 ", "v 2 ")
+}
 
 /// Checks that `cloth` has two panels and one open seam of three pairs, each
 /// pair two vertices at one position.
@@ -207,7 +180,7 @@ fn assert_sides_distinct(cloth: &ObjCloth) {
 
 #[test]
 fn open_seam_whose_sides_lie_on_each_other_reads_back_with_every_pair_distinct() {
-    let cloth = load("on_each_other", SIDES_ON_EACH_OTHER).expect("the garment loads");
+    let cloth = load("on_each_other", &sides_on_each_other()).expect("the garment loads");
     assert_sides_distinct(&cloth);
     let dir = temp_dir("on_each_other_export");
     let path = write_mesh_obj(&dir, 0, &cloth.positions, &cloth.mesh).expect("export");
