@@ -18,7 +18,9 @@ pub(crate) fn allowed(path: &str) -> Option<&'static str> {
         "simulation.dt" => {
             "\"auto\", \"adaptive\" (implicit integrator) or a finite number of seconds > 0 and <= 1/frame_rate"
         }
-        "simulation.adaptive_dt" => "a table [simulation.adaptive_dt] (with dt = \"adaptive\")",
+        "simulation.adaptive_dt" => {
+            "a table [simulation.adaptive_dt] (used with dt = \"adaptive\")"
+        }
         "simulation.adaptive_dt.tolerance" => "a finite number > 0 (m)",
         "simulation.adaptive_dt.penetration" => "a finite number > 0 (m)",
         "simulation.adaptive_dt.min" => "a finite number of seconds > 0 and <= 1/frame_rate",

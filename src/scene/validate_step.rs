@@ -5,20 +5,14 @@ use super::validate::{out_of_range, positive};
 use super::{Integrator, Simulation, TimeStep};
 
 /// `dt = "adaptive"` needs the implicit integrator (its error estimate is
-/// backward Euler's); `[simulation.adaptive_dt]` is read only with it, and its
-/// tolerances are positive, its steps ordered and no longer than a frame.
+/// backward Euler's), and its tolerances are positive, its steps ordered and
+/// no longer than a frame. With another `dt` the `[simulation.adaptive_dt]`
+/// table is neither used nor checked, as `[adapt]` is with `method = "none"`:
+/// `--set simulation.dt=0.005` runs a scene that steps adaptively at a fixed
+/// step (the time-step ladder does so).
 pub(super) fn adaptive_dt(s: &Simulation) -> Result<(), Issue> {
     let at = |k: &str| keys(&["simulation", "adaptive_dt", k]);
     if s.dt != TimeStep::Adaptive {
-        if s.adaptive_dt.is_some() {
-            return Err(Issue::new(
-                keys(&["simulation", "adaptive_dt"]),
-                Kind::NotApplicable,
-                "[simulation.adaptive_dt] sets the tolerances of dt = \"adaptive\", and this scene's dt is not",
-            )
-            .allowed("set dt = \"adaptive\", or remove the table")
-            .because(keys(&["simulation", "dt"])));
-        }
         return Ok(());
     }
     if s.integrator != Integrator::Implicit {
