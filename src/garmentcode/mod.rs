@@ -215,6 +215,7 @@ pub fn check(pattern: &Pattern, max_edge: f64) -> Result<(), Why> {
     let garment = Garment {
         panels: pattern.panels.clone(),
         seams: pattern.seams.clone(),
+        holds: Vec::new(),
         max_edge,
     };
     match build(&garment) {

@@ -31,6 +31,7 @@ fn built(pattern: &Pattern) -> garment::BuiltGarment {
     garment::build(&Garment {
         panels: pattern.panels.clone(),
         seams: pattern.seams.clone(),
+        holds: Vec::new(),
         max_edge: 0.03,
     })
     .expect("the garment builds")
@@ -288,3 +289,4 @@ fn the_shipped_garmentcode_scenes_load_and_build() {
     }
     assert_eq!(built_scenes, 4, "shirt, hoody, dress and jumpsuit");
 }
+
