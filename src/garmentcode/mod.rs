@@ -14,6 +14,7 @@
 //! frame (y up); the scene written from it turns it into drape's z-up world
 //! (`scene_text.rs`).
 
+pub mod attach;
 pub mod body;
 mod convert;
 mod facing;
