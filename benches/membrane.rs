@@ -69,6 +69,7 @@ fn setup(resolution: u32, membrane: Membrane) -> (World, Model) {
         integrator: Integrator::Implicit,
         cg_tolerance: 1e-6,
         cg_max_iterations: 500,
+        attachments: Vec::new(),
         solver: SolverSettings::default(),
     };
     (world, model)

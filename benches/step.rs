@@ -56,6 +56,7 @@ fn setup(resolution: u32, bending_model: BendingModel) -> Setup {
         integrator: Integrator::SymplecticEuler,
         cg_tolerance: 1e-6,
         cg_max_iterations: 500,
+        attachments: Vec::new(),
         solver: drape::physics::SolverSettings::default(),
     };
     let stepper = Stepper::new(&model, &world);

@@ -12,6 +12,7 @@
 use serde::Deserialize;
 
 mod adapt;
+mod attachment;
 mod curve;
 mod garment;
 mod obstacle_spec;
@@ -23,6 +24,7 @@ pub use adapt::{
     Adapt, AdaptCriterion, AdaptEvery, AdaptMethod, DEFAULT_HYSTERESIS, DEFAULT_URGENT_RATIO,
     Measurement, RedDiagonals,
 };
+pub use attachment::{Attachment, AttachmentTable, DEFAULT_ATTACHMENT_STIFFNESS, HoldSpec};
 pub use curve::{Curve, SideCurve};
 pub use garment::{
     DEFAULT_SEWING_STIFFNESS, DEFAULT_WELD_GAP, Garment, Gather, PanelSpec, Placement,

@@ -69,6 +69,7 @@ pub fn setup(
         integrator: Integrator::Implicit,
         cg_tolerance: 1e-6,
         cg_max_iterations: 5000,
+        attachments: Vec::new(),
         solver: SolverSettings {
             solver,
             refactor_iterations,

@@ -13,7 +13,7 @@
 
 use super::transfer::{Origin, PanelCorners};
 use crate::math::Vector2;
-use crate::mesh::{Mesh, MeshError, Panels, Pattern, Seam};
+use crate::mesh::{Hold, Mesh, MeshError, Panels, Pattern, Seam};
 
 /// What the new triangles say about one vertex: its home panel and coordinate,
 /// and whether its corners disagree (it lies on a welded seam).
@@ -78,14 +78,41 @@ pub(super) fn panels_after_remesh(
         .iter()
         .map(|s| carry_seam(s, old_index, origin, &seen))
         .collect::<Result<Vec<_>, _>>()?;
+    let holds = carry_holds(&old_panels.holds, old_index, origin);
     let pattern = Pattern::Panels(Panels {
         names: old_panels.names.clone(),
         of_triangle: new.of_triangle,
         corners: new.corners,
         of_vertex: seen.iter().map(|c| c.panel).collect(),
         seams,
+        holds,
     });
     Ok((pattern, seen.iter().map(|c| c.at).collect()))
+}
+
+/// The attachments' held chains on the new topology: kept vertices stay, and
+/// each new midpoint of two neighbours of a chain joins it between them
+/// ([`Hold::carried`]).
+fn carry_holds(holds: &[Hold], old_index: &[u32], origin: &[Origin]) -> Vec<Hold> {
+    if holds.is_empty() {
+        return Vec::new();
+    }
+    let midpoints: std::collections::HashMap<(u32, u32), u32> = origin
+        .iter()
+        .enumerate()
+        .filter_map(|(i, o)| match *o {
+            Origin::Midpoint(a, b) => Some(((a.min(b), a.max(b)), i as u32)),
+            Origin::Old(_) => None,
+        })
+        .collect();
+    let map = |v: u32| {
+        old_index
+            .get(v as usize)
+            .copied()
+            .filter(|&i| i != u32::MAX)
+    };
+    let midpoint = |a: u32, b: u32| midpoints.get(&(a.min(b), a.max(b))).copied();
+    holds.iter().map(|h| h.carried(map, midpoint)).collect()
 }
 
 /// Seam `seam` on the new topology. An open seam keeps its pairs (remeshing

@@ -10,8 +10,10 @@ use clap::{Args, ValueEnum};
 
 use crate::cli::run::run_scene;
 use crate::{ColourChoice, EdgeChoice, OutputArgs, RunArgs, SceneArgs};
-use drape::garmentcode::body::check_body;
+use drape::garmentcode::attach::{self, PatternAttachment};
+use drape::garmentcode::body::{BodySize, check_body};
 use drape::garmentcode::scene_text::{Body, BodyUp, Draping, scene};
+use drape::garmentcode::{Labelled, Pattern};
 use drape::scene::load_scene_str_in;
 
 /// The draping settings the written scene starts from (`docs/garmentcode.md`).
@@ -54,16 +56,53 @@ pub struct BodyArgs {
     /// Metres per unit of the body file: 1 for metres, 0.01 for centimetres.
     #[arg(long, value_name = "SCALE", default_value_t = 1.0)]
     pub body_scale: f64,
+    /// GarmentCode's measurements of the body (`assets/bodies/*.yaml`, cm),
+    /// which place the planes labelled edges are held at; default: the body's
+    /// file with the extension `.yaml`, when there is one.
+    #[arg(long, value_name = "BODY.yaml")]
+    pub body_measurements: Option<PathBuf>,
 }
 
 impl BodyArgs {
-    /// Checks the scale and the body file (readable, with faces, of a human size).
-    pub fn check(&self) -> Result<()> {
+    /// Checks the scale and the body file (readable, with faces, of a human
+    /// size); returns the body's size.
+    pub fn check(&self) -> Result<BodySize> {
         if !(self.body_scale.is_finite() && self.body_scale > 0.0) {
             anyhow::bail!("--body-scale must be a number > 0, got {}", self.body_scale);
         }
-        check_body(&self.body, self.body_scale)?;
-        Ok(())
+        Ok(check_body(&self.body, self.body_scale)?)
+    }
+
+    /// The measurements file: the one given, or the body's `.yaml` beside it
+    /// when there is one.
+    pub fn measurements_file(&self) -> Option<PathBuf> {
+        let beside = self.body.with_extension("yaml");
+        self.body_measurements
+            .clone()
+            .or_else(|| beside.is_file().then_some(beside))
+    }
+
+    /// The attachments of the labelled sides of `pattern` on this body, whose
+    /// size is `size` (none without a measurements file, with a note when the
+    /// pattern has labels GarmentCode holds).
+    fn attachments(&self, pattern: &Pattern, size: &BodySize) -> Result<Vec<PatternAttachment>> {
+        let floor = match self.body_up {
+            Up::Y => size.lowest[1],
+            Up::Z => size.lowest[2],
+        };
+        let Some(file) = self.measurements_file() else {
+            let held = |l: &&Labelled| attach::HELD_LABELS.contains(&l.label.as_str());
+            if pattern.labels.iter().any(|l| held(&l)) {
+                eprintln!(
+                    "note: no body measurements ({} or --body-measurements): the labelled \
+                     edges are not held",
+                    self.body.with_extension("yaml").display()
+                );
+            }
+            return Ok(Vec::new());
+        };
+        let m = attach::load_measurements(&file)?;
+        Ok(attach::attachments(&pattern.labels, &m, floor))
     }
 }
 
@@ -85,7 +124,8 @@ pub fn cmd_garment(args: GarmentArgs) -> Result<ExitCode> {
             why,
         }
     })?;
-    args.body.check()?;
+    let size = args.body.check()?;
+    let attachments = args.body.attachments(&pattern, &size)?;
     let name = args
         .spec
         .file_stem()
@@ -113,6 +153,7 @@ pub fn cmd_garment(args: GarmentArgs) -> Result<ExitCode> {
         &name,
         &args.spec.display().to_string(),
         &pattern,
+        &attachments,
         &body,
         &DRAPING,
     );

@@ -96,6 +96,12 @@ pub fn cmd_garment_plan(args: GarmentPlanArgs) -> Result<ExitCode> {
         };
         argv.extend(["--body-up".into(), up.into()]);
         argv.extend(["--body-scale".into(), args.body.body_scale.to_string()]);
+        if let Some(file) = &args.body.body_measurements {
+            argv.extend([
+                "--body-measurements".into(),
+                cwd.join(file).display().to_string(),
+            ]);
+        }
         argv.extend(["--no-record".into(), "--quiet".into()]);
         argv.extend(["--summary".into(), format!("{name}.json")]);
         if args.obj {

@@ -8,8 +8,8 @@
 mod sides;
 
 use crate::math::{Vector, Vector2, rotation_from_euler_deg};
-use crate::mesh::{Mesh, MeshError, OutlineError, Panels, Seam, mesh_outline};
-use crate::spec::{Garment, Placement, SeamDirection, SeamSpec};
+use crate::mesh::{Hold, Mesh, MeshError, OutlineError, Panels, Seam, mesh_outline};
+use crate::spec::{Garment, HoldSpec, Placement, SeamDirection, SeamSide, SeamSpec};
 pub use sides::SEAM_LENGTH_TOLERANCE;
 
 /// Why a garment could not be built.
@@ -36,6 +36,14 @@ pub enum GarmentError {
     Seam {
         /// The seam.
         seam: String,
+        /// What is wrong.
+        reason: String,
+    },
+    /// An attachment names a panel or side that does not exist.
+    #[error("attachment `{attachment}`: {reason}")]
+    Attachment {
+        /// The attachment.
+        attachment: String,
         /// What is wrong.
         reason: String,
     },
@@ -144,12 +152,18 @@ pub fn build(garment: &Garment) -> Result<BuiltGarment, GarmentError> {
             })
         })
         .collect::<Result<Vec<Seam>, GarmentError>>()?;
+    let holds = garment
+        .holds
+        .iter()
+        .map(|h| hold(garment, h, &chains))
+        .collect::<Result<Vec<Hold>, GarmentError>>()?;
     let panels = Panels {
         names: garment.panels.iter().map(|p| p.name.clone()).collect(),
         of_triangle,
         corners,
         of_vertex,
         seams,
+        holds,
     };
     let mesh = Mesh::from_panels(material, triangles, panels)?;
     check_weldable(&mesh)?;
@@ -163,22 +177,43 @@ fn side_index(
     first: bool,
 ) -> Result<(usize, usize), GarmentError> {
     let side = if first { &s.a } else { &s.b };
+    find_side(garment, side).map_err(|reason| seam_error(s, reason))
+}
+
+/// The (panel, 0-based side) of `side`, or why there is none.
+fn find_side(garment: &Garment, side: &SeamSide) -> Result<(usize, usize), String> {
     let p = garment
         .panels
         .iter()
         .position(|p| p.name == side.panel)
-        .ok_or_else(|| seam_error(s, format!("there is no panel `{}`", side.panel)))?;
+        .ok_or_else(|| format!("there is no panel `{}`", side.panel))?;
     let count = garment.panels[p].outline.len();
     if side.side == 0 || side.side > count {
-        return Err(seam_error(
-            s,
-            format!(
-                "panel `{}` has sides 1 to {count}, not {}",
-                side.panel, side.side
-            ),
+        return Err(format!(
+            "panel `{}` has sides 1 to {count}, not {}",
+            side.panel, side.side
         ));
     }
     Ok((p, side.side - 1))
+}
+
+/// The vertices attachment `h` holds: the chain of each of its sides.
+fn hold(garment: &Garment, h: &HoldSpec, chains: &[Vec<Vec<u32>>]) -> Result<Hold, GarmentError> {
+    let sides = h
+        .sides
+        .iter()
+        .map(|side| {
+            let (p, k) = find_side(garment, side).map_err(|reason| GarmentError::Attachment {
+                attachment: h.name.clone(),
+                reason,
+            })?;
+            Ok(chains[p][k].clone())
+        })
+        .collect::<Result<Vec<_>, GarmentError>>()?;
+    Ok(Hold {
+        name: h.name.clone(),
+        chains: sides,
+    })
 }
 
 fn seam_error(s: &SeamSpec, reason: String) -> GarmentError {

@@ -44,9 +44,17 @@ pub enum BodyError {
     },
 }
 
-/// Checks the body file at `path` read with `scale`; returns its largest
-/// extent along an axis, m.
-pub fn check_body(path: &Path, scale: Scalar) -> Result<Scalar, BodyError> {
+/// A body file's size, m (the file's coordinates times its scale).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BodySize {
+    /// Its largest extent along an axis, m.
+    pub extent: Scalar,
+    /// Its smallest coordinate along each axis of the file, m.
+    pub lowest: [Scalar; 3],
+}
+
+/// Checks the body file at `path` read with `scale`; returns its size.
+pub fn check_body(path: &Path, scale: Scalar) -> Result<BodySize, BodyError> {
     let file = path.display().to_string();
     let options = tobj::LoadOptions {
         triangulate: true,
@@ -79,5 +87,8 @@ pub fn check_body(path: &Path, scale: Scalar) -> Result<Scalar, BodyError> {
             extent,
         });
     }
-    Ok(extent)
+    Ok(BodySize {
+        extent,
+        lowest: lo.map(|c| c * scale),
+    })
 }

@@ -14,6 +14,7 @@
 //! frame (y up); the scene written from it turns it into drape's z-up world
 //! (`scene_text.rs`).
 
+pub mod attach;
 pub mod body;
 mod convert;
 mod facing;
@@ -215,6 +216,7 @@ pub fn check(pattern: &Pattern, max_edge: f64) -> Result<(), Why> {
     let garment = Garment {
         panels: pattern.panels.clone(),
         seams: pattern.seams.clone(),
+        holds: Vec::new(),
         max_edge,
     };
     match build(&garment) {

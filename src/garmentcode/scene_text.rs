@@ -1,6 +1,7 @@
 //! The scene a GarmentCode pattern drapes in, written as TOML: the pattern's
-//! panels and seams as `[[panel]]` and `[[seam]]`, the body as a mesh
-//! obstacle, and the draping settings. `drape garment` runs this text and
+//! panels and seams as `[[panel]]` and `[[seam]]`, its held labelled edges as
+//! `[[attachment]]` (`attach.rs`), the body as a mesh obstacle, and the
+//! draping settings. `drape garment` runs this text and
 //! `--write-scene` saves it, so that what runs is what a user can edit.
 //!
 //! GarmentCode's frame has y up; drape's world has z up. The garment (and a
@@ -10,6 +11,7 @@
 use std::fmt::Write;
 
 use super::Pattern;
+use super::attach::{PatternAttachment, RELEASE, STIFFNESS};
 use crate::spec::{Curve, Gather, PanelSpec, Placement, SeamDirection, SeamSpec};
 
 /// Which axis of the body file points up.
@@ -51,8 +53,16 @@ pub struct Draping {
     pub rest_window: f64,
 }
 
-/// The scene of `pattern` (from the file `source`) on `body`, named `name`.
-pub fn scene(name: &str, source: &str, pattern: &Pattern, body: &Body, d: &Draping) -> String {
+/// The scene of `pattern` (from the file `source`) on `body`, named `name`,
+/// with its labelled sides held by `attachments`.
+pub fn scene(
+    name: &str,
+    source: &str,
+    pattern: &Pattern,
+    attachments: &[PatternAttachment],
+    body: &Body,
+    d: &Draping,
+) -> String {
     let mut s = String::new();
     header(&mut s, name, source, body, d);
     for p in &pattern.panels {
@@ -61,8 +71,30 @@ pub fn scene(name: &str, source: &str, pattern: &Pattern, body: &Body, d: &Drapi
     for seam in &pattern.seams {
         seam_table(&mut s, seam);
     }
+    for a in attachments {
+        attachment_table(&mut s, a);
+    }
     obstacle(&mut s, body);
     s
+}
+
+/// An `[[attachment]]` with GarmentCode's stiffness and release time.
+fn attachment_table(s: &mut String, a: &PatternAttachment) {
+    let sides: Vec<String> = a
+        .sides
+        .iter()
+        .map(|x| format!("  {{ panel = {}, side = {} }},\n", quoted(&x.panel), x.side))
+        .collect();
+    let _ = write!(
+        s,
+        "\n[[attachment]]               # GarmentCode holds these edges at the body\nname = {}\nsides = [\n{}]\npoint = {}\nnormal = {}\nstiffness = {:?}             # N/m per m of held side\nrelease = {:?}    # s: GarmentCode's 400 frames at 60 per second\n",
+        quoted(&a.name),
+        sides.concat(),
+        triple(a.point),
+        triple(a.normal),
+        STIFFNESS,
+        RELEASE,
+    );
 }
 
 /// A TOML string.

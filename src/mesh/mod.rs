@@ -7,6 +7,7 @@
 
 mod curve;
 mod generate;
+mod holds;
 mod obj;
 mod outline;
 mod pairmap;
@@ -18,6 +19,7 @@ pub use curve::{CURVE_STEPS, side_length, side_points};
 pub use generate::{
     GridCuts, cell_counts, disk, fitted_lines, rectangle, rectangle_cells, rectangle_on_lines,
 };
+pub use holds::Hold;
 pub use obj::{ObjCloth, ObjError, load_obj};
 pub use outline::{
     MAX_OUTLINE_POINTS, OUTLINE_ANGLE_LIMIT_DEG, OutlineError, OutlineMesh, mesh_outline,

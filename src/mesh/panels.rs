@@ -43,6 +43,8 @@ pub struct Panels {
     pub of_vertex: Vec<u16>,
     /// The seams, open or welded.
     pub seams: Vec<Seam>,
+    /// The vertices each attachment holds, in scene order.
+    pub holds: Vec<super::Hold>,
 }
 
 /// A seam: vertex pairs on two panel boundaries, sewn together. The mesh holds
@@ -137,6 +139,10 @@ impl Mesh {
         })?;
         topology::check_fans(&triangles, material.len())?;
         check_seams(&panels.seams, material.len(), &edges)?;
+        let mut held = panels.holds.iter().flat_map(|h| h.chains.iter().flatten());
+        if held.any(|&v| v as usize >= material.len()) {
+            return Err(MeshError::PanelTables);
+        }
         let levels = vec![0; triangles.len()];
         Ok(Mesh {
             material,
@@ -158,6 +164,12 @@ impl Mesh {
     /// The garment's seams, open or welded (none for a cloth without panels).
     pub fn seams(&self) -> &[Seam] {
         self.panels().map_or(&[], |p| &p.seams)
+    }
+
+    /// The vertices the garment's attachments hold (none for a cloth without
+    /// panels).
+    pub fn holds(&self) -> &[super::Hold] {
+        self.panels().map_or(&[], |p| &p.holds)
     }
 
     /// True while a seam of the garment is open.
@@ -248,6 +260,9 @@ impl Mesh {
             if open && other.is_open() {
                 other.pairs.retain(|p| p[0] != p[1]);
             }
+        }
+        for hold in &mut next.holds {
+            *hold = hold.renumbered(&new_index);
         }
         let triangles = self
             .triangles

@@ -38,6 +38,9 @@
 //! * Sewing ([`super::sewing`]): a zero-length spring per pair of an open seam,
 //!   `k = stiffness * s` with `s` the pair's share of the seam's length, and
 //!   with `max_force` a cap `max_force * s` on its force (a Huber energy).
+//! * Attachments ([`super::kinds::Attachments`]): a one-sided spring per held
+//!   vertex, `k = stiffness * s` with `s` the vertex's share of the held sides'
+//!   length, as for sewing.
 //! * Dihedral bending: hinge energy `E_e = (B/2) * theta^2 * L_e^2 / (A1 + A2)`,
 //!   i.e. curvature `theta / h_e` with `h_e = (A1 + A2) / L_e` (the mean height of
 //!   the two wings over the edge) integrated over the hinge's area `A1 + A2`
@@ -60,7 +63,7 @@ use super::kinds::{KindDeferred, KindSets};
 use super::membrane::Membrane;
 use crate::math::Scalar;
 use crate::mesh::Mesh;
-use crate::spec::{BendingModel, Sewing, StiffnessRule};
+use crate::spec::{Attachment, BendingModel, Sewing, StiffnessRule};
 
 /// Material parameters the elements are built from (per area, mesh independent).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -148,6 +151,27 @@ pub struct BuildContext<'a> {
     /// before (empty before the first build), for a kind that keeps what it
     /// can of its previous elements.
     pub previous_vertex_triangles: &'a Incidence,
+    /// The garment's attachments and the time they are built for.
+    pub holding: Holding<'a>,
+}
+
+/// The attachments that pull on the mesh's holds ([`Mesh::holds`], in the
+/// same order) and the time the elements are built for: an attachment whose
+/// release time has come builds no elements.
+#[derive(Debug, Clone, Copy)]
+pub struct Holding<'a> {
+    /// The attachments.
+    pub attachments: &'a [Attachment],
+    /// The time, s.
+    pub time: Scalar,
+}
+
+impl Holding<'_> {
+    /// No attachment.
+    pub const NONE: Holding<'static> = Holding {
+        attachments: &[],
+        time: 0.0,
+    };
 }
 
 /// All force elements of one mesh, with their per-vertex gather lists.
@@ -204,7 +228,7 @@ impl Elements {
     /// elements were built for keeps its matrix instead of computing it again;
     /// `kinds/shapes/reuse.rs`).
     pub fn rebuild(&mut self, mesh: &Mesh, mat: &MaterialParams, clamped: &[u32]) {
-        self.rebuild_but_deferred(mesh, mat, clamped);
+        self.rebuild_but_deferred(mesh, mat, clamped, Holding::NONE);
         let deferred = self.kinds.deferred();
         self.kinds.install(deferred);
     }
@@ -213,7 +237,13 @@ impl Elements {
     /// triangles' fold splits' system, left that of the mesh before):
     /// [`Elements::deferred`] makes it and may run beside other work that
     /// reads the rebuilt elements; [`Elements::install`] puts it in place.
-    pub fn rebuild_but_deferred(&mut self, mesh: &Mesh, mat: &MaterialParams, clamped: &[u32]) {
+    pub fn rebuild_but_deferred(
+        &mut self,
+        mesh: &Mesh,
+        mat: &MaterialParams,
+        clamped: &[u32],
+        holding: Holding<'_>,
+    ) {
         let n = mesh.vertex_count();
         let scratch = &mut self.scratch;
         scratch.area.clear();
@@ -248,6 +278,7 @@ impl Elements {
             area,
             clamped,
             previous_vertex_triangles: &scratch.previous_vertex_triangles,
+            holding,
         };
         self.kinds.build(&cx);
     }

@@ -1,5 +1,5 @@
 //! Force element kinds: each kind of force element (springs, dihedral hinges,
-//! shape triangles, membrane triangles) implements [`ForceKind`] in its own
+//! shape triangles, membrane triangles, held vertices of attachments) implements [`ForceKind`] in its own
 //! file under `kinds/`, and [`kind_list!`] names them once. Each kind owns its
 //! elements of one mesh and their incidence lists ([`ForceKind::Set`], all
 //! kinds' in [`KindSets`], held by [`Elements`]) and builds them
@@ -38,6 +38,7 @@
 #[macro_use]
 mod list;
 
+pub use attachments::{AttachmentLinear, AttachmentSet, Attachments, HeldVertex};
 pub use hinges::{Hinge, HingeLinear, HingeSet, Hinges};
 pub use membrane::{MembraneLinear, MembraneSet, MembraneTriangles};
 pub use shapes::{
@@ -304,6 +305,7 @@ kind_list! {
     hinges: Hinges,
     shapes: ShapeTriangles,
     membrane: MembraneTriangles,
+    attachments: Attachments,
 }
 
 #[cfg(test)]

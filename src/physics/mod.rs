@@ -25,7 +25,7 @@ pub mod timestep;
 pub mod work;
 
 pub use crate::spec::{Preconditioner, Refactor, Solver};
-pub use elements::{Elements, MaterialParams};
+pub use elements::{Elements, Holding, MaterialParams};
 pub use forces::{Energy, ExternalForces, WindForce};
 pub use implicit::SolveFailure;
 pub use kinds::{Hinge, Spring};
@@ -52,6 +52,32 @@ pub struct Model {
     pub cg_max_iterations: u32,
     /// Linear solver and Newton settings (implicit only).
     pub solver: SolverSettings,
+    /// How each of the garment's attachments pulls (in the order of the
+    /// mesh's holds, [`crate::mesh::Mesh::holds`]) and when it lets go.
+    pub attachments: Vec<crate::spec::Attachment>,
+}
+
+impl Model {
+    /// True when an attachment's release time lies in `(from, to]`: the
+    /// elements built before it hold a side that is let go at `to`.
+    pub fn releases_between(&self, from: Scalar, to: Scalar) -> bool {
+        self.attachments
+            .iter()
+            .any(|a| a.holds_at(from) && !a.holds_at(to))
+    }
+
+    /// True while an attachment holds at time `t`.
+    pub fn holds_at(&self, t: Scalar) -> bool {
+        self.attachments.iter().any(|a| a.holds_at(t))
+    }
+}
+
+/// The model's attachments at the world's time.
+fn holding<'a>(model: &'a Model, world: &World) -> Holding<'a> {
+    Holding {
+        attachments: &model.attachments,
+        time: world.time,
+    }
 }
 
 /// How the implicit integrator solves its equations.
@@ -213,11 +239,15 @@ pub struct Stepper {
 impl Stepper {
     /// A stepper for `model` on the world's current mesh.
     pub fn new(model: &Model, world: &World) -> Stepper {
-        let elements = Elements::build_clamped(
+        let mut elements = Elements::default();
+        elements.rebuild_but_deferred(
             &world.mesh,
             &model.material,
             &world.pins.clamped(world.mesh.vertex_count()),
+            holding(model, world),
         );
+        let deferred = elements.deferred();
+        elements.install(deferred);
         Stepper {
             elements,
             stats: StepStats::default(),
@@ -242,7 +272,12 @@ impl Stepper {
     /// elements, so the results do not depend on the thread count).
     pub fn rebuild(&mut self, model: &Model, world: &World) {
         let clamped = world.pins.clamped(world.mesh.vertex_count());
-        (self.elements).rebuild_but_deferred(&world.mesh, &model.material, &clamped);
+        (self.elements).rebuild_but_deferred(
+            &world.mesh,
+            &model.material,
+            &clamped,
+            holding(model, world),
+        );
         self.held.resize(world.mesh.vertex_count(), false);
         self.contacts.clear();
         self.contact_push.clear();

@@ -29,7 +29,7 @@ pub(super) fn check(scene: &Scene, setup: &Setup, world: &World) -> Result<(), R
 /// True when `scene`'s cloth is a disk specimen centred on a vertical support
 /// cylinder of `setup`'s obstacles.
 fn has_cusick_support(scene: &Scene, setup: &Setup) -> bool {
-    crate::scene::cloth_spec(&scene.cloth, &scene.panel, &scene.seam)
+    crate::scene::cloth_spec(&scene.cloth, &scene.panel, &scene.seam, &scene.attachment)
         .is_ok_and(|cloth| setup.obstacles.cusick_support(&cloth).is_some())
 }
 

@@ -1,8 +1,9 @@
 //! A garment's phases over a run: it sews weightless (gravity off while a
 //! seam is open, for at most `cloth.sewing.weightless` seconds), then drapes
 //! under gravity, and the run ends once it is at rest (`simulation.rest`:
-//! every seam welded and no vertex faster than `speed` over any frame of the
-//! last `window` seconds) or at `duration`. A vertex's speed over a frame is
+//! every seam welded, every attachment with a release time released, and no
+//! vertex faster than `speed` over any frame of the last `window` seconds) or
+//! at `duration`. A vertex's speed over a frame is
 //! how far it moved in the frame over the frame's time: what the frames
 //! show, where a velocity at the frame's end may still carry a contact's
 //! last correction.
@@ -21,6 +22,9 @@ pub(super) struct Phases {
     /// How long the garment may sew weightless, s.
     weightless: Option<Scalar>,
     rest: Option<Rest>,
+    /// The last release time of an attachment, s (0 when none has one): the
+    /// run is not at rest before it.
+    released_by: Scalar,
     /// The start of the current stretch of frames under the rest speed, s.
     calm_since: Option<Scalar>,
     /// When the rest criterion was met, s.
@@ -41,6 +45,12 @@ impl Phases {
             gravity: model.external.gravity,
             weightless: scene.cloth.sewing.weightless,
             rest: scene.simulation.rest,
+            released_by: model
+                .attachments
+                .iter()
+                .map(|a| a.release)
+                .filter(|t| t.is_finite())
+                .fold(0.0, Scalar::max),
             calm_since: None,
             at_rest: None,
             speed: None,
@@ -74,7 +84,8 @@ impl Phases {
             return false;
         };
         // The first frame, or a mesh that changed, is not calm: not yet comparable.
-        if self.speed.is_none_or(|speed| speed > rest.speed) || any_open(world) {
+        let held = world.time < self.released_by;
+        if self.speed.is_none_or(|speed| speed > rest.speed) || any_open(world) || held {
             self.calm_since = None;
             return false;
         }

@@ -40,6 +40,11 @@ fn tables() -> Vec<(&'static str, String, &'static str)> {
         ),
         ("panel", appended("[[panel]]\nzzz = 1"), "## Garments"),
         ("seam", appended("[[seam]]\nzzz = 1"), "## Garments"),
+        (
+            "attachment",
+            appended("[[attachment]]\nzzz = 1"),
+            "## Garments",
+        ),
         ("pin", appended("[[pin]]\nzzz = 1"), "## `[[pin]]`"),
         ("air", appended("[air]\nzzz = 1"), "## `[air]`"),
         ("wind", appended("[wind]\nzzz = 1"), "## `[wind]`"),

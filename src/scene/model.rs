@@ -51,6 +51,10 @@ pub struct Scene {
     /// Garment seams (`[[seam]]`, with `shape = "panels"`).
     #[serde(default)]
     pub seam: Vec<SeamTable>,
+    /// Garment attachments (`[[attachment]]`, with `shape = "panels"`): panel
+    /// sides held on one side of a plane until a release time.
+    #[serde(default)]
+    pub attachment: Vec<crate::spec::AttachmentTable>,
     /// Where the recording's 3D views look from; absent: they follow the cloth.
     pub camera: Option<super::CameraTable>,
 }

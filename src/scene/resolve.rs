@@ -17,13 +17,14 @@ use crate::world::{BuildError, World};
 use super::model::{PanelTable, SeamTable};
 use super::{Cloth, ClothShape, DEFAULT_AIR_DENSITY, Scene, TimeStep};
 use crate::sim::{AdaptiveStep, Settings, SimSpec, StepSize};
+use crate::spec::AttachmentTable;
 
 impl Scene {
     /// The engine's specification of this (validated) scene: the one input of
     /// [`crate::sim::build`].
     pub fn resolve(&self) -> Result<SimSpec, BuildError> {
         Ok(SimSpec {
-            cloth: cloth_spec(&self.cloth, &self.panel, &self.seam)?,
+            cloth: cloth_spec(&self.cloth, &self.panel, &self.seam, &self.attachment)?,
             pins: self.pin.clone(),
             model: Model::from_scene(self),
             obstacles: self
@@ -58,6 +59,7 @@ pub fn cloth_spec(
     c: &Cloth,
     panels: &[PanelTable],
     seams: &[SeamTable],
+    attachments: &[AttachmentTable],
 ) -> Result<ClothSpec, BuildError> {
     let need = |v: Option<f64>, name| v.ok_or(BuildError::Missing(name));
     let mesh = match c.shape {
@@ -94,6 +96,7 @@ pub fn cloth_spec(
                     gather: if s.gather { Gather::Any } else { Gather::None },
                 })
                 .collect(),
+            holds: attachments.iter().map(AttachmentTable::hold).collect(),
             max_edge: need(c.max_edge, "max_edge")?,
         }),
     };
@@ -153,7 +156,7 @@ impl World {
             .obstacle_specs()
             .map_err(|(index, why)| BuildError::Obstacle { index, why })?;
         World::from_spec(
-            &cloth_spec(&scene.cloth, &scene.panel, &scene.seam)?,
+            &cloth_spec(&scene.cloth, &scene.panel, &scene.seam, &scene.attachment)?,
             &scene.pin,
             &obstacles,
         )
@@ -173,7 +176,7 @@ impl Obstacles {
     /// vertical cylinder (the support disk) centred under it.
     pub fn cusick(&self, scene: &Scene, world: &World) -> Option<CusickSummary> {
         self.cusick_of(
-            &cloth_spec(&scene.cloth, &scene.panel, &scene.seam).ok()?,
+            &cloth_spec(&scene.cloth, &scene.panel, &scene.seam, &scene.attachment).ok()?,
             world,
         )
     }
@@ -221,6 +224,7 @@ impl Model {
                 newton_iterations: scene.simulation.newton_iterations,
                 newton_tolerance: scene.simulation.newton_tolerance,
             },
+            attachments: scene.attachment.iter().map(AttachmentTable::pull).collect(),
         }
     }
 }

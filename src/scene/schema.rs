@@ -66,6 +66,18 @@ pub(crate) fn allowed(path: &str) -> Option<&'static str> {
         "seam.a.side" | "seam.b.side" => "an integer from 1 to the panel's corner count",
         "seam.direction" => "\"opposite\" or \"same\"",
         "seam.gather" => "true or false",
+        "attachment" => "an array of tables [[attachment]] (with cloth.shape = \"panels\")",
+        "attachment.name" => "a non-empty string, unique among the attachments",
+        "attachment.sides" => {
+            "a non-empty array of tables { panel, side }: an existing panel and a side 1 to \
+             its corner count"
+        }
+        "attachment.sides.panel" => "the name of a [[panel]]",
+        "attachment.sides.side" => "an integer from 1 to the panel's corner count",
+        "attachment.point" => "an array of 3 finite numbers (m, world)",
+        "attachment.normal" => "an array of 3 finite numbers, not all 0 (world)",
+        "attachment.stiffness" => "a finite number > 0 (N/m per m of held side)",
+        "attachment.release" => "a finite number >= 0 (s); absent: never released",
         "cloth.sewing" => "a table [cloth.sewing] (shape = \"panels\" or \"obj\" only)",
         "cloth.sewing.stiffness" => "a finite number > 0 (N/m per m of seam)",
         "cloth.sewing.weld_gap" => "a finite number > 0 (m)",

@@ -1,16 +1,17 @@
-//! Checks of a garment's `[[panel]]` and `[[seam]]` tables: names, outlines,
-//! placements, and seams that name existing panel sides of matching length;
+//! Checks of a garment's `[[panel]]`, `[[seam]]` and `[[attachment]]` tables:
+//! names, outlines, placements, seams that name existing panel sides of
+//! matching length, and attachments that name existing sides and a plane;
 //! and of `[cloth.sewing]`, which sews both these seams and an OBJ's.
 //! Each check names the key path, which `parse.rs` turns into a line of the
 //! file or a `--set`.
 
 use super::error::{Issue, KeyPath, SceneErrorKind as Kind, Seg, keys};
 use super::model::{PanelTable, SeamTable, SewingTable};
-use super::validate::{all_finite, positive};
+use super::validate::{all_finite, non_negative, positive};
 use super::{ClothShape, Scene};
 use crate::garment::SEAM_LENGTH_TOLERANCE;
 use crate::math::Scalar;
-use crate::spec::{AdaptMethod, Curve, SeamSide};
+use crate::spec::{AdaptMethod, AttachmentTable, Curve, SeamSide};
 
 fn at(table: &str, i: usize, key: &str) -> KeyPath {
     vec![Seg::Key(table.into()), Seg::Index(i), Seg::Key(key.into())]
@@ -20,7 +21,11 @@ fn at(table: &str, i: usize, key: &str) -> KeyPath {
 pub(super) fn garment(scene: &Scene) -> Result<(), Issue> {
     let panels_shape = scene.cloth.shape == ClothShape::Panels;
     if !panels_shape {
-        for (table, count) in [("panel", scene.panel.len()), ("seam", scene.seam.len())] {
+        for (table, count) in [
+            ("panel", scene.panel.len()),
+            ("seam", scene.seam.len()),
+            ("attachment", scene.attachment.len()),
+        ] {
             if count > 0 {
                 return Err(Issue::new(
                     at(table, 0, "name"),
@@ -56,7 +61,53 @@ pub(super) fn garment(scene: &Scene) -> Result<(), Issue> {
     for (i, s) in scene.seam.iter().enumerate() {
         seam(i, s, &scene.seam[..i], &scene.panel)?;
     }
+    for (i, a) in scene.attachment.iter().enumerate() {
+        attachment(i, a, &scene.attachment[..i], &scene.panel)?;
+    }
     Ok(())
+}
+
+/// Checks `[[attachment]]` number `i` (`a`): a unique name, existing panel
+/// sides, a plane with a finite point and a non-zero normal, a positive
+/// stiffness and a release time >= 0.
+fn attachment(
+    i: usize,
+    a: &AttachmentTable,
+    earlier: &[AttachmentTable],
+    panels: &[PanelTable],
+) -> Result<(), Issue> {
+    let path = |key: &str| at("attachment", i, key);
+    unique_name(
+        path("name"),
+        &a.name,
+        earlier.iter().map(|e| e.name.clone()),
+    )?;
+    if a.sides.is_empty() {
+        return Err(Issue::new(
+            path("sides"),
+            Kind::BadValue,
+            "an attachment holds at least one panel side",
+        ));
+    }
+    for (k, side) in a.sides.iter().enumerate() {
+        let mut at_side = path("sides");
+        at_side.push(Seg::Index(k));
+        existing_side(at_side, side, panels)?;
+    }
+    all_finite(path("point"), &a.point)?;
+    all_finite(path("normal"), &a.normal)?;
+    if a.normal.iter().all(|&c| c == 0.0) {
+        return Err(Issue::new(
+            path("normal"),
+            Kind::BadValue,
+            "the normal is zero: it must give the side of the plane the sides are held on",
+        ));
+    }
+    positive(path("stiffness"), a.stiffness)?;
+    match a.release {
+        Some(t) => non_negative(path("release"), t),
+        None => Ok(()),
+    }
 }
 
 /// `[cloth.sewing]`: a positive, finite stiffness, weld gap and (when given)
@@ -199,10 +250,23 @@ fn side_length(
     side: &SeamSide,
     panels: &[PanelTable],
 ) -> Result<Scalar, Issue> {
+    let p = existing_side(at("seam", i, key), side, panels)?;
+    let n = p.outline.len();
+    let (u, w) = (p.outline[side.side - 1], p.outline[side.side % n]);
+    Ok((u[0] - w[0]).hypot(u[1] - w[1]))
+}
+
+/// The panel of `side` (the key at `path`), or the issue when there is no
+/// such panel or side.
+fn existing_side<'a>(
+    path: KeyPath,
+    side: &SeamSide,
+    panels: &'a [PanelTable],
+) -> Result<&'a PanelTable, Issue> {
     let Some(p) = panels.iter().find(|p| p.name == side.panel) else {
         let names: Vec<&str> = panels.iter().map(|p| p.name.as_str()).collect();
         return Err(Issue::new(
-            at("seam", i, key),
+            path,
             Kind::BadValue,
             format!("there is no panel `{}`", side.panel),
         )
@@ -211,7 +275,7 @@ fn side_length(
     let n = p.outline.len();
     if side.side == 0 || side.side > n {
         return Err(Issue::new(
-            at("seam", i, key),
+            path,
             Kind::OutOfRange,
             format!("panel `{}` has sides 1 to {n}, not {}", p.name, side.side),
         )
@@ -219,8 +283,7 @@ fn side_length(
             "1 to {n}: side k runs from outline corner k to corner k + 1"
         )));
     }
-    let (u, w) = (p.outline[side.side - 1], p.outline[side.side % n]);
-    Ok((u[0] - w[0]).hypot(u[1] - w[1]))
+    Ok(p)
 }
 
 /// The issue when a side of `[[seam]]` number `i` (`s`) is sewn by an earlier seam.

@@ -217,6 +217,7 @@ impl Pipeline {
             "the pipeline's elements are not those of the state's mesh: call mesh_changed"
         );
         let rollback = setup.settings.adapt.as_ref().is_some_and(|a| a.rollback);
+        let start = state.world.time;
         let mut rollbacks = 0;
         let mut next = None;
         loop {
@@ -241,6 +242,7 @@ impl Pipeline {
         state.ledger.steps_done += 1;
         let remeshed = self.adapt(setup, state)?;
         let remeshed = self.weld_closed_seams(setup, state)? || remeshed;
+        let remeshed = self.release_attachments(setup, state, start) || remeshed;
         Ok(StepOutcome {
             rollbacks,
             remeshed,

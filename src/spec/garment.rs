@@ -13,6 +13,8 @@ pub struct Garment {
     pub panels: Vec<PanelSpec>,
     /// The seams, in scene order.
     pub seams: Vec<SeamSpec>,
+    /// The held sides of each attachment, in scene order.
+    pub holds: Vec<super::HoldSpec>,
     /// The target edge length of the panels' triangles, m.
     pub max_edge: f64,
 }

@@ -70,6 +70,7 @@ fn swinging_stepper(
             integrator,
             cg_tolerance: 1e-6,
             cg_max_iterations: 500,
+            attachments: Vec::new(),
             solver: drape::physics::SolverSettings::default(),
         },
         w,

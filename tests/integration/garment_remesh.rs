@@ -75,6 +75,7 @@ fn welded_halves(width: Scalar, placements: [Placement; 2]) -> (World, Scalar) {
     let BuiltGarment { mesh, positions } = garment::build(&Garment {
         panels: vec![half("front", pf), half("back", pb)],
         seams,
+        holds: Vec::new(),
         max_edge: 0.06,
     })
     .expect("garment");

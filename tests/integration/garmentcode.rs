@@ -31,6 +31,7 @@ fn built(pattern: &Pattern) -> garment::BuiltGarment {
     garment::build(&Garment {
         panels: pattern.panels.clone(),
         seams: pattern.seams.clone(),
+        holds: Vec::new(),
         max_edge: 0.03,
     })
     .expect("the garment builds")
@@ -287,4 +288,79 @@ fn the_shipped_garmentcode_scenes_load_and_build() {
         built_scenes += 1;
     }
     assert_eq!(built_scenes, 4, "shirt, hoody, dress and jumpsuit");
+}
+
+/// GarmentCode's measurements of `mean_all` that place the planes, cm.
+const MEASUREMENTS: &str = "body:\n  armscye_depth: 12.8679\n  head_l: 26.3262\n  height: 171.99\n  \
+                            neck_w: 18.9328\n  waist_line: 36.8913\n";
+
+#[test]
+fn labelled_edges_become_attachments_at_the_planes_the_body_measurements_give() {
+    let dir = case("labels", |s| {
+        let edges = &mut s["pattern"]["panels"]["left_ftorso"]["edges"];
+        edges[0]["label"] = "lower_interface".into();
+        edges[1]["label"] = "hem".into();
+    });
+    let write = |extra: &[&str]| {
+        let mut args = vec![
+            "garment",
+            "shirt.json",
+            "--body",
+            "body.obj",
+            "--write-scene",
+            "shirt.toml",
+            "--no-record",
+            "-q",
+            "--set",
+            "simulation.duration=0.02",
+        ];
+        args.extend_from_slice(extra);
+        let out = drape(&dir, &args);
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let scene = drape::scene::load_scene_file(&dir.join("shirt.toml"), &[]).expect("scene");
+        (scene, String::from_utf8_lossy(&out.stderr).into_owned())
+    };
+    // No measurements beside the body: nothing held, and a note says so.
+    let (scene, stderr) = write(&[]);
+    assert!(scene.attachment.is_empty());
+    assert!(stderr.contains("labelled edges are not held"), "{stderr}");
+    // body.yaml beside body.obj: one attachment, its plane at the waist, lowered
+    // by as much as the body (a cube from y = -3 m) reaches below the floor.
+    std::fs::write(dir.join("body.yaml"), MEASUREMENTS).expect("write");
+    let (scene, _) = write(&[]);
+    assert_eq!(scene.attachment.len(), 1, "only lower_interface is held");
+    let a = &scene.attachment[0];
+    assert_eq!(a.name, "lower_interface");
+    assert_eq!(a.sides.len(), 1);
+    assert_eq!(
+        (a.sides[0].panel.as_str(), a.sides[0].side),
+        ("left_ftorso", 1)
+    );
+    let waist = (171.99 - 26.3262 - 36.8913) / 100.0;
+    assert!((a.point[2] - (waist - 3.0)).abs() < 1e-9, "{:?}", a.point);
+    assert_eq!(a.normal, [0.0, 0.0, 1.0]);
+    assert_eq!(a.stiffness, 1000.0);
+    assert!((a.release.expect("a release time") - 400.0 / 60.0).abs() < 1e-12);
+    // A measurements file without a height is refused, naming it.
+    std::fs::write(dir.join("bad.yaml"), "body:\n  head_l: 26\n").expect("write");
+    let args = [
+        "garment",
+        "shirt.json",
+        "--body",
+        "body.obj",
+        "--body-measurements",
+        "bad.yaml",
+        "--no-record",
+    ];
+    refused(
+        &drape(&dir, &args),
+        1,
+        &["body measurements bad.yaml", "`height`"],
+    );
+    std::fs::remove_dir_all(&dir).ok();
 }

@@ -210,6 +210,7 @@ fn cylinder_bending_energy(halves: usize, r: Scalar, max_edge: Scalar) -> Scalar
     let BuiltGarment { mesh, positions } = garment::build(&Garment {
         panels,
         seams,
+        holds: Vec::new(),
         max_edge,
     })
     .expect("garment");
@@ -296,6 +297,7 @@ fn open_seams_leave_the_panels_unjoined() {
             seam("s0", ("a", 2), ("b", 4)),
             seam("s1", ("b", 2), ("a", 4)),
         ],
+        holds: Vec::new(),
         max_edge: 0.03,
     })
     .expect("garment");

@@ -7,6 +7,7 @@ mod adapt_sizing;
 mod adapt_tensor;
 mod adaptive_dt;
 mod articulated;
+mod attachments;
 mod bad_cli;
 mod bad_input;
 mod bad_obj;

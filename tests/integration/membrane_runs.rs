@@ -187,6 +187,7 @@ fn implicit_steps(
         integrator: Integrator::Implicit,
         cg_tolerance: 1e-13,
         cg_max_iterations: 20000,
+        attachments: Vec::new(),
         solver: SolverSettings {
             solver,
             newton_iterations,

@@ -228,6 +228,7 @@ fn garmentcode_garments_read_back_from_their_first_frame_with_every_seam_and_pai
         let built = garment::build(&Garment {
             panels: pattern.panels,
             seams: pattern.seams,
+            holds: Vec::new(),
             max_edge: 0.02,
         })
         .expect("the garment builds");

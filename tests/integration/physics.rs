@@ -39,6 +39,7 @@ fn model(mat: MaterialParams, external: ExternalForces, integrator: Integrator) 
         integrator,
         cg_tolerance: 1e-12,
         cg_max_iterations: 2000,
+        attachments: Vec::new(),
         solver: SolverSettings::default(),
     }
 }
@@ -395,6 +396,7 @@ fn implicit_is_stable_at_a_sixtieth_of_a_second_on_stiff_fabric() {
         Model {
             cg_tolerance: 1e-6,
             cg_max_iterations: 1000,
+            attachments: Vec::new(),
             ..model(mat, ext, Integrator::Implicit)
         },
         &w,

@@ -39,6 +39,7 @@ fn implicit(mat: MaterialParams, external: ExternalForces, solver: Solver, tol: 
         integrator: Integrator::Implicit,
         cg_tolerance: tol,
         cg_max_iterations: 5000,
+        attachments: Vec::new(),
         solver: SolverSettings {
             solver,
             ..SolverSettings::default()

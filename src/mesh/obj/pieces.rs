@@ -92,6 +92,7 @@ pub(super) fn panels(
         corners,
         of_vertex,
         seams: Vec::new(),
+        holds: Vec::new(),
     };
     (material, panels)
 }

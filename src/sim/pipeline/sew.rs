@@ -1,5 +1,6 @@
 //! The pipeline's sewing phase: an open seam whose every pair has closed to
-//! within its weld gap becomes one surface ([`crate::world::World::weld_seam`]).
+//! within its weld gap becomes one surface ([`crate::world::World::weld_seam`]);
+//! and an attachment whose release time has passed lets its sides go.
 
 use super::Pipeline;
 use crate::math::{Scalar, Vector};
@@ -65,6 +66,28 @@ impl Pipeline {
             state.ledger.external_work += after - before;
             welded = true;
         }
+    }
+}
+
+impl Pipeline {
+    /// Release: once the time passes an attachment's release time (the step
+    /// that began at `from` ended after it), the elements are rebuilt without
+    /// it. The elastic energy it held goes with it, booked as external work,
+    /// as a weld's change is. True when it rebuilt.
+    pub(super) fn release_attachments(
+        &mut self,
+        setup: &Setup,
+        state: &mut SimState,
+        from: Scalar,
+    ) -> bool {
+        if !setup.model.releases_between(from, state.world.time) {
+            return false;
+        }
+        let before = self.stepper.energy(&setup.model, &state.world).total();
+        self.mesh_changed(setup, state);
+        let after = self.stepper.energy(&setup.model, &state.world).total();
+        state.ledger.external_work += after - before;
+        true
     }
 }
 
