@@ -61,6 +61,10 @@ pub struct BodyArgs {
     /// file with the extension `.yaml`, when there is one.
     #[arg(long, value_name = "BODY.yaml")]
     pub body_measurements: Option<PathBuf>,
+    /// Hold no labelled edge at the body (write no `[[attachment]]`), whatever
+    /// the measurements.
+    #[arg(long, conflicts_with = "body_measurements")]
+    pub no_hold: bool,
 }
 
 impl BodyArgs {
@@ -83,9 +87,12 @@ impl BodyArgs {
     }
 
     /// The attachments of the labelled sides of `pattern` on this body, whose
-    /// size is `size` (none without a measurements file, with a note when the
-    /// pattern has labels GarmentCode holds).
+    /// size is `size` (none with `--no-hold`, and none without a measurements
+    /// file, with a note when the pattern has labels GarmentCode holds).
     fn attachments(&self, pattern: &Pattern, size: &BodySize) -> Result<Vec<PatternAttachment>> {
+        if self.no_hold {
+            return Ok(Vec::new());
+        }
         let floor = match self.body_up {
             Up::Y => size.lowest[1],
             Up::Z => size.lowest[2],

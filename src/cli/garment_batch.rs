@@ -102,6 +102,9 @@ pub fn cmd_garment_plan(args: GarmentPlanArgs) -> Result<ExitCode> {
                 cwd.join(file).display().to_string(),
             ]);
         }
+        if args.body.no_hold {
+            argv.push("--no-hold".into());
+        }
         argv.extend(["--no-record".into(), "--quiet".into()]);
         argv.extend(["--summary".into(), format!("{name}.json")]);
         if args.obj {

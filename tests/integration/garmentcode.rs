@@ -346,6 +346,9 @@ fn labelled_edges_become_attachments_at_the_planes_the_body_measurements_give() 
     assert_eq!(a.normal, [0.0, 0.0, 1.0]);
     assert_eq!(a.stiffness, 1000.0);
     assert!((a.release.expect("a release time") - 400.0 / 60.0).abs() < 1e-12);
+    // --no-hold: nothing held, whatever the measurements.
+    let (scene, _) = write(&["--no-hold"]);
+    assert!(scene.attachment.is_empty());
     // A measurements file without a height is refused, naming it.
     std::fs::write(dir.join("bad.yaml"), "body:\n  head_l: 26\n").expect("write");
     let args = [
