@@ -24,7 +24,7 @@ pub mod shape;
 pub mod timestep;
 pub mod work;
 
-pub use crate::spec::{Preconditioner, Refactor, Solver};
+pub use crate::spec::{BendingMatrix, Preconditioner, Refactor, Solver};
 pub use elements::{Elements, MaterialParams};
 pub use forces::{Energy, ExternalForces, WindForce};
 pub use implicit::SolveFailure;
@@ -67,6 +67,9 @@ pub struct SolverSettings {
     pub refactor: Refactor,
     /// Direct solver: what it factors as its preconditioner.
     pub preconditioner: Preconditioner,
+    /// Direct solver: which of the shape triangles' bending blocks its matrix
+    /// holds (the others lumped on the diagonal).
+    pub bending_matrix: BendingMatrix,
     /// Newton iterations per step (1: Baraff and Witkin's linearised step).
     pub newton_iterations: u32,
     /// Relative residual at which Newton iterations stop.
@@ -82,10 +85,18 @@ impl Default for SolverSettings {
             refactor_iterations: 7,
             refactor: Refactor::Cost,
             preconditioner: Preconditioner::Factor,
+            bending_matrix: BendingMatrix::Exact,
             newton_iterations: 1,
             newton_tolerance: 1e-3,
         }
     }
+}
+
+/// Whether `model`'s direct solver lumps the shape triangles' second-ring
+/// blocks ([`BendingMatrix::FirstRing`]; the CG solver's products and the
+/// explicit integrators never read the blocks).
+fn lumps(model: &Model) -> bool {
+    model.solver.bending_matrix == BendingMatrix::FirstRing
 }
 
 /// Counters of what the stepper did.
@@ -213,11 +224,12 @@ pub struct Stepper {
 impl Stepper {
     /// A stepper for `model` on the world's current mesh.
     pub fn new(model: &Model, world: &World) -> Stepper {
-        let elements = Elements::build_clamped(
+        let mut elements = Elements::build_clamped(
             &world.mesh,
             &model.material,
             &world.pins.clamped(world.mesh.vertex_count()),
         );
+        elements.kinds.shapes.lump_second_ring = lumps(model);
         Stepper {
             elements,
             stats: StepStats::default(),
@@ -243,6 +255,7 @@ impl Stepper {
     pub fn rebuild(&mut self, model: &Model, world: &World) {
         let clamped = world.pins.clamped(world.mesh.vertex_count());
         (self.elements).rebuild_but_deferred(&world.mesh, &model.material, &clamped);
+        self.elements.kinds.shapes.lump_second_ring = lumps(model);
         self.held.resize(world.mesh.vertex_count(), false);
         self.contacts.clear();
         self.contact_push.clear();

@@ -16,6 +16,7 @@ use crate::physics::{Model, forces::PAR_MIN};
 use crate::scene::{BendingModel, DiagonalPattern, default_scene};
 use crate::world::World;
 
+mod lumped;
 mod projection;
 
 /// The default scene's sheet at 12 x 12 and its fabric, and the same grid
