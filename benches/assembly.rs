@@ -9,6 +9,11 @@
 //! factorization drops, `A dv_c` and the projected system. The state does not
 //! move on between iterations (the sheet stays where its warm-up left it).
 //!
+//! Each resolution runs twice: with the default exact bending matrix
+//! (`shape_operator`) and with the shape triangles' second-ring blocks
+//! lumped on the diagonal (`shape_operator_first_ring`,
+//! `simulation.bending_matrix = "first_ring"`).
+//!
 //! An element is one spring, one bending element (shape triangle or hinge) or
 //! one membrane triangle: Criterion's throughput is in elements, and after the
 //! group the time per element and per assembly is printed for each case, from
@@ -21,9 +26,9 @@ mod sheet;
 use std::time::{Duration, Instant};
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group};
-use drape::physics::Solver;
+use drape::physics::{BendingMatrix, Solver};
 use drape::scene::BendingModel;
-use sheet::{DT, Sheet, setup};
+use sheet::{DT, Sheet, setup_with};
 
 /// The sheet at each resolution (64 x 64 and 128 x 128 vertices).
 const RESOLUTIONS: [u32; 2] = [63, 127];
@@ -37,9 +42,22 @@ fn elements(sheet: &Sheet) -> u64 {
         + e.kinds.membrane.triangles.len()) as u64
 }
 
-/// The sheet with the shape operator and the default direct solver.
-fn shape_operator_sheet(resolution: u32) -> Sheet {
-    setup(resolution, BendingModel::ShapeOperator, Solver::Direct, 7)
+/// The bending matrices of the cases, with their names.
+const MATRICES: [(BendingMatrix, &str); 2] = [
+    (BendingMatrix::Exact, "shape_operator"),
+    (BendingMatrix::FirstRing, "shape_operator_first_ring"),
+];
+
+/// The sheet with the shape operator and the default direct solver with
+/// `matrix`.
+fn shape_operator_sheet(resolution: u32, matrix: BendingMatrix) -> Sheet {
+    setup_with(
+        resolution,
+        BendingModel::ShapeOperator,
+        Solver::Direct,
+        7,
+        matrix,
+    )
 }
 
 fn assembly(c: &mut Criterion) {
@@ -48,11 +66,14 @@ fn assembly(c: &mut Criterion) {
         .warm_up_time(Duration::from_secs(1))
         .measurement_time(Duration::from_secs(3))
         .sample_size(20);
-    for resolution in RESOLUTIONS {
-        let mut sheet = shape_operator_sheet(resolution);
+    for (resolution, (matrix, name)) in RESOLUTIONS
+        .into_iter()
+        .flat_map(|r| MATRICES.map(|m| (r, m)))
+    {
+        let mut sheet = shape_operator_sheet(resolution, matrix);
         let vertices = sheet.world.mesh.vertex_count();
         group.throughput(Throughput::Elements(elements(&sheet)));
-        group.bench_function(BenchmarkId::new("shape_operator", vertices), |b| {
+        group.bench_function(BenchmarkId::new(name, vertices), |b| {
             b.iter(|| {
                 let Sheet {
                     world,
@@ -70,8 +91,11 @@ fn assembly(c: &mut Criterion) {
 /// Time per assembly and per element over 200 assemblies, for each case.
 fn per_element() {
     println!("assembly over 200 repetitions (shape operator, direct solver):");
-    for resolution in RESOLUTIONS {
-        let mut sheet = shape_operator_sheet(resolution);
+    for (resolution, (matrix, name)) in RESOLUTIONS
+        .into_iter()
+        .flat_map(|r| MATRICES.map(|m| (r, m)))
+    {
+        let mut sheet = shape_operator_sheet(resolution, matrix);
         let Sheet {
             world,
             model,
@@ -94,7 +118,7 @@ fn per_element() {
         let wall = started.elapsed().as_secs_f64() / 200.0;
         let counted = (stepper.stats.assembly_s - before) / 200.0;
         println!(
-            "  {:>5} vertices, {count} elements ({springs} springs, {bending} bending, \
+            "  {name}: {:>5} vertices, {count} elements ({springs} springs, {bending} bending, \
              {membrane} membrane): {:.3} ms per assembly ({:.3} ms counted as assembly_s), \
              {:.1} ns per element",
             world.mesh.vertex_count(),

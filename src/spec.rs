@@ -127,6 +127,21 @@ pub enum Preconditioner {
     Laplacian,
 }
 
+/// What the direct solver's matrix holds of the shape triangles' bending
+/// blocks (`docs/model.md`, "The shape triangles' matrix").
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum BendingMatrix {
+    /// The blocks between vertices joined by a mesh edge (the first ring);
+    /// each second-ring block is lumped onto its two vertices' diagonal
+    /// blocks as a positive semi-definite rank-one pair, so that the matrix
+    /// stays positive definite and at least as stiff as the exact one.
+    FirstRing,
+    /// Every block of the Gauss-Newton Hessian `J^T M J`, the second ring too.
+    #[default]
+    Exact,
+}
+
 /// The time integrator.
 #[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq, Default)]
 #[serde(rename_all = "snake_case")]

@@ -7,7 +7,9 @@
 use std::hint::black_box;
 
 use drape::math::{Scalar, Vector};
-use drape::physics::{ExternalForces, MaterialParams, Model, Solver, SolverSettings, Stepper};
+use drape::physics::{
+    BendingMatrix, ExternalForces, MaterialParams, Model, Solver, SolverSettings, Stepper,
+};
 use drape::scene::{BendingModel, DiagonalPattern, Integrator, Pin, PinMotion, StiffnessRule};
 use drape::world::World;
 
@@ -37,12 +39,31 @@ fn corner(region: &str) -> Pin {
 }
 
 /// The swinging sheet at `resolution` with `bending`, after 30 steps, with its
-/// stepper.
+/// stepper (the `assembly` bench, which sets the bending matrix, does not
+/// use it).
+#[allow(dead_code)]
 pub fn setup(
     resolution: u32,
     bending: BendingModel,
     solver: Solver,
     refactor_iterations: u32,
+) -> Sheet {
+    setup_with(
+        resolution,
+        bending,
+        solver,
+        refactor_iterations,
+        BendingMatrix::default(),
+    )
+}
+
+/// As [`setup`], with the direct solver's `bending_matrix`.
+pub fn setup_with(
+    resolution: u32,
+    bending: BendingModel,
+    solver: Solver,
+    refactor_iterations: u32,
+    bending_matrix: BendingMatrix,
 ) -> Sheet {
     let mesh = drape::mesh::rectangle(1.0, 1.0, resolution, DiagonalPattern::Alternating)
         .expect("valid rectangle");
@@ -73,6 +94,7 @@ pub fn setup(
         solver: SolverSettings {
             solver,
             refactor_iterations,
+            bending_matrix,
             ..SolverSettings::default()
         },
     };

@@ -45,6 +45,11 @@
 //! joined by a spring or a membrane triangle's edge); each kind compensates on
 //! the diagonal for the blocks it adds that are dropped
 //! ([`super::kinds::ForceKind::dropped_terms`] and the in-place blocks' norms).
+//! The shape triangles' second-ring blocks (a tip with the triangle's
+//! opposite vertex or another tip) are not in the pattern at all with the
+//! default first-ring bending matrix, which lumps them on the diagonal of
+//! `A` itself (`kinds/shapes/blocks.rs`, "The first-ring matrix"); with the
+//! exact one they are dropped from the factor like the hinges' below.
 //! With dihedral hinges the only other blocks are the couplings between the two wing tips
 //! `p`, `q` of a hinge, and keeping them more than doubles the factor: on a 65 x 65
 //! grid its stored values go from 0.80 to 1.99 million and a numerical factorization

@@ -24,7 +24,7 @@ pub mod shape;
 pub mod timestep;
 pub mod work;
 
-pub use crate::spec::{Preconditioner, Refactor, Solver};
+pub use crate::spec::{BendingMatrix, Preconditioner, Refactor, Solver};
 pub use elements::{Elements, Holding, MaterialParams};
 pub use forces::{Energy, ExternalForces, WindForce};
 pub use implicit::SolveFailure;
@@ -93,6 +93,9 @@ pub struct SolverSettings {
     pub refactor: Refactor,
     /// Direct solver: what it factors as its preconditioner.
     pub preconditioner: Preconditioner,
+    /// Direct solver: which of the shape triangles' bending blocks its matrix
+    /// holds (the others lumped on the diagonal).
+    pub bending_matrix: BendingMatrix,
     /// Newton iterations per step (1: Baraff and Witkin's linearised step).
     pub newton_iterations: u32,
     /// Relative residual at which Newton iterations stop.
@@ -108,10 +111,18 @@ impl Default for SolverSettings {
             refactor_iterations: 7,
             refactor: Refactor::Cost,
             preconditioner: Preconditioner::Factor,
+            bending_matrix: BendingMatrix::Exact,
             newton_iterations: 1,
             newton_tolerance: 1e-3,
         }
     }
+}
+
+/// Whether `model`'s direct solver lumps the shape triangles' second-ring
+/// blocks ([`BendingMatrix::FirstRing`]; the CG solver's products and the
+/// explicit integrators never read the blocks).
+fn lumps(model: &Model) -> bool {
+    model.solver.bending_matrix == BendingMatrix::FirstRing
 }
 
 /// Counters of what the stepper did.
@@ -248,6 +259,7 @@ impl Stepper {
         );
         let deferred = elements.deferred();
         elements.install(deferred);
+        elements.kinds.shapes.lump_second_ring = lumps(model);
         Stepper {
             elements,
             stats: StepStats::default(),
@@ -278,6 +290,7 @@ impl Stepper {
             &clamped,
             holding(model, world),
         );
+        self.elements.kinds.shapes.lump_second_ring = lumps(model);
         self.held.resize(world.mesh.vertex_count(), false);
         self.contacts.clear();
         self.contact_push.clear();

@@ -119,6 +119,10 @@
 //! exact Hessian (which couples every fold through the splits and has no
 //! sparse form). The step's forces are exact; the Newton iterations converge
 //! to the same state.
+//! The direct solver's matrix, by default, keeps of `J^T M J` only the
+//! blocks between the ends of mesh edges and lumps the others on the
+//! diagonal, a positive semi-definite addition
+//! (`kinds/shapes/blocks.rs`, "The first-ring matrix").
 //!
 //! Clamp edges keep no split (the free triangle takes the whole fold, as
 //! above); free edges of the cloth have one of their own (below).

@@ -9,10 +9,10 @@ use serde::Deserialize;
 // The engine's own types, deserialised straight from the file (see `crate::spec`).
 use crate::physics::membrane::{Membrane, Orthotropic};
 pub use crate::spec::{
-    Adapt, AdaptCriterion, AdaptEvery, AdaptMethod, BendingModel, BodySurface, ClothShape,
-    DEFAULT_THICKNESS, DiagonalPattern, Integrator, Keyframe, KeyframeAfter, KeyframeEasing,
-    Measurement, MembraneModel, Obstacle, ObstacleShape, Part, Pin, PinMotion, Preconditioner,
-    Refactor, SelfCollision, SequenceFiles, Solver, StiffnessRule,
+    Adapt, AdaptCriterion, AdaptEvery, AdaptMethod, BendingMatrix, BendingModel, BodySurface,
+    ClothShape, DEFAULT_THICKNESS, DiagonalPattern, Integrator, Keyframe, KeyframeAfter,
+    KeyframeEasing, Measurement, MembraneModel, Obstacle, ObstacleShape, Part, Pin, PinMotion,
+    Preconditioner, Refactor, SelfCollision, SequenceFiles, Solver, StiffnessRule,
 };
 
 /// A whole scene file.
@@ -192,6 +192,10 @@ pub struct Simulation {
     /// gradients.
     #[serde(default)]
     pub preconditioner: Preconditioner,
+    /// Direct solver: which of the shape triangles' bending blocks its matrix
+    /// holds.
+    #[serde(default)]
+    pub bending_matrix: BendingMatrix,
     /// Newton iterations per implicit step (1: the linearised step of Baraff and Witkin).
     #[serde(default = "default_newton_iterations")]
     pub newton_iterations: u32,

@@ -221,6 +221,7 @@ impl Model {
                 refactor_iterations: scene.simulation.refactor_iterations,
                 refactor: scene.simulation.refactor,
                 preconditioner: scene.simulation.preconditioner,
+                bending_matrix: scene.simulation.bending_matrix,
                 newton_iterations: scene.simulation.newton_iterations,
                 newton_tolerance: scene.simulation.newton_tolerance,
             },

@@ -32,6 +32,7 @@ pub(crate) fn allowed(path: &str) -> Option<&'static str> {
         "simulation.refactor_iterations" => "an integer >= 1",
         "simulation.refactor" => "\"cost\", \"every_solve\" or \"per_mesh\"",
         "simulation.preconditioner" => "\"factor\", \"factor_single\" or \"laplacian\"",
+        "simulation.bending_matrix" => "\"first_ring\" or \"exact\"",
         "simulation.newton_iterations" => "an integer from 1 to 100",
         "simulation.newton_tolerance" => "a number in the open interval (0, 1)",
         "cloth" => "a table [cloth]",

@@ -117,11 +117,13 @@ impl BlockPattern {
     /// whose normal `n` is prescribed. `scale[i]` is the diagonal put back on the
     /// prescribed directions (the vertex's mass, so the matrix keeps its scale).
     /// By rows: a row's lower blocks are copied and its upper ones are their
-    /// mirrors' transposes, projected where either vertex is.
+    /// mirrors' transposes, projected where either vertex is: in the rows
+    /// that `touched` marks ([`Self::touched_rows`]).
     pub fn project(
         &self,
         lower: &[Matrix3],
         projection: &[Option<Vector>],
+        touched: &[bool],
         scale: &[Scalar],
         out: &mut Vec<Matrix3>,
     ) {
@@ -140,8 +142,7 @@ impl BlockPattern {
                 for (o, &m) in upper.iter_mut().zip(&self.mirror[diagonal + 1..end]) {
                     *o = lower[m as usize].transpose();
                 }
-                let projected = |slot: usize| projection[self.columns[slot] as usize].is_some();
-                if projection[i].is_some() || (start..end).any(projected) {
+                if touched[i] {
                     for (o, slot) in out.iter_mut().zip(start..) {
                         self.project_block(projection, scale, slot, o);
                     }
@@ -149,6 +150,21 @@ impl BlockPattern {
             }
         };
         self.for_each_row_chunk(0..self.vertices(), out, &rows);
+    }
+
+    /// Per row, into `touched`: whether the row holds a block of a projected
+    /// vertex (`projection` not `None`: the row's own or a column's), found
+    /// from the projected vertices' rows (the pattern is symmetric), so that
+    /// a step with few prescribed vertices visits few rows.
+    pub fn touched_rows(&self, projection: &[Option<Vector>], touched: &mut Vec<bool>) {
+        touched.clear();
+        touched.resize(self.vertices(), false);
+        for (i, _) in projection.iter().enumerate().filter(|(_, p)| p.is_some()) {
+            let row = self.row_start[i] as usize..self.row_start[i + 1] as usize;
+            for &j in &self.columns[row] {
+                touched[j as usize] = true;
+            }
+        }
     }
 
     /// Block `slot` of the projected system in place, `out` holding the block
@@ -226,11 +242,25 @@ impl BlockPattern {
     /// that meet a zero `x_j` are skipped (the solver's prescribed velocity
     /// change is zero but at pins and contacts): with finite blocks their
     /// products are zeros, which leave the sums as they are.
-    pub fn multiply_lower(&self, lower: &[Matrix3], x: &[Vector], y: &mut [Vector]) {
+    /// With `rows`, only the rows it marks are summed and the others set to
+    /// zero: the same values when `x` is zero in every column of an unmarked
+    /// row (as [`Self::touched_rows`] marks them for an `x` that is zero but
+    /// at projected vertices).
+    pub fn multiply_lower(
+        &self,
+        lower: &[Matrix3],
+        x: &[Vector],
+        rows: Option<&[bool]>,
+        y: &mut [Vector],
+    ) {
         y.par_iter_mut()
             .enumerate()
             .with_min_len(PAR_MIN_ROWS)
             .for_each(|(i, out)| {
+                if rows.is_some_and(|rows| !rows[i]) {
+                    *out = Vector::ZERO;
+                    return;
+                }
                 let range = self.row_start[i] as usize..self.row_start[i + 1] as usize;
                 let mut acc = Vector::ZERO;
                 for s in range {

@@ -16,6 +16,7 @@ use crate::physics::{Model, forces::PAR_MIN};
 use crate::scene::{BendingModel, DiagonalPattern, default_scene};
 use crate::world::World;
 
+mod lumped;
 mod projection;
 
 /// The default scene's sheet at 12 x 12 and its fabric, and the same grid
@@ -186,7 +187,9 @@ fn assemble(p: &BlockPattern, terms: &ElementBlocks<'_>) -> [Vec<Matrix3>; 3] {
         .collect();
     p.compensation(terms, &sigma, &projection, &mut extra);
     let scale: Vec<Scalar> = (0..n).map(|i| 1.0 + noise(i, 11)).collect();
-    p.project(&lower, &projection, &scale, &mut system);
+    let mut touched = Vec::new();
+    p.touched_rows(&projection, &mut touched);
+    p.project(&lower, &projection, &touched, &scale, &mut system);
     [lower, extra, system]
 }
 

@@ -125,6 +125,9 @@ pub(super) struct DirectScratch {
     compensation: Vec<Matrix3>,
     /// Per vertex: `None` free, `Some(0)` held, `Some(n)` contact normal.
     projection: Vec<Option<Vector>>,
+    /// Per row: whether it holds a block of a projected vertex
+    /// ([`BlockPattern::touched_rows`]).
+    touched: Vec<bool>,
     factorization: Factorization,
     /// What is factored: the block factor `factorization` (in its precision) or
     /// the scalar `laplacian`.
@@ -444,7 +447,7 @@ fn residual(a: &mut DirectScratch, pattern: &BlockPattern) {
 fn contact_pressure(st: &mut Stepper, pattern: &BlockPattern) {
     let s = &mut st.implicit;
     if s.filter.iter().any(|f| *f != Vector::ZERO) {
-        pattern.multiply_lower(&s.direct.lower, &s.dv, &mut s.direct.ap);
+        pattern.multiply_lower(&s.direct.lower, &s.dv, None, &mut s.direct.ap);
     }
     super::contact_push_from(
         &s.filter,

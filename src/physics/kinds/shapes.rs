@@ -353,9 +353,33 @@ impl ForceKind for ShapeTriangles {
         SHAPE_SLOTS * (SHAPE_SLOTS - 1) * el.kinds.shapes.triangles.len()
     }
 
+    /// Every pair of used slots, or with the first-ring matrix
+    /// (`lump_second_ring`, module [`blocks`]) the first-ring pairs alone.
     fn couplings(el: &Elements, pairs: &mut Vec<(u32, u32)>) {
+        if el.kinds.shapes.lump_second_ring {
+            Self::factored_pairs(el, |i, j| pairs.push((i, j)));
+            return;
+        }
         for t in &el.kinds.shapes.triangles {
             slot_pairs(t.slots(), pairs);
+        }
+    }
+
+    /// With the first-ring matrix, its pairs (the ends of mesh edges, which
+    /// the springs or membrane triangles factor too): none of its blocks is
+    /// dropped. Otherwise none of its own.
+    fn factored_pairs(el: &Elements, mut f: impl FnMut(u32, u32)) {
+        if !el.kinds.shapes.lump_second_ring {
+            return;
+        }
+        for t in &el.kinds.shapes.triangles {
+            for (k, i) in t.slots() {
+                for (l, j) in t.slots() {
+                    if k != l && i != j && !blocks::second_ring(k, l) {
+                        f(i, j);
+                    }
+                }
+            }
         }
     }
 

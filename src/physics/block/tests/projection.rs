@@ -59,7 +59,9 @@ fn projection_matches_the_per_block_formula() {
             })
             .collect();
         let mut system = Vec::new();
-        p.project(&lower, &projection, &scale, &mut system);
+        let mut touched = Vec::new();
+        p.touched_rows(&projection, &mut touched);
+        p.project(&lower, &projection, &touched, &scale, &mut system);
         let bits = |m: Matrix3| m.to_cols_array().map(Scalar::to_bits);
         for (slot, &got) in system.iter().enumerate() {
             let expected = projected_block(&p, &lower, &projection, &scale, slot);

@@ -72,10 +72,11 @@ pub(in crate::physics::implicit) fn assemble(st: &mut Stepper, held: &[bool]) ->
     split_prescribed(s, held);
     let terms = element_blocks!(s, &st.elements);
     let a = &mut s.direct;
+    pattern.touched_rows(&a.projection, &mut a.touched);
     pattern.compensation(&terms, &a.sigma, &a.projection, &mut a.compensation);
     // b_s = S (b - A dv_c).
     a.ap.resize(n, Vector::ZERO);
-    pattern.multiply_lower(&a.lower, &a.prescribed, &mut a.ap);
+    pattern.multiply_lower(&a.lower, &a.prescribed, Some(&a.touched), &mut a.ap);
     a.rhs.resize(n, Vector::ZERO);
     a.rhs
         .par_iter_mut()
@@ -83,7 +84,13 @@ pub(in crate::physics::implicit) fn assemble(st: &mut Stepper, held: &[bool]) ->
         .zip(a.projection.par_iter())
         .with_min_len(PAR_MIN)
         .for_each(|((r, (b, ap)), proj)| *r = project(*proj, *b - *ap));
-    pattern.project(&a.lower, &a.projection, &st.elements.mass, &mut a.system);
+    pattern.project(
+        &a.lower,
+        &a.projection,
+        &a.touched,
+        &st.elements.mass,
+        &mut a.system,
+    );
     st.stats.assembly_s += started.elapsed().as_secs_f64();
     pattern
 }

@@ -26,6 +26,23 @@
 //! |B|`, so the factored matrix stays positive definite (the tighter rank-one
 //! compensation `B B^T / |B|`, each such `B = u v^T` involving a tip, saves
 //! about 1 % of the iterations, not worth its code).
+//!
+//! # The first-ring matrix
+//! With [`crate::spec::BendingMatrix::FirstRing`] (`lump_second_ring`) the
+//! matrix itself leaves out a triangle's second-ring blocks, those that join
+//! the tip across edge `a` to the triangle's own vertex `a` or to another
+//! tip: vertices that no mesh edge joins, which widen the stencil from a
+//! vertex's edge neighbours to their neighbours too. Each such block
+//! involves a tip `t = 3 + a`, which moves angle `a` alone, so it is the
+//! rank-one `B = u w^T` with `u = J_at` (the tip's gradient) and `w = h^2
+//! (M J)_ao` (the other slot's). It is lumped onto the two diagonal blocks
+//! as `(|w| / |u|) u u^T` on the tip's and `(|u| / |w|) w w^T` on the other
+//! vertex's: with `B`'s pair this is the positive semi-definite `z z^T`,
+//! `z = (sqrt(s) u, -w / sqrt(s))`, `s = |w| / |u|`, so the lumped matrix is
+//! the exact one plus a positive semi-definite term: positive definite, and
+//! stiffer only along the folds' gradients (the cloth's normals). The
+//! pattern then has no second-ring blocks, the factor needs no compensation
+//! for them and a fresh factor is exact.
 
 use crate::math::{Matrix3, Scalar, Vector};
 use crate::physics::block::{BAND_ROWS, Band, BlockPattern, group_by_key, outer};
@@ -48,6 +65,21 @@ pub(crate) struct ShapeOp {
     pub dropped: bool,
 }
 
+/// One second-ring block `(k, l)` (slots) of a shape triangle that the
+/// first-ring matrix lumps onto the diagonal blocks `row` (of vertex `v[k]`)
+/// and `column` (of `v[l]`) (module docs, "The first-ring matrix").
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct ShapeLump {
+    /// The diagonal block of the row slot's vertex.
+    pub row: u32,
+    /// The diagonal block of the column slot's vertex.
+    pub column: u32,
+    /// Its row slot.
+    pub k: u8,
+    /// Its column slot.
+    pub l: u8,
+}
+
 /// The pattern of the shape triangles' blocks: per triangle the blocks it
 /// adds, per band the triangles with a used slot in it.
 #[derive(Debug, Clone, Default)]
@@ -56,6 +88,11 @@ pub struct ShapeBlocks {
     /// ([`ShapeOp`]), in the order of its slot pairs `(k, l)`.
     pub(crate) op_start: Vec<u32>,
     pub(crate) ops: Vec<ShapeOp>,
+    /// Per shape triangle, CSC-like: the second-ring blocks lumped on the
+    /// diagonal ([`ShapeLump`]; none unless `lump_second_ring`), in the order
+    /// of its slot pairs.
+    pub(crate) lump_start: Vec<u32>,
+    pub(crate) lumps: Vec<ShapeLump>,
     /// Per band of [`BAND_ROWS`] rows, CSC-like: the shape triangles with a
     /// used slot in the band, ascending.
     pub(crate) band_start: Vec<u32>,
@@ -65,11 +102,13 @@ pub struct ShapeBlocks {
 impl ShapeBlocks {
     /// The pattern of `el`'s shape triangles on the built pattern `p`.
     pub(super) fn build(el: &Elements, p: &BlockPattern) -> ShapeBlocks {
-        let (op_start, ops) = shape_ops(el, p);
+        let (op_start, ops, lump_start, lumps) = shape_ops(el, p);
         let (band_start, band_shapes) = bands(el, p);
         ShapeBlocks {
             op_start,
             ops,
+            lump_start,
+            lumps,
             band_start,
             band_shapes,
         }
@@ -92,31 +131,49 @@ impl ShapeBlocks {
         for &tri in &self.band_shapes[shapes] {
             let tri = tri as usize;
             let ops = self.op_start[tri] as usize..self.op_start[tri + 1] as usize;
+            let lumps = match self.lump_start.get(tri + 1) {
+                Some(&end) => &self.lumps[self.lump_start[tri] as usize..end as usize],
+                None => &[],
+            };
             add_shape(
                 band,
                 &el.kinds.shapes.triangles[tri],
                 &el.kinds.shapes.fold_edges.angles(tri, edges).1,
                 h2,
-                &self.ops[ops],
+                (&self.ops[ops], lumps),
             );
         }
     }
 }
 
+/// The lists of [`shape_ops`]: per triangle its ops and its lumps.
+type OpLists = (Vec<u32>, Vec<ShapeOp>, Vec<u32>, Vec<ShapeLump>);
+
 /// Per shape triangle, the blocks that the assembly computes ([`ShapeOp`]):
 /// each pair of used slots `(k, l)` (`k` outer, `l` inner, ascending) whose
 /// block is in the lower triangle (`v[l] <= v[k]`), marked when the
-/// factorization drops it.
-fn shape_ops(el: &Elements, p: &BlockPattern) -> (Vec<u32>, Vec<ShapeOp>) {
+/// factorization drops it; with `lump_second_ring`, the second-ring pairs on
+/// distinct vertices as lumps instead ([`ShapeLump`]).
+fn shape_ops(el: &Elements, p: &BlockPattern) -> OpLists {
     let shapes = &el.kinds.shapes.triangles;
+    let lumped = el.kinds.shapes.lump_second_ring;
     let (mut start, mut ops) = (Vec::with_capacity(shapes.len() + 1), Vec::new());
+    let (mut lump_start, mut lumps) = (Vec::new(), Vec::new());
     start.push(0);
+    if lumped {
+        lump_start.reserve(shapes.len() + 1);
+        lump_start.push(0);
+    }
     for t in shapes {
         let active = shape_active(t);
         for k in (0..SHAPE_SLOTS).filter(|&k| active >> k & 1 != 0) {
             for l in (0..SHAPE_SLOTS).filter(|&l| active >> l & 1 != 0) {
                 let (i, j) = (t.v[k], t.v[l]);
-                if j <= i {
+                if j <= i && lumped && i != j && second_ring(k, l) {
+                    let (row, column) = (p.slot(i, i), p.slot(j, j));
+                    let (k, l) = (k as u8, l as u8);
+                    lumps.push(ShapeLump { row, column, k, l });
+                } else if j <= i {
                     let slot = p.slot(i, j);
                     let dropped = i != j && !p.is_factored(slot);
                     let (k, l) = (k as u8, l as u8);
@@ -130,8 +187,22 @@ fn shape_ops(el: &Elements, p: &BlockPattern) -> (Vec<u32>, Vec<ShapeOp>) {
             }
         }
         start.push(ops.len() as u32);
+        if lumped {
+            lump_start.push(lumps.len() as u32);
+        }
     }
-    (start, ops)
+    (start, ops, lump_start, lumps)
+}
+
+/// Whether slots `k` and `l` of a shape triangle are a second-ring pair
+/// (module docs, "The first-ring matrix"): the tip across edge `a` with the
+/// triangle's own vertex `a` or with another tip. The other pairs join the
+/// ends of a mesh edge (the triangle's own edges, and a tip with the ends
+/// of the edge it lies across).
+#[inline(always)]
+pub(crate) fn second_ring(k: usize, l: usize) -> bool {
+    let (low, high) = (k.min(l), k.max(l));
+    high >= 3 && (low >= 3 || low == high - 3)
 }
 
 /// Per band, the shape triangles with a used slot in it, ascending.
@@ -175,11 +246,14 @@ fn add_shape(
     t: &ShapeTriangle,
     jac: &ShapeJacobian,
     h2: Scalar,
-    ops: &[ShapeOp],
+    (ops, lumps): (&[ShapeOp], &[ShapeLump]),
 ) {
     let mut mj = [[Vector::ZERO; SHAPE_SLOTS]; 3];
     times_m(&t.m, jac, &mut mj);
     let rows = band.rows();
+    for lump in lumps {
+        add_lump(band, t, jac, &mj, h2, lump);
+    }
     for op in ops {
         let (row, column) = (t.v[op.k as usize] as usize, t.v[op.l as usize] as usize);
         let (in_row, in_column) = (rows.contains(&row), rows.contains(&column));
@@ -203,6 +277,42 @@ fn add_shape(
             if in_column {
                 band.sigma[column - band.first_row] += norm;
             }
+        }
+    }
+}
+
+/// Lumps the second-ring block `lump` of shape triangle `t` onto the
+/// diagonal blocks of its two vertices that lie in the band (module docs,
+/// "The first-ring matrix"), from the Jacobian `jac` and `mj = M J`.
+#[inline(always)]
+fn add_lump(
+    band: &mut Band<'_>,
+    t: &ShapeTriangle,
+    jac: &ShapeJacobian,
+    mj: &[[Vector; SHAPE_SLOTS]; 3],
+    h2: Scalar,
+    lump: &ShapeLump,
+) {
+    let rows = band.rows();
+    let (k, l) = (lump.k as usize, lump.l as usize);
+    // The tip (the row slot when both are tips) and the other slot.
+    let (tip, other, tip_diagonal, other_diagonal) = if k >= 3 {
+        (k, l, lump.row, lump.column)
+    } else {
+        (l, k, lump.column, lump.row)
+    };
+    let a = tip - 3;
+    let (u, w) = (jac[a][tip], mj[a][other] * h2);
+    let (nu, nw) = (u.length(), w.length());
+    if nu == 0.0 || nw == 0.0 {
+        return;
+    }
+    for (vertex, diagonal, g, scale) in [
+        (t.v[tip], tip_diagonal, u, nw / nu),
+        (t.v[other], other_diagonal, w, nu / nw),
+    ] {
+        if rows.contains(&(vertex as usize)) {
+            band.lower[diagonal as usize - band.base] += outer(g, g * scale);
         }
     }
 }

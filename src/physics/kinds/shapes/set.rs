@@ -23,6 +23,11 @@ pub struct ShapeSet {
     /// Shape-triangle slots `SHAPE_SLOTS * element + k` where the vertex is
     /// `v[k]` (used slots only).
     pub slots: Incidence,
+    /// The direct solver's matrix holds only the first-ring blocks, each
+    /// second-ring block lumped on the diagonal (module `blocks`); set by the
+    /// stepper from [`crate::spec::BendingMatrix`], false (every block) for
+    /// elements built alone. A rebuild keeps it.
+    pub lump_second_ring: bool,
     /// The number of split unknowns of `triangles` (the size of the system
     /// [`ShapeSet::renewed_fold_splits`] makes).
     splits: usize,
