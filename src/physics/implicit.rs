@@ -37,6 +37,10 @@
 //! * `cg` ([`cg`]): matrix-free conjugate gradients with the diagonal of `A` as the
 //!   preconditioner, applied with the same element pass + per-vertex gather as the
 //!   forces.
+//! * `quasi_newton` ([`quasi_newton`]): no linear solve; L-BFGS on the backward
+//!   Euler equations themselves (as with Newton iterations, to
+//!   `newton_tolerance`), with a scalar Laplacian factor of `A` as the initial
+//!   Hessian and a line search (Liu, Bouaziz and Kavan 2017).
 //!
 //! A linear solve that does not reach `cg_tolerance` (relative residual) within
 //! `cg_max_iterations`, a matrix that is not positive definite, or Newton iterations

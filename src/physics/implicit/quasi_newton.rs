@@ -325,7 +325,8 @@ fn line_search(
     (h, held): (Scalar, &[bool]),
     slope: Scalar,
 ) -> Option<Scalar> {
-    if !(slope < 0.0) {
+    // Not a descent direction (or not a number): no step is acceptable.
+    if slope.is_nan() || slope >= 0.0 {
         return None;
     }
     let mut alpha = 1.0;
@@ -363,7 +364,7 @@ fn remember(q: &mut QuasiNewtonScratch) {
         .extend(q.g_trial.iter().zip(&q.g).map(|(a, b)| *a - *b));
     let sy = dot(&pair.s, &pair.y);
     let scale = dot(&pair.s, &pair.s).sqrt() * dot(&pair.y, &pair.y).sqrt();
-    if !(sy > 1e-12 * scale) {
+    if sy.is_nan() || sy <= 1e-12 * scale {
         q.spare.push(pair);
         return;
     }
