@@ -94,6 +94,9 @@ pub enum Solver {
     Direct,
     /// Matrix-free conjugate gradients with a Jacobi (diagonal) preconditioner.
     Cg,
+    /// L-BFGS on the backward Euler equations, the scalar Laplacian factor as
+    /// its initial Hessian, with a line search (Liu, Bouaziz and Kavan 2017).
+    QuasiNewton,
 }
 
 /// When the direct solver factors its matrix anew (`docs/model.md`, "The linear

@@ -98,6 +98,13 @@ fn describe_implicit_solver(s: &mut String, sim: &Simulation) {
             }
         },
         Solver::Cg => "cg (matrix-free, Jacobi preconditioner)".to_string(),
+        Solver::QuasiNewton => format!(
+            "quasi_newton (L-BFGS, {} pairs, on the backward Euler equations; initial Hessian one scalar Cholesky factor of a weighted graph Laplacian plus the mass, refactored when a step needs {} iterations more than the step after the last factorization; relative residual {:e}, at most {} iterations)",
+            crate::physics::implicit::QUASI_NEWTON_HISTORY,
+            sim.refactor_iterations,
+            sim.newton_tolerance,
+            crate::physics::implicit::QUASI_NEWTON_MAX_ITERATIONS
+        ),
     };
     let _ = writeln!(s, "  linear solver: {solver}");
     if sim.solver == Solver::Direct {

@@ -37,6 +37,10 @@
 //! * `cg` ([`cg`]): matrix-free conjugate gradients with the diagonal of `A` as the
 //!   preconditioner, applied with the same element pass + per-vertex gather as the
 //!   forces.
+//! * `quasi_newton` ([`quasi_newton`]): no linear solve; L-BFGS on the backward
+//!   Euler equations themselves (as with Newton iterations, to
+//!   `newton_tolerance`), with a scalar Laplacian factor of `A` as the initial
+//!   Hessian and a line search (Liu, Bouaziz and Kavan 2017).
 //!
 //! A linear solve that does not reach `cg_tolerance` (relative residual) within
 //! `cg_max_iterations`, a matrix that is not positive definite, or Newton iterations
@@ -75,9 +79,13 @@
 mod cg;
 mod direct;
 mod linearise;
+mod quasi_newton;
 mod refactor;
 
 use linearise::linearise;
+pub use quasi_newton::{
+    HISTORY as QUASI_NEWTON_HISTORY, MAX_ITERATIONS as QUASI_NEWTON_MAX_ITERATIONS,
+};
 
 use rayon::prelude::*;
 
@@ -113,6 +121,19 @@ pub enum SolveFailure {
     )]
     NewtonNotConverged {
         /// Newton iterations done.
+        iterations: u32,
+        /// Relative residual of the implicit equations reached.
+        residual: Scalar,
+        /// Relative residual asked for.
+        tolerance: Scalar,
+    },
+    /// The quasi-Newton iterations did not reach their tolerance, or their line
+    /// search found no acceptable step ([`quasi_newton`]).
+    #[error(
+        "quasi-Newton iterations did not converge (relative residual {residual:.3e} after {iterations} iterations, tolerance {tolerance:.1e})"
+    )]
+    QuasiNewtonNotConverged {
+        /// Quasi-Newton iterations done.
         iterations: u32,
         /// Relative residual of the implicit equations reached.
         residual: Scalar,
@@ -164,8 +185,12 @@ pub struct ImplicitScratch {
     /// Positions and velocities at the start of the step.
     x0: Vec<Vector>,
     v0: Vec<Vector>,
+    /// With the quasi-Newton solver: the linearisation gathers the block
+    /// matrix too (this step factors anew).
+    gather_blocks: bool,
     cg: cg::CgScratch,
     direct: direct::DirectScratch,
+    quasi: quasi_newton::QuasiNewtonScratch,
 }
 
 impl ImplicitScratch {
@@ -173,6 +198,7 @@ impl ImplicitScratch {
     /// start is simulation state, not scratch: its owner clears it.
     pub fn mesh_changed(&mut self) {
         self.direct.mesh_changed();
+        self.quasi.mesh_changed();
     }
 
     /// After [`ImplicitScratch::mesh_changed`], with the direct solver: the new
@@ -204,6 +230,7 @@ pub fn backward_euler(
         s.x0.extend_from_slice(&w.x);
         s.v0.clear();
         s.v0.extend_from_slice(&w.v);
+        s.gather_blocks = model.solver.solver == Solver::QuasiNewton && s.quasi.wants_factor(h);
     }
     linearise(st, model, w, h, false);
     let s = &mut st.implicit;
@@ -230,7 +257,12 @@ pub fn backward_euler(
     contact_filters(s, &st.contacts, &st.held, &w.v);
     // Taken out for the solve so that the solvers can borrow the stepper.
     let held = std::mem::take(&mut st.held);
-    let result = newton(st, model, w, h, &held);
+    let result = if model.solver.solver == Solver::QuasiNewton {
+        let reference = filtered_norm(&st.implicit, &held);
+        quasi_newton::solve(st, model, w, h, &held, reference)
+    } else {
+        newton(st, model, w, h, &held)
+    };
     st.held = held;
     warm_start.clear();
     warm_start.extend_from_slice(&st.implicit.dv);
@@ -367,7 +399,10 @@ fn linear_solve(
 ) -> Result<(), SolveFailure> {
     match model.solver.solver {
         Solver::Cg => cg::solve(st, model, held, reference, contact_push),
-        Solver::Direct => direct::solve(st, model, held, reference, contact_push),
+        // A quasi-Newton step takes no linear solve (`backward_euler`).
+        Solver::Direct | Solver::QuasiNewton => {
+            direct::solve(st, model, held, reference, contact_push)
+        }
     }
 }
 

@@ -139,8 +139,11 @@ pub struct StepStats {
     /// Implicit steps that failed: an unconverged linear solve, a matrix that was not
     /// positive definite, or Newton iterations that did not converge.
     pub failed_solves: u64,
-    /// Newton iterations (linear solves) over all implicit steps.
+    /// Newton iterations (linear solves) over all implicit steps; with the
+    /// quasi-Newton solver, one per step.
     pub newton_iterations: u64,
+    /// L-BFGS iterations of the quasi-Newton solver over all implicit steps.
+    pub quasi_newton_iterations: u64,
     /// Symbolic analyses (orderings) of the sparse system: one per mesh topology.
     pub symbolic_analyses: u64,
     /// Numerical Cholesky factorizations.
@@ -177,10 +180,17 @@ impl StepStats {
         if self.newton_iterations == 0 && self.failed_solves == 0 {
             return "no implicit solves".to_string();
         }
-        let mut s = format!(
-            "{} linear solves, {} CG iterations",
-            self.newton_iterations, self.cg_iterations
-        );
+        let mut s = if self.quasi_newton_iterations > 0 {
+            format!(
+                "{} quasi-Newton solves, {} quasi-Newton iterations",
+                self.newton_iterations, self.quasi_newton_iterations
+            )
+        } else {
+            format!(
+                "{} linear solves, {} CG iterations",
+                self.newton_iterations, self.cg_iterations
+            )
+        };
         if self.factorizations > 0 {
             let full = match self.full_factorizations {
                 0 => String::new(),

@@ -325,6 +325,9 @@ fn solver_hint(failure: &StepFailure) -> &'static str {
         StepFailure::Solver(SolveFailure::NotConverged { .. }) => {
             "; or let the linear solve converge: `simulation.solver = \"direct\"`, a larger `simulation.cg_max_iterations` or `simulation.cg_tolerance`"
         }
+        StepFailure::Solver(SolveFailure::QuasiNewtonNotConverged { .. }) => {
+            "; or a larger `simulation.newton_tolerance`"
+        }
         StepFailure::Solver(SolveFailure::NewtonNotConverged { .. }) => {
             "; or allow more `simulation.newton_iterations` or a larger `simulation.newton_tolerance`"
         }

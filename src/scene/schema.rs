@@ -28,7 +28,7 @@ pub(crate) fn allowed(path: &str) -> Option<&'static str> {
         "simulation.gravity" => "an array of 3 finite numbers (m/s^2)",
         "simulation.cg_tolerance" => "a number in the open interval (0, 1)",
         "simulation.cg_max_iterations" => "an integer >= 1",
-        "simulation.solver" => "\"direct\" or \"cg\"",
+        "simulation.solver" => "\"direct\", \"cg\" or \"quasi_newton\"",
         "simulation.refactor_iterations" => "an integer >= 1",
         "simulation.refactor" => "\"cost\", \"every_solve\" or \"per_mesh\"",
         "simulation.preconditioner" => "\"factor\", \"factor_single\" or \"laplacian\"",

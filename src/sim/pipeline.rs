@@ -373,6 +373,7 @@ fn absorb(total: &mut StepStats, step: &mut StepStats) {
         cg_capped,
         failed_solves,
         newton_iterations,
+        quasi_newton_iterations,
         symbolic_analyses,
         factorizations,
         full_factorizations,
@@ -388,6 +389,7 @@ fn absorb(total: &mut StepStats, step: &mut StepStats) {
     total.cg_capped += cg_capped;
     total.failed_solves += failed_solves;
     total.newton_iterations += newton_iterations;
+    total.quasi_newton_iterations += quasi_newton_iterations;
     total.symbolic_analyses += symbolic_analyses;
     total.factorizations += factorizations;
     total.full_factorizations += full_factorizations;

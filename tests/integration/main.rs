@@ -52,6 +52,7 @@ mod physics;
 mod pins;
 mod pins_attached;
 mod presets;
+mod quasi_newton;
 mod recording;
 mod recording_run;
 mod remesh_gate;

@@ -176,6 +176,12 @@ impl DirectScratch {
         std::mem::take(&mut self.pattern_s)
     }
 
+    /// The projected matrix `A_s` of the last assembly ([`assemble`]), in the
+    /// pattern's lower blocks.
+    pub(super) fn system(&self) -> &[Matrix3] {
+        &self.system
+    }
+
     /// Makes `preconditioner` the one factored from now on (a change forgets
     /// the factor).
     fn choose(&mut self, preconditioner: Preconditioner) {

@@ -27,7 +27,8 @@ pub(super) fn linearise(st: &mut Stepper, model: &Model, w: &World, h: Scalar, n
     // The `-h^2 K v` term of the linearised step (none in a Newton residual).
     let k_term = if newton { 0.0 } else { 1.0 };
     s.h2 = h * h;
-    let direct = model.solver.solver == Solver::Direct;
+    // The block matrix: the direct solver's, or the quasi-Newton solver's to factor.
+    let direct = model.solver.solver == Solver::Direct || s.gather_blocks;
     ShapeTriangles::fold(el, x, direct, &mut s.kinds.shapes);
     // The fold splits are a sequential sparse solve, which leaves the other
     // cores idle: the other kinds' terms and the direct solver's block
