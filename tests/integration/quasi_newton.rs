@@ -47,6 +47,7 @@ fn model(solver: Solver, tolerance: Scalar) -> Model {
             newton_tolerance: tolerance,
             ..SolverSettings::default()
         },
+        attachments: Vec::new(),
     }
 }
 
