@@ -12,11 +12,11 @@
 //! every step factors), `direct_single` (the same factor in single precision),
 //! `direct_laplacian` (one scalar factor of a weighted graph Laplacian plus the
 //! mass as the preconditioner, factored by the same rule), `cg` (matrix-free
-//! Jacobi CG) and `quasi_newton` (L-BFGS on the backward Euler equations with
-//! that scalar factor as its initial Hessian, to a relative residual of 1e-2:
-//! at the default 1e-3 it does not converge within its 200 iterations on the
-//! sheet's first steps; its iterations are printed as CG iterations in the
-//! time split).
+//! Jacobi CG). The `quasi_newton` solver is not a case: on this sheet it does
+//! not reach its tolerance within its 200 iterations during the warm-up steps
+//! (at the default 1e-3 and at 1e-2 alike), which a run retries with halved
+//! steps and a benchmark of one fixed step cannot; its whole-run figures are
+//! in `docs/model.md`, "Every class, measured".
 //!
 //! After the Criterion groups, the time split per step (assembly, factorization,
 //! solve, the rest) of 60 further steps is printed for each case, and for the
@@ -52,7 +52,7 @@ use drape::world::World;
 use sheet::setup;
 
 /// The solver cases: label, solver, refactor_iterations, preconditioner.
-const CASES: [(&str, Solver, u32, Preconditioner); 6] = [
+const CASES: [(&str, Solver, u32, Preconditioner); 5] = [
     ("direct", Solver::Direct, 7, Preconditioner::Factor),
     (
         "direct_every_step",
@@ -73,12 +73,6 @@ const CASES: [(&str, Solver, u32, Preconditioner); 6] = [
         Preconditioner::Laplacian,
     ),
     ("cg", Solver::Cg, 4, Preconditioner::Factor),
-    (
-        "quasi_newton",
-        Solver::QuasiNewton,
-        7,
-        Preconditioner::Laplacian,
-    ),
 ];
 
 /// The sheet of a case with `bending`.

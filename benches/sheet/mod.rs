@@ -95,14 +95,6 @@ pub fn setup_with(
             solver,
             refactor_iterations,
             bending_matrix,
-            newton_tolerance: match solver {
-                // At the default 1e-3 the quasi-Newton step does not reach its
-                // tolerance within its 200 iterations on this sheet's first
-                // steps, which a run would retry with halved steps and a
-                // bench cannot.
-                Solver::QuasiNewton => 1e-2,
-                _ => SolverSettings::default().newton_tolerance,
-            },
             ..SolverSettings::default()
         },
     };
