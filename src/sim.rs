@@ -46,8 +46,8 @@ pub use step_control::{
 };
 
 use crate::adapt::Adapter;
-use crate::collide::{CollideError, Obstacles};
-use crate::math::Scalar;
+use crate::collide::{CollideError, Inside, Obstacles};
+use crate::math::{Scalar, Vector};
 use crate::physics::Model;
 use crate::spec::{ClothSpec, ObstacleSpec, Pin};
 use crate::world::{BuildError, World};
@@ -106,23 +106,67 @@ pub enum SimBuildError {
 /// A garment must start outside every body: one starting inside would be
 /// thrown out by the first collision pass.
 fn garment_outside_bodies(world: &World, obstacles: &Obstacles) -> Result<(), SimBuildError> {
-    let Some(panels) = world.mesh.panels() else {
-        return Ok(());
-    };
-    match obstacles.deepest_inside(&world.x, world.time) {
+    match inside(world, obstacles).into_iter().next() {
         None => Ok(()),
-        Some((v, obstacle, depth)) => {
-            let p = world.x[v];
-            Err(SimBuildError::PanelInsideBody {
-                panel: panels.names[panels.of_vertex[v] as usize].clone(),
-                obstacle,
-                x: p.x,
-                y: p.y,
-                z: p.z,
-                depth_mm: 1e3 * depth,
-            })
-        }
+        Some(p) => Err(SimBuildError::PanelInsideBody {
+            obstacle: p.inside.obstacle,
+            x: p.position.x,
+            y: p.position.y,
+            z: p.position.z,
+            depth_mm: 1e3 * p.inside.depth,
+            panel: p.panel,
+        }),
     }
+}
+
+/// A garment panel that starts inside an obstacle ([`panels_inside`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PanelInside {
+    /// The panel's name.
+    pub panel: String,
+    /// Its vertex deepest inside an obstacle.
+    pub inside: Inside,
+    /// That vertex's position, m.
+    pub position: Vector,
+    /// The panel's unit normal as placed: its triangles' area-weighted mean
+    /// (either side; a panel starts flat).
+    pub panel_normal: Vector,
+}
+
+/// The garment panels of `spec` that start inside an obstacle, deepest first;
+/// empty for a cloth that is not a garment. What [`build`] refuses, for a
+/// caller that places the panels (`drape garment`).
+pub fn panels_inside(spec: &SimSpec) -> Result<Vec<PanelInside>, SimBuildError> {
+    let world = World::from_spec(&spec.cloth, &spec.pins, &spec.obstacles)?;
+    Ok(inside(&world, &Obstacles::new(&spec.obstacles)?))
+}
+
+fn inside(world: &World, obstacles: &Obstacles) -> Vec<PanelInside> {
+    let Some(panels) = world.mesh.panels() else {
+        return Vec::new();
+    };
+    let deepest =
+        obstacles.deepest_inside(&world.x, world.time, &panels.of_vertex, panels.names.len());
+    let mut normals = vec![Vector::ZERO; panels.names.len()];
+    for (t, &p) in world.mesh.triangles.iter().zip(&panels.of_triangle) {
+        let [a, b, c] = t.map(|i| world.x[i as usize]);
+        normals[p as usize] += (b - a).cross(c - a);
+    }
+    let mut out: Vec<PanelInside> = deepest
+        .into_iter()
+        .zip(normals)
+        .enumerate()
+        .filter_map(|(k, (d, n))| {
+            d.map(|inside| PanelInside {
+                panel: panels.names[k].clone(),
+                position: world.x[inside.vertex],
+                inside,
+                panel_normal: n.normalize_or_zero(),
+            })
+        })
+        .collect();
+    out.sort_by(|a, b| b.inside.depth.total_cmp(&a.inside.depth));
+    out
 }
 
 /// A simulation ready to run: what it holds fixed, its initial state and the

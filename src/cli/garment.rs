@@ -12,9 +12,11 @@ use crate::cli::run::run_scene;
 use crate::{ColourChoice, EdgeChoice, OutputArgs, RunArgs, SceneArgs};
 use drape::garmentcode::attach::{self, PatternAttachment};
 use drape::garmentcode::body::{BodySize, check_body};
+use drape::garmentcode::clearance::Clearance;
 use drape::garmentcode::scene_text::{Body, BodyUp, Draping, scene};
 use drape::garmentcode::{Labelled, Pattern};
 use drape::scene::load_scene_str_in;
+use drape::sim::panels_inside;
 
 /// The draping settings the written scene starts from (`docs/garmentcode.md`).
 const DRAPING: Draping = Draping {
@@ -156,23 +158,46 @@ pub fn cmd_garment(args: GarmentArgs) -> Result<ExitCode> {
         },
         scale: args.body.body_scale,
     };
-    let text = scene(
-        &name,
-        &args.spec.display().to_string(),
-        &pattern,
-        &attachments,
-        &body,
-        &DRAPING,
-    );
+    let write = |pattern: &Pattern| {
+        scene(
+            &name,
+            &args.spec.display().to_string(),
+            pattern,
+            &attachments,
+            &body,
+            &DRAPING,
+        )
+    };
     let origin = match &args.write_scene {
-        Some(file) => {
-            std::fs::write(file, &text)
-                .with_context(|| format!("cannot write the scene {}", file.display()))?;
-            file.display().to_string()
-        }
+        Some(file) => file.display().to_string(),
         None => format!("the scene of {}", args.spec.display()),
     };
-    let loaded = load_scene_str_in(&text, &origin, &scene_dir, &args.overrides)?;
+    let mut pattern = pattern;
+    let mut clearance = Clearance::default();
+    let loaded = loop {
+        let text = write(&pattern);
+        if let Some(file) = &args.write_scene {
+            std::fs::write(file, &text)
+                .with_context(|| format!("cannot write the scene {}", file.display()))?;
+        }
+        let loaded = load_scene_str_in(&text, &origin, &scene_dir, &args.overrides)?;
+        let inside = panels_inside(&loaded.resolve()?)?;
+        if inside.is_empty() {
+            break loaded;
+        }
+        clearance
+            .round(&mut pattern, &inside)
+            .with_context(|| format!("{}", args.spec.display()))?;
+    };
+    for m in clearance.moved() {
+        eprintln!(
+            "{}: panel `{}` starts {:.1} mm inside the body: moved {:.1} mm out along its normal",
+            args.spec.display(),
+            m.panel,
+            1e3 * m.depth,
+            1e3 * m.shift.length()
+        );
+    }
     let run = RunArgs {
         scene: SceneArgs {
             scene: None,

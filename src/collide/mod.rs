@@ -228,21 +228,34 @@ impl Obstacles {
         out
     }
 
-    /// The vertex of `x` deepest inside an obstacle at time `t`, with the
-    /// obstacle's name and the depth below its surface, m; `None` when no vertex
-    /// is inside one.
-    pub fn deepest_inside(&self, x: &[Vector], t: Scalar) -> Option<(usize, String, Scalar)> {
-        let mut deepest: Option<(usize, usize, Scalar)> = None;
-        for (k, body) in self.bodies.iter().enumerate() {
+    /// Per group of vertices (vertex `i` is in group `group[i]`, groups
+    /// `0..groups`), the vertex of `x` deepest inside an obstacle at time `t`;
+    /// `None` for a group with no vertex inside one.
+    pub fn deepest_inside(
+        &self,
+        x: &[Vector],
+        t: Scalar,
+        group: &[u16],
+        groups: usize,
+    ) -> Vec<Option<Inside>> {
+        let mut deepest: Vec<Option<Inside>> = vec![None; groups];
+        for body in &self.bodies {
             let at = body.at(t);
             for (i, &p) in x.iter().enumerate() {
-                let depth = -body.probe(&at, at.pose.inverse_transform_point(p)).signed;
-                if depth > 0.0 && deepest.is_none_or(|d| depth > d.2) {
-                    deepest = Some((i, k, depth));
+                let probe = body.probe(&at, at.pose.inverse_transform_point(p));
+                let depth = -probe.signed;
+                let slot = &mut deepest[group[i] as usize];
+                if depth > 0.0 && slot.as_ref().is_none_or(|d| depth > d.depth) {
+                    *slot = Some(Inside {
+                        vertex: i,
+                        obstacle: body.name.clone(),
+                        depth,
+                        normal: at.pose.rotation * probe.normal,
+                    });
                 }
             }
         }
-        deepest.map(|(i, k, depth)| (i, self.bodies[k].name.clone(), depth))
+        deepest
     }
 
     /// Per vertex of `x`, the tangent plane of the nearest obstacle surface
@@ -265,6 +278,19 @@ impl Obstacles {
                 .expect("at least one obstacle")
         }));
     }
+}
+
+/// A vertex inside an obstacle ([`Obstacles::deepest_inside`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Inside {
+    /// The vertex.
+    pub vertex: usize,
+    /// The obstacle (and part) it is inside.
+    pub obstacle: String,
+    /// How deep below the surface, m.
+    pub depth: Scalar,
+    /// The outward unit normal of the surface point nearest to it, world frame.
+    pub normal: Vector,
 }
 
 /// The collision passes of a run and their per-step scratch (the obstacles

@@ -16,6 +16,7 @@
 
 pub mod attach;
 pub mod body;
+pub mod clearance;
 mod convert;
 mod facing;
 mod json;

@@ -139,26 +139,7 @@ fn case(name: &str, edit: impl Fn(&mut Value)) -> PathBuf {
     edit(&mut spec);
     std::fs::write(dir.join("shirt.json"), spec.to_string()).expect("write");
     // A closed 0.5 m cube (y up) 2 m below the garment.
-    let mut body = String::new();
-    for k in 0..8 {
-        let (x, y, z) = (k & 1, (k >> 1) & 1, (k >> 2) & 1);
-        body.push_str(&format!(
-            "v {} {} {}\n",
-            0.5 * x as f64,
-            0.5 * y as f64 - 3.0,
-            0.5 * z as f64
-        ));
-    }
-    for f in [
-        [1, 3, 4, 2],
-        [5, 6, 8, 7],
-        [1, 2, 6, 5],
-        [3, 7, 8, 4],
-        [1, 5, 7, 3],
-        [2, 4, 8, 6],
-    ] {
-        body.push_str(&format!("f {} {} {} {}\n", f[0], f[1], f[2], f[3]));
-    }
+    let body = box_obj([0.0, -3.0, 0.0], [0.5, -2.5, 0.5]);
     std::fs::write(dir.join("body.obj"), body).expect("write body");
     dir
 }
@@ -288,6 +269,81 @@ fn the_shipped_garmentcode_scenes_load_and_build() {
         built_scenes += 1;
     }
     assert_eq!(built_scenes, 4, "shirt, hoody, dress and jumpsuit");
+}
+
+/// A closed axis-aligned box as an OBJ file, corners `lo` and `hi`.
+fn box_obj(lo: [f64; 3], hi: [f64; 3]) -> String {
+    let mut obj = String::new();
+    for k in 0..8 {
+        let pick = |axis: usize| {
+            if (k >> axis) & 1 == 1 {
+                hi[axis]
+            } else {
+                lo[axis]
+            }
+        };
+        obj.push_str(&format!("v {} {} {}\n", pick(0), pick(1), pick(2)));
+    }
+    for f in [
+        [1, 3, 4, 2],
+        [5, 6, 8, 7],
+        [1, 2, 6, 5],
+        [3, 7, 8, 4],
+        [1, 5, 7, 3],
+        [2, 4, 8, 6],
+    ] {
+        obj.push_str(&format!("f {} {} {} {}\n", f[0], f[1], f[2], f[3]));
+    }
+    obj
+}
+
+#[test]
+fn a_panel_placed_inside_the_body_is_moved_out_along_its_normal() {
+    let dir = case("inside", |_| {});
+    // The shirt's left front panel lies in the plane z = 0.25 m (y up); this
+    // box's front face is 20 mm in front of it, over part of the panel.
+    let body = box_obj([0.05, 1.1, 0.0], [0.15, 1.2, 0.27]);
+    std::fs::write(dir.join("body.obj"), body).expect("write body");
+    let args = [
+        "garment",
+        "shirt.json",
+        "--body",
+        "body.obj",
+        "--write-scene",
+        "shirt.toml",
+        "--no-record",
+        "-q",
+        "--set",
+        "simulation.duration=0.02",
+    ];
+    let out = drape(&dir, &args);
+    assert_eq!(out.status.code(), Some(0));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let moved: Vec<&str> = stderr.lines().filter(|l| l.contains("moved")).collect();
+    assert_eq!(
+        moved,
+        [
+            "shirt.json: panel `left_ftorso` starts 20.0 mm inside the body: moved 25.0 mm out \
+          along its normal"
+        ]
+    );
+    // The written scene starts outside the body; the pattern as GarmentCode
+    // places it does not.
+    let scene = drape::scene::load_scene_file(&dir.join("shirt.toml"), &[]).expect("scene");
+    let spec = scene.resolve().expect("resolved");
+    assert_eq!(drape::sim::panels_inside(&spec).expect("built"), []);
+    let mut unmoved = spec.clone();
+    let pattern = garmentcode::load(&dir.join("shirt.json")).expect("pattern");
+    let drape::spec::ClothMesh::Panels(garment) = &mut unmoved.cloth.mesh else {
+        panic!("a garment");
+    };
+    garment.panels = pattern.panels.clone();
+    let inside = drape::sim::panels_inside(&unmoved).expect("built");
+    let names: Vec<&str> = inside.iter().map(|p| p.panel.as_str()).collect();
+    assert_eq!(names, ["left_ftorso"]);
+    println!("as placed: {:.2} mm inside", 1e3 * inside[0].inside.depth);
+    assert!((inside[0].inside.depth - 0.02).abs() < 1e-9);
+    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// GarmentCode's measurements of `mean_all` that place the planes, cm.
