@@ -103,7 +103,7 @@ fn describe_implicit_solver(s: &mut String, sim: &Simulation) {
             crate::physics::implicit::QUASI_NEWTON_HISTORY,
             sim.refactor_iterations,
             sim.newton_tolerance,
-            crate::physics::implicit::QUASI_NEWTON_MAX_ITERATIONS
+            sim.quasi_newton_iterations
         ),
     };
     let _ = writeln!(s, "  linear solver: {solver}");

@@ -83,9 +83,7 @@ mod quasi_newton;
 mod refactor;
 
 use linearise::linearise;
-pub use quasi_newton::{
-    HISTORY as QUASI_NEWTON_HISTORY, MAX_ITERATIONS as QUASI_NEWTON_MAX_ITERATIONS,
-};
+pub use quasi_newton::HISTORY as QUASI_NEWTON_HISTORY;
 
 use rayon::prelude::*;
 

@@ -100,6 +100,8 @@ pub struct SolverSettings {
     pub newton_iterations: u32,
     /// Relative residual at which Newton iterations stop.
     pub newton_tolerance: Scalar,
+    /// Iterations after which an unconverged quasi-Newton step fails.
+    pub quasi_newton_iterations: u32,
 }
 
 impl Default for SolverSettings {
@@ -114,6 +116,7 @@ impl Default for SolverSettings {
             bending_matrix: BendingMatrix::Exact,
             newton_iterations: 1,
             newton_tolerance: 1e-3,
+            quasi_newton_iterations: 200,
         }
     }
 }

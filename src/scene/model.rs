@@ -203,6 +203,10 @@ pub struct Simulation {
     /// (used when `newton_iterations` > 1).
     #[serde(default = "default_newton_tolerance")]
     pub newton_tolerance: f64,
+    /// Iterations after which an unconverged quasi-Newton step fails (used by
+    /// `solver = "quasi_newton"`).
+    #[serde(default = "default_quasi_newton_iterations")]
+    pub quasi_newton_iterations: u32,
     /// When the run ends at rest (absent: it runs for `duration`).
     #[serde(default)]
     pub rest: Option<crate::spec::Rest>,
@@ -429,6 +433,9 @@ fn default_newton_iterations() -> u32 {
 }
 fn default_newton_tolerance() -> f64 {
     1e-3
+}
+fn default_quasi_newton_iterations() -> u32 {
+    200
 }
 fn default_one() -> f64 {
     1.0

@@ -224,6 +224,7 @@ impl Model {
                 bending_matrix: scene.simulation.bending_matrix,
                 newton_iterations: scene.simulation.newton_iterations,
                 newton_tolerance: scene.simulation.newton_tolerance,
+                quasi_newton_iterations: scene.simulation.quasi_newton_iterations,
             },
             attachments: scene.attachment.iter().map(AttachmentTable::pull).collect(),
         }

@@ -35,6 +35,7 @@ pub(crate) fn allowed(path: &str) -> Option<&'static str> {
         "simulation.bending_matrix" => "\"first_ring\" or \"exact\"",
         "simulation.newton_iterations" => "an integer from 1 to 100",
         "simulation.newton_tolerance" => "a number in the open interval (0, 1)",
+        "simulation.quasi_newton_iterations" => "an integer from 1 to 100000",
         "cloth" => "a table [cloth]",
         "cloth.shape" => "\"rectangle\", \"disk\", \"obj\" or \"panels\"",
         "cloth.max_edge" => "a finite number > 0 (m; panels only)",

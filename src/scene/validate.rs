@@ -201,6 +201,15 @@ fn simulation(s: &Simulation) -> Result<(), Issue> {
             ),
         ));
     }
+    if !(1..=100_000).contains(&s.quasi_newton_iterations) {
+        return Err(out_of_range(
+            at("quasi_newton_iterations"),
+            format!(
+                "{} is out of range: must be from 1 to 100000",
+                s.quasi_newton_iterations
+            ),
+        ));
+    }
     finite(&at("newton_tolerance"), s.newton_tolerance)?;
     if !(s.newton_tolerance > 0.0 && s.newton_tolerance < 1.0) {
         return Err(out_of_range(

@@ -219,3 +219,33 @@ fn an_unreachable_tolerance_fails_the_quasi_newton_step() {
         "{message}"
     );
 }
+
+/// The iteration cap is the scene's `quasi_newton_iterations`: a run the
+/// default cap of 200 carries through fails with a cap of 2, naming it, and
+/// a cap of 0 is refused.
+#[test]
+fn the_quasi_newton_iteration_cap_is_the_scenes() {
+    let run_with = |cap: u32| {
+        let scene = default_scene(&[
+            "simulation.solver=\"quasi_newton\"".into(),
+            "simulation.duration=0.05".into(),
+            format!("simulation.quasi_newton_iterations={cap}"),
+        ])
+        .expect("scene");
+        let opts = RunOptions {
+            threads: Some(2),
+            ..RunOptions::default()
+        };
+        run(&scene, &opts, &AtomicBool::new(false), &mut |_| {})
+    };
+    run_with(200).expect("the default cap");
+    let message = run_with(2).expect_err("a cap of 2").to_string();
+    assert!(message.contains("after 2 iterations"), "{message}");
+    let refused = default_scene(&["simulation.quasi_newton_iterations=0".into()])
+        .expect_err("0")
+        .to_string();
+    assert!(
+        refused.contains("simulation.quasi_newton_iterations") && refused.contains("1 to 100000"),
+        "{refused}"
+    );
+}

@@ -35,7 +35,7 @@
 //! # Stopping
 //! The iteration stops once `|S g|` falls below `newton_tolerance` times the
 //! first linearisation's `|S b|` (the Newton iterations' test). A step that has
-//! not converged after [`MAX_ITERATIONS`] iterations, or whose line search
+//! not converged after `quasi_newton_iterations` iterations, or whose line search
 //! finds no acceptable step, fails with
 //! [`SolveFailure::QuasiNewtonNotConverged`] and is retried with halved steps.
 //!
@@ -63,8 +63,6 @@ use crate::world::World;
 
 /// Pairs `(s, y)` the L-BFGS direction keeps.
 pub const HISTORY: usize = 8;
-/// Iterations after which an unconverged step fails.
-pub const MAX_ITERATIONS: u32 = 200;
 /// Halvings of the line search before an unconverged step fails.
 pub const HALVINGS: u32 = 12;
 /// Armijo's sufficient decrease constant of the line search.
@@ -243,7 +241,7 @@ fn iterate(
             residual: norm / reference.max(Scalar::MIN_POSITIVE),
             tolerance,
         };
-        if iterations >= MAX_ITERATIONS {
+        if iterations >= model.solver.quasi_newton_iterations {
             return Err(failed(iterations, norm));
         }
         let slope = direction(st, held);
