@@ -193,14 +193,24 @@ fn row(run: &RunPlan, reps: &[Samples], reference: &Samples, compare: Compare) -
     let frames: Vec<FrameSamples> = first.frames.iter().map(|f| shifted(f, shift)).collect();
     let errors = sampling::run_errors(&frames, &reference.frames, diagonal);
     let failure = reps.iter().find_map(|s| s.failure.clone());
-    let complete =
-        failure.is_none() && errors.len() == frames.len() && errors.len() == reference.frames.len();
-    let (mean_error, final_error) = match complete {
-        true => (
-            Compare::Frames.of(errors.iter().map(|e| e.1)),
-            Compare::Rest.of(errors.iter().map(|e| e.1)),
-        ),
-        false => (Scalar::NAN, Scalar::NAN),
+    let every_frame = errors.len() == frames.len() && errors.len() == reference.frames.len();
+    // Runs that end at rest end at frames of their own: at rest, their last
+    // frames are compared.
+    let both_at_rest =
+        compare == Compare::Rest && first.rest_time.is_some() && reference.rest_time.is_some();
+    let rest = match both_at_rest {
+        true => sampling::rest_error(&frames, &reference.frames, diagonal),
+        false => None,
+    };
+    let complete = failure.is_none() && (every_frame || rest.is_some());
+    let mean_error = match complete && every_frame {
+        true => Compare::Frames.of(errors.iter().map(|e| e.1)),
+        false => Scalar::NAN,
+    };
+    let final_error = match (complete, rest) {
+        (false, _) => Scalar::NAN,
+        (true, Some((_, error))) => error,
+        (true, None) => Compare::Rest.of(errors.iter().map(|e| e.1)),
     };
     let walls: Vec<Scalar> = reps.iter().map(|s| s.wall_s).collect();
     Row {

@@ -100,6 +100,10 @@ pub struct Samples {
     pub peak_vertices: Scalar,
     /// The numerical failure that stopped the run early, if any.
     pub failure: Option<String>,
+    /// When the run came to rest and ended there (`simulation.rest`), s;
+    /// `None` when it ran for its whole duration.
+    #[serde(default)]
+    pub rest_time: Option<Scalar>,
     /// Samples of every frame done.
     pub frames: Vec<FrameSamples>,
 }
@@ -194,6 +198,12 @@ impl<'a> Sampler<'a> {
             mean_vertices: summary.mesh.vertices.mean,
             peak_vertices: summary.mesh.vertices.max,
             failure,
+            rest_time: summary
+                .checks
+                .rest
+                .as_ref()
+                .filter(|r| r.at_rest)
+                .and_then(|r| r.time),
             frames: self.frames,
         })
     }
@@ -287,6 +297,24 @@ pub fn run_errors(
             Some((f.time, frame_error(f, r, diagonal)?))
         })
         .collect()
+}
+
+/// The error of a run's last frame against the reference's last frame,
+/// whatever their times (two runs that ended at rest, each when it came to
+/// rest), as `(the run's last time, error)`; `None` without frames or with no
+/// sample found in both.
+pub fn rest_error(
+    run: &[FrameSamples],
+    reference: &[FrameSamples],
+    diagonal: Scalar,
+) -> Option<(Scalar, Scalar)> {
+    let (last, reference) = (run.last()?, reference.last()?);
+    let aligned = FrameSamples {
+        frame: reference.frame,
+        time: reference.time,
+        ..last.clone()
+    };
+    Some((last.time, frame_error(&aligned, reference, diagonal)?))
 }
 
 /// How far the samples moved between the last two frames, as the relative RMS

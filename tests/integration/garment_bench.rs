@@ -6,7 +6,7 @@
 use std::sync::atomic::AtomicBool;
 
 use drape::bench::metric::locate_in_panels;
-use drape::bench::{BenchError, BenchOptions, Ladder, Rung, bench, make_plan};
+use drape::bench::{BenchError, BenchOptions, Compare, Ladder, Rung, bench, make_plan};
 use drape::scene::load_scene_file;
 use drape::world::World;
 
@@ -123,6 +123,52 @@ fn a_garment_benches_with_its_default_ladder() {
     };
     assert!(error("uniform 0.1 m") > 0.0);
     assert!(error("reference lifted") < 1e-3 * error("uniform 0.1 m"));
+}
+
+/// Runs that end at rest end at frames of their own: with `compare =
+/// "rest"` each run's last frame is compared with the reference's last
+/// frame, and the mean over the frames, which the runs do not share, is
+/// left out.
+#[test]
+fn garment_runs_that_end_at_rest_at_different_frames_compare_their_last_frames() {
+    let dir = temp_dir("garment-rest");
+    let scene = dir.join("squares.toml");
+    let resting = SQUARES
+        .replace(
+            "dt = 0.005\n",
+            "dt = 0.005\nrest = { speed = 0.05, window = 0.2 }\n",
+        )
+        .replace("damping = 0.001", "damping = 0.05")
+        .replace(
+            "max_edge = 0.05\n",
+            "max_edge = 0.05\nsewing = { weld_gap = 0.03 }\n",
+        );
+    std::fs::write(&scene, resting).expect("write scene");
+    let mut opts = options(scene.to_str().expect("utf-8"), None);
+    opts.duration = Some(4.0);
+    opts.compare = Some(Compare::Rest);
+    let (result, _) = bench(
+        &opts,
+        &dir.join("out"),
+        &AtomicBool::new(false),
+        &mut |_| {},
+    )
+    .expect("bench");
+    let mut own_frames = 0;
+    for r in &result.rows {
+        let last = r.errors.last().map(|e| e.0);
+        println!(
+            "{}: {} vertices, error at rest {:.3e}, mean {:.3e}, last shared frame {last:?}, {}",
+            r.run.label, r.mean_vertices, r.error, r.mean_error, r.status
+        );
+        assert_eq!(r.status, "ok");
+        assert!(r.error.is_finite() && r.error > 0.0);
+        own_frames += usize::from(r.mean_error.is_nan());
+    }
+    assert!(
+        own_frames > 0,
+        "every run came to rest on the reference's frame"
+    );
 }
 
 const SQUARES: &str = r#"
