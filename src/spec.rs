@@ -28,7 +28,7 @@ pub use attachment::{Attachment, AttachmentTable, DEFAULT_ATTACHMENT_STIFFNESS, 
 pub use curve::{Curve, SideCurve};
 pub use garment::{
     DEFAULT_SEWING_STIFFNESS, DEFAULT_WELD_GAP, Garment, Gather, PanelSpec, Placement,
-    SeamDirection, SeamSide, SeamSpec, Sewing,
+    SeamDirection, SeamEdge, SeamSide, SeamSpec, Sewing,
 };
 pub use obstacle_spec::{
     Geometry, ObstacleMotion, ObstacleSpec, ObstacleSpecError, PartSpec, Primitive,

@@ -127,28 +127,16 @@ pub fn build(garment: &Garment) -> Result<BuiltGarment, GarmentError> {
         .iter()
         .map(|s| {
             let (a, b) = (
-                side_index(garment, s, true)?,
-                side_index(garment, s, false)?,
+                edge_sides(garment, s, true)?,
+                edge_sides(garment, s, false)?,
             );
-            let (chain_a, chain_b) = (&chains[a.0][a.1], &chains[b.0][b.1]);
-            let mut pairs: Vec<[u32; 2]> = match s.direction {
-                SeamDirection::Opposite => chain_a
-                    .iter()
-                    .zip(chain_b.iter().rev())
-                    .map(|(&u, &w)| [u, w])
-                    .collect(),
-                SeamDirection::Same => chain_a
-                    .iter()
-                    .zip(chain_b.iter())
-                    .map(|(&u, &w)| [u, w])
-                    .collect(),
-            };
-            // Two adjacent sides of one panel (a dart) share their corner,
-            // which is joined already.
-            pairs.retain(|p| p[0] != p[1]);
             Ok(Seam {
                 name: s.name.clone(),
-                pairs,
+                pairs: seam_pairs(
+                    &edge_points(&chains, &a),
+                    &edge_points(&chains, &b),
+                    s.direction,
+                ),
             })
         })
         .collect::<Result<Vec<Seam>, GarmentError>>()?;
@@ -170,14 +158,65 @@ pub fn build(garment: &Garment) -> Result<BuiltGarment, GarmentError> {
     Ok(BuiltGarment { mesh, positions })
 }
 
-/// The (panel, 0-based side) of a seam's first (`first`) or second side.
-fn side_index(
+/// The (panel, 0-based side) of each panel side of a seam's first (`first`)
+/// or second edge, in order.
+fn edge_sides(
     garment: &Garment,
     s: &SeamSpec,
     first: bool,
-) -> Result<(usize, usize), GarmentError> {
-    let side = if first { &s.a } else { &s.b };
-    find_side(garment, side).map_err(|reason| seam_error(s, reason))
+) -> Result<Vec<(usize, usize)>, GarmentError> {
+    let edge = if first { &s.a } else { &s.b };
+    if edge.is_empty() {
+        return Err(seam_error(
+            s,
+            "an edge of the seam has no panel side".into(),
+        ));
+    }
+    edge.iter()
+        .map(|side| find_side(garment, side).map_err(|reason| seam_error(s, reason)))
+        .collect()
+}
+
+/// The points of an edge along its panel sides' vertex chains, in order: one
+/// vertex each, or at a joint between two sides that do not share their
+/// corner (two panels) the two sides' end vertices together.
+fn edge_points(chains: &[Vec<Vec<u32>>], sides: &[(usize, usize)]) -> Vec<Vec<u32>> {
+    let mut points: Vec<Vec<u32>> = Vec::new();
+    for (k, &(p, side)) in sides.iter().enumerate() {
+        for (i, &v) in chains[p][side].iter().enumerate() {
+            match points.last_mut() {
+                Some(joint) if i == 0 && k > 0 => {
+                    if !joint.contains(&v) {
+                        joint.push(v);
+                    }
+                }
+                _ => points.push(vec![v]),
+            }
+        }
+    }
+    points
+}
+
+/// The pairs of a seam whose edges have the points `a` and `b` (the same
+/// number: [`sides::side_segments`] gives both edges the same segments).
+/// Point i of `a` meets point i of `b`, or of `b` reversed for
+/// [`SeamDirection::Opposite`]; every vertex of a joint is paired with the
+/// point's first vertex, so that the weld joins them all. A pair of one vertex
+/// with itself (two adjacent sides of one panel, a dart, share their corner)
+/// is joined already and left out.
+fn seam_pairs(a: &[Vec<u32>], b: &[Vec<u32>], direction: SeamDirection) -> Vec<[u32; 2]> {
+    let b: Vec<&Vec<u32>> = match direction {
+        SeamDirection::Opposite => b.iter().rev().collect(),
+        SeamDirection::Same => b.iter().collect(),
+    };
+    debug_assert_eq!(a.len(), b.len(), "the edges' points");
+    let mut pairs = Vec::new();
+    for (pa, pb) in a.iter().zip(b) {
+        let first = pa[0];
+        pairs.extend(pa[1..].iter().chain(pb).map(|&v| [first, v]));
+    }
+    pairs.retain(|p| p[0] != p[1]);
+    pairs
 }
 
 /// The (panel, 0-based side) of `side`, or why there is none.

@@ -158,37 +158,75 @@ pub fn side_segments(garment: &Garment) -> Result<Vec<Vec<usize>>, GarmentError>
                 .collect()
         })
         .collect();
-    let mut used_sides: Vec<(usize, usize)> = Vec::new();
-    for s in &garment.seams {
+    // Each side sewn so far, with its seam.
+    let mut used_sides: Vec<((usize, usize), usize)> = Vec::new();
+    for (i, s) in garment.seams.iter().enumerate() {
         let (a, b) = (
-            super::side_index(garment, s, true)?,
-            super::side_index(garment, s, false)?,
+            super::edge_sides(garment, s, true)?,
+            super::edge_sides(garment, s, false)?,
         );
-        if a == b {
-            return Err(seam_error(s, "both sides are the same panel side".into()));
-        }
-        for side in [a, b] {
-            if let Some(k) = used_sides.iter().position(|&u| u == side) {
-                // Two sides per seam, in seam order.
-                let name = &garment.seams[k / 2].name;
+        for &side in a.iter().chain(&b) {
+            if let Some(&(_, j)) = used_sides.iter().find(|u| u.0 == side) {
+                let panel = &garment.panels[side.0].name;
                 return Err(seam_error(
                     s,
-                    format!(
-                        "side {} of panel `{}` is already sewn by seam `{name}`",
-                        side.1 + 1,
-                        garment.panels[side.0].name
-                    ),
+                    match j == i {
+                        true => format!(
+                            "side {} of panel `{panel}` is on the seam twice; a panel side is \
+                             sewn once",
+                            side.1 + 1
+                        ),
+                        false => format!(
+                            "side {} of panel `{panel}` is already sewn by seam `{}`",
+                            side.1 + 1,
+                            garment.seams[j].name
+                        ),
+                    },
                 ));
             }
-            used_sides.push(side);
+            used_sides.push((side, i));
         }
         let len = |(p, k): (usize, usize)| panel_side_length(&garment.panels[p], k);
-        check_lengths(s, len(a), len(b))?;
-        let n = segments[a.0][a.1].max(segments[b.0][b.1]);
-        segments[a.0][a.1] = n;
-        segments[b.0][b.1] = n;
+        let lengths = |e: &[(usize, usize)]| e.iter().map(|&x| len(x)).collect::<Vec<_>>();
+        let (la, lb) = (lengths(&a), lengths(&b));
+        check_lengths(s, la.iter().sum(), lb.iter().sum())?;
+        let count = |e: &[(usize, usize)]| e.iter().map(|&(p, k)| segments[p][k]).sum::<usize>();
+        let total = count(&a).max(count(&b)).max(a.len()).max(b.len());
+        for (edge, lengths) in [(&a, &la), (&b, &lb)] {
+            for (&(p, k), n) in edge.iter().zip(shares(total, lengths)) {
+                segments[p][k] = n;
+            }
+        }
     }
     Ok(segments)
+}
+
+/// `total` segments shared among sides of `lengths`, in proportion to their
+/// lengths and at least one each (largest remainders first); `total` is at
+/// least the number of sides.
+fn shares(total: usize, lengths: &[Scalar]) -> Vec<usize> {
+    let sum: Scalar = lengths.iter().sum();
+    let exact: Vec<Scalar> = lengths
+        .iter()
+        .map(|l| total as Scalar * l / sum.max(Scalar::MIN_POSITIVE))
+        .collect();
+    let mut n: Vec<usize> = exact.iter().map(|e| (e.floor() as usize).max(1)).collect();
+    while n.iter().sum::<usize>() < total {
+        let k = (0..n.len())
+            .max_by(|&i, &j| (exact[i] - n[i] as Scalar).total_cmp(&(exact[j] - n[j] as Scalar)))
+            .unwrap_or(0);
+        n[k] += 1;
+    }
+    while n.iter().sum::<usize>() > total {
+        let Some(k) = (0..n.len())
+            .filter(|&i| n[i] > 1)
+            .min_by(|&i, &j| (exact[i] - n[i] as Scalar).total_cmp(&(exact[j] - n[j] as Scalar)))
+        else {
+            break;
+        };
+        n[k] -= 1;
+    }
+    n
 }
 
 /// A seam that does not gather has sides within [`SEAM_LENGTH_TOLERANCE`].

@@ -342,8 +342,8 @@ pub fn stitch(i: usize, entry: &[Value], panels: &[PanelSpec]) -> Result<SeamSpe
     };
     Ok(SeamSpec {
         name: format!("stitch{i}"),
-        a: side(sides[0]),
-        b: side(sides[1]),
+        a: vec![side(sides[0])],
+        b: vec![side(sides[1])],
         direction,
         gather,
     })

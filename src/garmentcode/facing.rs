@@ -27,13 +27,15 @@ pub fn turned_over(names: &[String], seams: &[SeamSpec]) -> Vec<bool> {
     // links[p]: (q, flip): q is turned iff p is, XOR flip.
     let mut links: Vec<Vec<(usize, bool)>> = vec![Vec::new(); names.len()];
     for s in seams {
-        let (Some(&a), Some(&b)) = (index.get(s.a.panel.as_str()), index.get(s.b.panel.as_str()))
-        else {
-            continue;
-        };
         let flip = s.direction == SeamDirection::Same;
-        links[a].push((b, flip));
-        links[b].push((a, flip));
+        for (a, b) in s.a.iter().flat_map(|a| s.b.iter().map(move |b| (a, b))) {
+            let (Some(&a), Some(&b)) = (index.get(a.panel.as_str()), index.get(b.panel.as_str()))
+            else {
+                continue;
+            };
+            links[a].push((b, flip));
+            links[b].push((a, flip));
+        }
     }
     let mut turned = vec![false; names.len()];
     let mut seen = vec![false; names.len()];
@@ -92,8 +94,8 @@ mod tests {
         };
         SeamSpec {
             name: format!("{a}-{b}"),
-            a: side(a),
-            b: side(b),
+            a: vec![side(a)],
+            b: vec![side(b)],
             direction,
             gather: Gather::None,
         }

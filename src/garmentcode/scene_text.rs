@@ -212,8 +212,12 @@ fn panel(s: &mut String, p: &PanelSpec) {
 }
 
 fn seam_table(s: &mut String, seam: &SeamSpec) {
-    let side = |x: &crate::spec::SeamSide| {
+    let one = |x: &crate::spec::SeamSide| {
         format!("{{ panel = {}, side = {} }}", quoted(&x.panel), x.side)
+    };
+    let side = |sides: &[crate::spec::SeamSide]| match sides {
+        [x] => one(x),
+        many => format!("[{}]", many.iter().map(one).collect::<Vec<_>>().join(", ")),
     };
     let _ = write!(
         s,

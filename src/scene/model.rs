@@ -97,10 +97,11 @@ pub struct WrapTable {
 pub struct SeamTable {
     /// The seam's name (unique).
     pub name: String,
-    /// The first side: `{ panel = "front", side = 2 }`.
-    pub a: crate::spec::SeamSide,
-    /// The second side, sewn end to start against the first.
-    pub b: crate::spec::SeamSide,
+    /// The first edge: `{ panel = "front", side = 2 }`, or several such
+    /// sides joined end to end, `[{ ... }, { ... }]`.
+    pub a: crate::spec::SeamEdge,
+    /// The second edge, sewn end to start against the first.
+    pub b: crate::spec::SeamEdge,
     /// Which way the second side runs against the first.
     #[serde(default)]
     pub direction: crate::spec::SeamDirection,

@@ -90,8 +90,8 @@ pub fn cloth_spec(
                 .iter()
                 .map(|s| SeamSpec {
                     name: s.name.clone(),
-                    a: s.a.clone(),
-                    b: s.b.clone(),
+                    a: s.a.sides().to_vec(),
+                    b: s.b.sides().to_vec(),
                     direction: s.direction,
                     gather: if s.gather { Gather::Any } else { Gather::None },
                 })

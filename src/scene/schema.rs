@@ -62,7 +62,8 @@ pub(crate) fn allowed(path: &str) -> Option<&'static str> {
         "seam" => "an array of tables [[seam]] (with cloth.shape = \"panels\")",
         "seam.name" => "a non-empty string, unique among the seams",
         "seam.a" | "seam.b" => {
-            "a table { panel, side }: an existing panel and a side 1 to its corner count"
+            "a table { panel, side } (an existing panel and a side 1 to its corner count), \
+             or a non-empty array of such tables joined end to end"
         }
         "seam.a.panel" | "seam.b.panel" => "the name of a [[panel]]",
         "seam.a.side" | "seam.b.side" => "an integer from 1 to the panel's corner count",

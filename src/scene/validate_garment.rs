@@ -11,7 +11,7 @@ use super::validate::{all_finite, non_negative, positive};
 use super::{ClothShape, Scene};
 use crate::garment::SEAM_LENGTH_TOLERANCE;
 use crate::math::Scalar;
-use crate::spec::{AdaptMethod, AttachmentTable, Curve, SeamSide};
+use crate::spec::{AdaptMethod, AttachmentTable, Curve, SeamEdge, SeamSide};
 
 fn at(table: &str, i: usize, key: &str) -> KeyPath {
     vec![Seg::Key(table.into()), Seg::Index(i), Seg::Key(key.into())]
@@ -228,32 +228,54 @@ fn seam(
         earlier.iter().map(|e| e.name.clone()),
     )?;
     let length = [
-        side_length(i, "a", &s.a, panels)?,
-        side_length(i, "b", &s.b, panels)?,
+        edge_length(i, "a", &s.a, panels)?,
+        edge_length(i, "b", &s.b, panels)?,
     ];
-    if s.a == s.b {
+    let sides: Vec<&SeamSide> = s.a.sides().iter().chain(s.b.sides()).collect();
+    if let Some((k, side)) = sides
+        .iter()
+        .enumerate()
+        .find(|(k, side)| sides[..*k].contains(side))
+    {
+        let key = if k < s.a.sides().len() { "a" } else { "b" };
         return Err(Issue::new(
-            at("seam", i, "b"),
+            at("seam", i, key),
             Kind::BadValue,
-            "both sides of the seam are the same panel side",
+            format!(
+                "side {} of panel `{}` is on the seam twice; a panel side is sewn once",
+                side.side, side.panel
+            ),
         ));
     }
     not_sewn_before(i, s, earlier)?;
     seam_lengths_match(i, s, panels, length)
 }
 
-/// The length of the panel side `side`, key `key` of `[[seam]]` number `i`,
-/// or the issue when there is no such panel or side.
-fn side_length(
+/// The length of the edge `edge` (its sides' straight lengths summed), key
+/// `key` of `[[seam]]` number `i`, or the issue when it has no side or names
+/// a panel or side that is not there.
+fn edge_length(
     i: usize,
     key: &str,
-    side: &SeamSide,
+    edge: &SeamEdge,
     panels: &[PanelTable],
 ) -> Result<Scalar, Issue> {
-    let p = existing_side(at("seam", i, key), side, panels)?;
-    let n = p.outline.len();
-    let (u, w) = (p.outline[side.side - 1], p.outline[side.side % n]);
-    Ok((u[0] - w[0]).hypot(u[1] - w[1]))
+    if edge.sides().is_empty() {
+        return Err(Issue::new(
+            at("seam", i, key),
+            Kind::BadValue,
+            "the array of panel sides is empty",
+        )
+        .allowed("one table { panel, side } or a non-empty array of them"));
+    }
+    let mut length = 0.0;
+    for side in edge.sides() {
+        let p = existing_side(at("seam", i, key), side, panels)?;
+        let n = p.outline.len();
+        let (u, w) = (p.outline[side.side - 1], p.outline[side.side % n]);
+        length += (u[0] - w[0]).hypot(u[1] - w[1]);
+    }
+    Ok(length)
 }
 
 /// The panel of `side` (the key at `path`), or the issue when there is no
@@ -289,8 +311,9 @@ fn existing_side<'a>(
 /// The issue when a side of `[[seam]]` number `i` (`s`) is sewn by an earlier seam.
 fn not_sewn_before(i: usize, s: &SeamTable, earlier: &[SeamTable]) -> Result<(), Issue> {
     for (j, e) in earlier.iter().enumerate() {
-        for (key, side) in [("a", &s.a), ("b", &s.b)] {
-            if *side == e.a || *side == e.b {
+        let sewn = |side: &SeamSide| e.a.sides().contains(side) || e.b.sides().contains(side);
+        for (key, edge) in [("a", &s.a), ("b", &s.b)] {
+            if let Some(side) = edge.sides().iter().find(|side| sewn(side)) {
                 return Err(Issue::new(
                     at("seam", i, key),
                     Kind::BadValue,
@@ -316,7 +339,7 @@ fn seam_lengths_match(
     panels: &[PanelTable],
     length: [Scalar; 2],
 ) -> Result<(), Issue> {
-    let curved = [&s.a, &s.b].iter().any(|side| {
+    let curved = s.a.sides().iter().chain(s.b.sides()).any(|side| {
         panels
             .iter()
             .find(|p| p.name == side.panel)

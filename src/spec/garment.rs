@@ -58,19 +58,22 @@ pub enum Placement {
     },
 }
 
-/// A seam: two panel sides sewn together, by default the first side's start
-/// to the second side's end (two counter-clockwise outlines run a shared seam
-/// in opposite directions). Both sides are divided into the same number of
-/// segments, each side's points equally spaced along its own length, so a
-/// longer side gathers into a shorter one.
+/// A seam: two edges sewn together, by default the first edge's start to the
+/// second edge's end (two counter-clockwise outlines run a shared seam in
+/// opposite directions). Each edge is one panel side or several joined end to
+/// end (a waistband's long side sewn to the tops of a skirt's front and
+/// back). Both edges are divided into the same number of segments, each
+/// panel side's points equally spaced along its own length and each side's
+/// share of its edge's segments in proportion to its length, so a longer
+/// edge gathers into a shorter one.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SeamSpec {
     /// The seam's name.
     pub name: String,
-    /// The first side.
-    pub a: SeamSide,
-    /// The second side.
-    pub b: SeamSide,
+    /// The first edge: one or more panel sides, joined end to end in order.
+    pub a: Vec<SeamSide>,
+    /// The second edge.
+    pub b: Vec<SeamSide>,
     /// Which way the second side runs against the first.
     pub direction: SeamDirection,
     /// How much longer one side may be than the other.
@@ -99,7 +102,50 @@ pub enum Gather {
     Any,
 }
 
-/// One side of a seam: a panel and one of its outline's sides.
+/// One of the edges of a seam, as a scene writes it: one panel side, or
+/// several joined end to end in order.
+#[derive(Debug, Clone, PartialEq)]
+pub enum SeamEdge {
+    /// One panel side: `{ panel = "front", side = 2 }`.
+    One(SeamSide),
+    /// Several: `[{ panel = "front", side = 3 }, { panel = "back", side = 3 }]`.
+    Many(Vec<SeamSide>),
+}
+
+/// A table is one side, an array several; a mistake inside either is
+/// reported as that table's own (an unknown key, a missing `side`).
+impl<'de> Deserialize<'de> for SeamEdge {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<SeamEdge, D::Error> {
+        struct Edge;
+        impl<'de> serde::de::Visitor<'de> for Edge {
+            type Value = SeamEdge;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a table { panel, side } or an array of them")
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(self, map: A) -> Result<SeamEdge, A::Error> {
+                let one = serde::de::value::MapAccessDeserializer::new(map);
+                SeamSide::deserialize(one).map(SeamEdge::One)
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, seq: A) -> Result<SeamEdge, A::Error> {
+                let many = serde::de::value::SeqAccessDeserializer::new(seq);
+                Vec::<SeamSide>::deserialize(many).map(SeamEdge::Many)
+            }
+        }
+        d.deserialize_any(Edge)
+    }
+}
+
+impl SeamEdge {
+    /// The panel sides, in order.
+    pub fn sides(&self) -> &[SeamSide] {
+        match self {
+            SeamEdge::One(side) => std::slice::from_ref(side),
+            SeamEdge::Many(sides) => sides,
+        }
+    }
+}
+
+/// A panel side: a panel and one of its outline's sides.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SeamSide {

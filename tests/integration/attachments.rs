@@ -115,8 +115,8 @@ fn held_squares() -> BuiltGarment {
         panels: vec![square("left", -0.2), square("right", 0.0)],
         seams: vec![SeamSpec {
             name: "middle".into(),
-            a: side("left", 2),
-            b: side("right", 4),
+            a: vec![side("left", 2)],
+            b: vec![side("right", 4)],
             direction: SeamDirection::Opposite,
             gather: Gather::None,
         }],

@@ -59,15 +59,15 @@ fn welded_halves(width: Scalar, placements: [Placement; 2]) -> (World, Scalar) {
     let seams = vec![
         SeamSpec {
             name: "left".into(),
-            a: side("front", 2),
-            b: side("back", 4),
+            a: vec![side("front", 2)],
+            b: vec![side("back", 4)],
             direction: SeamDirection::Opposite,
             gather: Gather::None,
         },
         SeamSpec {
             name: "right".into(),
-            a: side("back", 2),
-            b: side("front", 4),
+            a: vec![side("back", 2)],
+            b: vec![side("front", 4)],
             direction: SeamDirection::Opposite,
             gather: Gather::None,
         },

@@ -20,14 +20,14 @@ use crate::common::Sim;
 fn seam(name: &str, a: (&str, usize), b: (&str, usize)) -> SeamSpec {
     SeamSpec {
         name: name.into(),
-        a: SeamSide {
+        a: vec![SeamSide {
             panel: a.0.into(),
             side: a.1,
-        },
-        b: SeamSide {
+        }],
+        b: vec![SeamSide {
             panel: b.0.into(),
             side: b.1,
-        },
+        }],
         direction: SeamDirection::Opposite,
         gather: Gather::None,
     }
@@ -340,7 +340,7 @@ fn garment_mistakes_name_file_line_and_key() {
         ),
         (
             edit(b, "b = { panel = \"left\", side = 2 }"),
-            "garment.toml:26: key `seam.0.b`: both sides of the seam are the same panel side",
+            "garment.toml:26: key `seam.0.b`: side 2 of panel `left` is on the seam twice; a panel side is sewn once",
         ),
         (
             edit(

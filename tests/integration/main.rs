@@ -29,6 +29,7 @@ mod fuzz;
 mod garment_batch;
 mod garment_bench;
 mod garment_curves;
+mod garment_edges;
 mod garment_phases;
 mod garment_recording;
 mod garment_remesh;
