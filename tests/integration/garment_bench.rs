@@ -102,13 +102,7 @@ fn a_garment_benches_with_its_default_ladder() {
     let scene = dir.join("squares.toml");
     std::fs::write(&scene, SQUARES).expect("write scene");
     let opts = options(scene.to_str().expect("utf-8"), None);
-    let (result, _) = bench(
-        &opts,
-        &dir.join("out"),
-        &AtomicBool::new(false),
-        &mut |_| {},
-    )
-    .expect("bench");
+    let result = bench_in(&dir, &opts);
     for r in &result.rows {
         println!(
             "{}: {} vertices, error {:.3e}, {}",
@@ -147,13 +141,7 @@ fn garment_runs_that_end_at_rest_at_different_frames_compare_their_last_frames()
     let mut opts = options(scene.to_str().expect("utf-8"), None);
     opts.duration = Some(4.0);
     opts.compare = Some(Compare::Rest);
-    let (result, _) = bench(
-        &opts,
-        &dir.join("out"),
-        &AtomicBool::new(false),
-        &mut |_| {},
-    )
-    .expect("bench");
+    let result = bench_in(&dir, &opts);
     let mut own_frames = 0;
     for r in &result.rows {
         let last = r.errors.last().map(|e| e.0);
@@ -169,6 +157,13 @@ fn garment_runs_that_end_at_rest_at_different_frames_compare_their_last_frames()
         own_frames > 0,
         "every run came to rest on the reference's frame"
     );
+}
+
+/// The bench of `opts`, written into `dir/out`.
+fn bench_in(dir: &std::path::Path, opts: &BenchOptions) -> drape::bench::BenchResult {
+    let out = dir.join("out");
+    let (result, _) = bench(opts, &out, &AtomicBool::new(false), &mut |_| {}).expect("bench");
+    result
 }
 
 const SQUARES: &str = r#"
