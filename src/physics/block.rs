@@ -44,10 +44,10 @@
 //! kinds keep ([`super::kinds::ForceKind::factored_pairs`]: vertex pairs
 //! joined by a spring or a membrane triangle's edge); each kind compensates on
 //! the diagonal for the blocks it adds that are dropped
-//! ([`super::kinds::ForceKind::dropped_terms`] and the in-place blocks' norms).
-//! The shape triangles' second-ring blocks (a tip with the triangle's
-//! opposite vertex or another tip) are not in the pattern at all with the
-//! default first-ring bending matrix, which lumps them on the diagonal of
+//! ([`super::kinds::ForceKind::dropped_terms`] and the in-place blocks'
+//! rank-one lumps). The shape triangles' second-ring blocks (a tip with the
+//! triangle's opposite vertex or another tip) are not in the pattern at all
+//! with the first-ring bending matrix, which lumps them on the diagonal of
 //! `A` itself (`kinds/shapes/blocks.rs`, "The first-ring matrix"); with the
 //! exact one they are dropped from the factor like the hinges' below.
 //! With dihedral hinges the only other blocks are the couplings between the two wing tips

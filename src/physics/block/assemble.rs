@@ -12,56 +12,56 @@ use crate::math::{Matrix3, Scalar, Vector};
 impl BlockPattern {
     /// Sums the lower blocks of `M + h D + h^2 K` into `lower` (one entry per
     /// block; the upper ones are left as they are, zero when first grown), and
-    /// the norms of the dropped in-place blocks per vertex into `sigma` (module
+    /// the compensation of the dropped in-place blocks per vertex into `lumps` (module
     /// docs, "Assembly"): band by band, each lower block's listed blocks kind
     /// by kind, the kinds' in-place blocks, and the mass on the diagonal.
     pub fn gather(
         &self,
         terms: &ElementBlocks<'_>,
-        sigma: &mut Vec<Scalar>,
+        lumps: &mut Vec<Matrix3>,
         lower: &mut Vec<Matrix3>,
     ) {
         lower.resize(self.blocks(), Matrix3::ZERO);
-        sigma.resize(self.vertices(), 0.0);
+        lumps.resize(self.vertices(), Matrix3::ZERO);
         let values = terms.kinds.block_values();
-        let band = |b: usize, lower: &mut [Matrix3], sigma: &mut [Scalar]| {
+        let band = |b: usize, lower: &mut [Matrix3], lumps: &mut [Matrix3]| {
             let rows = self.band_rows(b);
             let mut band = Band {
                 first_row: rows.start,
                 base: self.row_start[rows.start] as usize,
                 lower,
-                sigma,
+                lumps,
             };
             self.gather_band(terms, &values, &mut band);
         };
-        self.for_each_band(0..self.bands(), lower, sigma, &band);
+        self.for_each_band(0..self.bands(), lower, lumps, &band);
     }
 
-    /// Runs `f(band, lower, sigma)` for the bands in `bands`, in parallel, each
-    /// with the slices of its own rows (`lower` and `sigma` start at the first
+    /// Runs `f(band, lower, lumps)` for the bands in `bands`, in parallel, each
+    /// with the slices of its own rows (`lower` and `lumps` start at the first
     /// band's first row), by halving the range: no allocation, and each band's
     /// work the same at any thread count.
     fn for_each_band<F>(
         &self,
         bands: std::ops::Range<usize>,
         lower: &mut [Matrix3],
-        sigma: &mut [Scalar],
+        lumps: &mut [Matrix3],
         f: &F,
     ) where
-        F: Fn(usize, &mut [Matrix3], &mut [Scalar]) + Sync,
+        F: Fn(usize, &mut [Matrix3], &mut [Matrix3]) + Sync,
     {
         match bands.len() {
             0 => {}
-            1 => f(bands.start, lower, sigma),
+            1 => f(bands.start, lower, lumps),
             len => {
                 let mid = bands.start + len / 2;
                 let (first, split) = (self.band_rows(bands.start).start, self.band_rows(mid).start);
                 let blocks = (self.row_start[split] - self.row_start[first]) as usize;
                 let (lower_a, lower_b) = lower.split_at_mut(blocks);
-                let (sigma_a, sigma_b) = sigma.split_at_mut(split - first);
+                let (lumps_a, lumps_b) = lumps.split_at_mut(split - first);
                 rayon::join(
-                    || self.for_each_band(bands.start..mid, lower_a, sigma_a, f),
-                    || self.for_each_band(mid..bands.end, lower_b, sigma_b, f),
+                    || self.for_each_band(bands.start..mid, lower_a, lumps_a, f),
+                    || self.for_each_band(mid..bands.end, lower_b, lumps_b, f),
                 );
             }
         }
@@ -69,12 +69,12 @@ impl BlockPattern {
 
     /// Per vertex: the diagonal compensation of the dropped blocks (module
     /// docs, "The factored matrix"): the kinds' compensation terms, kind by
-    /// kind, then the norms `sigma` of the dropped in-place blocks (from
+    /// kind, then the compensation `lumps` of the dropped in-place blocks (from
     /// [`Self::gather`]), projected like the system (`S c g g^T S`).
     pub fn compensation(
         &self,
         terms: &ElementBlocks<'_>,
-        sigma: &[Scalar],
+        lumps: &[Matrix3],
         projection: &[Option<Vector>],
         extra: &mut Vec<Matrix3>,
     ) {
@@ -87,7 +87,7 @@ impl BlockPattern {
                 let mut m = Matrix3::ZERO;
                 let dropped = std::array::from_fn(|kind| self.dropped[kind].of(i));
                 terms.kinds.add_dropped(dropped, &mut m);
-                m += Matrix3::from_diagonal(Vector::splat(sigma[i]));
+                m += lumps[i];
                 *out = match projection[i] {
                     None => m,
                     Some(n) if n == Vector::ZERO => Matrix3::ZERO,

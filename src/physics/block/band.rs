@@ -3,7 +3,7 @@
 //! kinds add in place, and the mass on the diagonal.
 
 use super::{BAND_ROWS, BlockPattern, ElementBlocks, NEGATE};
-use crate::math::{Matrix3, Scalar, Vector};
+use crate::math::{Matrix3, Vector};
 
 /// One band's share of the assembly: its rows' lower blocks (the band's first
 /// block at `base`) and its vertices' diagonal compensation of dropped blocks.
@@ -15,9 +15,9 @@ pub struct Band<'a> {
     pub base: usize,
     /// The band's blocks (lower ones filled, upper ones unused).
     pub lower: &'a mut [Matrix3],
-    /// Per row of the band, the norms of the dropped blocks that compensate
-    /// on its diagonal (added by the kinds' in-place blocks).
-    pub sigma: &'a mut [Scalar],
+    /// Per row of the band, the compensation of the dropped in-place blocks
+    /// on its diagonal block (added by the kinds' in-place blocks).
+    pub lumps: &'a mut [Matrix3],
 }
 
 impl Band<'_> {
@@ -30,7 +30,7 @@ impl Band<'_> {
     /// The band's rows.
     #[inline(always)]
     pub fn rows(&self) -> std::ops::Range<usize> {
-        self.first_row..self.first_row + self.sigma.len()
+        self.first_row..self.first_row + self.lumps.len()
     }
 }
 
@@ -61,7 +61,7 @@ impl BlockPattern {
                 band.lower[slot - band.base] = m;
             }
         }
-        band.sigma.fill(0.0);
+        band.lumps.fill(Matrix3::ZERO);
         terms
             .kinds
             .add_in_place(terms.elements, &self.in_place, terms.h2, band);

@@ -175,9 +175,9 @@ fn shape_block(terms: &ElementBlocks<'_>, tri: usize, k: usize, l: usize) -> Mat
 /// The assembly's outputs: lower blocks, compensation, projected system.
 fn assemble(p: &BlockPattern, terms: &ElementBlocks<'_>) -> [Vec<Matrix3>; 3] {
     let n = p.vertices();
-    let mut sigma = Vec::new();
+    let mut lumps = Vec::new();
     let (mut lower, mut extra, mut system) = (Vec::new(), Vec::new(), Vec::new());
-    p.gather(terms, &mut sigma, &mut lower);
+    p.gather(terms, &mut lumps, &mut lower);
     let projection: Vec<Option<Vector>> = (0..n)
         .map(|i| match i % 7 {
             0 => Some(Vector::ZERO),
@@ -185,7 +185,7 @@ fn assemble(p: &BlockPattern, terms: &ElementBlocks<'_>) -> [Vec<Matrix3>; 3] {
             _ => None,
         })
         .collect();
-    p.compensation(terms, &sigma, &projection, &mut extra);
+    p.compensation(terms, &lumps, &projection, &mut extra);
     let scale: Vec<Scalar> = (0..n).map(|i| 1.0 + noise(i, 11)).collect();
     let mut touched = Vec::new();
     p.touched_rows(&projection, &mut touched);
@@ -390,14 +390,18 @@ fn gather_matches_the_per_term_sum_and_a_dense_assembly() {
                 );
             }
             // The compensation of a free vertex: its dropped hinge tips' c g g^T
-            // and its dropped shape blocks' norms (one vertex in 7 is free of
-            // both projections in `assemble`).
-            let mut sigma = vec![0.0; p.vertices()];
+            // and its dropped shape blocks' rank-one lumps, `B B^T / |B|` for
+            // the block `B = x y^T` of a pair from its row vertex (one vertex
+            // in 7 is free of both projections in `assemble`).
+            let mut lumps = vec![Matrix3::ZERO; p.vertices()];
             for (ti, tri) in el.kinds.shapes.triangles.iter().enumerate() {
                 for (k, i) in tri.slots() {
                     for (l, j) in tri.slots() {
                         if i != j && !p.factored[p.lower_slot(i, j) as usize] {
-                            sigma[i as usize] += frobenius(&shape_block(&t, ti, k, l));
+                            let b = shape_block(&t, ti, k, l);
+                            if frobenius(&b) > 0.0 {
+                                lumps[i as usize] += b * b.transpose() * (1.0 / frobenius(&b));
+                            }
                         }
                     }
                 }
@@ -412,7 +416,7 @@ fn gather_matches_the_per_term_sum_and_a_dense_assembly() {
                 }
             }
             for i in (0..p.vertices()).filter(|i| ![0, 3].contains(&(i % 7))) {
-                let expected = Matrix3::from_diagonal(Vector::splat(sigma[i])) + tips[i];
+                let expected = lumps[i] + tips[i];
                 let error = frobenius(&(extra[i] - expected));
                 assert!(error <= 1e-12 * frobenius(&expected), "vertex {i}");
             }

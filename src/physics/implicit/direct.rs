@@ -116,9 +116,9 @@ pub(super) struct DirectScratch {
     tips_break_even: Option<Scalar>,
     /// The lower blocks of `A` (the upper ones are their mirrors' transposes).
     lower: Vec<Matrix3>,
-    /// Per vertex: the norms of the dropped in-place blocks that compensate
-    /// on its diagonal ([`BlockPattern::gather`]).
-    sigma: Vec<Scalar>,
+    /// Per vertex: the compensation of the dropped in-place blocks on its
+    /// diagonal block ([`BlockPattern::gather`]).
+    lumps: Vec<Matrix3>,
     /// `A_s`, the projected matrix.
     system: Vec<Matrix3>,
     /// Per vertex: the diagonal compensation added to the factored matrix.

@@ -52,11 +52,11 @@ fn the_first_ring_matrix_keeps_the_edges_and_bounds_the_exact_one() {
         assert!(pl.blocks() < pe.blocks());
         assert!(pl.in_place.shapes.ops.iter().all(|op| !op.dropped));
         let (te, tl) = (Terms::new(&exact, &x), Terms::new(&lumped, &x));
-        let (mut sigma_e, mut lower_e, mut sigma_l, mut lower_l) =
+        let (mut lumps_e, mut lower_e, mut lumps_l, mut lower_l) =
             (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-        pe.gather(&te.view(&exact), &mut sigma_e, &mut lower_e);
-        pl.gather(&tl.view(&lumped), &mut sigma_l, &mut lower_l);
-        assert!(sigma_l.iter().all(|&s| s == 0.0));
+        pe.gather(&te.view(&exact), &mut lumps_e, &mut lower_e);
+        pl.gather(&tl.view(&lumped), &mut lumps_l, &mut lower_l);
+        assert!(lumps_l.iter().all(|&s| s == Matrix3::ZERO));
         let bits = |m: Matrix3| m.to_cols_array().map(Scalar::to_bits);
         let mut largest: Scalar = 0.0;
         for salt in 0..6 {

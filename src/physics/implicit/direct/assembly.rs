@@ -53,7 +53,7 @@ pub(in crate::physics::implicit) fn gather(
     }
     s.kinds.write_blocks(el);
     let terms = element_blocks!(s, el);
-    pattern.gather(&terms, &mut s.direct.sigma, &mut s.direct.lower);
+    pattern.gather(&terms, &mut s.direct.lumps, &mut s.direct.lower);
     pattern
 }
 
@@ -73,7 +73,7 @@ pub(in crate::physics::implicit) fn assemble(st: &mut Stepper, held: &[bool]) ->
     let terms = element_blocks!(s, &st.elements);
     let a = &mut s.direct;
     pattern.touched_rows(&a.projection, &mut a.touched);
-    pattern.compensation(&terms, &a.sigma, &a.projection, &mut a.compensation);
+    pattern.compensation(&terms, &a.lumps, &a.projection, &mut a.compensation);
     // b_s = S (b - A dv_c).
     a.ap.resize(n, Vector::ZERO);
     pattern.multiply_lower(&a.lower, &a.prescribed, Some(&a.touched), &mut a.ap);

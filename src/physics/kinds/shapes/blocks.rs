@@ -1,6 +1,6 @@
 //! The shape triangles' blocks in the direct solver's assembly, added in place
 //! band by band ([`crate::physics::kinds::ForceKind::add_in_place`]) with the
-//! norms of those the factorization drops.
+//! compensation of those the factorization drops.
 //!
 //! The shape triangles are the bulk (21 blocks each, against 3 per spring).
 //! Summed per block from the Jacobians, a triangle's products `sum_b M_ab
@@ -16,16 +16,21 @@
 //! Each triangle with a slot in the band, in triangle order, forms its
 //! products once and adds its blocks `h^2 sum_a J_ak (M J)_al^T` with their
 //! row in the band straight into them, by its precomputed slots, and the
-//! Frobenius norm of each dropped block into the diagonal compensation of both
+//! compensation of each dropped block into the diagonal compensation of both
 //! its vertices that lie in the band (the lower block serves its transpose
 //! too). A triangle's Jacobian is read from its edges' folds.
 //!
 //! A dropped block `B` (pair of used slots on distinct vertices whose block is
-//! not factored) compensates with its norm on the diagonals of both its
-//! vertices: `[[s I, -B], [-B^T, s I]]` is positive semi-definite for `s >=
-//! |B|`, so the factored matrix stays positive definite (the tighter rank-one
-//! compensation `B B^T / |B|`, each such `B = u v^T` involving a tip, saves
-//! about 1 % of the iterations, not worth its code).
+//! not factored: with the exact matrix, the second-ring pairs below) is the
+//! rank-one `u w^T` of the first-ring matrix below, and it compensates with
+//! the same lumps, `(|w| / |u|) u u^T` and `(|u| / |w|) w w^T`, on the
+//! diagonals of its two vertices: with `B`'s pair left out, the factored
+//! matrix is `A` plus the positive semi-definite `z z^T` of each dropped
+//! block, so it stays positive definite. The lumps add stiffness only along
+//! `u` and `w`, where the norm `|B| I` on both diagonals (also positive
+//! semi-definite) adds it in every direction: on the uniform 128 hanging
+//! sheet at 5 ms steps, the lumps' factor needs 912 CG iterations over 105
+//! solves against the norms' 1,106 (`docs/model.md`, "Which factor").
 //!
 //! # The first-ring matrix
 //! With [`crate::spec::BendingMatrix::FirstRing`] (`lump_second_ring`) the
@@ -51,7 +56,7 @@ use crate::physics::shape::{SHAPE_SLOTS, ShapeJacobian, ShapeTriangle};
 
 /// One lower block `(k, l)` (slots) of a shape triangle, which the assembly
 /// computes and adds to block `slot`; when the factorization drops it, its
-/// norm compensates the diagonals of both its vertices (module docs).
+/// rank-one lumps compensate the diagonals of both its vertices (module docs).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct ShapeOp {
     /// The lower block it adds to.
@@ -237,7 +242,7 @@ fn shape_active(t: &ShapeTriangle) -> u32 {
 
 /// Computes shape triangle `t`'s blocks `ops` with a vertex in the band (with
 /// the triangle's Jacobian `jac`): adds each to its block when its row is in
-/// the band, and a dropped one's norm to the compensation of each of its two
+/// the band, and a dropped one's lumps to the compensation of each of its two
 /// vertices in the band. The products `M J` are formed once for all its
 /// blocks.
 #[inline(always)]
@@ -270,15 +275,41 @@ fn add_shape(
             band.lower[op.slot as usize - band.base] += block;
         }
         if op.dropped {
-            let norm = frobenius(&block);
-            if in_row {
-                band.sigma[row - band.first_row] += norm;
-            }
-            if in_column {
-                band.sigma[column - band.first_row] += norm;
+            // A dropped block is a second-ring pair's, rank one: lumped on
+            // its two vertices' compensation as the first-ring matrix lumps it.
+            for (vertex, lump) in rank_one_lumps(t, jac, &mj, h2, (k, l)) {
+                if rows.contains(&(vertex as usize)) {
+                    band.lumps[vertex as usize - band.first_row] += lump;
+                }
             }
         }
     }
+}
+
+/// The lumps of the second-ring block of slots `(k, l)` of shape triangle `t`
+/// (module docs, "The first-ring matrix"): the block is `u w^T`, `u` the
+/// tip's gradient of its fold and `w` the other vertex's row of `h^2 M J`
+/// (the row slot is the tip when both are), lumped as `(|w|/|u|) u u^T` on
+/// the tip and `(|u|/|w|) w w^T` on the other vertex; none when either is zero.
+#[inline(always)]
+fn rank_one_lumps(
+    t: &ShapeTriangle,
+    jac: &ShapeJacobian,
+    mj: &[[Vector; SHAPE_SLOTS]; 3],
+    h2: Scalar,
+    (k, l): (usize, usize),
+) -> impl Iterator<Item = (u32, Matrix3)> {
+    let (tip, other) = if k >= 3 { (k, l) } else { (l, k) };
+    let a = tip - 3;
+    let (u, w) = (jac[a][tip], mj[a][other] * h2);
+    let (nu, nw) = (u.length(), w.length());
+    let lumps = (nu > 0.0 && nw > 0.0).then(|| {
+        [
+            (t.v[tip], outer(u, u * (nw / nu))),
+            (t.v[other], outer(w, w * (nu / nw))),
+        ]
+    });
+    lumps.into_iter().flatten()
 }
 
 /// Lumps the second-ring block `lump` of shape triangle `t` onto the
@@ -295,24 +326,15 @@ fn add_lump(
 ) {
     let rows = band.rows();
     let (k, l) = (lump.k as usize, lump.l as usize);
-    // The tip (the row slot when both are tips) and the other slot.
-    let (tip, other, tip_diagonal, other_diagonal) = if k >= 3 {
-        (k, l, lump.row, lump.column)
-    } else {
-        (l, k, lump.column, lump.row)
-    };
-    let a = tip - 3;
-    let (u, w) = (jac[a][tip], mj[a][other] * h2);
-    let (nu, nw) = (u.length(), w.length());
-    if nu == 0.0 || nw == 0.0 {
-        return;
-    }
-    for (vertex, diagonal, g, scale) in [
-        (t.v[tip], tip_diagonal, u, nw / nu),
-        (t.v[other], other_diagonal, w, nu / nw),
-    ] {
+    for (vertex, block) in rank_one_lumps(t, jac, mj, h2, (k, l)) {
+        // The diagonal slot of the row slot's vertex or the column slot's.
+        let diagonal = if vertex == t.v[k] {
+            lump.row
+        } else {
+            lump.column
+        };
         if rows.contains(&(vertex as usize)) {
-            band.lower[diagonal as usize - band.base] += outer(g, g * scale);
+            band.lower[diagonal as usize - band.base] += block;
         }
     }
 }
@@ -341,7 +363,7 @@ pub(crate) fn moved_angles(k: usize) -> std::ops::Range<usize> {
 }
 
 /// The Frobenius norm of `b`.
-#[inline(always)]
+#[cfg(test)]
 pub(crate) fn frobenius(b: &Matrix3) -> Scalar {
     (b.x_axis.length_squared() + b.y_axis.length_squared() + b.z_axis.length_squared()).sqrt()
 }
