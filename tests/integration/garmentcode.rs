@@ -226,9 +226,9 @@ fn bad_bodies_are_one_line_naming_the_body_file() {
 }
 
 /// `drape garment` of the case's shirt on its body for 0.02 s, writing
-/// `shirt.toml`.
-fn write_scene(dir: &Path) -> std::process::Output {
-    let args = [
+/// `shirt.toml`, with `extra` arguments.
+fn write_scene(dir: &Path, extra: &[&str]) -> std::process::Output {
+    let mut args = vec![
         "garment",
         "shirt.json",
         "--body",
@@ -240,13 +240,14 @@ fn write_scene(dir: &Path) -> std::process::Output {
         "--set",
         "simulation.duration=0.02",
     ];
+    args.extend_from_slice(extra);
     drape(dir, &args)
 }
 
 #[test]
 fn the_written_scene_loads_as_a_scene_with_every_panel_curve_and_seam() {
     let dir = case("write-scene", |_| {});
-    let out = write_scene(&dir);
+    let out = write_scene(&dir, &[]);
     assert_eq!(out.status.code(), Some(0));
     let scene = drape::scene::load_scene_file(&dir.join("shirt.toml"), &[]).expect("scene");
     let pattern = garmentcode::load(&dir.join("shirt.json")).expect("pattern");
@@ -310,7 +311,7 @@ fn a_panel_placed_inside_the_body_is_moved_out_along_its_normal() {
     // box's front face is 20 mm in front of it, over part of the panel.
     let body = box_obj([0.05, 1.1, 0.0], [0.15, 1.2, 0.27]);
     std::fs::write(dir.join("body.obj"), body).expect("write body");
-    let out = write_scene(&dir);
+    let out = write_scene(&dir, &[]);
     assert_eq!(out.status.code(), Some(0));
     let stderr = String::from_utf8_lossy(&out.stderr);
     let moved: Vec<&str> = stderr.lines().filter(|l| l.contains("moved")).collect();
@@ -352,20 +353,7 @@ fn labelled_edges_become_attachments_at_the_planes_the_body_measurements_give() 
         edges[1]["label"] = "hem".into();
     });
     let write = |extra: &[&str]| {
-        let mut args = vec![
-            "garment",
-            "shirt.json",
-            "--body",
-            "body.obj",
-            "--write-scene",
-            "shirt.toml",
-            "--no-record",
-            "-q",
-            "--set",
-            "simulation.duration=0.02",
-        ];
-        args.extend_from_slice(extra);
-        let out = drape(&dir, &args);
+        let out = write_scene(&dir, extra);
         assert_eq!(
             out.status.code(),
             Some(0),
