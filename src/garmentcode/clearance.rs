@@ -50,16 +50,15 @@ pub enum ClearanceError {
     },
     /// A panel would move further than [`MAX_SHIFT`].
     #[error(
-        "panel `{panel}` is still {depth_mm:.1} mm inside the body after moving it \
-         {moved_mm:.0} mm out along its normal (at most {max_mm:.0} mm); place it around the body"
+        "panel `{panel}` is {depth_mm:.1} mm inside the body, and moving it out along its \
+         normal would take it more than {max_mm:.0} mm from where the pattern places it; place \
+         it around the body"
     )]
     TooFar {
         /// The panel.
         panel: String,
-        /// How deep inside it still is, mm.
+        /// How deep inside it is now, mm.
         depth_mm: Scalar,
-        /// How far it has moved, mm.
-        moved_mm: Scalar,
         /// [`MAX_SHIFT`], mm.
         max_mm: Scalar,
     },
@@ -112,7 +111,6 @@ impl Clearance {
                 return Err(ClearanceError::TooFar {
                     panel: p.panel.clone(),
                     depth_mm: 1e3 * p.inside.depth,
-                    moved_mm: 1e3 * (moved.shift - shift).length(),
                     max_mm: 1e3 * MAX_SHIFT,
                 });
             }

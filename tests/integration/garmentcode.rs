@@ -305,7 +305,7 @@ fn box_obj(lo: [f64; 3], hi: [f64; 3]) -> String {
 }
 
 #[test]
-fn a_panel_placed_inside_the_body_is_moved_out_along_its_normal() {
+fn a_panel_placed_inside_the_body_is_moved_out_along_its_normal_or_refused_beyond_150_mm() {
     let dir = case("inside", |_| {});
     // The shirt's left front panel lies in the plane z = 0.25 m (y up); this
     // box's front face is 20 mm in front of it, over part of the panel.
@@ -338,6 +338,26 @@ fn a_panel_placed_inside_the_body_is_moved_out_along_its_normal() {
     assert_eq!(names, ["left_ftorso"]);
     println!("as placed: {:.2} mm inside", 1e3 * inside[0].inside.depth);
     assert!((inside[0].inside.depth - 0.02).abs() < 1e-9);
+    // Deep in a box whose nearest faces meet the panel edge-on (the panel's
+    // middle is 43 mm from the box's sides and 200 mm behind its front), the
+    // panel would move further than 150 mm: refused.
+    let deep = box_obj([0.05, 1.1, 0.0], [0.15, 1.2, 0.45]);
+    std::fs::write(dir.join("body.obj"), deep).expect("write body");
+    let out = drape(
+        &dir,
+        &["garment", "shirt.json", "--body", "body.obj", "--no-record"],
+    );
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let line = stderr.trim_end();
+    assert!(
+        line.starts_with("error: shirt.json: panel `left_ftorso` is ")
+            && line.ends_with(
+                " mm inside the body, and moving it out along its normal would take it more \
+                 than 150 mm from where the pattern places it; place it around the body"
+            ),
+        "{line}"
+    );
     std::fs::remove_dir_all(&dir).ok();
 }
 
