@@ -277,9 +277,18 @@ fn add_shape(
         if op.dropped {
             // A dropped block is a second-ring pair's, rank one: lumped on
             // its two vertices' compensation as the first-ring matrix lumps it.
-            for (vertex, lump) in rank_one_lumps(t, jac, &mj, h2, (k, l)) {
-                if rows.contains(&(vertex as usize)) {
-                    band.lumps[vertex as usize - band.first_row] += lump;
+            let (tip, other) = if k >= 3 { (k, l) } else { (l, k) };
+            let a = tip - 3;
+            let (u, w) = (jac[a][tip], mj[a][other] * h2);
+            let (uu, ww) = (u.length_squared(), w.length_squared());
+            if uu > 0.0 && ww > 0.0 {
+                let ratio = (ww / uu).sqrt();
+                let (vt, vo) = (t.v[tip] as usize, t.v[other] as usize);
+                if rows.contains(&vt) {
+                    band.lumps[vt - band.first_row] += outer(u, u * ratio);
+                }
+                if rows.contains(&vo) {
+                    band.lumps[vo - band.first_row] += outer(w, w / ratio);
                 }
             }
         }
@@ -302,11 +311,12 @@ fn rank_one_lumps(
     let (tip, other) = if k >= 3 { (k, l) } else { (l, k) };
     let a = tip - 3;
     let (u, w) = (jac[a][tip], mj[a][other] * h2);
-    let (nu, nw) = (u.length(), w.length());
-    let lumps = (nu > 0.0 && nw > 0.0).then(|| {
+    let (uu, ww) = (u.length_squared(), w.length_squared());
+    let lumps = (uu > 0.0 && ww > 0.0).then(|| {
+        let ratio = (ww / uu).sqrt();
         [
-            (t.v[tip], outer(u, u * (nw / nu))),
-            (t.v[other], outer(w, w * (nu / nw))),
+            (t.v[tip], outer(u, u * ratio)),
+            (t.v[other], outer(w, w / ratio)),
         ]
     });
     lumps.into_iter().flatten()
